@@ -1,0 +1,109 @@
+# packd — build, test, sanitize, bench, run.
+#   make          build build/packd (installs missing Debian packages first)
+#   make test     build and run every unit and integration test
+#   make sanitize the same tests under AddressSanitizer + UBSan (build-san/)
+#   make bench    build and run the benchmarks in bench/
+#   make run      build and start the daemon with its embedded defaults
+#
+# Source files are found by wildcard: a new core/foo.c or tests/unit/test_foo.c
+# needs no edit here.
+
+BUILD   ?= build
+CC      ?= cc
+OPT     ?= -O2
+SAN     ?=
+VERSION := $(shell cat VERSION 2>/dev/null || echo 0.0.0)
+
+PKGS    := hdf5 jansson libmicrohttpd sqlite3
+DEPS_OK := $(BUILD)/.deps-ok
+
+WARN    := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wno-unused-parameter
+CSTD    := -std=c17 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
+BASE_CFLAGS := $(CSTD) $(OPT) -g $(WARN) $(SAN) -DPACKD_VERSION='"$(VERSION)"'
+
+# core/ is plain C17 + libm: compiled without any external include path.
+CORE_CFLAGS := $(BASE_CFLAGS)
+EXT_CFLAGS   = $(BASE_CFLAGS) $(shell pkg-config --cflags $(PKGS) 2>/dev/null) -Icore -Iapi -I$(BUILD)/gen
+EXT_LIBS     = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lm -lpthread
+
+CORE_SRC   := $(wildcard core/*.c)
+API_SRC    := $(wildcard api/*.c)
+DAEMON_SRC := $(filter-out daemon/main.c,$(wildcard daemon/*.c))
+SCHEMAS    := $(sort $(wildcard schemas/*.json))
+UNIT_SRC   := $(wildcard tests/unit/test_*.c)
+BENCH_SRC  := $(wildcard bench/*.c)
+
+CORE_OBJ   := $(CORE_SRC:%.c=$(BUILD)/obj/%.o)
+API_OBJ    := $(API_SRC:%.c=$(BUILD)/obj/%.o) $(BUILD)/obj/gen/schemas_embedded.o
+DAEMON_OBJ := $(DAEMON_SRC:%.c=$(BUILD)/obj/%.o)
+LIB_OBJ    := $(DAEMON_OBJ) $(API_OBJ) $(CORE_OBJ)
+UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
+BENCH_BIN  := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
+
+.PHONY: all deps test sanitize bench run clean check-schemas
+.SECONDARY:
+
+all: $(BUILD)/packd
+
+# Install missing Debian packages once (deploy/install-deps.sh is idempotent).
+$(DEPS_OK): deploy/install-deps.sh
+	@mkdir -p $(@D)
+	@if ! pkg-config --exists $(PKGS) || ! command -v h5dump >/dev/null || ! command -v curl >/dev/null; then \
+	    echo "packd: installing missing packages (deploy/install-deps.sh)"; \
+	    sh deploy/install-deps.sh || exit 1; \
+	fi
+	@touch $@
+
+deps: $(DEPS_OK)
+
+$(BUILD)/obj/core/%.o: core/%.c $(wildcard core/*.h) | $(DEPS_OK)
+	@mkdir -p $(@D)
+	$(CC) $(CORE_CFLAGS) -c $< -o $@
+
+$(BUILD)/obj/api/%.o: api/%.c $(wildcard core/*.h api/*.h) | $(DEPS_OK)
+	@mkdir -p $(@D)
+	$(CC) $(EXT_CFLAGS) -c $< -o $@
+
+$(BUILD)/obj/daemon/%.o: daemon/%.c $(wildcard core/*.h api/*.h daemon/*.h) | $(DEPS_OK)
+	@mkdir -p $(@D)
+	$(CC) $(EXT_CFLAGS) -Idaemon -c $< -o $@
+
+# The schemas are compiled into the binary so `packd validate` and the daemon
+# serve exactly the files in schemas/, wherever packd is installed.
+$(BUILD)/gen/schemas_embedded.c: $(SCHEMAS) tools/embed-schemas.sh
+	@mkdir -p $(@D)
+	sh tools/embed-schemas.sh $(SCHEMAS) > $@
+
+$(BUILD)/obj/gen/schemas_embedded.o: $(BUILD)/gen/schemas_embedded.c
+	@mkdir -p $(@D)
+	$(CC) $(BASE_CFLAGS) -Iapi -c $< -o $@
+
+$(BUILD)/packd: $(BUILD)/obj/daemon/main.o $(LIB_OBJ)
+	$(CC) $(SAN) -o $@ $^ $(EXT_LIBS)
+
+$(BUILD)/tests/%: tests/unit/%.c tests/check.h $(LIB_OBJ)
+	@mkdir -p $(@D)
+	$(CC) $(EXT_CFLAGS) -Idaemon -Itests -o $@ $< $(LIB_OBJ) $(EXT_LIBS)
+
+$(BUILD)/bench/%: bench/%.c $(LIB_OBJ)
+	@mkdir -p $(@D)
+	$(CC) $(EXT_CFLAGS) -Idaemon -o $@ $< $(LIB_OBJ) $(EXT_LIBS)
+
+test: $(BUILD)/packd $(UNIT_BIN)
+	@sh tests/run.sh $(BUILD)
+
+sanitize:
+	$(MAKE) BUILD=build-san OPT=-O1 SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all" test
+
+bench: $(BUILD)/packd $(BENCH_BIN)
+	@for b in $(BENCH_BIN); do echo "== $$b"; $$b || exit 1; done
+
+run: $(BUILD)/packd
+	$(BUILD)/packd serve
+
+# Cross-check schemas and examples with an independent validator (python3-jsonschema).
+check-schemas: $(DEPS_OK)
+	sh tests/integration/test_schemas.sh
+
+clean:
+	rm -rf build build-san

@@ -1,0 +1,13 @@
+/* h5_inspect.h — a JSON view of a packd result file (`packd inspect`, the
+ * daemon's results document): box, grain count, every observable. */
+#ifndef PK_H5_INSPECT_H
+#define PK_H5_INSPECT_H
+
+#include <jansson.h>
+#include <stddef.h>
+
+/* New JSON object, or NULL with err.  Arrays longer than max_array elements
+ * are summarised by their shape. */
+json_t *pk_h5_inspect(const char *path, size_t max_array, char *err, size_t errlen);
+
+#endif

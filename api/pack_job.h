@@ -1,0 +1,58 @@
+/* pack_job.h — the 'pack' process: JSON inputs ⇄ job struct, feasibility plan, run. */
+#ifndef PK_PACK_JOB_H
+#define PK_PACK_JOB_H
+
+#include <jansson.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "box.h"
+#include "json_schema.h"
+#include "progress.h"
+#include "psd.h"
+
+typedef enum { PK_ALGO_RSA = 0 } pk_pack_algorithm;
+
+typedef struct pk_pack_job {
+    int dim;
+    pk_box box;
+    char unit[8];
+    pk_grading grading;          /* the whole curve, before the cut at d_min */
+    int discrete;                /* 1 = one diameter per class (Meier) */
+    double d_min;                /* cut-off diameter (0 = none) */
+    int has_phi, phi_is_mix;
+    double phi;                  /* target value as given */
+    size_t count;                /* 0 = not given */
+    double delta_d;
+    pk_pack_algorithm algorithm;
+    uint64_t seed;
+    uint64_t max_failed_draws;
+    size_t max_particles;
+    double wall_time_s;          /* 0 = none */
+} pk_pack_job;
+
+/* What the job implies before anything is drawn. */
+typedef struct pk_pack_plan {
+    pk_grading resolved;         /* grading cut at d_min */
+    double mass_cut;             /* F_m(d_min): mass share not modelled (Eq. 14) */
+    double phi_mix;              /* φ_M target (Eq. 15) */
+    double phi_resolved;         /* φ_eff target (Eqs. 16–17) */
+    double expected_n;           /* expected number of grains */
+    double scale;                /* expected size scale (count + phi), else 1 */
+    double d_max;                /* largest diameter after scaling */
+} pk_pack_plan;
+
+/* Inputs (already schema-valid) → job.  Semantic errors are appended with
+ * pointers relative to the inputs object; returns their number. */
+size_t pk_pack_job_from_json(json_t *inputs, pk_pack_job *job, pk_schema_errors *errs);
+
+/* Feasibility: cut the curve, targets, expected N vs max_particles, box vs
+ * grain size.  Returns the number of errors appended. */
+size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_errors *errs);
+
+/* process table hooks (see process.h) */
+void pk_pack_check(json_t *inputs, pk_schema_errors *errs);
+int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_monitor *mon,
+                json_t **summary, char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,88 @@
+#include "process.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pack_job.h"
+
+static const pk_process pack_process = {
+    .id = "pack",
+    .title = "Pack grains from a grading curve",
+    .description = "Draw grain sizes from a grading (sieve) curve and place them in a 2D or 3D "
+                   "box (periodic or walled) with a minimum gap; writes an H5MD result file.",
+    .inputs_schema = "pack.inputs.schema.json",
+    .check = pk_pack_check,
+    .run = pk_pack_run,
+};
+
+const pk_process *const pk_processes[] = {&pack_process, NULL};
+
+const pk_process *pk_process_find(const char *id)
+{
+    for (size_t i = 0; id && pk_processes[i]; i++)
+        if (strcmp(pk_processes[i]->id, id) == 0)
+            return pk_processes[i];
+    return NULL;
+}
+
+size_t pk_process_validate_inputs(const pk_process *p, json_t *inputs, pk_schema_errors *errs)
+{
+    size_t before = errs->n;
+    pk_schema_validate_embedded(p->inputs_schema, inputs, errs);
+    if (errs->n == before && p->check)
+        p->check(inputs, errs);
+    return errs->n - before;
+}
+
+/* Prefix the pointers of errors [from, n) with "/inputs". */
+static void prefix_inputs(pk_schema_errors *errs, size_t from)
+{
+    for (size_t i = from; i < errs->n; i++) {
+        char *ptr = errs->items[i].pointer;
+        size_t len = strlen(ptr), cap = sizeof errs->items[i].pointer;
+        if (len + 8 > cap) /* keep the tail of very deep pointers */
+            len = cap - 8;
+        memmove(ptr + 7, ptr, len);
+        memcpy(ptr, "/inputs", 7);
+        ptr[len + 7] = 0;
+    }
+}
+
+size_t pk_job_validate(json_t *job, const pk_process **proc, pk_schema_errors *errs)
+{
+    size_t before = errs->n;
+    *proc = NULL;
+    if (pk_schema_validate_embedded("job.schema.json", job, errs) != 0)
+        return errs->n - before;
+    const pk_process *p = pk_process_find(json_string_value(json_object_get(job, "process")));
+    if (!p) { /* the envelope schema's enum should have caught this */
+        pk_schema_errors_add(errs, "/process", "enum", "unknown process");
+        return errs->n - before;
+    }
+    size_t mark = errs->n;
+    pk_process_validate_inputs(p, json_object_get(job, "inputs"), errs);
+    prefix_inputs(errs, mark);
+    if (errs->n == before)
+        *proc = p;
+    return errs->n - before;
+}
+
+int pk_job_run(json_t *job, const char *out_path, pk_monitor *mon, json_t **summary,
+               pk_schema_errors *errs, char *err, size_t errlen)
+{
+    const pk_process *p;
+    *summary = NULL;
+    if (pk_job_validate(job, &p, errs) != 0) {
+        snprintf(err, errlen, "invalid job");
+        return 1;
+    }
+    char *text = json_dumps(job, JSON_SORT_KEYS | JSON_COMPACT);
+    if (!text) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    int rc = p->run(json_object_get(job, "inputs"), text, out_path, mon, summary, err, errlen);
+    free(text);
+    return rc;
+}

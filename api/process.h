@@ -1,0 +1,46 @@
+/* process.h — the table of processes packd offers (OGC API – Processes ids).
+ * One table serves `packd run`/`validate`, the daemon's /processes routes and
+ * its workers: adding a process means adding one row here. */
+#ifndef PK_PROCESS_H
+#define PK_PROCESS_H
+
+#include <jansson.h>
+#include <stddef.h>
+
+#include "json_schema.h"
+#include "progress.h"
+
+typedef struct pk_process {
+    const char *id;             /* "pack" */
+    const char *title;
+    const char *description;
+    const char *inputs_schema;  /* file name in schemas/ */
+    /* Semantic checks beyond the schema (cross-field rules, feasibility).
+     * Appends errors with JSON pointers relative to the inputs object. */
+    void (*check)(json_t *inputs, pk_schema_errors *errs);
+    /* Run validated inputs, write the result file, return a summary object
+     * (new reference) in *summary.  0 on success; -1 with err on failure. */
+    int (*run)(json_t *inputs, const char *job_json, const char *out_path, pk_monitor *mon,
+               json_t **summary, char *err, size_t errlen);
+} pk_process;
+
+/* NULL-terminated table. */
+extern const pk_process *const pk_processes[];
+
+const pk_process *pk_process_find(const char *id);
+
+/* Validate inputs for a process: schema first, then (only if the schema
+ * passed) the semantic checks.  Returns the number of errors appended. */
+size_t pk_process_validate_inputs(const pk_process *p, json_t *inputs, pk_schema_errors *errs);
+
+/* A whole job file {"process", "inputs"}: envelope, then inputs.  On success
+ * *proc is set.  Pointers in errors are relative to the job file root. */
+size_t pk_job_validate(json_t *job, const pk_process **proc, pk_schema_errors *errs);
+
+/* Validate and run a job (the one code path of `packd run` and the daemon's
+ * workers).  Returns 0 on success; on invalid input returns 1 with errs
+ * filled; on a runtime failure returns -1 with err. */
+int pk_job_run(json_t *job, const char *out_path, pk_monitor *mon, json_t **summary,
+               pk_schema_errors *errs, char *err, size_t errlen);
+
+#endif

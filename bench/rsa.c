@@ -1,0 +1,78 @@
+/* bench/rsa — RSA placement rate.  Prints one machine-readable line per case:
+ *   bench=rsa case=NAME n=N placed=N seconds=S rate=PLACEMENTS_PER_S draws_per_grain=X
+ * and a final line with the rate ratio 1e6/1e4 (flat = the grid scales). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pack_job.h"
+#include "process.h"
+#include "rsa.h"
+
+static double mono(const char *name, int dim, size_t n, double phi)
+{
+    /* box edge so that n unit spheres fill phi */
+    double v = dim == 3 ? 3.14159265358979 / 6 : 3.14159265358979 / 4;
+    double L = dim == 3 ? cbrt((double)n * v / phi) : sqrt((double)n * v / phi);
+    pk_box b = {.dim = dim, .L = {L, L, dim == 3 ? L : 0}, .periodic = {true, true, true}};
+    double *d = malloc(n * sizeof *d);
+    int32_t *sp = calloc(n, sizeof *sp);
+    for (size_t i = 0; i < n; i++)
+        d[i] = 1.0;
+    pk_particles p;
+    pk_particles_init(&p, dim, n);
+    pk_rsa_params prm = {.delta_d = 0, .max_failed_draws = 1000000, .seed = 1};
+    pk_rsa_stats st;
+    pk_rsa_place(&b, d, sp, n, &prm, NULL, &p, &st);
+    double rate = (double)st.placed / st.seconds;
+    printf("bench=rsa case=%s n=%zu placed=%zu seconds=%.3f rate=%.0f draws_per_grain=%.3f\n", name,
+           n, st.placed, st.seconds, rate, (double)st.draws / (double)(st.placed ? st.placed : 1));
+    fflush(stdout);
+    free(d);
+    free(sp);
+    pk_particles_free(&p);
+    return rate;
+}
+
+static void job_case(const char *name, const char *path)
+{
+    json_error_t e;
+    json_t *job = json_load_file(path, 0, &e);
+    if (!job) {
+        printf("bench=rsa case=%s error=\"%s\"\n", name, e.text);
+        return;
+    }
+    pk_schema_errors errs = {0};
+    json_t *sum = NULL;
+    char err[512];
+    const char *out = "/tmp/packd-bench-rsa.h5";
+    int rc = pk_job_run(job, out, NULL, &sum, &errs, err, sizeof err);
+    if (rc == 0) {
+        double s = json_real_value(json_object_get(sum, "seconds_place"));
+        json_int_t placed = json_integer_value(json_object_get(sum, "count_placed"));
+        printf("bench=rsa case=%s n=%lld placed=%lld seconds=%.3f rate=%.0f phi=%.4f reason=%s\n",
+               name, (long long)json_integer_value(json_object_get(sum, "count_requested")),
+               (long long)placed, s, (double)placed / s,
+               json_real_value(json_object_get(sum, "phi_resolved")),
+               json_string_value(json_object_get(sum, "termination_reason")));
+    } else {
+        printf("bench=rsa case=%s error=\"%s\"\n", name, err);
+    }
+    remove(out);
+    json_decref(sum);
+    json_decref(job);
+    pk_schema_errors_free(&errs);
+}
+
+int main(int argc, char **argv)
+{
+    const char *src = getenv("PACKD_SRC");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/examples/din-a16-3d-walled.json", src ? src : ".");
+    job_case("din_a16_phiM40_walled_dd1", path);
+    double r4 = mono("mono3d_phi030_1e4", 3, 10000, 0.30);
+    mono("mono3d_phi030_1e5", 3, 100000, 0.30);
+    double r6 = mono("mono3d_phi030_1e6", 3, 1000000, 0.30);
+    printf("bench=rsa case=scaling rate_ratio_1e6_over_1e4=%.3f\n", r6 / r4);
+    return 0;
+}

@@ -1,0 +1,42 @@
+#include "progress.h"
+
+#include <time.h>
+
+double pk_wall_seconds(void)
+{
+    /* POSIX monotonic clock: wall-clock jumps must not cancel a run. */
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void pk_monitor_begin(pk_monitor *m)
+{
+    if (!m)
+        return;
+    if (m->interval_s <= 0)
+        m->interval_s = 0.5;
+    m->t_start = pk_wall_seconds();
+    m->t_last = m->t_start - m->interval_s; /* first tick reports */
+    m->cancelled = 0;
+}
+
+int pk_monitor_tick(pk_monitor *m, pk_progress *p, int force)
+{
+    if (!m)
+        return 0;
+    if (m->cancelled)
+        return m->cancelled;
+    if (m->cancel && *m->cancel)
+        return m->cancelled = 1;
+    double now = pk_wall_seconds();
+    if (m->wall_limit_s > 0 && now - m->t_start > m->wall_limit_s)
+        return m->cancelled = 2;
+    if (!force && now - m->t_last < m->interval_s)
+        return 0;
+    m->t_last = now;
+    p->elapsed_s = now - m->t_start;
+    if (m->fn && m->fn(p, m->ctx))
+        return m->cancelled = 1;
+    return 0;
+}

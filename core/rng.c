@@ -1,0 +1,45 @@
+#include "rng.h"
+
+#include <math.h>
+
+static uint64_t splitmix64(uint64_t *x)
+{
+    uint64_t z = (*x += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+void pk_rng_seed(pk_rng *g, uint64_t seed, uint64_t stream)
+{
+    uint64_t x = seed ^ (0xD1B54A32D192ED03ull * (stream + 1));
+    for (int i = 0; i < 4; i++)
+        g->s[i] = splitmix64(&x);
+}
+
+static inline uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
+
+uint64_t pk_rng_next(pk_rng *g)
+{
+    uint64_t *s = g->s;
+    uint64_t result = rotl(s[1] * 5, 7) * 9;
+    uint64_t t = s[1] << 17;
+    s[2] ^= s[0];
+    s[3] ^= s[1];
+    s[1] ^= s[2];
+    s[0] ^= s[3];
+    s[2] ^= t;
+    s[3] = rotl(s[3], 45);
+    return result;
+}
+
+double pk_rng_uniform(pk_rng *g) { return (double)(pk_rng_next(g) >> 11) * 0x1.0p-53; }
+
+double pk_rng_range(pk_rng *g, double a, double b) { return a + (b - a) * pk_rng_uniform(g); }
+
+double pk_rng_normal(pk_rng *g)
+{
+    double u1 = 1.0 - pk_rng_uniform(g); /* (0,1] so log is finite */
+    double u2 = pk_rng_uniform(g);
+    return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
+}

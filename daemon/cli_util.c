@@ -1,0 +1,39 @@
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+
+static void print_json(json_t *out)
+{
+    json_dumpf(out, stdout, JSON_INDENT(2));
+    putchar('\n');
+    fflush(stdout);
+}
+
+json_t *cli_load_json(const char *path)
+{
+    json_error_t e;
+    json_t *j = strcmp(path, "-") == 0 ? json_loadf(stdin, JSON_REJECT_DUPLICATES, &e)
+                                       : json_load_file(path, JSON_REJECT_DUPLICATES, &e);
+    if (!j) {
+        pk_schema_errors errs = {0};
+        pk_schema_errors_add(&errs, "", "json", "line %d, column %d: %s", e.line, e.column, e.text);
+        cli_print_errors(path, &errs);
+        pk_schema_errors_free(&errs);
+    }
+    return j;
+}
+
+void cli_print_errors(const char *path, const pk_schema_errors *errs)
+{
+    json_t *out = json_object();
+    json_object_set_new(out, "valid", json_false());
+    json_object_set_new(out, "file", json_string(path));
+    json_object_set_new(out, "errors", pk_schema_errors_json(errs));
+    print_json(out);
+    json_decref(out);
+    for (size_t i = 0; i < errs->n; i++)
+        fprintf(stderr, "%s: %s: %s (rule %s)\n", path,
+                errs->items[i].pointer[0] ? errs->items[i].pointer : "/", errs->items[i].message,
+                errs->items[i].rule);
+}

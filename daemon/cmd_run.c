@@ -1,0 +1,108 @@
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "process.h"
+
+static volatile sig_atomic_t cancel_requested;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    cancel_requested = 1;
+}
+
+typedef struct {
+    FILE *out;   /* JSON lines of progress, or NULL */
+} progress_sink;
+
+/* One JSON object per line: what the daemon relays to its SSE listeners. */
+static int print_progress(const pk_progress *p, void *ctx)
+{
+    progress_sink *s = ctx;
+    if (!s->out)
+        return 0;
+    json_t *j = json_pack("{s:s,s:f,s:f,s:I,s:I,s:f}", "stage", p->stage ? p->stage : "",
+                          "fraction", p->fraction, "phi", p->phi, "done", (json_int_t)p->done,
+                          "total", (json_int_t)p->total, "elapsed_s", p->elapsed_s);
+    if (p->eta_s >= 0)
+        json_object_set_new(j, "eta_s", json_real(p->eta_s));
+    if (p->message)
+        json_object_set_new(j, "message", json_string(p->message));
+    json_dumpf(j, s->out, JSON_COMPACT);
+    fputc('\n', s->out);
+    fflush(s->out);
+    json_decref(j);
+    return 0;
+}
+
+int cmd_run(int argc, char **argv)
+{
+    const char *job_path = NULL, *out_path = NULL;
+    int progress_fd = -1;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "-o") && i + 1 < argc)
+            out_path = argv[++i];
+        else if (!strcmp(argv[i], "--progress"))
+            progress_fd = 2;
+        else if (!strcmp(argv[i], "--progress-fd") && i + 1 < argc)
+            progress_fd = atoi(argv[++i]);
+        else if (!job_path && argv[i][0] != '-')
+            job_path = argv[i];
+        else if (!job_path && !strcmp(argv[i], "-"))
+            job_path = argv[i];
+        else {
+            job_path = NULL;
+            break;
+        }
+    }
+    if (!job_path || !out_path) {
+        fprintf(stderr, "usage: packd run JOB.json -o OUT.h5 [--progress] [--progress-fd N]\n");
+        return 64;
+    }
+    json_t *job = cli_load_json(job_path);
+    if (!job)
+        return 1;
+
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+
+    progress_sink sink = {NULL};
+    if (progress_fd >= 0) {
+        sink.out = progress_fd == 2 ? stderr : fdopen(progress_fd, "w");
+        if (!sink.out)
+            fprintf(stderr, "packd run: --progress-fd %d: %s\n", progress_fd, strerror(errno));
+    }
+    pk_monitor mon = {.fn = print_progress, .ctx = &sink, .cancel = &cancel_requested,
+                      .interval_s = 0.5};
+    pk_schema_errors errs = {0};
+    json_t *summary = NULL;
+    char err[1024] = "";
+    int rc = pk_job_run(job, out_path, &mon, &summary, &errs, err, sizeof err);
+    int status;
+    if (rc == 1) {
+        cli_print_errors(job_path, &errs);
+        status = 1;
+    } else if (rc != 0) {
+        fprintf(stderr, "packd run: %s\n", err);
+        status = 2;
+    } else {
+        json_object_set_new(summary, "output", json_string(out_path));
+        json_dumpf(summary, stdout, JSON_INDENT(2) | JSON_REAL_PRECISION(10));
+        putchar('\n');
+        status = 0;
+    }
+    if (sink.out && sink.out != stderr)
+        fclose(sink.out);
+    json_decref(summary);
+    pk_schema_errors_free(&errs);
+    json_decref(job);
+    return status;
+}

@@ -1,0 +1,135 @@
+#!/bin/sh
+# test_cli.sh — packd run / validate / inspect end to end: real result files
+# read back with h5dump, every invalid job refused with its pointer and rule.
+set -u
+PACKD=${PACKD:-build/packd}
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+pass() { echo "PASS $1"; }
+fail() { echo "FAIL $1${2:+: $2}"; }
+check() { # name, condition command...
+    name=$1
+    shift
+    if "$@"; then pass "$name"; else fail "$name"; fi
+}
+
+# 1. every example runs, ends complete, and h5dump reads the H5MD layout
+for ex in examples/*.json; do
+    b=$(basename "$ex" .json)
+    if "$PACKD" run "$ex" -o "$T/$b.h5" >"$T/$b.json" 2>"$T/$b.err" &&
+        grep -q '"complete": true' "$T/$b.json" &&
+        h5dump -H "$T/$b.h5" >"$T/$b.dump" &&
+        grep -q 'GROUP "h5md"' "$T/$b.dump" &&
+        grep -q 'DATASET "position"' "$T/$b.dump" &&
+        grep -q 'DATASET "radius"' "$T/$b.dump" &&
+        grep -q 'DATASET "species"' "$T/$b.dump" &&
+        grep -q 'DATASET "edges"' "$T/$b.dump" &&
+        grep -q 'DATASET "job"' "$T/$b.dump" &&
+        grep -q 'DATASET "smallest_gap"' "$T/$b.dump" &&
+        ! ls "$T"/*.tmp.* >/dev/null 2>&1; then
+        pass "example_$b"
+    else
+        fail "example_$b" "$(cat "$T/$b.err")"
+    fi
+done
+
+# 2. H5MD metadata values as h5dump prints them
+h5dump -a /h5md/version "$T/din-a16-3d-walled.h5" >"$T/ver" 2>&1
+check h5md_version grep -q '(0): 1, 1' "$T/ver"
+h5dump -a /particles/grains/box/boundary "$T/meier-quartz-2d.h5" >"$T/bnd" 2>&1
+check box_boundary_periodic grep -q '"periodic", "periodic"' "$T/bnd"
+h5dump -a /particles/grains/position/unit "$T/din-a16-3d-walled.h5" >"$T/unit" 2>&1
+check position_unit grep -q '"mm"' "$T/unit"
+
+# 3. the result's own audit: no pair closer than Δd = 1 mm, no grain closer than 0.5 mm to a wall
+"$PACKD" inspect "$T/din-a16-3d-walled.h5" >"$T/insp.json"
+check inspect_gap_audit python3 -c "
+import json,sys; d=json.load(open('$T/insp.json')); o=d['observables']
+assert o['smallest_gap'] >= 1.0 - 1e-9, o['smallest_gap']
+assert o['smallest_wall_gap'] >= 0.5 - 1e-9, o['smallest_wall_gap']
+assert o['pairs_below_delta_d'] == 0 and d['grains'] == o['count_placed']
+assert abs(o['phi_mix'] - 0.40) < 0.01, o['phi_mix']   # one coarse grain overshoot at most
+"
+
+# 4. same job + seed → byte-identical particle data; another seed → different
+"$PACKD" run examples/fuller-3d-periodic.json -o "$T/again.h5" >/dev/null 2>&1
+for ds in position radius species; do
+    h5dump -b LE -d /particles/grains/$ds -o "$T/a.$ds" "$T/fuller-3d-periodic.h5" >/dev/null 2>&1
+    h5dump -b LE -d /particles/grains/$ds -o "$T/b.$ds" "$T/again.h5" >/dev/null 2>&1
+done
+check reproducible_same_seed sh -c "cmp -s '$T/a.position' '$T/b.position' && cmp -s '$T/a.radius' '$T/b.radius' && cmp -s '$T/a.species' '$T/b.species' && test -s '$T/a.position'"
+sed 's/"seed": 7/"seed": 8/' examples/fuller-3d-periodic.json >"$T/seed8.json"
+"$PACKD" run "$T/seed8.json" -o "$T/seed8.h5" >/dev/null 2>&1
+h5dump -b LE -d /particles/grains/position -o "$T/c.position" "$T/seed8.h5" >/dev/null 2>&1
+check other_seed_differs sh -c "! cmp -s '$T/a.position' '$T/c.position'"
+
+# 5. invalid jobs: exit 1, JSON errors naming the pointer and the rule, never a crash
+expect_invalid() { # file pointer rule
+    out=$("$PACKD" validate "$1" 2>/dev/null)
+    rc=$?
+    if [ $rc -eq 1 ] && printf '%s' "$out" | python3 -c "
+import json,sys; d=json.load(sys.stdin)
+assert d['valid'] is False
+assert any(e['pointer']=='$2' and e['rule']=='$3' for e in d['errors']), d['errors']"; then
+        pass "invalid_$(basename "$1" .json)"
+    else
+        fail "invalid_$(basename "$1" .json)" "rc=$rc $out"
+    fi
+}
+# invalid/: broken by the schema alone; infeasible/: schema-valid, refused by the semantic checks
+D=tests/data/invalid
+F=tests/data/infeasible
+expect_invalid $D/phi-ge-1.json /inputs/phi/value exclusiveMaximum
+expect_invalid $D/negative-size.json /inputs/domain/box/size/1 exclusiveMinimum
+expect_invalid $D/empty-curve.json /inputs/grading/sizes minItems
+expect_invalid $F/non-monotonic-sieve.json /inputs/grading/passing/2 nonDecreasing
+expect_invalid $D/unknown-field.json /inputs/colour additionalProperties
+expect_invalid $D/unknown-preset.json /inputs/grading/name enum
+expect_invalid $D/missing-phi-and-count.json /inputs anyOf
+expect_invalid $F/wrong-size-count.json /inputs/domain/box/size dim
+expect_invalid $F/periodic-box-too-small.json /inputs/domain/box/size/0 periodicSize
+expect_invalid $F/too-many-grains.json /inputs/phi maxParticles
+expect_invalid $D/unknown-process.json /process enum
+expect_invalid $F/dmin-above-dmax.json /inputs/d_min lessThanDmax
+n_invalid=$(ls $D/*.json $F/*.json | wc -l)
+check every_invalid_file_listed test "$n_invalid" -eq 12
+
+# 6. malformed JSON (NaN is not JSON, nor is a truncated file): clear error, exit 1
+printf '{"process": "pack", "inputs": {"dim": 3, "phi": NaN}}' >"$T/nan.json"
+out=$("$PACKD" validate "$T/nan.json" 2>/dev/null)
+check nan_rejected sh -c "test $? -eq 1 && printf '%s' '$out' | grep -q '\"rule\": \"json\"'"
+printf '{"process": "pack", "inp' >"$T/trunc.json"
+"$PACKD" run "$T/trunc.json" -o "$T/trunc.h5" >/dev/null 2>&1
+rc=$?
+check truncated_rejected sh -c "test $rc -eq 1 && ! test -e '$T/trunc.h5'"
+"$PACKD" run $D/phi-ge-1.json -o "$T/bad.h5" >/dev/null 2>&1
+rc=$?
+check run_refuses_invalid sh -c "test $rc -eq 1 && ! test -e '$T/bad.h5'"
+
+# 7. an unreachable target ends cleanly: the file holds what was placed and says so
+cat >"$T/over.json" <<'JOB'
+{"process": "pack", "inputs": {"dim": 2, "domain": {"box": {"size": [20, 20], "periodic": false}},
+ "grading": {"type": "classes", "classes": [{"d": 1.0, "volume_percent": 100}]},
+ "phi": {"value": 0.8, "refers_to": "resolved"}, "rsa": {"max_failed_draws": 20000}, "seed": 3}}
+JOB
+"$PACKD" run "$T/over.json" -o "$T/over.h5" >"$T/over.out" 2>/dev/null
+rc=$?
+check unreachable_target_ends_cleanly python3 -c "
+import json; d=json.load(open('$T/over.out'))
+assert $rc == 0 and d['complete'] is False and d['termination_reason'] == 'max_failed_draws', d
+assert 0 < d['count_placed'] < d['count_requested'], d
+assert d['phi_resolved'] < 0.8
+"
+"$PACKD" inspect "$T/over.h5" >"$T/over.insp" 2>/dev/null
+check unreachable_target_file python3 -c "
+import json; d=json.load(open('$T/over.insp')); o=d['observables']
+assert o['termination_reason'] == 'max_failed_draws' and d['grains'] == o['count_placed'] < o['count_requested']"
+
+# 8. progress lines are JSON
+"$PACKD" run examples/din-a16-3d-walled.json -o "$T/p.h5" --progress >/dev/null 2>"$T/progress"
+check progress_json_lines python3 -c "
+import json; lines=[l for l in open('$T/progress') if l.startswith('{')]
+assert lines, 'no progress'
+for l in lines: d=json.loads(l); assert d['stage']=='rsa' and 0 <= d['fraction'] <= 1
+"
+exit 0
