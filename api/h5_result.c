@@ -262,6 +262,56 @@ int pk_h5_obs_ints(pk_h5 *h, const char *name, const int64_t *v, size_t n)
     return write_dataset(h->obs, h->lcpl, name, H5T_NATIVE_INT64, 1, &d, v, NULL);
 }
 
+int pk_h5_obs_json(pk_h5 *h, const char *prefix, json_t *obj)
+{
+    const char *key;
+    json_t *v;
+    int rc = 0;
+    json_object_foreach(obj, key, v)
+    {
+        char name[256];
+        snprintf(name, sizeof name, "%s/%s", prefix, key);
+        if (json_is_integer(v))
+            rc |= pk_h5_obs_int(h, name, (int64_t)json_integer_value(v));
+        else if (json_is_real(v))
+            rc |= pk_h5_obs_double(h, name, json_real_value(v), NULL);
+        else if (json_is_boolean(v))
+            rc |= pk_h5_obs_int(h, name, json_is_true(v));
+        else if (json_is_string(v))
+            rc |= pk_h5_obs_string(h, name, json_string_value(v));
+        else if (json_is_object(v))
+            rc |= pk_h5_obs_json(h, name, v);
+        else if (json_is_array(v)) {
+            size_t n = json_array_size(v), i;
+            int all_int = 1, all_num = 1;
+            json_t *e;
+            json_array_foreach(v, i, e)
+            {
+                all_int &= json_is_integer(e);
+                all_num &= json_is_number(e);
+            }
+            if (!all_num)
+                continue;
+            if (all_int) {
+                int64_t *a = malloc((n ? n : 1) * sizeof *a);
+                if (!a)
+                    return -1;
+                json_array_foreach(v, i, e) a[i] = (int64_t)json_integer_value(e);
+                rc |= pk_h5_obs_ints(h, name, a, n);
+                free(a);
+            } else {
+                double *a = malloc((n ? n : 1) * sizeof *a);
+                if (!a)
+                    return -1;
+                json_array_foreach(v, i, e) a[i] = json_number_value(e);
+                rc |= pk_h5_obs_doubles(h, name, a, n, NULL);
+                free(a);
+            }
+        }
+    }
+    return rc ? -1 : 0;
+}
+
 static void h5_free(pk_h5 *h)
 {
     free(h->path);

@@ -36,6 +36,13 @@ int pk_h5_obs_string(pk_h5 *h, const char *name, const char *v);
 int pk_h5_obs_doubles(pk_h5 *h, const char *name, const double *v, size_t n, const char *unit);
 int pk_h5_obs_ints(pk_h5 *h, const char *name, const int64_t *v, size_t n);
 
+/* Every member of a JSON object as observables under prefix ("rsa" →
+ * /observables/rsa/<key>): reals → float64, integers → int64, strings,
+ * booleans → int64 0/1, arrays of numbers → 1-d arrays, objects → sub-groups.
+ * Other values are skipped.  0 on success. */
+#include <jansson.h>
+int pk_h5_obs_json(pk_h5 *h, const char *prefix, json_t *obj);
+
 /* Close, fsync and rename into place.  Frees h.  0 on success. */
 int pk_h5_commit(pk_h5 *h, char *err, size_t errlen);
 /* Close and remove the temporary file.  Frees h. */

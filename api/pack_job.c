@@ -1,4 +1,5 @@
 #include "pack_job.h"
+#include "pack_placer.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -195,9 +196,12 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
     json_t *count = json_object_get(in, "count");
     job->count = count ? (size_t)json_integer_value(count) : 0;
     job->delta_d = num(in, "delta_d", 0);
-    job->algorithm = PK_ALGO_RSA;
+    const char *algo = json_string_value(json_object_get(in, "algorithm"));
+    snprintf(job->algorithm, sizeof job->algorithm, "%s", algo ? algo : "rsa");
+    if (!pk_placer_find(job->algorithm))
+        pk_schema_errors_add(errs, "/algorithm", "enum", "no placer named \"%s\"", job->algorithm);
+    job->inputs = in;
     job->seed = json_object_get(in, "seed") ? (uint64_t)json_integer_value(json_object_get(in, "seed")) : 1;
-    job->max_failed_draws = (uint64_t)num(json_object_get(in, "rsa"), "max_failed_draws", 1e6);
     job->max_particles = (size_t)num(json_object_get(in, "limits"), "max_particles", 2e7);
     job->wall_time_s = num(json_object_get(in, "limits"), "wall_time_s", 0);
     return errs->n - before;
@@ -307,6 +311,9 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
                                  "a walled edge must hold the largest grain plus Δd = %g (got %g)",
                                  need, job->box.L[k]);
     }
+    const pk_placer *placer = pk_placer_find(job->algorithm);
+    if (placer && placer->check && errs->n == before)
+        placer->check(job, plan, errs);
     return errs->n - before;
 }
 

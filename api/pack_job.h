@@ -11,8 +11,6 @@
 #include "progress.h"
 #include "psd.h"
 
-typedef enum { PK_ALGO_RSA = 0 } pk_pack_algorithm;
-
 typedef struct pk_pack_job {
     int dim;
     pk_box box;
@@ -24,9 +22,9 @@ typedef struct pk_pack_job {
     double phi;                  /* target value as given */
     size_t count;                /* 0 = not given */
     double delta_d;
-    pk_pack_algorithm algorithm;
+    char algorithm[16];          /* placer name, see pack_placer.h */
+    json_t *inputs;              /* borrowed: placers read their own options from it */
     uint64_t seed;
-    uint64_t max_failed_draws;
     size_t max_particles;
     double wall_time_s;          /* 0 = none */
 } pk_pack_job;

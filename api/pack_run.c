@@ -7,9 +7,9 @@
 #include "gap_audit.h"
 #include "h5_result.h"
 #include "pack_job.h"
+#include "pack_placer.h"
 #include "particles.h"
 #include "rng.h"
-#include "rsa.h"
 
 /* Draw the grain sizes the plan asks for (random stream 0 of the seed). */
 static int draw_sizes(const pk_pack_job *job, const pk_pack_plan *plan, pk_sizes *sz,
@@ -53,7 +53,7 @@ static double target_passing(const pk_pack_plan *plan, double d)
 
 static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const char *job_json,
                         const pk_particles *p, const pk_sizes *sz, double scale,
-                        const pk_rsa_stats *st, const pk_gap_report *gap, double t_sizes,
+                        const pk_place_stats *st, const pk_gap_report *gap, double t_sizes,
                         double t_audit, const char *out_path, json_t *summary, char *err,
                         size_t errlen)
 {
@@ -80,8 +80,9 @@ static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const 
     rc |= pk_h5_obs_int(h, "count_placed", (int64_t)st->placed);
     rc |= pk_h5_obs_double(h, "count_expected", plan->expected_n, NULL);
     rc |= pk_h5_obs_string(h, "termination_reason", pk_stop_reason_name(st->reason));
-    rc |= pk_h5_obs_string(h, "algorithm", "rsa");
-    rc |= pk_h5_obs_int(h, "rsa/draws", (int64_t)st->draws);
+    rc |= pk_h5_obs_string(h, "algorithm", job->algorithm);
+    if (st->obs)
+        rc |= pk_h5_obs_json(h, job->algorithm, st->obs);
     rc |= pk_h5_obs_double(h, "smallest_gap", gap->min_gap, u);
     rc |= pk_h5_obs_double(h, "smallest_wall_gap", isinf(gap->min_wall_gap) ? -1 : gap->min_wall_gap, u);
     rc |= pk_h5_obs_int(h, "pairs_below_delta_d", (int64_t)gap->pairs_below);
@@ -205,13 +206,14 @@ int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_m
         snprintf(err, errlen, "out of memory for %zu grains", sz.n);
         return -1;
     }
-    pk_rsa_params prm = {.delta_d = job.delta_d, .max_failed_draws = job.max_failed_draws,
-                         .seed = job.seed};
-    pk_rsa_stats st;
-    if (pk_rsa_place(&job.box, sz.d, sz.species, sz.n, &prm, mon, &p, &st) != 0) {
+    const pk_placer *placer = pk_placer_find(job.algorithm);
+    pk_place_stats st = {0};
+    if (!placer || placer->place(&job, &plan, &sz, mon, &p, &st, err, errlen) != 0) {
+        if (!placer)
+            snprintf(err, errlen, "no placer named %s", job.algorithm);
         pk_sizes_free(&sz);
         pk_particles_free(&p);
-        snprintf(err, errlen, "placement failed (%s)", pk_stop_reason_name(st.reason));
+        json_decref(st.obs);
         return -1;
     }
 
@@ -224,6 +226,7 @@ int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_m
     /* tolerance: 1e-12 of the largest length, far below any meaningful gap */
     double tol = 1e-12 * fmax(job.box.L[0], fmax(job.box.L[1], job.box.L[2]));
     if (pk_gap_audit(&job.box, &p, job.delta_d, tol, horizon, &gap) != 0) {
+        json_decref(st.obs);
         pk_sizes_free(&sz);
         pk_particles_free(&p);
         snprintf(err, errlen, "out of memory in the gap audit");
@@ -233,7 +236,7 @@ int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_m
 
     json_t *sum = json_object();
     json_object_set_new(sum, "process", json_string("pack"));
-    json_object_set_new(sum, "algorithm", json_string("rsa"));
+    json_object_set_new(sum, "algorithm", json_string(job.algorithm));
     json_object_set_new(sum, "termination_reason", json_string(pk_stop_reason_name(st.reason)));
     json_object_set_new(sum, "complete", json_boolean(st.reason == PK_STOP_COMPLETE));
     json_object_set_new(sum, "count_placed", json_integer((json_int_t)st.placed));
@@ -253,6 +256,9 @@ int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_m
                           out_path, sum, err, errlen);
     pk_sizes_free(&sz);
     pk_particles_free(&p);
+    if (st.obs)
+        json_object_set(sum, job.algorithm, st.obs);
+    json_decref(st.obs);
     if (rc != 0) {
         json_decref(sum);
         return -1;

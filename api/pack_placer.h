@@ -1,0 +1,43 @@
+/* pack_placer.h — the placement algorithms of the 'pack' process.
+ *
+ * The pack process draws sizes (core/psd), hands them to one placer, audits
+ * the result and writes the file.  A placer is one row in pk_placers[]
+ * (api/pack_placers.c) plus one file api/pack_place_<name>.c: it reads its
+ * own parameter object from the inputs (e.g. "edmd": {...}), runs its core/
+ * algorithm and reports common statistics plus any algorithm-specific
+ * observables as a JSON object, which the writer stores under
+ * /observables/<name>/ (numbers, integers, strings, arrays of numbers). */
+#ifndef PK_PACK_PLACER_H
+#define PK_PACK_PLACER_H
+
+#include <jansson.h>
+
+#include "pack_job.h"
+#include "particles.h"
+#include "psd.h"
+#include "rsa.h"
+
+typedef struct pk_place_stats {
+    pk_stop_reason reason;
+    size_t placed, requested;
+    double seconds;
+    json_t *obs;          /* algorithm-specific observables (new reference) or NULL */
+} pk_place_stats;
+
+typedef struct pk_placer {
+    const char *name;     /* the "algorithm" value */
+    /* Semantic checks of the placer's own inputs (schema already passed);
+     * may be NULL. */
+    void (*check)(const pk_pack_job *job, const pk_pack_plan *plan, pk_schema_errors *errs);
+    /* Place the grains (diameters sz->d, descending) into job->box, appending
+     * to p (initialised, dim = job->dim).  0 when the run ended cleanly for
+     * whatever reason (st->reason), -1 on failure with err. */
+    int (*place)(const pk_pack_job *job, const pk_pack_plan *plan, const pk_sizes *sz,
+                 pk_monitor *mon, pk_particles *p, pk_place_stats *st, char *err, size_t errlen);
+} pk_placer;
+
+/* NULL-terminated table. */
+extern const pk_placer *const pk_placers[];
+const pk_placer *pk_placer_find(const char *name);
+
+#endif
