@@ -1,0 +1,165 @@
+/* test_h5_result.c — result files read back with the HDF5 library itself:
+ * the H5MD layout, exact round trip of the grains, atomic commit/abort. */
+#include <hdf5.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "check.h"
+#include "h5_inspect.h"
+#include "h5_result.h"
+
+static char dir[] = "/tmp/packd-h5-XXXXXX";
+
+static void fill(pk_particles *p, int dim, size_t n)
+{
+    pk_particles_init(p, dim, n);
+    for (size_t i = 0; i < n; i++) {
+        double x[3] = {0.1 * (double)i, 1.0 / (double)(i + 1), dim == 3 ? 3.0 + (double)i : 0};
+        pk_particles_push(p, x, 0.01 + 1e-3 * (double)i, (int32_t)(i % 3));
+    }
+}
+
+static int exists(const char *path) { return access(path, F_OK) == 0; }
+
+static void test_round_trip_and_layout(void)
+{
+    char path[256];
+    snprintf(path, sizeof path, "%s/a.h5", dir);
+    pk_box b = {.dim = 3, .L = {1, 2, 3}, .periodic = {true, false, true}};
+    pk_particles p;
+    fill(&p, 3, 100);
+    char err[256];
+    pk_h5 *h = pk_h5_create(path, err, sizeof err);
+    CHECK(h != NULL);
+    CHECK(!exists(path)); /* nothing at the final name before commit */
+    CHECK(pk_h5_write_particles(h, &b, &p, "mm") == 0);
+    CHECK(pk_h5_write_parameters(h, "pack", "{\"process\":\"pack\"}", 42) == 0);
+    CHECK(pk_h5_obs_double(h, "phi_resolved", 0.5, NULL) == 0);
+    CHECK(pk_h5_obs_string(h, "termination_reason", "complete") == 0);
+    json_t *extra = json_pack("{s:i,s:[f,f],s:{s:s}}", "events", 7, "hist", 0.1, 0.2, "sub", "k", "v");
+    CHECK(pk_h5_obs_json(h, "edmd", extra) == 0);
+    json_decref(extra);
+    CHECK(pk_h5_commit(h, err, sizeof err) == 0);
+    CHECK(exists(path));
+
+    /* grains: exact round trip through pk_h5_read_particles */
+    pk_box b2;
+    pk_particles q;
+    CHECK(pk_h5_read_particles(path, &b2, &q, err, sizeof err) == 0);
+    CHECK(b2.dim == 3 && q.n == p.n);
+    CHECK(memcmp(b2.L, b.L, sizeof b.L) == 0);
+    CHECK(b2.periodic[0] && !b2.periodic[1] && b2.periodic[2]);
+    CHECK(memcmp(q.x, p.x, 3 * p.n * sizeof(double)) == 0);
+    CHECK(memcmp(q.r, p.r, p.n * sizeof(double)) == 0);
+    CHECK(memcmp(q.species, p.species, p.n * sizeof(int32_t)) == 0);
+    pk_particles_free(&q);
+
+    /* H5MD layout, read with the HDF5 library directly */
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    CHECK(f >= 0);
+    int ver[2] = {0, 0};
+    hid_t a = H5Aopen_by_name(f, "h5md", "version", H5P_DEFAULT, H5P_DEFAULT);
+    CHECK(a >= 0 && H5Aread(a, H5T_NATIVE_INT, ver) >= 0);
+    H5Aclose(a);
+    CHECK(ver[0] == 1 && ver[1] == 1);
+    CHECK(H5Lexists(f, "h5md/creator", H5P_DEFAULT) > 0);
+    hid_t d = H5Dopen2(f, "particles/grains/position", H5P_DEFAULT);
+    hid_t s = H5Dget_space(d);
+    hsize_t dims[2];
+    CHECK(H5Sget_simple_extent_ndims(s) == 2);
+    H5Sget_simple_extent_dims(s, dims, NULL);
+    CHECK(dims[0] == 100 && dims[1] == 3);
+    CHECK(H5Aexists(d, "unit") > 0);
+    H5Sclose(s);
+    H5Dclose(d);
+    CHECK(H5Lexists(f, "observables/edmd", H5P_DEFAULT) > 0);
+    CHECK(H5Lexists(f, "observables/edmd/sub", H5P_DEFAULT) > 0);
+    CHECK(H5Lexists(f, "parameters/job", H5P_DEFAULT) > 0);
+    H5Fclose(f);
+
+    /* the JSON view */
+    json_t *j = pk_h5_inspect(path, 64, err, sizeof err);
+    CHECK(j != NULL);
+    json_t *o = json_object_get(j, "observables");
+    CHECK(json_integer_value(json_object_get(o, "edmd/events")) == 7);
+    CHECK(json_array_size(json_object_get(o, "edmd/hist")) == 2);
+    CHECK(strcmp(json_string_value(json_object_get(o, "termination_reason")), "complete") == 0);
+    CHECK(json_integer_value(json_object_get(j, "grains")) == 100);
+    json_decref(j);
+    pk_particles_free(&p);
+    unlink(path);
+}
+
+static void test_2d_positions_have_two_columns(void)
+{
+    char path[256];
+    snprintf(path, sizeof path, "%s/b.h5", dir);
+    pk_box b = {.dim = 2, .L = {5, 5}, .periodic = {true, true}};
+    pk_particles p;
+    fill(&p, 2, 10);
+    char err[256];
+    pk_h5 *h = pk_h5_create(path, err, sizeof err);
+    pk_h5_write_particles(h, &b, &p, "mm");
+    CHECK(pk_h5_commit(h, err, sizeof err) == 0);
+    pk_box b2;
+    pk_particles q;
+    CHECK(pk_h5_read_particles(path, &b2, &q, err, sizeof err) == 0);
+    CHECK(b2.dim == 2 && q.n == 10 && q.x[3 * 5 + 2] == 0.0);
+    CHECK(q.x[3 * 5 + 1] == p.x[3 * 5 + 1]);
+    pk_particles_free(&p);
+    pk_particles_free(&q);
+    unlink(path);
+}
+
+/* abort leaves nothing behind; an existing file is only replaced on commit */
+static void test_abort_and_atomic_replace(void)
+{
+    char path[256], tmp[300];
+    snprintf(path, sizeof path, "%s/c.h5", dir);
+    FILE *old = fopen(path, "w");
+    fputs("old content", old);
+    fclose(old);
+    char err[256];
+    pk_h5 *h = pk_h5_create(path, err, sizeof err);
+    CHECK(h != NULL);
+    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
+    CHECK(exists(tmp));
+    pk_h5_abort(h);
+    CHECK(!exists(tmp));
+    FILE *f = fopen(path, "r");
+    char buf[32] = "";
+    CHECK(f && fgets(buf, sizeof buf, f) && strcmp(buf, "old content") == 0);
+    if (f)
+        fclose(f);
+    /* a failing create reports an error instead of crashing */
+    CHECK(pk_h5_create("/nonexistent-dir/x.h5", err, sizeof err) == NULL);
+    CHECK(strlen(err) > 0);
+    unlink(path);
+}
+
+static void test_read_rejects_non_result(void)
+{
+    char path[256], err[256];
+    snprintf(path, sizeof path, "%s/not.h5", dir);
+    FILE *f = fopen(path, "w");
+    fputs("this is not HDF5", f);
+    fclose(f);
+    pk_box b;
+    pk_particles p;
+    CHECK(pk_h5_read_particles(path, &b, &p, err, sizeof err) != 0);
+    CHECK(strstr(err, "HDF5") != NULL);
+    unlink(path);
+}
+
+int main(void)
+{
+    if (!mkdtemp(dir))
+        return 1;
+    RUN(test_round_trip_and_layout);
+    RUN(test_2d_positions_have_two_columns);
+    RUN(test_abort_and_atomic_replace);
+    RUN(test_read_rejects_non_result);
+    rmdir(dir);
+    return check_summary();
+}
