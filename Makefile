@@ -23,8 +23,8 @@ BASE_CFLAGS := $(CSTD) $(OPT) -g $(WARN) $(SAN) -DPACKD_VERSION='"$(VERSION)"'
 
 # core/ is plain C17 + libm: compiled without any external include path.
 CORE_CFLAGS := $(BASE_CFLAGS)
-EXT_CFLAGS   = $(BASE_CFLAGS) $(shell pkg-config --cflags $(PKGS) 2>/dev/null) -Icore -Iapi -I$(BUILD)/gen
-EXT_LIBS     = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lm -lpthread
+EXT_CFLAGS   = $(BASE_CFLAGS) $(shell pkg-config --cflags $(PKGS) 2>/dev/null) -I/usr/include/suitesparse -Icore -Iapi -I$(BUILD)/gen
+EXT_LIBS     = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lcholmod -lm -lpthread
 
 CORE_SRC   := $(wildcard core/*.c)
 API_SRC    := $(wildcard api/*.c)
@@ -48,7 +48,7 @@ all: $(BUILD)/packd
 # Install missing Debian packages once (deploy/install-deps.sh is idempotent).
 $(DEPS_OK): deploy/install-deps.sh
 	@mkdir -p $(@D)
-	@if ! pkg-config --exists $(PKGS) || ! command -v h5dump >/dev/null || ! command -v curl >/dev/null; then \
+	@if ! pkg-config --exists $(PKGS) || ! command -v h5dump >/dev/null || ! command -v curl >/dev/null || [ ! -f /usr/include/suitesparse/cholmod.h ]; then \
 	    echo "packd: installing missing packages (deploy/install-deps.sh)"; \
 	    sh deploy/install-deps.sh || exit 1; \
 	fi

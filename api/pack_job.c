@@ -147,7 +147,9 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
     json_t *box = json_object_get(json_object_get(in, "domain"), "box");
     json_t *size = json_object_get(box, "size");
     job->box.dim = job->dim;
-    if (json_array_size(size) != (size_t)job->dim)
+    if (!box) /* a mesh domain: the placer reports its box (pack_placer.h) */
+        ;
+    else if (json_array_size(size) != (size_t)job->dim)
         pk_schema_errors_add(errs, "/domain/box/size", "dim",
                              "needs %d edge lengths for dim = %d (got %zu)", job->dim, job->dim,
                              json_array_size(size));
@@ -198,8 +200,13 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
     job->delta_d = num(in, "delta_d", 0);
     const char *algo = json_string_value(json_object_get(in, "algorithm"));
     snprintf(job->algorithm, sizeof job->algorithm, "%s", algo ? algo : "rsa");
-    if (!pk_placer_find(job->algorithm))
+    const pk_placer *placer = pk_placer_find(job->algorithm);
+    if (!placer)
         pk_schema_errors_add(errs, "/algorithm", "enum", "no placer named \"%s\"", job->algorithm);
+    else if (!box && !placer->own_sizes)
+        pk_schema_errors_add(errs, "/domain", "boxDomain",
+                             "algorithm \"%s\" needs a box domain (a mesh needs \"tetfill\")",
+                             job->algorithm);
     job->inputs = in;
     job->seed = json_object_get(in, "seed") ? (uint64_t)json_integer_value(json_object_get(in, "seed")) : 1;
     job->max_particles = (size_t)num(json_object_get(in, "limits"), "max_particles", 2e7);
@@ -214,6 +221,14 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
     size_t before = errs->n;
     memset(plan, 0, sizeof *plan);
     plan->scale = 1;
+    const pk_placer *own = pk_placer_find(job->algorithm);
+    if (own && own->own_sizes) { /* no grading: the placer plans and checks alone */
+        plan->phi_resolved = plan->phi_mix = job->has_phi ? job->phi : 0;
+        plan->expected_n = (double)job->count;
+        if (own->check)
+            own->check(job, plan, errs);
+        return errs->n - before;
+    }
     const pk_grading *g = &job->grading;
     if (g->nclass <= 0)
         return errs->n - before; /* grading errors already reported */

@@ -17,15 +17,29 @@
 #include "psd.h"
 #include "rsa.h"
 
+struct pk_h5;
+
 typedef struct pk_place_stats {
     pk_stop_reason reason;
     size_t placed, requested;
     double seconds;
     json_t *obs;          /* algorithm-specific observables (new reference) or NULL */
+    /* Placers that fill their own domain (tetfill: a mesh) report it here:
+     * the box written to the file and audited, and its true measure. */
+    int has_domain;
+    pk_box domain_box;
+    double domain_measure;
+    double overlap_tol;   /* overlaps the placer allows by design (0 = hard grains) */
+    /* Bulk datasets too large for obs (e.g. the mesh): written under
+     * /observables/<algorithm>/ by write_extra, released by free_extra. */
+    void *extra;
+    int (*write_extra)(struct pk_h5 *h, const char *prefix, void *extra);
+    void (*free_extra)(void *extra);
 } pk_place_stats;
 
 typedef struct pk_placer {
     const char *name;     /* the "algorithm" value */
+    int own_sizes;        /* 1 = the placer makes its own sizes: no grading, no size draw */
     /* Semantic checks of the placer's own inputs (schema already passed);
      * may be NULL. */
     void (*check)(const pk_pack_job *job, const pk_pack_plan *plan, pk_schema_errors *errs);

@@ -3,9 +3,13 @@
 #include "pack_placer.h"
 
 extern const pk_placer pk_placer_rsa;
+extern const pk_placer pk_placer_edmd;
+extern const pk_placer pk_placer_tetfill;
 
 const pk_placer *const pk_placers[] = {
     &pk_placer_rsa,
+    &pk_placer_edmd,
+    &pk_placer_tetfill,
     NULL,
 };
 

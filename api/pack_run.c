@@ -52,7 +52,7 @@ static double target_passing(const pk_pack_plan *plan, double d)
 }
 
 static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const char *job_json,
-                        const pk_particles *p, const pk_sizes *sz, double scale,
+                        const pk_box *box, double V, const pk_particles *p, const pk_sizes *sz, double scale,
                         const pk_place_stats *st, const pk_gap_report *gap, double t_sizes,
                         double t_audit, const char *out_path, json_t *summary, char *err,
                         size_t errlen)
@@ -62,11 +62,10 @@ static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const 
         return -1;
     const char *u = job->unit;
     const int dim = job->dim;
-    double V = pk_box_measure(&job->box);
     double solid = pk_particles_solid_measure(p);
     double phi = solid / V;
     int rc = 0;
-    rc |= pk_h5_write_particles(h, &job->box, p, u);
+    rc |= pk_h5_write_particles(h, box, p, u);
     rc |= pk_h5_write_parameters(h, "pack", job_json, job->seed);
     rc |= pk_h5_obs_double(h, "phi_resolved", phi, NULL);
     rc |= pk_h5_obs_double(h, "phi_mix", phi / (1 - plan->mass_cut), NULL);
@@ -83,6 +82,8 @@ static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const 
     rc |= pk_h5_obs_string(h, "algorithm", job->algorithm);
     if (st->obs)
         rc |= pk_h5_obs_json(h, job->algorithm, st->obs);
+    if (st->write_extra)
+        rc |= st->write_extra(h, job->algorithm, st->extra);
     rc |= pk_h5_obs_double(h, "smallest_gap", gap->min_gap, u);
     rc |= pk_h5_obs_double(h, "smallest_wall_gap", isinf(gap->min_wall_gap) ? -1 : gap->min_wall_gap, u);
     rc |= pk_h5_obs_int(h, "pairs_below_delta_d", (int64_t)gap->pairs_below);
@@ -193,8 +194,9 @@ int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_m
 
     double t0 = pk_wall_seconds();
     pk_sizes sz = {0};
-    double scale;
-    if (draw_sizes(&job, &plan, &sz, &scale) != 0) {
+    double scale = 1;
+    const pk_placer *placer = pk_placer_find(job.algorithm);
+    if (!(placer && placer->own_sizes) && draw_sizes(&job, &plan, &sz, &scale) != 0) {
         snprintf(err, errlen, "drawing sizes failed: %s", pk_psd_error());
         return -1;
     }
@@ -206,7 +208,6 @@ int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_m
         snprintf(err, errlen, "out of memory for %zu grains", sz.n);
         return -1;
     }
-    const pk_placer *placer = pk_placer_find(job.algorithm);
     pk_place_stats st = {0};
     if (!placer || placer->place(&job, &plan, &sz, mon, &p, &st, err, errlen) != 0) {
         if (!placer)
@@ -214,8 +215,12 @@ int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_m
         pk_sizes_free(&sz);
         pk_particles_free(&p);
         json_decref(st.obs);
+        if (st.free_extra)
+            st.free_extra(st.extra);
         return -1;
     }
+    const pk_box box = st.has_domain ? st.domain_box : job.box;
+    const double V = st.has_domain ? st.domain_measure : pk_box_measure(&job.box);
 
     double t1 = pk_wall_seconds();
     pk_gap_report gap;
@@ -223,10 +228,14 @@ int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_m
     for (size_t i = 0; i < p.n; i++)
         rmax = fmax(rmax, p.r[i]);
     double horizon = fmax(job.delta_d, rmax) + 1e-300;
-    /* tolerance: 1e-12 of the largest length, far below any meaningful gap */
-    double tol = 1e-12 * fmax(job.box.L[0], fmax(job.box.L[1], job.box.L[2]));
-    if (pk_gap_audit(&job.box, &p, job.delta_d, tol, horizon, &gap) != 0) {
+    /* tolerance: 1e-12 of the largest length, far below any meaningful gap;
+     * placers with bounded overlaps by design (tetfill: ε r_min) add their
+     * bound, so only overlaps beyond it count as violations */
+    double tol = 1e-12 * fmax(box.L[0], fmax(box.L[1], box.L[2])) + st.overlap_tol;
+    if (pk_gap_audit(&box, &p, job.delta_d, tol, horizon, &gap) != 0) {
         json_decref(st.obs);
+        if (st.free_extra)
+            st.free_extra(st.extra);
         pk_sizes_free(&sz);
         pk_particles_free(&p);
         snprintf(err, errlen, "out of memory in the gap audit");
@@ -252,10 +261,14 @@ int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_m
     json_object_set_new(sum, "size_scale", json_real(scale));
     json_object_set_new(sum, "seconds_place", json_real(st.seconds));
 
-    int rc = write_result(&job, &plan, job_json, &p, &sz, scale, &st, &gap, t_sizes, t_audit,
+    if (st.overlap_tol > 0)
+        json_object_set_new(sum, "overlap_tolerance", json_real(st.overlap_tol));
+    int rc = write_result(&job, &plan, job_json, &box, V, &p, &sz, scale, &st, &gap, t_sizes, t_audit,
                           out_path, sum, err, errlen);
     pk_sizes_free(&sz);
     pk_particles_free(&p);
+    if (st.free_extra)
+        st.free_extra(st.extra);
     if (st.obs)
         json_object_set(sum, job.algorithm, st.obs);
     json_decref(st.obs);

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "homog_job.h"
 #include "pack_job.h"
 
 static const pk_process pack_process = {
@@ -16,7 +17,19 @@ static const pk_process pack_process = {
     .run = pk_pack_run,
 };
 
-const pk_process *const pk_processes[] = {&pack_process, NULL};
+static const pk_process homogenize_process = {
+    .id = "homogenize",
+    .title = "Homogenize a packing (DEM RVE)",
+    .description = "Load a packing as a soft-contact DEM RVE with a path of macroscopic "
+                   "deformation gradients under Taylor, restricted Taylor or periodic boundary "
+                   "conditions; per step the Piola and Cauchy stress, energies, relaxation "
+                   "figures and optionally the tangent (Meier 2009); writes an H5MD result file.",
+    .inputs_schema = "homogenize.inputs.schema.json",
+    .check = pk_homog_check,
+    .run = pk_homog_run,
+};
+
+const pk_process *const pk_processes[] = {&pack_process, &homogenize_process, NULL};
 
 const pk_process *pk_process_find(const char *id)
 {

@@ -5,7 +5,9 @@
  * surface) or, on a walled axis, closer than Δd/2 to a wall (the draw range
  * is shrunk so this never needs a test: spec §2.1 step 2).  After
  * `max_failed_draws` consecutive rejections of one grain the run stops with
- * what it has placed (Titscher's N^F failure criterion). */
+ * what it has placed (Titscher's N^F failure criterion).  When the draws come
+ * from the voxels not yet covered (rsa_voxels.h) and none is left, the box is
+ * provably full for the next grain: the run stops as PK_STOP_SATURATED. */
 #ifndef PK_RSA_H
 #define PK_RSA_H
 
@@ -24,7 +26,8 @@ typedef enum pk_stop_reason {
     PK_STOP_WALL_TIME,           /* wall-clock limit */
     PK_STOP_JAMMED,              /* (EDMD) jamming criterion met */
     PK_STOP_STALLED,             /* (EDMD) no progress */
-    PK_STOP_ERROR                /* out of memory or invalid input */
+    PK_STOP_ERROR,               /* out of memory or invalid input */
+    PK_STOP_SATURATED            /* no free space is left for the next grain */
 } pk_stop_reason;
 
 /* Stable machine name ("complete", "max_failed_draws", ...). */
@@ -34,6 +37,10 @@ typedef struct pk_rsa_params {
     double delta_d;              /* minimum surface gap Δd (>= 0) */
     uint64_t max_failed_draws;   /* N^F (e.g. 1e6) */
     uint64_t seed;               /* positions use stream 1 of this seed */
+    int plain_draws;             /* 1: uniform draws over the whole range only (the
+                                    reference path of the tests); 0: draws from the
+                                    voxels not yet covered where that pays (same
+                                    statistics, see rsa_voxels.h) */
 } pk_rsa_params;
 
 typedef struct pk_rsa_stats {

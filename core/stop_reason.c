@@ -11,6 +11,7 @@ const char *pk_stop_reason_name(pk_stop_reason r)
     case PK_STOP_JAMMED: return "jammed";
     case PK_STOP_STALLED: return "stalled";
     case PK_STOP_ERROR: return "error";
+    case PK_STOP_SATURATED: return "saturated";
     }
     return "unknown";
 }

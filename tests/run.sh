@@ -4,8 +4,12 @@
 # line "N passed, N failed".  Exit status is non-zero on any failure.
 # A binary or script that dies without printing FAIL counts as one failure.
 BUILD=${1:-build}
-export PACKD="$PWD/$BUILD/packd"
-export PACKD_BUILD="$PWD/$BUILD"
+case "$BUILD" in
+/*) ;;
+*) BUILD="$PWD/$BUILD" ;;
+esac
+export PACKD="$BUILD/packd"
+export PACKD_BUILD="$BUILD"
 export PACKD_SRC="$PWD"
 passed=0
 failed=0

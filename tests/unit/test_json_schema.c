@@ -557,6 +557,8 @@ static void test_embedded(void)
         CHECK(strlen(s->text) == s->len);
         json_t *a = pk_schema_get(s->name);
         CHECK(a && a == pk_schema_get(s->name)); /* parsed once, cached */
+        if (!json_object_get(a, "$schema")) /* not a JSON Schema: e.g. openapi.json, served as is */
+            continue;
         /* whatever the instance, no embedded schema may report a schema bug */
         const char *insts[] = {"{}", "[]", "1", "\"x\"", "null", "{\"type\":\"sieve\"}"};
         for (size_t i = 0; i < sizeof insts / sizeof insts[0]; i++) {

@@ -1,0 +1,197 @@
+/* homog_job.c — parse and check 'homogenize' inputs; build the F̄ path. */
+#include "homog_job.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "homog_tensor.h"
+
+void pk_homog_job_free(pk_homog_job *job)
+{
+    free(job->F);
+    job->F = NULL;
+    job->nstep = 0;
+}
+
+static double num(json_t *o, const char *key, double dflt)
+{
+    json_t *v = json_object_get(o, key);
+    return json_is_number(v) ? json_number_value(v) : dflt;
+}
+
+static int push_F(pk_homog_job *job, size_t *cap, const double F[9])
+{
+    if (job->nstep == *cap) {
+        size_t c = *cap ? 2 * *cap : 64;
+        double *n = realloc(job->F, c * 9 * sizeof *n);
+        if (!n)
+            return -1;
+        job->F = n;
+        *cap = c;
+    }
+    memcpy(&job->F[9 * job->nstep++], F, 9 * sizeof *F);
+    return 0;
+}
+
+/* "12" → (0, 1) */
+static void plane_of(json_t *load, int *i, int *j)
+{
+    const char *s = json_string_value(json_object_get(load, "plane"));
+    if (!s || strlen(s) != 2)
+        s = "12";
+    *i = s[0] - '1';
+    *j = s[1] - '1';
+}
+
+/* (1 − λc)1 ramped over pre_steps, then the shear history λs(t) (steps). */
+static int shear_path(pk_homog_job *job, size_t *cap, json_t *load, int cyclic)
+{
+    double lc = num(load, "precompression", 0.01);
+    int pre = (int)num(load, "pre_steps", 10);
+    int steps = (int)num(load, "steps", 1);
+    int pi, pj;
+    plane_of(load, &pi, &pj);
+    double F[9];
+    for (int k = 1; k <= pre; k++) {
+        pk_m3_identity(F);
+        for (int a = 0; a < 3; a++)
+            F[4 * a] = 1 - lc * k / pre;
+        if (push_F(job, cap, F))
+            return -1;
+    }
+    double amp = cyclic ? num(load, "amplitude", 0.5) : num(load, "shear", 1);
+    for (int k = 1; k <= steps; k++) {
+        double t = (double)k / steps, ls;
+        if (!cyclic)
+            ls = amp * t;
+        else if (t <= 0.25) /* 0 → a → −a → 0, piecewise linear */
+            ls = 4 * amp * t;
+        else if (t <= 0.75)
+            ls = amp * (1 - 4 * (t - 0.25));
+        else
+            ls = -amp + 4 * amp * (t - 0.75);
+        pk_m3_identity(F);
+        for (int a = 0; a < 3; a++)
+            F[4 * a] = 1 - lc;
+        F[3 * pi + pj] += ls;
+        if (push_F(job, cap, F))
+            return -1;
+    }
+    return 0;
+}
+
+size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_errors *errs)
+{
+    size_t before = errs->n;
+    memset(job, 0, sizeof *job);
+    json_t *rve = json_object_get(inputs, "rve");
+    snprintf(job->rve_file, sizeof job->rve_file, "%s",
+             json_string_value(json_object_get(rve, "file")) ? json_string_value(json_object_get(rve, "file")) : "");
+    const char *bc = json_string_value(json_object_get(inputs, "boundary_condition"));
+    job->bc = bc && !strcmp(bc, "taylor") ? PK_BC_TAYLOR
+              : bc && !strcmp(bc, "restricted_taylor") ? PK_BC_RESTRICTED_TAYLOR
+                                                     : PK_BC_PERIODIC;
+    job->E_n = num(json_object_get(inputs, "contact"), "E_n", 1);
+    json_t *dr = json_object_get(inputs, "relaxation");
+    job->tol = num(dr, "tol", 1e-8);
+    job->abs_tol = num(dr, "abs_tol", 1e-13);
+    job->max_iter = (size_t)num(dr, "max_iter", 1e6);
+    job->lanczos_steps = (int)num(dr, "lanczos_steps", 40);
+    job->refresh = (size_t)num(dr, "refresh", 200);
+    const char *pred = json_string_value(json_object_get(dr, "predictor"));
+    job->affine_predictor = !(pred && !strcmp(pred, "none"));
+    job->tangent = json_is_true(json_object_get(inputs, "tangent"));
+    json_t *out = json_object_get(inputs, "output");
+    job->out_micro = json_is_true(json_object_get(out, "micro_state"));
+    job->out_contacts = json_is_true(json_object_get(out, "contacts"));
+    json_t *ini = json_object_get(inputs, "initial_state");
+    const char *pol = json_string_value(json_object_get(ini, "policy"));
+    job->radius_factor = 1;
+    if (pol && !strcmp(pol, "radius_inflation"))
+        job->radius_factor = 1 + num(ini, "value", 0);
+    if (pol && !strcmp(pol, "precompress"))
+        job->precompress = num(ini, "value", 0);
+    job->wall_time_s = num(json_object_get(inputs, "limits"), "wall_time_s", 0);
+
+    json_t *load = json_object_get(inputs, "load");
+    const char *type = json_string_value(json_object_get(load, "type"));
+    size_t cap = 0;
+    int rc = 0;
+    if (type && !strcmp(type, "list")) {
+        json_t *list = json_object_get(load, "F"), *row;
+        size_t k;
+        json_array_foreach(list, k, row) {
+            size_t m = json_array_size(row);
+            char ptr[64];
+            snprintf(ptr, sizeof ptr, "/load/F/%zu", k);
+            if (m != 4 && m != 9) {
+                pk_schema_errors_add(errs, ptr, "semantic", "F̄ needs 4 (2D) or 9 (3D) numbers, got %zu", m);
+                continue;
+            }
+            int d = m == 4 ? 2 : 3;
+            if (job->fdim && job->fdim != d)
+                pk_schema_errors_add(errs, ptr, "semantic", "all F̄ of a path must have the same dimension");
+            job->fdim = d;
+            double F[9];
+            pk_m3_identity(F);
+            for (int a = 0; a < d; a++)
+                for (int b = 0; b < d; b++)
+                    F[3 * a + b] = json_number_value(json_array_get(row, (size_t)(a * d + b)));
+            rc |= push_F(job, &cap, F);
+        }
+    } else if (type && !strcmp(type, "uniaxial_compression")) {
+        int axis = (int)num(load, "axis", 1) - 1, steps = (int)num(load, "steps", 1);
+        double lam = num(load, "strain", 0.3);
+        if (axis == 2)
+            job->fdim = 3;
+        for (int k = 1; k <= steps; k++) {
+            double F[9];
+            pk_m3_identity(F);
+            F[4 * axis] = 1 - lam * k / steps;
+            rc |= push_F(job, &cap, F);
+        }
+    } else {
+        int cyc = type && !strcmp(type, "cyclic_shear");
+        int pi, pj;
+        plane_of(load, &pi, &pj);
+        if (pi == pj)
+            pk_schema_errors_add(errs, "/load/plane", "semantic", "a shear plane needs two different axes");
+        if (pi == 2 || pj == 2)
+            job->fdim = 3;
+        rc |= shear_path(job, &cap, load, cyc);
+    }
+    if (rc) {
+        pk_schema_errors_add(errs, "/load", "memory", "out of memory for the load path");
+    }
+    /* every step: finite, det F̄ >= margin (spec H13) */
+    for (size_t k = 0; k < job->nstep && errs->n - before < 20; k++) {
+        const double *F = &job->F[9 * k];
+        double d = pk_m3_det(F);
+        int finite = 1;
+        for (int e = 0; e < 9; e++)
+            finite &= isfinite(F[e]) != 0;
+        char ptr[64];
+        if (type && !strcmp(type, "list"))
+            snprintf(ptr, sizeof ptr, "/load/F/%zu", k);
+        else
+            snprintf(ptr, sizeof ptr, "/load");
+        if (!finite)
+            pk_schema_errors_add(errs, ptr, "semantic", "F̄ of step %zu is not finite", k);
+        else if (!(d >= PK_HOMOG_MIN_DET))
+            pk_schema_errors_add(errs, ptr, "semantic",
+                                 "det F̄ of step %zu is %g: must be >= %g (no inversion or collapse)", k,
+                                 d, PK_HOMOG_MIN_DET);
+    }
+    if (errs->n != before)
+        pk_homog_job_free(job);
+    return errs->n - before;
+}
+
+void pk_homog_check(json_t *inputs, pk_schema_errors *errs)
+{
+    pk_homog_job job;
+    if (pk_homog_job_from_json(inputs, &job, errs) == 0)
+        pk_homog_job_free(&job);
+}

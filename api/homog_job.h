@@ -1,0 +1,45 @@
+/* homog_job.h — the 'homogenize' process: JSON inputs → job struct and load
+ * path (schemas/homogenize.inputs.schema.json), semantic checks, run. */
+#ifndef PK_HOMOG_JOB_H
+#define PK_HOMOG_JOB_H
+
+#include <jansson.h>
+#include <stddef.h>
+
+#include "homog_bc.h"
+#include "json_schema.h"
+#include "progress.h"
+
+#define PK_HOMOG_MIN_DET 1e-3 /* det F̄ margin of every load step */
+
+typedef struct pk_homog_job {
+    char rve_file[1024];
+    pk_homog_bc bc;
+    double E_n;
+    double tol, abs_tol;
+    size_t max_iter;
+    int lanczos_steps;
+    size_t refresh;
+    int affine_predictor;
+    int tangent;
+    int out_micro, out_contacts;
+    double radius_factor;      /* initial_state radius_inflation */
+    double precompress;        /* initial_state precompress λ₀ */
+    double wall_time_s;
+    size_t nstep;
+    int fdim;                  /* 2 or 3: dimension the load path is written for (0 = any) */
+    double *F;                 /* [nstep][9] row-major, 3D-embedded */
+} pk_homog_job;
+
+/* Inputs (schema-valid) → job; semantic errors appended with pointers
+ * relative to the inputs object.  Returns their number (job->F is freed on
+ * error). */
+size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_errors *errs);
+void pk_homog_job_free(pk_homog_job *job);
+
+/* process table hooks (see process.h) */
+void pk_homog_check(json_t *inputs, pk_schema_errors *errs);
+int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_monitor *mon,
+                 json_t **summary, char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,285 @@
+/* homog_run.c — run a 'homogenize' job: RVE file → load path of relaxed,
+ * committed steps (Table 4.1/4.2) → H5MD result with per-step observables. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dem_rattler.h"
+#include "h5_result.h"
+#include "homog_job.h"
+#include "homog_record.h"
+#include "homog_tangent.h"
+#include "homog_tensor.h"
+#include "sparse_cholmod.h"
+
+static void opts_of(const pk_homog_job *job, const pk_homog_rve *rve, pk_homog_opts *o)
+{
+    double rmean = 0;
+    for (size_t i = 0; i < rve->n; i++)
+        rmean += rve->r[i] / (double)rve->n;
+    memset(o, 0, sizeof *o);
+    o->E_n = job->E_n;
+    o->affine_predictor = job->affine_predictor;
+    o->dr.tol = job->tol;
+    /* absolute floor scaled like the round-off of |f| (~1e-16·E·r̄·N) */
+    o->dr.abs_floor = job->abs_tol * job->E_n * rmean * (double)rve->n;
+    o->dr.max_iter = job->max_iter;
+    o->dr.lanczos_steps = job->lanczos_steps;
+    o->dr.refresh = job->refresh;
+    o->dr.skin = 0.3 * rmean;
+}
+
+static const char *eval_error(int rc)
+{
+    return rc == -2 ? "the periodic box is too small for this F̄ (an image contact could be missed)"
+           : rc == -3 ? "det F̄ <= 0"
+                      : "out of memory";
+}
+
+/* Final micro state and contact network (output options). */
+static int final_state_json(const pk_homog_rve *rve, const pk_homog_opts *o,
+                            const pk_homog_state *s, int micro, int contacts, json_t *rec)
+{
+    const int dim = rve->dim;
+    pk_dem_geom g = {.dim = dim, .periodic = rve->periodic};
+    memcpy(g.L, rve->L, sizeof g.L);
+    pk_dem_geom_set_F(&g, s->F);
+    pk_dem_pairs c = {0};
+    uint8_t *fr = malloc(rve->n ? rve->n : 1), *rat = malloc(rve->n ? rve->n : 1);
+    int rc = (!fr || !rat) ? -1 : pk_dem_pairs_build(&c, &g, s->x, rve->r, rve->n, o->dr.skin);
+    if (rc == 0) {
+        pk_dem_eval(&c, &g, s->x, rve->r, rve->n, o->E_n, NULL, NULL, NULL);
+        for (size_t i = 0; i < rve->n; i++)
+            fr[i] = !rve->fixed[i];
+        if (pk_dem_rattlers(&c, dim, rve->n, fr, rat) == (size_t)-1)
+            rc = -1;
+    }
+    if (rc == 0 && micro) {
+        json_t *m = json_object(), *x = json_array(), *xi = json_array(), *ra = json_array(),
+               *gr = json_array(), *fx = json_array(), *hu = json_array();
+        for (size_t i = 0; i < rve->n; i++) {
+            double X[3];
+            pk_m3_vec(g.Finv, &s->x[3 * i], X);
+            for (int a = 0; a < dim; a++) {
+                json_array_append_new(x, json_real(s->x[3 * i + a]));
+                json_array_append_new(xi, json_real(X[a] - rve->X[3 * i + a])); /* Ξ (4.18) */
+            }
+            json_array_append_new(ra, json_integer(rat[i]));
+            json_array_append_new(gr, json_integer(rve->grain[i]));
+            json_array_append_new(fx, json_integer(rve->fixed[i]));
+            json_array_append_new(hu, json_integer(rve->hull[i]));
+        }
+        json_object_set_new(m, "position", x);
+        json_object_set_new(m, "fluctuation", xi);
+        json_object_set_new(m, "rattler", ra);
+        json_object_set_new(m, "grain", gr);
+        json_object_set_new(m, "prescribed", fx);
+        json_object_set_new(m, "hull", hu);
+        json_object_set_new(rec, "final_state", m);
+    }
+    if (rc == 0 && contacts) {
+        json_t *k = json_object(), *ci = json_array(), *cj = json_array(), *ov = json_array(),
+               *fn = json_array(), *br = json_array();
+        for (size_t p = 0; p < c.n; p++) {
+            if (!(c.eps[p] >= 0) || !(c.len[p] > 0))
+                continue;
+            json_array_append_new(ci, json_integer(c.i[p]));
+            json_array_append_new(cj, json_integer(c.j[p]));
+            json_array_append_new(ov, json_real(c.eps[p]));
+            json_array_append_new(fn, json_real(o->E_n * c.eps[p]));
+            for (int a = 0; a < dim; a++)
+                json_array_append_new(br, json_real(c.l[3 * p + a]));
+        }
+        json_object_set_new(k, "i", ci);
+        json_object_set_new(k, "j", cj);
+        json_object_set_new(k, "overlap", ov);
+        json_object_set_new(k, "normal_force", fn);
+        json_object_set_new(k, "branch", br);
+        json_object_set_new(rec, "final_contacts", k);
+    }
+    pk_dem_pairs_free(&c);
+    free(fr);
+    free(rat);
+    return rc;
+}
+
+static json_t *tensor_json(const double T[9], int dim)
+{
+    json_t *a = json_array();
+    for (int i = 0; i < dim; i++)
+        for (int j = 0; j < dim; j++)
+            json_array_append_new(a, json_real(T[3 * i + j]));
+    return a;
+}
+
+int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_monitor *mon,
+                 json_t **summary, char *err, size_t errlen)
+{
+    *summary = NULL;
+    pk_homog_job job;
+    pk_schema_errors errs = {0};
+    if (pk_homog_job_from_json(inputs, &job, &errs) != 0) {
+        snprintf(err, errlen, "%s: %s", errs.items[0].pointer, errs.items[0].message);
+        pk_schema_errors_free(&errs);
+        return -1;
+    }
+    if (mon && job.wall_time_s > 0)
+        mon->wall_limit_s = job.wall_time_s;
+    pk_box box;
+    pk_particles p;
+    if (pk_h5_read_particles(job.rve_file, &box, &p, err, errlen) != 0) {
+        pk_homog_job_free(&job);
+        return -1;
+    }
+    const int dim = box.dim;
+    int rc = -1;
+    pk_homog_rve rve = {0};
+    pk_homog_state com = {0}, tr = {0};
+    json_t *rec = NULL;
+    if (job.fdim && job.fdim != dim) {
+        snprintf(err, errlen, "the load path is %dD but the RVE is %dD", job.fdim, dim);
+        goto out;
+    }
+    if (pk_homog_rve_build(&box, &p, job.bc, job.radius_factor, &rve, err, errlen) != 0)
+        goto out;
+    pk_homog_opts o;
+    opts_of(&job, &rve, &o);
+    if (pk_homog_state_init(&rve, &o, &com) != 0) {
+        snprintf(err, errlen, "out of memory");
+        goto out;
+    }
+    double F0[9];
+    pk_m3_identity(F0);
+    pk_homog_step st;
+    if (job.precompress > 0) { /* initial-state policy: relaxed, committed, not recorded */
+        for (int a = 0; a < dim; a++)
+            F0[4 * a] = 1 - job.precompress;
+        int e = pk_homog_eval(&rve, &o, &com, F0, &tr, &st, mon);
+        if (e != 0) {
+            snprintf(err, errlen, "pre-compression: %s", eval_error(e));
+            goto out;
+        }
+        pk_homog_commit(&com, &tr);
+    }
+    rec = pk_homog_record_new(dim, job.tangent);
+    const char *reason = "complete";
+    size_t done = 0, total_iter = 0, max_iter_step = 0, not_converged = 0;
+    double A[81] = {0};
+    int have_A = 0;
+    pk_progress pr = {.stage = "homogenize", .phi = -1, .eta_s = -1, .total = job.nstep};
+    for (size_t k = 0; k < job.nstep; k++) {
+        double F[9];
+        pk_m3_mul(&job.F[9 * k], F0, F); /* F̄ = F̄_load·F̄_0 */
+        int e = pk_homog_eval(&rve, &o, &com, F, &tr, &st, mon);
+        if (e != 0) {
+            snprintf(err, errlen, "load step %zu: %s", k, eval_error(e));
+            goto out;
+        }
+        if (st.dr.stop == PK_DR_CANCELLED || st.dr.stop == PK_DR_WALL_TIME) {
+            reason = pk_dr_stop_name(st.dr.stop);
+            break;
+        }
+        if (pk_homog_commit(&com, &tr) != 0 || pk_homog_record_step(rec, dim, &st) != 0) {
+            snprintf(err, errlen, "out of memory");
+            goto out;
+        }
+        not_converged += !pk_dr_stop_ok(st.dr.stop);
+        total_iter += st.dr.iterations;
+        if (st.dr.iterations > max_iter_step)
+            max_iter_step = st.dr.iterations;
+        if (job.tangent) {
+            pk_tangent_info ti;
+            int t = pk_homog_tangent(&rve, &o, &com, &pk_sparse_cholmod, A, &ti);
+            if (t < 0) {
+                snprintf(err, errlen, "tangent of step %zu: %s", k,
+                         t == -2 ? eval_error(-2) : "solver failure or out of memory");
+                goto out;
+            }
+            if (t == 0 && ti.jammed_contacts == 0) {
+                snprintf(err, errlen,
+                         "tangent asked but the RVE has no jammed contact at load step %zu (a loose "
+                         "packing: use a jammed RVE or initial_state precompress)", k);
+                goto out;
+            }
+            have_A = t == 0;
+            pk_homog_record_tangent(rec, dim, k, A, &ti, t == 0);
+        }
+        done = k + 1;
+        pr.done = done;
+        pr.fraction = (double)done / (double)job.nstep;
+        if (mon) {
+            int m = pk_monitor_tick(mon, &pr, 0);
+            if (m) {
+                reason = m == 1 ? "cancelled" : "wall_time";
+                break;
+            }
+        }
+    }
+    if ((job.out_micro || job.out_contacts) &&
+        final_state_json(&rve, &o, &com, job.out_micro, job.out_contacts, rec) != 0) {
+        snprintf(err, errlen, "out of memory");
+        goto out;
+    }
+    json_object_set_new(rec, "boundary_condition", json_string(pk_homog_bc_name(job.bc)));
+    json_object_set_new(rec, "steps", json_integer((json_int_t)done));
+    json_object_set_new(rec, "steps_requested", json_integer((json_int_t)job.nstep));
+    json_object_set_new(rec, "steps_not_converged", json_integer((json_int_t)not_converged));
+    json_object_set_new(rec, "termination_reason", json_string(reason));
+    json_object_set_new(rec, "rve_particles", json_integer((json_int_t)rve.n));
+    json_object_set_new(rec, "rve_volume", json_real(rve.V));
+    json_object_set_new(rec, "E_n", json_real(job.E_n));
+    json_object_set_new(rec, "radius_factor", json_real(job.radius_factor));
+    json_object_set_new(rec, "precompression", json_real(job.precompress));
+
+    pk_h5 *h = pk_h5_create(out_path, err, errlen);
+    if (!h)
+        goto out;
+    int w = pk_h5_write_particles(h, &box, &p, "1");
+    w |= pk_h5_write_parameters(h, "homogenize", job_json, 0);
+    w |= pk_h5_obs_json(h, "homogenize", rec);
+    if (w != 0) {
+        pk_h5_abort(h);
+        snprintf(err, errlen, "writing %s failed", out_path);
+        goto out;
+    }
+    if (pk_h5_commit(h, err, errlen) != 0)
+        goto out;
+
+    json_t *sum = json_object();
+    json_object_set_new(sum, "process", json_string("homogenize"));
+    json_object_set_new(sum, "boundary_condition", json_string(pk_homog_bc_name(job.bc)));
+    json_object_set_new(sum, "termination_reason", json_string(reason));
+    json_object_set_new(sum, "complete", json_boolean(!strcmp(reason, "complete") && !not_converged));
+    json_object_set_new(sum, "steps", json_integer((json_int_t)done));
+    json_object_set_new(sum, "steps_not_converged", json_integer((json_int_t)not_converged));
+    json_object_set_new(sum, "rve_particles", json_integer((json_int_t)rve.n));
+    json_object_set_new(sum, "dr_iterations_total", json_integer((json_int_t)total_iter));
+    json_object_set_new(sum, "dr_iterations_max", json_integer((json_int_t)max_iter_step));
+    if (done) {
+        json_object_set_new(sum, "F", tensor_json(com.F, dim));
+        json_object_set_new(sum, "P", tensor_json(st.P, dim));
+        json_object_set_new(sum, "sigma", tensor_json(st.sigma, dim));
+        json_object_set_new(sum, "energy_density", json_real(st.energy_density));
+        json_object_set_new(sum, "contacts", json_integer((json_int_t)st.contacts));
+        json_object_set_new(sum, "rattlers", json_integer((json_int_t)st.rattlers));
+        if (have_A) {
+            json_t *a = json_array();
+            for (int i = 0; i < dim * dim; i++)
+                for (int j = 0; j < dim * dim; j++)
+                    json_array_append_new(a, json_real(A[(3 * (i / dim) + i % dim) * 9 +
+                                                         3 * (j / dim) + j % dim]));
+            json_object_set_new(sum, "tangent", a);
+        }
+    }
+    *summary = sum;
+    rc = 0;
+out:
+    json_decref(rec);
+    pk_homog_state_free(&com);
+    pk_homog_state_free(&tr);
+    pk_homog_rve_free(&rve);
+    pk_particles_free(&p);
+    pk_homog_job_free(&job);
+    return rc;
+}

@@ -1,0 +1,173 @@
+/* pack_place_edmd.c — the 'edmd' placer: core/edmd (Lubachevsky–Stillinger
+ * growth) with the job's "edmd" options; start from zero radii (Meier) or
+ * from RSA at δ·d (Titscher/Kansal, core/rsa). */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "edmd.h"
+#include "edmd_contacts.h"
+#include "pack_placer.h"
+
+static double num(json_t *o, const char *key, double def)
+{
+    json_t *v = json_object_get(o, key);
+    return json_is_number(v) ? json_number_value(v) : def;
+}
+
+static const char *str(json_t *o, const char *key, const char *def)
+{
+    json_t *v = json_object_get(o, key);
+    return json_is_string(v) ? json_string_value(v) : def;
+}
+
+/* Options → parameters (schema-valid input assumed). */
+static void read_params(const pk_pack_job *job, const pk_pack_plan *plan, pk_edmd_params *prm)
+{
+    json_t *o = json_object_get(job->inputs, "edmd");
+    pk_edmd_params_default(prm);
+    prm->seed = job->seed;
+    prm->delta_d = job->delta_d;
+    int maximize = strcmp(str(o, "maximize", "none"), "delta_d") == 0;
+    prm->growth = maximize || strcmp(str(o, "growth", "relative"), "shell") == 0
+                      ? PK_EDMD_GROW_SHELL
+                      : PK_EDMD_GROW_RELATIVE;
+    prm->until = maximize || strcmp(str(o, "until", "target"), "jammed") == 0 ? PK_EDMD_UNTIL_JAMMED
+                                                                             : PK_EDMD_UNTIL_TARGET;
+    const char *start = str(o, "start", prm->growth == PK_EDMD_GROW_SHELL ? "rsa" : "zero");
+    prm->start_zero = strcmp(start, "zero") == 0;
+    prm->delta = prm->growth == PK_EDMD_GROW_SHELL ? 1.0 : num(o, "delta", prm->delta);
+    if (prm->growth == PK_EDMD_GROW_RELATIVE && job->has_phi)
+        prm->phi_target = plan->phi_resolved;
+    prm->growth_rate = num(o, "growth_rate", prm->growth_rate);
+    json_t *jam = json_object_get(o, "jamming");
+    prm->p_max = num(jam, "reduced_pressure", prm->p_max);
+    prm->dphi_crit = num(jam, "delta_phi", prm->dphi_crit);
+    prm->dphi_events = (uint64_t)num(jam, "events", 0);
+    json_t *stall = json_object_get(o, "stall");
+    prm->stall_events = (uint64_t)num(stall, "events", (double)prm->stall_events);
+    prm->stall_growth = num(stall, "growth", prm->stall_growth);
+    json_t *rs = json_object_get(o, "rescale");
+    if (json_is_boolean(rs))
+        prm->rescale = json_is_true(rs);
+    prm->rescale_tol = num(o, "rescale_tolerance", prm->rescale_tol);
+    prm->skin = num(o, "skin", prm->skin);
+    prm->equal_masses = strcmp(str(o, "masses", "volume"), "equal") == 0;
+    prm->max_events = (uint64_t)num(o, "max_events", 0);
+}
+
+static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, pk_schema_errors *errs)
+{
+    json_t *o = json_object_get(job->inputs, "edmd");
+    pk_edmd_params prm;
+    read_params(job, plan, &prm);
+    if (prm.growth == PK_EDMD_GROW_SHELL && json_object_get(o, "start") && prm.start_zero)
+        pk_schema_errors_add(errs, "/edmd/start", "consistent",
+                             "shell growth starts from an RSA configuration (start: rsa)");
+    if (prm.growth == PK_EDMD_GROW_SHELL && prm.until == PK_EDMD_UNTIL_TARGET && !(job->delta_d > 0))
+        pk_schema_errors_add(errs, "/delta_d", "consistent",
+                             "shell growth to a target needs delta_d > 0 (or maximize: delta_d)");
+    /* the periodic edge > 2 (d_max + Δd) rule is the plan's (pack_job.c) */
+}
+
+static json_t *doubles(const double *a, size_t n)
+{
+    json_t *arr = json_array();
+    for (size_t i = 0; i < n; i++)
+        json_array_append_new(arr, json_real(a[i]));
+    return arr;
+}
+
+static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk_sizes *sz,
+                      pk_monitor *mon, pk_particles *p, pk_place_stats *st, char *err,
+                      size_t errlen)
+{
+    pk_edmd_params prm;
+    read_params(job, plan, &prm);
+    if (prm.start_zero) {
+        double x[3] = {0, 0, 0};
+        for (size_t i = 0; i < sz->n; i++)
+            if (pk_particles_push(p, x, 0.5 * sz->d[i], sz->species[i]) == (size_t)-1) {
+                snprintf(err, errlen, "out of memory for %zu grains", sz->n);
+                return -1;
+            }
+    } else {
+        pk_rsa_stats rs;
+        double gap = prm.growth == PK_EDMD_GROW_SHELL ? 0.0 : job->delta_d;
+        if (pk_edmd_start_rsa(&job->box, sz->d, sz->species, sz->n, prm.delta, gap, job->seed, mon,
+                              p, &rs) != 0) {
+            snprintf(err, errlen, "RSA start configuration failed");
+            return -1;
+        }
+        if (rs.reason == PK_STOP_CANCELLED || rs.reason == PK_STOP_WALL_TIME) {
+            *st = (pk_place_stats){.reason = rs.reason, .placed = rs.placed,
+                                   .requested = sz->n, .seconds = rs.seconds};
+            return 0;
+        }
+        if (rs.placed < sz->n) {
+            snprintf(err, errlen,
+                     "RSA start placed only %zu of %zu grains at delta = %g: lower edmd.delta or use "
+                     "start: zero",
+                     rs.placed, sz->n, prm.delta);
+            return -1;
+        }
+    }
+    pk_edmd_stats es;
+    if (pk_edmd_run(&job->box, p, &prm, mon, &es) != 0) {
+        snprintf(err, errlen, "EDMD failed (bad parameters, periodic box too small or out of memory)");
+        return -1;
+    }
+    if (prm.growth == PK_EDMD_GROW_SHELL && es.delta_d < job->delta_d * (1 - 1e-12)) {
+        /* the shell did not reach the job's Δd (jammed, stalled, cancelled):
+         * no result honours the job's minimum gap */
+        snprintf(err, errlen,
+                 "EDMD shell growth stopped (%s) at delta_d = %.6g before reaching %.6g; lower phi or "
+                 "delta_d, or try a smaller edmd.growth_rate",
+                 pk_edmd_criterion_name(es.criterion), es.delta_d, job->delta_d);
+        return -1;
+    }
+    pk_contact_stats cs;
+    /* contact: gap within 1e-6 (r_i + r_j) of Δd — far above round-off,
+     * far below any gap left by a run that stopped short of jamming */
+    double ctol = 1e-6;
+    if (pk_contact_stats_compute(&job->box, p, es.delta_d, ctol, &cs) != 0) {
+        snprintf(err, errlen, "out of memory in the contact analysis");
+        return -1;
+    }
+    *st = (pk_place_stats){.reason = es.reason, .placed = p->n, .requested = sz->n,
+                           .seconds = es.seconds};
+    json_t *obs = json_object();
+    json_object_set_new(obs, "phi_final", json_real(es.phi));
+    json_object_set_new(obs, "phi_shell", json_real(es.phi_sim));
+    json_object_set_new(obs, "reduced_pressure", json_real(es.pressure));
+    if (isfinite(es.phi_jam_estimate))
+        json_object_set_new(obs, "phi_jamming_estimate", json_real(es.phi_jam_estimate));
+    json_object_set_new(obs, "termination_criterion", json_string(pk_edmd_criterion_name(es.criterion)));
+    json_object_set_new(obs, "delta_d_reached", json_real(es.delta_d));
+    json_object_set_new(obs, "time_simulated", json_real(es.t_stop));
+    if (isfinite(es.t_end))
+        json_object_set_new(obs, "time_end", json_real(es.t_end));
+    json_object_set_new(obs, "events", json_integer((json_int_t)es.events));
+    json_object_set_new(obs, "events_pair", json_integer((json_int_t)es.pair));
+    json_object_set_new(obs, "events_wall", json_integer((json_int_t)es.wall));
+    json_object_set_new(obs, "events_neighbour_list", json_integer((json_int_t)es.nlist));
+    json_object_set_new(obs, "events_invalidated", json_integer((json_int_t)es.invalid));
+    json_object_set_new(obs, "rescales", json_integer((json_int_t)es.rescales));
+    json_object_set_new(obs, "overlaps_predicted", json_integer((json_int_t)es.overlaps));
+    json_object_set_new(obs, "collisions_per_second",
+                        json_real(es.seconds > 0 ? (double)es.pair / es.seconds : 0));
+    json_object_set_new(obs, "contacts", json_integer((json_int_t)cs.contacts));
+    json_object_set_new(obs, "mean_contact_number", json_real(cs.mean_contacts));
+    json_object_set_new(obs, "rattler_fraction", json_real(cs.rattler_fraction));
+    json_object_set_new(obs, "contact_tolerance", json_real(ctol));
+    json_t *h = json_object();
+    json_object_set_new(h, "events", doubles(es.hist_events, es.nhist));
+    json_object_set_new(h, "time", doubles(es.hist_t, es.nhist));
+    json_object_set_new(h, "phi", doubles(es.hist_phi, es.nhist));
+    json_object_set_new(h, "reduced_pressure", doubles(es.hist_p, es.nhist));
+    json_object_set_new(obs, "history", h);
+    st->obs = obs;
+    return 0;
+}
+
+const pk_placer pk_placer_edmd = {.name = "edmd", .check = check_edmd, .place = place_edmd};

@@ -1,0 +1,193 @@
+/* bench/edmd — EDMD growth packing (issue 3).  One machine-readable line per case:
+ *   bench=edmd case=NAME n=N phi=F reason=R criterion=C events=E collisions=C
+ *         seconds=S cpu_s=T collisions_per_cpu_s=X events_per_cpu_s=Y peak_rss_mb=M p=P
+ * (job cases: rates per wall second of the placement, cpu_s of the whole job)
+ * Cases: monodisperse 3D periodic N = 10^4 to φ = 0.60 and to jamming,
+ * N = 2000 slow/fast (the MRJ band and the rate dependence), Fuller-like
+ * 3D diameters 1–16 (counts ∝ d^-2.5) N = 10^4 to jamming, Titscher's
+ * walled A16 with Δd = 1 mm at φ_M = 53.5 %, Meier's 2D quartz and A32
+ * (nop = 1000) to jamming over 3 seeds.  The N = 10^6 case (to φ = 0.55)
+ * takes minutes: opt in with PACKD_BENCH_LARGE=1.  peak_rss_mb is the
+ * process peak so far (getrusage), so it is monotone over the cases. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+
+#include "edmd.h"
+#include "process.h"
+
+static double peak_mb(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (double)ru.ru_maxrss / 1024.0;
+}
+
+/* CPU seconds of this process: on the shared 2-core machine wall time
+ * measures the neighbours' load, CPU time measures the code. */
+static double cpu_s(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+           (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+}
+
+static void line(const char *name, size_t n, const pk_edmd_stats *st, double cpu)
+{
+    printf("bench=edmd case=%s n=%zu phi=%.5f reason=%s criterion=%s events=%llu collisions=%llu "
+           "seconds=%.3f cpu_s=%.3f collisions_per_cpu_s=%.3g events_per_cpu_s=%.3g "
+           "peak_rss_mb=%.1f p=%.3g\n",
+           name, n, st->phi, pk_stop_reason_name(st->reason), pk_edmd_criterion_name(st->criterion),
+           (unsigned long long)st->events, (unsigned long long)st->pair, st->seconds, cpu,
+           (double)st->pair / cpu, (double)st->events / cpu, peak_mb(), st->pressure);
+    fflush(stdout);
+}
+
+/* radii r[i] in a periodic cube filled to phi0 at those radii */
+static void run_core(const char *name, int dim, const double *r, size_t n, double phi0,
+                     double rate, int jammed, double phi_target, pk_edmd_stats *st)
+{
+    double vol = 0;
+    for (size_t i = 0; i < n; i++)
+        vol += pk_ball_measure(dim, r[i]);
+    pk_box b;
+    memset(&b, 0, sizeof b);
+    b.dim = dim;
+    for (int k = 0; k < dim; k++) {
+        b.L[k] = pow(vol / phi0, 1.0 / dim);
+        b.periodic[k] = true;
+    }
+    pk_particles p;
+    pk_particles_init(&p, dim, n);
+    double x[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; i++)
+        pk_particles_push(&p, x, r[i], 0);
+    pk_edmd_params prm;
+    pk_edmd_params_default(&prm);
+    prm.growth_rate = rate;
+    prm.until = jammed ? PK_EDMD_UNTIL_JAMMED : PK_EDMD_UNTIL_TARGET;
+    prm.phi_target = phi_target;
+    double c0 = cpu_s();
+    pk_edmd_run(&b, &p, &prm, NULL, st);
+    line(name, n, st, cpu_s() - c0);
+    pk_particles_free(&p);
+}
+
+static double mono(const char *name, size_t n, double rate, int jammed, double phi_target)
+{
+    double *r = malloc(n * sizeof *r);
+    for (size_t i = 0; i < n; i++)
+        r[i] = 0.5;
+    pk_edmd_stats st;
+    run_core(name, 3, r, n, jammed ? 0.5 : phi_target, rate, jammed, phi_target, &st);
+    free(r);
+    return st.phi;
+}
+
+/* Fuller-like: diameters 1..16, number density ∝ d^-2.5 (inverse CDF). */
+static void fuller(const char *name, size_t n, double rate)
+{
+    double *r = malloc(n * sizeof *r);
+    double a = 1.5; /* ∫ d^-2.5 → CDF ∝ 1 − d^-1.5 */
+    double lo = 1, hi = pow(16, -a);
+    for (size_t i = 0; i < n; i++) {
+        double u = ((double)i + 0.5) / (double)n;
+        double d = pow(lo - u * (lo - hi), -1 / a);
+        r[n - 1 - i] = 0.5 * d; /* descending */
+    }
+    pk_edmd_stats st;
+    run_core(name, 3, r, n, 0.5, rate, 1, 0, &st);
+    free(r);
+}
+
+static void job_case(const char *name, const char *json)
+{
+    json_error_t e;
+    json_t *job = json_loads(json, 0, &e);
+    if (!job) {
+        printf("bench=edmd case=%s error=\"%s\"\n", name, e.text);
+        return;
+    }
+    pk_schema_errors errs = {0};
+    json_t *sum = NULL;
+    char err[512];
+    const char *out = "/tmp/packd-bench-edmd.h5";
+    double c0 = cpu_s();
+    int rc = pk_job_run(job, out, NULL, &sum, &errs, err, sizeof err);
+    double cpu = cpu_s() - c0;
+    if (rc == 0) {
+        json_t *o = json_object_get(sum, "edmd");
+        double s = json_real_value(json_object_get(sum, "seconds_place"));
+        double coll = (double)json_integer_value(json_object_get(o, "events_pair"));
+        double ev = (double)json_integer_value(json_object_get(o, "events"));
+        printf("bench=edmd case=%s n=%lld phi=%.5f phi_mix=%.5f reason=%s criterion=%s events=%.0f "
+               "collisions=%.0f seconds=%.3f cpu_s=%.3f collisions_per_s=%.3g events_per_s=%.3g "
+               "peak_rss_mb=%.1f delta_d=%.4g p=%.3g\n",
+               name, (long long)json_integer_value(json_object_get(sum, "count_placed")),
+               json_real_value(json_object_get(sum, "phi_resolved")),
+               json_real_value(json_object_get(sum, "phi_mix")),
+               json_string_value(json_object_get(sum, "termination_reason")),
+               json_string_value(json_object_get(o, "termination_criterion")), ev, coll, s, cpu,
+               coll / s, ev / s, peak_mb(),
+               json_real_value(json_object_get(o, "delta_d_reached")),
+               json_real_value(json_object_get(o, "reduced_pressure")));
+    } else {
+        printf("bench=edmd case=%s error=\"%s\" cpu_s=%.3f\n", name, err, cpu);
+    }
+    fflush(stdout);
+    remove(out);
+    json_decref(sum);
+    json_decref(job);
+    pk_schema_errors_free(&errs);
+}
+
+static const char *QUARTZ =
+    "{\"type\":\"classes\",\"classes\":[{\"d\":0.25,\"volume_percent\":2.5},{\"d\":0.16,"
+    "\"volume_percent\":39.72},{\"d\":0.125,\"volume_percent\":44.22},{\"d\":0.1,\"volume_percent\":"
+    "9.58},{\"d\":0.063,\"volume_percent\":3.7},{\"d\":0.05,\"volume_percent\":0.28}]}";
+static const char *A32 =
+    "{\"type\":\"classes\",\"classes\":[{\"d\":16,\"volume_percent\":38},{\"d\":8,\"volume_percent\":"
+    "24},{\"d\":4,\"volume_percent\":15},{\"d\":2,\"volume_percent\":9},{\"d\":1,\"volume_percent\":"
+    "14}]}";
+
+static void meier(const char *name, const char *grading, double L, int seed)
+{
+    char job[2048], nm[64];
+    snprintf(job, sizeof job,
+             "{\"process\":\"pack\",\"inputs\":{\"dim\":2,\"domain\":{\"box\":{\"size\":[%g,%g],"
+             "\"periodic\":true}},\"grading\":%s,\"sampling\":\"discrete\",\"count\":1000,"
+             "\"phi\":{\"value\":0.45,\"refers_to\":\"resolved\"},\"algorithm\":\"edmd\","
+             "\"edmd\":{\"start\":\"zero\",\"until\":\"jammed\",\"masses\":\"equal\","
+             "\"growth_rate\":0.01},\"seed\":%d}}",
+             L, L, grading, seed);
+    snprintf(nm, sizeof nm, "%s_seed%d", name, seed);
+    job_case(nm, job);
+}
+
+int main(void)
+{
+    mono("mono3d_1e4_to_phi060", 10000, 0.1, 0, 0.60);
+    mono("mono3d_1e4_jam_rate0.02", 10000, 0.02, 1, 0);
+    double slow = mono("mono3d_2000_jam_rate0.01", 2000, 0.01, 1, 0);
+    double fast = mono("mono3d_2000_jam_rate0.1", 2000, 0.1, 1, 0);
+    printf("bench=edmd case=mono3d_2000_check band_0.634_0.652=%s faster_is_looser=%s\n",
+           slow >= 0.634 && slow <= 0.652 ? "yes" : "no", fast < slow ? "yes" : "no");
+    fuller("fuller3d_d1to16_1e4_jam", 10000, 0.01);
+    job_case("titscher_a16_walled_phiM0.535_dd1",
+             "{\"process\":\"pack\",\"inputs\":{\"dim\":3,\"domain\":{\"box\":{\"size\":[80,80,80],"
+             "\"periodic\":false}},\"grading\":{\"type\":\"preset\",\"name\":\"A16\"},\"d_min\":2,"
+             "\"phi\":{\"value\":0.535,\"refers_to\":\"mix\"},\"delta_d\":1,\"algorithm\":\"edmd\","
+             "\"edmd\":{\"growth\":\"shell\",\"growth_rate\":0.01},\"seed\":1}}");
+    for (int s = 1; s <= 3; s++)
+        meier("meier_quartz_2d_jam", QUARTZ, 3.0, s);
+    for (int s = 1; s <= 3; s++)
+        meier("meier_a32_2d_jam", A32, 100.0, s);
+    if (getenv("PACKD_BENCH_LARGE") && atoi(getenv("PACKD_BENCH_LARGE")))
+        mono("mono3d_1e6_to_phi055", 1000000, 0.1, 0, 0.55);
+    else
+        printf("bench=edmd case=mono3d_1e6_to_phi055 skipped=set_PACKD_BENCH_LARGE=1\n");
+    return 0;
+}

@@ -1,0 +1,107 @@
+/* bench/tetfill.c — Jerier's mesh filling: cost per sphere vs mesh size
+ * (flat = linear, his Fig. 8a at φ₀ = 0.6), 10⁵ spheres (bar < 10 s), 10⁶
+ * spheres with PACKD_BENCH_LARGE=1 (bar < 2 min, < 2 GiB), and the R sweep
+ * on the Gmsh cube of 1127 tets (his Fig. 4a/7a: 1112 tets) to saturation. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <sys/resource.h>
+
+#include "mesh.h"
+#include "mesh_io.h"
+#include "tetfill.h"
+#include "tetfill_stats.h"
+
+static double max_rss_mib(void)
+{
+    struct rusage u;
+    getrusage(RUSAGE_SELF, &u);
+    return (double)u.ru_maxrss / 1024.0;
+}
+
+/* A walled cube of edge L, r ∈ [0.1, 0.3] (R = 3), mesh edge ≈ 8 r̄. */
+static int box_case(const char *name, double L, double phi0, size_t n0)
+{
+    pk_mesh m;
+    char err[256];
+    double E[3] = {L, L, L};
+    if (pk_mesh_box(&m, E, 8 * 0.2 / 1.282, 0, err, sizeof err) != 0) {
+        fprintf(stderr, "%s\n", err);
+        return -1;
+    }
+    pk_tetfill_params prm;
+    pk_tetfill_defaults(&prm);
+    prm.r_min = 0.1;
+    prm.r_max = 0.3;
+    prm.phi_target = phi0;
+    prm.n_target = n0;
+    pk_particles p;
+    pk_particles_init(&p, 3, 1024);
+    pk_tetfill_stats st;
+    int rc = pk_tetfill(&m, &prm, NULL, &p, &st);
+    printf("bench=tetfill case=%s tets=%zu spheres=%zu phi=%.4f reason=%s seconds=%.3f "
+           "us_per_sphere=%.2f spheres_per_s=%.0f max_rss_mib=%.0f\n",
+           name, m.ntet, p.n, st.phi, pk_stop_reason_name(st.reason), st.seconds,
+           1e6 * st.seconds / (double)(p.n ? p.n : 1), (double)p.n / st.seconds, max_rss_mib());
+    fflush(stdout);
+    pk_particles_free(&p);
+    pk_mesh_free(&m);
+    return rc;
+}
+
+static int sweep_case(const char *path, double R)
+{
+    pk_mesh m;
+    char err[512];
+    if (pk_mesh_read_msh(path, 0, &m, err, sizeof err) != 0 ||
+        pk_mesh_check(&m, 0, NULL, err, sizeof err) != 0) {
+        fprintf(stderr, "%s\n", err);
+        return -1;
+    }
+    double lo[3] = {m.lo[0], m.lo[1], m.lo[2]};
+    pk_mesh_translate(&m, lo);
+    pk_tetfill_params prm;
+    pk_tetfill_defaults(&prm);
+    double rbar = m.edge_mean / 8; /* ratio alone: Jerier's rule */
+    prm.r_min = 2 * rbar / (R + 1);
+    prm.r_max = 2 * rbar - prm.r_min;
+    for (int dens = 0; dens <= 1; dens++) {
+        prm.densify = dens;
+        pk_particles p;
+        pk_particles_init(&p, 3, 1024);
+        pk_tetfill_stats st;
+        pk_tetfill_measures o;
+        if (pk_tetfill(&m, &prm, NULL, &p, &st) != 0 ||
+            pk_tetfill_measure(&m, &p, prm.r_min, prm.eps, &o) != 0)
+            return -1;
+        printf("bench=tetfill case=sweep_R%g stage=%s tets=%zu spheres=%zu n_per_tet=%.2f "
+               "phi=%.4f z=%.3f F1=%.4f F2=%.4f F3=%.4f passes=%d seconds=%.3f\n",
+               R, dens ? "saturated" : "steps1-6", m.ntet, p.n, (double)p.n / (double)m.ntet,
+               o.phi, o.z_mean, o.fabric_eig[0], o.fabric_eig[1], o.fabric_eig[2], st.passes,
+               st.seconds);
+        fflush(stdout);
+        pk_tetfill_measures_free(&o);
+        pk_particles_free(&p);
+    }
+    pk_mesh_free(&m);
+    return 0;
+}
+
+int main(void)
+{
+    int rc = 0;
+    /* cost per sphere vs mesh size at φ₀ = 0.6: 8×, 64× the tets */
+    rc |= box_case("linear_L5", 5, 0.6, 0);
+    rc |= box_case("linear_L10", 10, 0.6, 0);
+    rc |= box_case("linear_L20", 20, 0.6, 0);
+    rc |= box_case("spheres_1e5", 17, 0, 100000);
+    if (getenv("PACKD_BENCH_LARGE"))
+        rc |= box_case("spheres_1e6", 36, 0, 1000000);
+    const char *src = getenv("PACKD_SRC");
+    char path[4096];
+    snprintf(path, sizeof path, "%s/tests/data/meshes/cube41.msh", src ? src : ".");
+    const double R[4] = {2, 3, 5, 7};
+    for (int i = 0; i < 4; i++)
+        rc |= sweep_case(path, R[i]);
+    return rc ? 1 : 0;
+}

@@ -1,0 +1,313 @@
+#include "dem_contact.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "grid.h"
+#include "homog_tensor.h"
+
+double pk_dem_geom_set_F(pk_dem_geom *g, const double F[9])
+{
+    double Fi[9];
+    double d = pk_m3_inv(F, Fi);
+    if (d == 0 || !isfinite(d))
+        return 0;
+    memcpy(g->F, F, sizeof g->F);
+    memcpy(g->Finv, Fi, sizeof g->Finv);
+    return d;
+}
+
+void pk_dem_pairs_free(pk_dem_pairs *c)
+{
+    free(c->i);
+    free(c->j);
+    free(c->l);
+    free(c->len);
+    free(c->eps);
+    free(c->xb);
+    memset(c, 0, sizeof *c);
+}
+
+static int pairs_push(pk_dem_pairs *c, int32_t i, int32_t j)
+{
+    if (c->n == c->cap) {
+        size_t cap = c->cap ? 2 * c->cap : 1024;
+        int32_t *ni = realloc(c->i, cap * sizeof *ni);
+        if (ni)
+            c->i = ni;
+        int32_t *nj = realloc(c->j, cap * sizeof *nj);
+        if (nj)
+            c->j = nj;
+        double *nl = realloc(c->l, 3 * cap * sizeof *nl);
+        if (nl)
+            c->l = nl;
+        double *nn = realloc(c->len, cap * sizeof *nn);
+        if (nn)
+            c->len = nn;
+        double *ne = realloc(c->eps, cap * sizeof *ne);
+        if (ne)
+            c->eps = ne;
+        if (!ni || !nj || !nl || !nn || !ne)
+            return -1;
+        c->cap = cap;
+    }
+    c->i[c->n] = i;
+    c->j[c->n] = j;
+    c->n++;
+    return 0;
+}
+
+/* Reference-frame difference s_j − s_i = F⁻¹(x_j − x_i), minimum image. */
+static void ref_diff(const pk_dem_geom *g, const double *xi, const double *xj, double ds[3])
+{
+    double d[3] = {xj[0] - xi[0], xj[1] - xi[1], g->dim == 3 ? xj[2] - xi[2] : 0};
+    pk_m3_vec(g->Finv, d, ds);
+    if (g->periodic)
+        for (int k = 0; k < g->dim; k++)
+            ds[k] -= g->L[k] * nearbyint(ds[k] / g->L[k]);
+    if (g->dim == 2)
+        ds[2] = 0;
+}
+
+typedef struct build_ctx {
+    pk_dem_pairs *c;
+    const pk_dem_geom *g;
+    const double *x, *r;
+    size_t i;
+    double inv_smin, skin;
+    int fail;
+} build_ctx;
+
+static int visit(size_t j, const double dx[PK_MAXDIM], double dist2, void *vctx)
+{
+    (void)dx;
+    (void)dist2;
+    build_ctx *b = vctx;
+    if (j <= b->i)
+        return 0;
+    double ds[3];
+    ref_diff(b->g, &b->x[3 * b->i], &b->x[3 * j], ds);
+    double lim = (b->r[b->i] + b->r[j] + b->skin) * b->inv_smin;
+    if (ds[0] * ds[0] + ds[1] * ds[1] + ds[2] * ds[2] < lim * lim &&
+        pairs_push(b->c, (int32_t)b->i, (int32_t)j) != 0) {
+        b->fail = 1;
+        return 1;
+    }
+    return 0;
+}
+
+int pk_dem_pairs_build(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
+                       size_t np, double skin)
+{
+    const int dim = g->dim;
+    c->n = 0;
+    c->skin = skin;
+    if (c->np != np || !c->xb) {
+        free(c->xb);
+        c->xb = malloc(3 * (np ? np : 1) * sizeof *c->xb);
+        if (!c->xb)
+            return -1;
+        c->np = np;
+    }
+    memcpy(c->xb, x, 3 * np * sizeof *x);
+    if (np < 2)
+        return 0;
+    double rmin = INFINITY, rmax = 0;
+    for (size_t i = 0; i < np; i++) {
+        rmin = fmin(rmin, r[i]);
+        rmax = fmax(rmax, r[i]);
+    }
+    /* |F ds| >= σ_min |ds|: a contact needs |ds| < (R + skin)/σ_min (σ_min >= 1 is
+     * not used to shrink the search: factor 1 then) */
+    double smin = pk_m3_sigma_min(g->F, dim);
+    if (!(smin > 0))
+        return -2;
+    double inv_smin = fmax(1.0, 1.0 / smin);
+    double reach_max = (2 * rmax + skin) * inv_smin;
+    pk_box box = {.dim = dim};
+    double off[3] = {0, 0, 0};
+    if (g->periodic) {
+        for (int k = 0; k < dim; k++) {
+            if (!(2 * reach_max < g->L[k]))
+                return -2;
+            box.L[k] = g->L[k];
+            box.periodic[k] = true;
+        }
+    } else {
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (size_t i = 0; i < np; i++) {
+            double s[3];
+            pk_m3_vec(g->Finv, &x[3 * i], s);
+            for (int k = 0; k < dim; k++) {
+                lo[k] = fmin(lo[k], s[k]);
+                hi[k] = fmax(hi[k], s[k]);
+            }
+        }
+        for (int k = 0; k < dim; k++) {
+            off[k] = reach_max - lo[k];
+            box.L[k] = hi[k] - lo[k] + 2 * reach_max;
+        }
+    }
+    pk_particles ref;
+    if (pk_particles_init(&ref, dim, np) != 0)
+        return -1;
+    for (size_t i = 0; i < np; i++) {
+        double s[3];
+        pk_m3_vec(g->Finv, &x[3 * i], s);
+        for (int k = 0; k < 3; k++)
+            s[k] = k < dim ? s[k] + off[k] : 0;
+        pk_box_wrap(&box, s);
+        pk_particles_push(&ref, s, r[i], 0);
+    }
+    pk_grid grid;
+    if (pk_grid_init(&grid, &box, rmin, rmax, 0, np) != 0) {
+        pk_particles_free(&ref);
+        return -1;
+    }
+    int rc = 0;
+    for (size_t i = 0; i < np && rc == 0; i++)
+        if (pk_grid_insert(&grid, &ref, i) != 0)
+            rc = -1;
+    build_ctx b = {.c = c, .g = g, .x = x, .r = r, .inv_smin = inv_smin, .skin = skin};
+    /* grid contact distance is r_i + r_j + extra in reference units */
+    for (size_t i = 0; i < np && rc == 0; i++) {
+        b.i = i;
+        double extra = (r[i] + rmax + skin) * inv_smin - r[i] - rmax;
+        pk_grid_query(&grid, &ref, &ref.x[3 * i], r[i], extra, visit, &b);
+        if (b.fail)
+            rc = -1;
+    }
+    pk_grid_free(&grid);
+    pk_particles_free(&ref);
+    return rc;
+}
+
+int pk_dem_pairs_stale(const pk_dem_pairs *c, const double *x, int dim)
+{
+    double lim2 = 0.25 * c->skin * c->skin;
+    for (size_t i = 0; i < c->np; i++) {
+        double s = 0;
+        for (int k = 0; k < dim; k++) {
+            double d = x[3 * i + k] - c->xb[3 * i + k];
+            s += d * d;
+        }
+        if (s > lim2)
+            return 1;
+    }
+    return 0;
+}
+
+size_t pk_dem_eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
+                   size_t np, double E, double *f, double *energy, double S[9])
+{
+    const int dim = g->dim;
+    if (f)
+        memset(f, 0, 3 * np * sizeof *f);
+    if (S)
+        memset(S, 0, 9 * sizeof *S);
+    double phi = 0;
+    size_t nc = 0;
+    for (size_t p = 0; p < c->n; p++) {
+        size_t i = (size_t)c->i[p], j = (size_t)c->j[p];
+        double *l = &c->l[3 * p];
+        if (g->periodic) {
+            double ds[3];
+            ref_diff(g, &x[3 * i], &x[3 * j], ds);
+            pk_m3_vec(g->F, ds, l);
+        } else {
+            for (int k = 0; k < 3; k++)
+                l[k] = x[3 * j + k] - x[3 * i + k];
+        }
+        if (dim == 2)
+            l[2] = 0;
+        double len = sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
+        double eps = r[i] + r[j] - len; /* (4.1) */
+        c->len[p] = len;
+        c->eps[p] = eps;
+        if (!(eps >= 0) || !(len > 0)) /* (4.2); coincident centres carry no direction */
+            continue;
+        nc++;
+        phi += 0.5 * E * eps * eps; /* (4.3), each contact once (4.7) */
+        double fn = E * eps;        /* f_ij = −E ε n_ij on i (4.8) */
+        for (int a = 0; a < dim; a++) {
+            double fa = -fn * l[a] / len;
+            if (f) {
+                f[3 * i + a] += fa;
+                f[3 * j + a] -= fa;
+            }
+            if (S)
+                for (int b = 0; b < dim; b++)
+                    S[3 * a + b] += fa * l[b];
+        }
+    }
+    if (energy)
+        *energy = phi;
+    return nc;
+}
+
+/* k_ij·d with k_ij = E/|l| [ε 1 − R n⊗n] (4.12)₁ */
+static inline void kblock_apply(int dim, double E, double len, double eps, const double *l,
+                                const double *d, double *out)
+{
+    double R = eps + len, c = E / len, nd = 0;
+    for (int a = 0; a < dim; a++)
+        nd += l[a] * d[a];
+    nd /= len;
+    for (int a = 0; a < dim; a++)
+        out[a] = c * (eps * d[a] - R * nd * l[a] / len);
+}
+
+void pk_dem_kv(const pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *mask,
+               const double *v, double *out)
+{
+    memset(out, 0, 3 * np * sizeof *out);
+    for (size_t p = 0; p < c->n; p++) {
+        if (!(c->eps[p] >= 0) || !(c->len[p] > 0))
+            continue;
+        size_t i = (size_t)c->i[p], j = (size_t)c->j[p];
+        int mi = mask[i] != 0, mj = mask[j] != 0;
+        if (!mi && !mj)
+            continue;
+        double d[3] = {0, 0, 0}, kd[3];
+        for (int a = 0; a < dim; a++)
+            d[a] = (mj ? v[3 * j + a] : 0) - (mi ? v[3 * i + a] : 0);
+        /* (K v)_i = Σ_j k_ij (v_j − v_i) by (4.14) */
+        kblock_apply(dim, E, c->len[p], c->eps[p], &c->l[3 * p], d, kd);
+        for (int a = 0; a < dim; a++) {
+            if (mi)
+                out[3 * i + a] += kd[a];
+            if (mj)
+                out[3 * j + a] -= kd[a];
+        }
+    }
+}
+
+double pk_dem_gershgorin(const pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *mask)
+{
+    double *row = calloc(3 * (np ? np : 1), sizeof *row);
+    if (!row)
+        return INFINITY;
+    for (size_t p = 0; p < c->n; p++) {
+        if (!(c->eps[p] >= 0) || !(c->len[p] > 0))
+            continue;
+        size_t i = (size_t)c->i[p], j = (size_t)c->j[p];
+        const double *l = &c->l[3 * p];
+        double len = c->len[p], eps = c->eps[p], R = eps + len, cc = E / len;
+        for (int a = 0; a < dim; a++) {
+            double s = 0; /* Σ_b |k_ab| */
+            for (int b = 0; b < dim; b++)
+                s += fabs(cc * ((a == b ? eps : 0) - R * l[a] * l[b] / (len * len)));
+            /* the block enters the diagonal of both and the off-diagonal once */
+            if (mask[i])
+                row[3 * i + a] += s * (mask[j] ? 2 : 1);
+            if (mask[j])
+                row[3 * j + a] += s * (mask[i] ? 2 : 1);
+        }
+    }
+    double m = 0;
+    for (size_t k = 0; k < 3 * np; k++)
+        m = fmax(m, row[k]);
+    free(row);
+    return m;
+}

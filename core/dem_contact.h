@@ -1,0 +1,66 @@
+/* dem_contact.h — soft frictionless contacts between disks/spheres (Meier 2009
+ * §4.2, spec §2.1–2.4): overlap ε = r_i + r_j − |l| (4.1), contact iff ε ≥ 0
+ * (4.2), potential Φ = E/2 ε² (4.3), force on i f_ij = −E ε n_ij (4.8),
+ * off-diagonal stiffness block k_ij = E/|l| [ε 1 − (r_i+r_j) n⊗n] (4.12)
+ * with k_ii = −Σ_j k_ij (4.14).  The same formulas serve 2D and 3D.
+ *
+ * Geometry: spatial centres x (stride 3) under a macroscopic F̄.  On a
+ * periodic RVE the branch vector is the minimum image taken in the reference
+ * frame, l = F̄·minimg(F̄⁻¹(x_j − x_i)), i.e. the lattice vectors are F̄L
+ * (spec §2.5.4 "equivalent simpler form").  Candidate pairs (a Verlet list
+ * with a skin) come from the shared pk_grid built on reference coordinates. */
+#ifndef PK_DEM_CONTACT_H
+#define PK_DEM_CONTACT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+typedef struct pk_dem_geom {
+    int dim;
+    int periodic;        /* 1 = minimum image across the reference box L */
+    double L[3];         /* reference box edges (periodic only) */
+    double F[9], Finv[9];
+} pk_dem_geom;
+
+/* Set F (row-major 3×3; 2D uses the upper 2×2 block with F[8] = 1) and its
+ * inverse.  Returns det F (0 = singular, geometry unchanged). */
+double pk_dem_geom_set_F(pk_dem_geom *g, const double F[9]);
+
+typedef struct pk_dem_pairs {
+    size_t n, cap;
+    int32_t *i, *j;      /* candidate pairs, i < j */
+    double *l;           /* [n][3] branch vector x_j − x_i (min image) */
+    double *len;         /* |l| */
+    double *eps;         /* overlap; contact iff eps >= 0 */
+    double *xb;          /* [np][3] positions at the last build (skin test) */
+    size_t np;
+    double skin;
+} pk_dem_pairs;
+
+void pk_dem_pairs_free(pk_dem_pairs *c);
+
+/* Rebuild the candidate list: every pair whose spatial distance can be below
+ * r_i + r_j + skin.  -1 on allocation failure, -2 when a periodic box is too
+ * small for the deformed contact range (an image pair could be missed). */
+int pk_dem_pairs_build(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
+                       size_t np, double skin);
+
+/* 1 when some centre moved more than skin/2 since the last build. */
+int pk_dem_pairs_stale(const pk_dem_pairs *c, const double *x, int dim);
+
+/* Evaluate every candidate pair at x: fills l, len, eps.  When f != NULL it
+ * is overwritten with the particle forces f_i = Σ_j f_ij (4.10); *energy
+ * (may be NULL) gets Φ_n (4.7); S (may be NULL, 9 entries) gets the contact
+ * sum Σ_c f_ij ⊗ l_ij (each contact once).  Returns the number of contacts. */
+size_t pk_dem_eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
+                   size_t np, double E, double *f, double *energy, double S[9]);
+
+/* out = K v on the particles with mask[i] != 0 (the others are held: v = 0
+ * there, out = 0 there).  K = ∂²Φ_n/∂x∂x from the last pk_dem_eval. */
+void pk_dem_kv(const pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *mask,
+               const double *v, double *out);
+
+/* Gershgorin bound of the largest eigenvalue of K restricted to mask. */
+double pk_dem_gershgorin(const pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *mask);
+
+#endif

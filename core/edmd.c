@@ -1,0 +1,521 @@
+/* edmd.c — the EDMD growth-packing driver (spec §3; issue 3).
+ *
+ * Time unit: the time a grain at the rms speed per axis (u = mean target
+ * diameter d̄ per unit time) needs to cross d̄.  Relative growth: every
+ * diameter is d_i·s(t) with s' = γ (Meier: s(0) = 0; Titscher §6.2: s(0) = δ,
+ * t_end = (1 − δ)/γ, Eq. 30).  Shell growth: true radii fixed, the shell
+ * grows at γ·d̄/2 (Titscher §6.3: t_end = Δd/(2γ_a), Eq. 31; §6.4: until
+ * jammed, Δd_max = 2 h(t_stop)). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "edmd_state.h"
+#include "rng.h"
+
+static void state_free(edmd_state *s)
+{
+    edmd_nlist_free(s);
+    free(s->x0);
+    free(s->v);
+    free(s->t0);
+    free(s->a);
+    free(s->g);
+    free(s->m);
+    free(s->ev_t);
+    free(s->ev_partner);
+    free(s->ev_stamp);
+    free(s->ev_kind);
+    free(s->ncoll);
+    free(s->heap);
+    free(s->hpos);
+    free(s->skin);
+    free(s->rref);
+}
+
+static int state_alloc(edmd_state *s, size_t n)
+{
+    size_t c = n ? n : 1;
+    s->x0 = calloc(3 * c, sizeof *s->x0);
+    s->v = calloc(3 * c, sizeof *s->v);
+    s->t0 = calloc(c, sizeof *s->t0);
+    s->a = calloc(c, sizeof *s->a);
+    s->g = calloc(c, sizeof *s->g);
+    s->m = calloc(c, sizeof *s->m);
+    s->ev_t = calloc(c, sizeof *s->ev_t);
+    s->ev_partner = calloc(c, sizeof *s->ev_partner);
+    s->ev_stamp = calloc(c, sizeof *s->ev_stamp);
+    s->ev_kind = calloc(c, sizeof *s->ev_kind);
+    s->ncoll = calloc(c, sizeof *s->ncoll);
+    s->heap = calloc(c, sizeof *s->heap);
+    s->hpos = calloc(c, sizeof *s->hpos);
+    s->skin = calloc(c, sizeof *s->skin);
+    s->rref = calloc(c, sizeof *s->rref);
+    s->nl = calloc(c, sizeof *s->nl);
+    if (!s->x0 || !s->v || !s->t0 || !s->a || !s->g || !s->m || !s->ev_t || !s->ev_partner ||
+        !s->ev_stamp || !s->ev_kind || !s->ncoll || !s->heap || !s->hpos || !s->skin || !s->rref || !s->nl)
+        return -1;
+    return pk_particles_init(&s->bs, s->dim, c);
+}
+
+/* True radius R_i(t) = ρ_i(t) − h(t), clamped at 0. */
+static inline double true_radius(const edmd_state *s, size_t i, double t)
+{
+    return fmax(s->a[i] + s->g[i] * t - (s->h0 + s->h1 * t), 0);
+}
+
+static double phi_true(const edmd_state *s, double t)
+{
+    double sum = 0;
+    for (size_t i = 0; i < s->n; i++)
+        sum += pk_ball_measure(s->dim, true_radius(s, i, t));
+    return sum / pk_box_measure(&s->box);
+}
+
+static double phi_sim(const edmd_state *s, double t)
+{
+    double sum = 0;
+    for (size_t i = 0; i < s->n; i++)
+        sum += pk_ball_measure(s->dim, s->a[i] + s->g[i] * t);
+    return sum / pk_box_measure(&s->box);
+}
+
+/* Smallest t >= 0 with φ_true(t) >= phi (φ_true is non-decreasing). */
+static double time_of_phi(const edmd_state *s, double phi)
+{
+    double lo = 0, hi = 1;
+    while (phi_true(s, hi) < phi && hi < 1e300)
+        hi *= 2;
+    for (int it = 0; it < 200 && hi - lo > 1e-15 * hi; it++) {
+        double mid = 0.5 * (lo + hi);
+        if (phi_true(s, mid) >= phi)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    return hi;
+}
+
+static int all_periodic(const edmd_state *s)
+{
+    for (int k = 0; k < s->dim; k++)
+        if (!s->box.periodic[k])
+            return 0;
+    return 1;
+}
+
+static double kinetic(const edmd_state *s)
+{
+    double K = 0;
+    for (size_t i = 0; i < s->n; i++)
+        for (int k = 0; k < s->dim; k++)
+            K += 0.5 * s->m[i] * s->v[3 * i + k] * s->v[3 * i + k];
+    return K;
+}
+
+/* In a fully periodic box the centre of mass is at rest (Meier's Eq. 3.9
+ * does not conserve momentum for unequal rates; spec §3.5). */
+static void remove_drift(edmd_state *s)
+{
+    if (!all_periodic(s))
+        return;
+    double P[3] = {0, 0, 0}, M = 0;
+    for (size_t i = 0; i < s->n; i++) {
+        M += s->m[i];
+        for (int k = 0; k < s->dim; k++)
+            P[k] += s->m[i] * s->v[3 * i + k];
+    }
+    for (size_t i = 0; i < s->n; i++)
+        for (int k = 0; k < s->dim; k++)
+            s->v[3 * i + k] -= P[k] / M;
+}
+
+static void predict_all(edmd_state *s)
+{
+    for (size_t i = 0; i < s->n; i++)
+        edmd_predict(s, i);
+    edmd_queue_init(s);
+}
+
+/* Synchronise everyone and move the time origin to now (spec §6: |t| stays
+ * small against Δt).  Predictions are shifted, not recomputed. */
+static void rebase(edmd_state *s)
+{
+    double T = s->t;
+    for (size_t i = 0; i < s->n; i++) {
+        edmd_sync(s, i);
+        pk_box_wrap(&s->box, &s->x0[3 * i]);
+        s->t0[i] = 0;
+        s->a[i] += s->g[i] * T;
+    }
+    s->h0 += s->h1 * T;
+    edmd_queue_shift(s, T);
+    s->t = 0;
+}
+
+/* Kinetic-energy rescaling: every trajectory changes, so all predictions are
+ * redone (spec §3.5). */
+static void rescale(edmd_state *s, double K0)
+{
+    for (size_t i = 0; i < s->n; i++)
+        edmd_sync(s, i);
+    remove_drift(s);
+    double K = kinetic(s);
+    double lam = K > 0 ? sqrt(K0 / K) : 1;
+    for (size_t i = 0; i < 3 * s->n; i++)
+        s->v[i] *= lam;
+    s->K = kinetic(s);
+    for (size_t i = 0; i < s->n; i++)
+        s->ncoll[i]++;
+    predict_all(s);
+}
+
+static void hist_push(pk_edmd_stats *st, uint64_t *stride, uint64_t ev, double t, double phi,
+                      double p)
+{
+    if (st->nhist == PK_EDMD_HIST_MAX) { /* keep every other point, double the stride */
+        size_t k = 0;
+        for (size_t q = 0; q < st->nhist; q += 2, k++) {
+            st->hist_events[k] = st->hist_events[q];
+            st->hist_t[k] = st->hist_t[q];
+            st->hist_phi[k] = st->hist_phi[q];
+            st->hist_p[k] = st->hist_p[q];
+        }
+        st->nhist = k;
+        *stride *= 2;
+    }
+    st->hist_events[st->nhist] = (double)ev;
+    st->hist_t[st->nhist] = t;
+    st->hist_phi[st->nhist] = phi;
+    st->hist_p[st->nhist] = p;
+    st->nhist++;
+}
+
+/* Set rates, masses, velocities, positions (zero start), skins.  Returns the
+ * stop time (INFINITY when growing until jammed) or NAN on bad input. */
+static double setup(edmd_state *s, const pk_particles *p, const pk_edmd_params *prm,
+                    pk_edmd_stats *st)
+{
+    const size_t n = s->n;
+    const int dim = s->dim;
+    double dbar = 0, rmax = 0;
+    for (size_t i = 0; i < n; i++) {
+        dbar += 2 * p->r[i] / (double)n;
+        rmax = fmax(rmax, p->r[i]);
+    }
+    if (!(dbar > 0) || !(prm->growth_rate > 0))
+        return NAN;
+    const double gam = prm->growth_rate, h = 0.5 * prm->delta_d;
+    double t_end;
+    if (prm->growth == PK_EDMD_GROW_RELATIVE) {
+        double s0 = prm->start_zero ? 0 : prm->delta;
+        if (!(s0 >= 0 && s0 < 1))
+            return NAN;
+        t_end = (1 - s0) / gam;
+        for (size_t i = 0; i < n; i++) {
+            if (prm->start_zero) { /* ρ = (r + h)·γt: the shell scales with the grain */
+                s->a[i] = 0;
+                s->g[i] = (p->r[i] + h) * gam;
+            } else {
+                s->a[i] = s0 * p->r[i] + h;
+                s->g[i] = p->r[i] * gam;
+            }
+        }
+        s->h0 = h;
+        s->h1 = 0;
+    } else {
+        if (prm->start_zero)
+            return NAN;
+        double ga = 0.5 * gam * dbar;
+        for (size_t i = 0; i < n; i++) {
+            s->a[i] = p->r[i];
+            s->g[i] = ga;
+        }
+        s->h0 = 0;
+        s->h1 = ga;
+        t_end = h / ga;
+    }
+    st->t_end = t_end;
+    double t_stop = t_end;
+    if (prm->until == PK_EDMD_UNTIL_JAMMED)
+        t_stop = INFINITY;
+    else if (prm->growth == PK_EDMD_GROW_RELATIVE && prm->phi_target > 0)
+        t_stop = time_of_phi(s, prm->phi_target);
+
+    /* masses (normalised to mean 1) and equipartition velocities */
+    double msum = 0;
+    for (size_t i = 0; i < n; i++) {
+        s->m[i] = prm->equal_masses ? 1.0 : pow(p->r[i] / rmax, dim);
+        if (!(s->m[i] > 0))
+            s->m[i] = 1e-300;
+        msum += s->m[i];
+    }
+    pk_rng rng;
+    pk_rng_seed(&rng, prm->seed, 2);
+    for (size_t i = 0; i < n; i++) {
+        s->m[i] *= (double)n / msum;
+        double sc = dbar / sqrt(s->m[i]);
+        for (int k = 0; k < dim; k++)
+            s->v[3 * i + k] = sc * pk_rng_normal(&rng);
+    }
+    remove_drift(s);
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++)
+            s->x0[3 * i + k] = k >= dim ? 0 : p->x[3 * i + k];
+    /* skins: a fraction of the radius at the reference time, capped at twice
+     * the mean so coarse grains do not list hundreds of fines */
+    double t_ref = isfinite(t_end) ? t_end : 0;
+    double rho_mean = 0, rho_max = 0;
+    for (size_t i = 0; i < n; i++) {
+        double r = s->a[i] + s->g[i] * t_ref;
+        rho_mean += r / (double)n;
+        rho_max = fmax(rho_max, r);
+    }
+    double Lper = INFINITY;
+    for (int k = 0; k < dim; k++)
+        if (s->box.periodic[k])
+            Lper = fmin(Lper, s->box.L[k]);
+    /* periodic images: a pair must have one image within reach (spec §3.3d) */
+    double grow_max = 1; /* growing until jammed: bound the sizes by φ <= 1 (spec §3.3d) */
+    if (prm->until == PK_EDMD_UNTIL_JAMMED && prm->growth == PK_EDMD_GROW_RELATIVE)
+        grow_max = pow(1 / fmax(phi_sim(s, t_ref), 1e-300), 1.0 / dim);
+    double room = 0.25 * Lper - rho_max * grow_max;
+    if (!(room > 0))
+        return NAN;
+    s->sig_hi = 0;
+    for (size_t i = 0; i < n; i++) {
+        double r = s->a[i] + s->g[i] * t_ref;
+        s->rref[i] = r;
+        s->skin[i] = prm->skin * fmin(r, 2 * rho_mean);
+        if (0.5 * s->skin[i] > room)
+            s->skin[i] = 2 * room;
+        s->sig_hi = fmax(s->sig_hi, r + 0.5 * s->skin[i]);
+    }
+    double vmax_g = 0;
+    for (size_t i = 0; i < n; i++)
+        vmax_g = fmax(vmax_g, s->g[i]);
+    s->eps_v = 1e-9 * fmax(dbar, 2 * vmax_g);
+    return t_stop;
+}
+
+int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_monitor *mon,
+                pk_edmd_stats *st)
+{
+    memset(st, 0, sizeof *st);
+    st->reason = PK_STOP_ERROR;
+    st->criterion = PK_EDMD_CRIT_ERROR;
+    if (!b || !p || !prm || p->dim != b->dim || p->n == 0 || p->n > INT32_MAX)
+        return -1;
+    double w0 = pk_wall_seconds();
+    edmd_state S;
+    memset(&S, 0, sizeof S);
+    edmd_state *s = &S;
+    pk_particles q = {0};
+    size_t *perm = NULL;
+    s->box = *b;
+    s->dim = b->dim;
+    s->n = p->n;
+    int rc = -1;
+    if (state_alloc(s, s->n) != 0)
+        goto out;
+    /* zero start: uniform positions (stream 3); then the engine works on a
+     * copy q in Z-order (perm[k] = grain of p at engine index k) */
+    if (prm->start_zero) {
+        pk_rng rng;
+        pk_rng_seed(&rng, prm->seed, 3);
+        for (size_t i = 0; i < p->n; i++)
+            for (int k = 0; k < 3; k++)
+                p->x[3 * i + k] = k < b->dim ? pk_rng_range(&rng, 0, b->L[k]) : 0;
+    }
+    double hcell = 0;
+    for (size_t i = 0; i < p->n; i++)
+        hcell += 2 * p->r[i] / (double)p->n;
+    perm = malloc(p->n * sizeof *perm);
+    if (!perm || pk_particles_init(&q, p->dim, p->n) != 0 ||
+        edmd_spatial_order(b, p->x, p->n, hcell > 0 ? hcell : 1, perm) != 0)
+        goto out;
+    for (size_t k = 0; k < p->n; k++)
+        pk_particles_push(&q, &p->x[3 * perm[k]], p->r[perm[k]], p->species[perm[k]]);
+    double t_stop = setup(s, &q, prm, st);
+    if (isnan(t_stop))
+        goto out;
+    if (edmd_nlist_build_all(s) != 0)
+        goto out;
+    s->K = kinetic(s);
+    const double K0 = s->K;
+    predict_all(s);
+
+    const uint64_t c_win = prm->dphi_events ? prm->dphi_events : (uint64_t)s->n;
+    /* stall window: at least one event per grain (Titscher: 1000 events) */
+    uint64_t stall_win = prm->stall_events ? prm->stall_events : 1000;
+    if (stall_win < (uint64_t)s->n)
+        stall_win = (uint64_t)s->n;
+    uint64_t next_check = c_win, hist_stride = 1, hist_count = 0, stall_ev = 0;
+    double t_base = 0;           /* absolute time of the re-based origin t = 0 */
+    double stall_acc = 0, phi_prev = phi_sim(s, 0), pressure = 0;
+    pk_progress pr = {.stage = "edmd", .fraction = -1, .phi = phi_true(s, 0), .eta_s = -1};
+    char msg[160];
+    pk_monitor_begin(mon);
+    hist_push(st, &hist_stride, 0, 0, pr.phi, 0);
+    pk_edmd_criterion crit = PK_EDMD_CRIT_NONE;
+
+    for (;;) {
+        size_t i = (size_t)s->heap[0];
+        double te = s->ev_t[i];
+        if (te >= t_stop - t_base) {
+            double tt = fmax(t_stop - t_base, s->t);
+            s->kint += s->K * (tt - s->t);
+            s->t = tt;
+            crit = PK_EDMD_CRIT_TARGET;
+            break;
+        }
+        if (!(te < INFINITY)) {
+            crit = PK_EDMD_CRIT_STALL; /* nothing will ever happen (no growth, no motion) */
+            break;
+        }
+        s->kint += s->K * (te - s->t);
+        stall_acc += te - s->t;
+        s->t = te;
+        st->events++;
+        switch (s->ev_kind[i]) {
+        case EV_PAIR: {
+            size_t j = (size_t)s->ev_partner[i];
+            if (s->ev_stamp[i] != s->ncoll[j]) { /* partner changed course since */
+                st->invalid++;
+                edmd_predict(s, i);
+                edmd_queue_update(s, i);
+                break;
+            }
+            s->virial += edmd_collide_pair(s, i, j);
+            s->ncoll[i]++;
+            s->ncoll[j]++;
+            st->pair++;
+            edmd_predict(s, i);
+            edmd_queue_update(s, i);
+            edmd_predict(s, j);
+            edmd_queue_update(s, j);
+            break;
+        }
+        case EV_WALL:
+            edmd_collide_wall(s, i, s->ev_partner[i]);
+            s->ncoll[i]++;
+            st->wall++;
+            edmd_predict(s, i);
+            edmd_queue_update(s, i);
+            break;
+        case EV_NLIST:
+            if (edmd_nlist_rebuild(s, i) != 0)
+                goto out;
+            st->nlist++;
+            edmd_predict(s, i);
+            edmd_queue_update(s, i);
+            break;
+        default:
+            edmd_predict(s, i);
+            edmd_queue_update(s, i);
+            break;
+        }
+        if (prm->rescale && (s->K > K0 * (1 + prm->rescale_tol) ||
+                             s->K < K0 / (1 + prm->rescale_tol))) {
+            rescale(s, K0);
+            st->rescales++;
+        }
+        if (st->events - stall_ev >= stall_win) {
+            if (stall_acc * prm->growth_rate < prm->stall_growth) {
+                crit = PK_EDMD_CRIT_STALL;
+                break;
+            }
+            stall_ev = st->events;
+            stall_acc = 0;
+        }
+        if (prm->max_events && st->events >= prm->max_events) {
+            crit = PK_EDMD_CRIT_MAX_EVENTS;
+            break;
+        }
+        if ((st->events & 1023) == 0) {
+            pr.done = (size_t)st->events;
+            if (isfinite(t_stop)) {
+                pr.fraction = fmin(1, (t_base + s->t) / t_stop);
+                pr.eta_s = pr.fraction > 0 ? (pk_wall_seconds() - w0) * (1 - pr.fraction) / pr.fraction : -1;
+            }
+            snprintf(msg, sizeof msg, "events=%llu collisions=%llu reduced_pressure=%.4g",
+                     (unsigned long long)st->events, (unsigned long long)st->pair, pressure);
+            pr.message = msg;
+            int m = pk_monitor_tick(mon, &pr, 0);
+            if (m) {
+                crit = m == 2 ? PK_EDMD_CRIT_WALL_TIME : PK_EDMD_CRIT_CANCEL;
+                break;
+            }
+        }
+        if (st->events >= next_check) {
+            next_check = st->events + c_win;
+            double phi = phi_true(s, s->t);
+            double phis = phi_sim(s, s->t); /* grows in both modes (shell: φ_true is fixed) */
+            pressure = s->kint > 0 ? 1 + s->virial / (2 * s->kint) : 0;
+            s->virial = s->kint = 0;
+            pr.phi = phi;
+            if (++hist_count % hist_stride == 0)
+                hist_push(st, &hist_stride, st->events, t_base + s->t, phi, pressure);
+            if (prm->until == PK_EDMD_UNTIL_JAMMED) {
+                if (pressure >= prm->p_max) {
+                    crit = PK_EDMD_CRIT_PRESSURE;
+                    break;
+                }
+                /* Meier Eq. 3.11; only in a dense state (p > 10^3): from zero
+                 * radii φ ∝ t^d barely moves over the first windows */
+                if (prm->dphi_crit > 0 && pressure > 1e3 && phis - phi_prev < prm->dphi_crit) {
+                    crit = PK_EDMD_CRIT_DELTA_PHI;
+                    break;
+                }
+            }
+            phi_prev = phis;
+            t_base += s->t;
+            rebase(s);
+            st->rebases++;
+        }
+    }
+    /* final state */
+    if (s->kint > 0)
+        pressure = 1 + s->virial / (2 * s->kint);
+    for (size_t i = 0; i < s->n; i++) {
+        edmd_sync(s, i);
+        double *x = &p->x[3 * perm[i]];
+        for (int k = 0; k < 3; k++)
+            x[k] = k < s->dim ? s->x0[3 * i + k] : 0;
+        pk_box_wrap(b, x);
+        for (int k = 0; k < s->dim; k++) /* walled axes: keep round-off inside */
+            if (!b->periodic[k])
+                x[k] = fmin(fmax(x[k], 0), b->L[k]);
+        p->r[perm[i]] = true_radius(s, i, s->t);
+    }
+    st->criterion = crit;
+    switch (crit) {
+    case PK_EDMD_CRIT_TARGET: st->reason = PK_STOP_COMPLETE; break;
+    case PK_EDMD_CRIT_PRESSURE:
+    case PK_EDMD_CRIT_DELTA_PHI: st->reason = PK_STOP_JAMMED; break;
+    case PK_EDMD_CRIT_STALL: /* growing until jammed, a stall is the jam (Titscher §6.4) */
+        st->reason = prm->until == PK_EDMD_UNTIL_JAMMED ? PK_STOP_JAMMED : PK_STOP_STALLED;
+        break;
+    case PK_EDMD_CRIT_MAX_EVENTS: st->reason = PK_STOP_STALLED; break;
+    case PK_EDMD_CRIT_CANCEL: st->reason = PK_STOP_CANCELLED; break;
+    case PK_EDMD_CRIT_WALL_TIME: st->reason = PK_STOP_WALL_TIME; break;
+    default: st->reason = PK_STOP_ERROR; break;
+    }
+    st->phi = phi_true(s, s->t);
+    st->phi_sim = phi_sim(s, s->t);
+    st->pressure = pressure;
+    st->phi_jam_estimate = pressure > s->dim ? st->phi / (1 - s->dim / pressure) : NAN;
+    st->delta_d = 2 * (s->h0 + s->h1 * s->t);
+    st->t_stop = t_base + s->t;
+    st->overlaps = s->n_overlap;
+    st->max_overlap_rel = s->max_overlap_rel;
+    hist_push(st, &hist_stride, st->events, t_base + s->t, st->phi, pressure);
+    rc = 0;
+out:
+    st->seconds = pk_wall_seconds() - w0;
+    state_free(s);
+    pk_particles_free(&q);
+    free(perm);
+    return rc;
+}

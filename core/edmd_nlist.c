@@ -1,0 +1,124 @@
+/* edmd_nlist.c — Donev-style neighbour lists for growing grains (spec §3.3c).
+ *
+ * At its build time particle i gets a bounding sphere (centre c_i = x_i,
+ * radius σ_i = ρ_i + s_i/2); j is in i's list iff the bounding spheres
+ * overlap.  Spheres inside disjoint bounding spheres cannot touch, so the
+ * lists stay exact while every grain stays inside its sphere; the exit time
+ * (motion AND growth) is a per-particle event, after which only that grain's
+ * sphere and list are rebuilt (symmetrically).  σ_i uses at least the
+ * grain's target radius, so early (small, fast) grains rebuild rarely.  The bounding spheres live in
+ * the shared multi-level grid (core/grid.h), so wide size ratios cost O(1)
+ * cells per query. */
+#include <math.h>
+#include <stdlib.h>
+
+#include "edmd_state.h"
+
+static int push(edmd_nlist *L, int32_t j)
+{
+    if (L->n == L->cap) {
+        uint32_t cap = L->cap ? 2 * L->cap : 16;
+        int32_t *nb = realloc(L->nb, cap * sizeof *nb);
+        if (!nb)
+            return -1;
+        L->nb = nb;
+        L->cap = cap;
+    }
+    L->nb[L->n++] = j;
+    return 0;
+}
+
+static void drop(edmd_nlist *L, int32_t j)
+{
+    for (uint32_t q = 0; q < L->n; q++)
+        if (L->nb[q] == j) {
+            L->nb[q] = L->nb[--L->n];
+            return;
+        }
+}
+
+typedef struct visit_ctx {
+    edmd_state *s;
+    int32_t self;
+    int symmetric;
+    int failed;
+} visit_ctx;
+
+static int visit(size_t j, const double dx[PK_MAXDIM], double dist2, void *ctx)
+{
+    (void)dx;
+    (void)dist2;
+    visit_ctx *c = ctx;
+    if ((int32_t)j == c->self)
+        return 0;
+    if (push(&c->s->nl[c->self], (int32_t)j) != 0 ||
+        (c->symmetric && push(&c->s->nl[j], c->self) != 0)) {
+        c->failed = 1;
+        return 1;
+    }
+    return 0;
+}
+
+/* Bounding sphere of i at the current time (i synced). */
+static void set_sphere(edmd_state *s, size_t i)
+{
+    for (int k = 0; k < 3; k++)
+        s->bs.x[3 * i + k] = s->x0[3 * i + k];
+    pk_box_wrap(&s->box, &s->bs.x[3 * i]);
+    /* never smaller than the grain at its reference (target) size: while
+     * grains are small and far apart the lists then last much longer */
+    s->bs.r[i] = fmax(s->a[i] + s->g[i] * s->t, s->rref[i]) + 0.5 * s->skin[i];
+}
+
+int edmd_nlist_build_all(edmd_state *s)
+{
+    double lo = INFINITY, hi = 0;
+    for (size_t i = 0; i < s->n; i++) {
+        edmd_sync(s, i);
+        set_sphere(s, i);
+        s->nl[i].n = 0;
+        lo = fmin(lo, s->bs.r[i]);
+        hi = fmax(hi, s->bs.r[i]);
+    }
+    s->bs.n = s->n;
+    pk_grid_free(&s->grid);
+    hi = fmax(hi, s->sig_hi);
+    if (pk_grid_init(&s->grid, &s->box, fmin(lo, hi), hi, 0.0, s->n) != 0)
+        return -1;
+    for (size_t i = 0; i < s->n; i++)
+        if (pk_grid_insert(&s->grid, &s->bs, i) != 0)
+            return -1;
+    for (size_t i = 0; i < s->n; i++) {
+        visit_ctx c = {s, (int32_t)i, 0, 0};
+        pk_grid_query(&s->grid, &s->bs, &s->bs.x[3 * i], s->bs.r[i], 0.0, visit, &c);
+        if (c.failed)
+            return -1;
+    }
+    return 0;
+}
+
+int edmd_nlist_rebuild(edmd_state *s, size_t i)
+{
+    edmd_nlist *L = &s->nl[i];
+    for (uint32_t q = 0; q < L->n; q++)
+        drop(&s->nl[L->nb[q]], (int32_t)i);
+    L->n = 0;
+    edmd_sync(s, i);
+    set_sphere(s, i);
+    if (pk_grid_update(&s->grid, &s->bs, i) != 0)
+        return -1;
+    visit_ctx c = {s, (int32_t)i, 1, 0};
+    pk_grid_query(&s->grid, &s->bs, &s->bs.x[3 * i], s->bs.r[i], 0.0, visit, &c);
+    return c.failed ? -1 : 0;
+}
+
+void edmd_nlist_free(edmd_state *s)
+{
+    if (s->nl)
+        for (size_t i = 0; i < s->n; i++)
+            free(s->nl[i].nb);
+    free(s->nl);
+    s->nl = NULL;
+    pk_grid_free(&s->grid);
+    pk_particles_free(&s->bs);
+}

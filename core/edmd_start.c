@@ -1,0 +1,55 @@
+/* edmd_start.c — EDMD parameters' defaults, criterion names and the RSA start
+ * configuration at reduced size δ·d (Titscher §6.2, Kansal). */
+#include <stdlib.h>
+
+#include "edmd.h"
+
+void pk_edmd_params_default(pk_edmd_params *prm)
+{
+    *prm = (pk_edmd_params){
+        .growth = PK_EDMD_GROW_RELATIVE,
+        .until = PK_EDMD_UNTIL_TARGET,
+        .start_zero = 1,
+        .delta = 0.9,
+        .growth_rate = 0.01,
+        .p_max = 1e12,
+        .dphi_crit = 1e-9,
+        .dphi_events = 0,
+        .stall_growth = 1e-12,
+        .stall_events = 1000,
+        .rescale = 1,
+        .rescale_tol = 0.1,
+        .skin = 0.6,
+        .equal_masses = 0,
+        .seed = 1,
+    };
+}
+
+const char *pk_edmd_criterion_name(pk_edmd_criterion c)
+{
+    static const char *names[] = {"none",  "target",     "pressure",  "delta_phi", "stall",
+                                  "max_events", "cancelled", "wall_time", "error"};
+    return (unsigned)c < sizeof names / sizeof *names ? names[c] : "unknown";
+}
+
+int pk_edmd_start_rsa(const pk_box *b, const double *d, const int32_t *species, size_t n,
+                      double delta, double delta_d, uint64_t seed, pk_monitor *mon,
+                      pk_particles *p, pk_rsa_stats *rs)
+{
+    if (!(delta > 0) || delta > 1)
+        return -1;
+    double *dd = malloc((n ? n : 1) * sizeof *dd);
+    if (!dd)
+        return -1;
+    for (size_t i = 0; i < n; i++)
+        dd[i] = delta * d[i];
+    pk_rsa_params prm = {.delta_d = delta_d, .max_failed_draws = 1000000, .seed = seed};
+    size_t first = p->n;
+    int rc = pk_rsa_place(b, dd, species, n, &prm, mon, p, rs);
+    free(dd);
+    if (rc != 0)
+        return -1;
+    for (size_t i = first; i < p->n; i++)
+        p->r[i] /= delta; /* back to the target radius; the engine starts at δ·r */
+    return 0;
+}

@@ -1,0 +1,75 @@
+/* edmd_state.h — the EDMD engine's internal state, shared by core/edmd*.c.
+ * Structure of arrays; particle i's position at time t is
+ * x0[3i..] + v[3i..]·(t − t0[i]) (delayed state), its simulated radius
+ * a[i] + g[i]·t and its true radius that minus the shell h0 + h1·t. */
+#ifndef PK_EDMD_STATE_H
+#define PK_EDMD_STATE_H
+
+#include "edmd.h"
+#include "grid.h"
+
+enum { EV_NONE = 0, EV_PAIR, EV_WALL, EV_NLIST };
+
+typedef struct edmd_nlist {
+    int32_t *nb;      /* neighbour indices */
+    uint32_t n, cap;
+} edmd_nlist;
+
+typedef struct edmd_state {
+    pk_box box;
+    int dim;
+    size_t n;
+    /* kinematics */
+    double *x0, *v, *t0;      /* [3n], [3n], [n] */
+    double *a, *g, *m;        /* radius offset, radius rate, mass */
+    double h0, h1;            /* shell h(t) = h0 + h1 t */
+    double t;                 /* current time (re-based) */
+    double eps_v;             /* extra separation speed (spec §3.4) */
+    /* events: one per particle */
+    double *ev_t;
+    int32_t *ev_partner;      /* partner (EV_PAIR) or wall code 2k+side (EV_WALL) */
+    uint32_t *ev_stamp;       /* partner's ncoll at prediction time */
+    uint8_t *ev_kind;
+    uint32_t *ncoll;          /* velocity changes of each particle (validity counter) */
+    int32_t *heap, *hpos;     /* binary heap of particle indices keyed by ev_t */
+    size_t hn;
+    /* neighbour lists */
+    edmd_nlist *nl;
+    pk_particles bs;          /* bounding spheres: centre c_i, radius σ_i */
+    pk_grid grid;             /* on the bounding spheres */
+    double *skin;             /* per-particle skin s_i */
+    double *rref;             /* radius at the reference time (target size) */
+    double sig_hi;            /* expected largest bounding sphere (grid cell size) */
+    /* physics accumulators */
+    double K;                 /* kinetic energy ½Σm v² */
+    double virial;            /* Σ σ J over particle collisions in the window */
+    double kint;              /* ∫K dt over the window */
+    uint64_t n_overlap;
+    double max_overlap_rel;
+} edmd_state;
+
+/* edmd_predict.c */
+void edmd_position(const edmd_state *s, size_t i, double t, double x[3]);
+void edmd_sync(edmd_state *s, size_t i);               /* x0 ← x(t), t0 ← t */
+void edmd_predict(edmd_state *s, size_t i);            /* refresh i's event and heap slot */
+double edmd_wall_time(const edmd_state *s, size_t i, int *code);
+
+/* edmd_collide.c */
+double edmd_collide_pair(edmd_state *s, size_t i, size_t j);   /* returns σ·J */
+void edmd_collide_wall(edmd_state *s, size_t i, int code);
+
+/* edmd_queue.c */
+int edmd_queue_init(edmd_state *s);
+void edmd_queue_update(edmd_state *s, size_t i);       /* after ev_t[i] changed */
+void edmd_queue_shift(edmd_state *s, double dt);       /* all times −= dt */
+
+/* edmd_order.c: perm[k] = index of the k-th grain along a Z-order curve of
+ * cells of edge h.  0 or -1 (out of memory). */
+int edmd_spatial_order(const pk_box *b, const double *x, size_t n, double h, size_t *perm);
+
+/* edmd_nlist.c */
+int edmd_nlist_build_all(edmd_state *s);
+int edmd_nlist_rebuild(edmd_state *s, size_t i);
+void edmd_nlist_free(edmd_state *s);
+
+#endif

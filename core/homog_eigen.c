@@ -1,0 +1,110 @@
+#include "homog_eigen.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* number of eigenvalues of T below s (Sturm sequence) */
+static int sturm_count(const double *a, const double *b, int m, double s)
+{
+    int cnt = 0;
+    double q = a[0] - s;
+    for (int k = 0;; k++) {
+        if (q == 0)
+            q = -1e-300;
+        if (q < 0)
+            cnt++;
+        if (k + 1 >= m)
+            break;
+        q = a[k + 1] - s - b[k] * b[k] / q;
+    }
+    return cnt;
+}
+
+double pk_tridiag_min_eig(const double *a, const double *b, int m)
+{
+    double lo = INFINITY, hi = -INFINITY;
+    for (int k = 0; k < m; k++) { /* Gershgorin interval */
+        double rad = (k > 0 ? fabs(b[k - 1]) : 0) + (k + 1 < m ? fabs(b[k]) : 0);
+        lo = fmin(lo, a[k] - rad);
+        hi = fmax(hi, a[k] + rad);
+    }
+    for (int it = 0; it < 200 && hi - lo > 1e-15 * fmax(fabs(lo), fabs(hi)); it++) {
+        double mid = 0.5 * (lo + hi);
+        if (sturm_count(a, b, m, mid) >= 1)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+static double dot_mask(const double *u, const double *v, const uint8_t *mask, size_t np, int dim)
+{
+    double s = 0;
+    for (size_t i = 0; i < np; i++)
+        if (mask[i])
+            for (int a = 0; a < dim; a++)
+                s += u[3 * i + a] * v[3 * i + a];
+    return s;
+}
+
+double pk_homog_rayleigh(const pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *mask,
+                         const double *v, double *work)
+{
+    double vv = dot_mask(v, v, mask, np, dim);
+    if (!(vv > 0))
+        return NAN;
+    pk_dem_kv(c, dim, np, E, mask, v, work);
+    return dot_mask(v, work, mask, np, dim) / vv;
+}
+
+double pk_homog_lanczos_min(const pk_dem_pairs *c, int dim, size_t np, double E,
+                            const uint8_t *mask, int steps)
+{
+    size_t ndof = 0;
+    for (size_t i = 0; i < np; i++)
+        ndof += mask[i] ? (size_t)dim : 0;
+    if (ndof == 0)
+        return 0;
+    if ((size_t)steps > ndof)
+        steps = (int)ndof;
+    double *q = calloc(3 * np, sizeof *q), *qp = calloc(3 * np, sizeof *qp);
+    double *w = calloc(3 * np, sizeof *w);
+    double *al = calloc((size_t)steps + 1, sizeof *al), *be = calloc((size_t)steps + 1, sizeof *be);
+    if (!q || !qp || !w || !al || !be) {
+        free(q), free(qp), free(w), free(al), free(be);
+        return NAN;
+    }
+    /* deterministic, non-special start vector */
+    uint64_t h = 0x9E3779B97F4A7C15ull;
+    for (size_t i = 0; i < np; i++)
+        if (mask[i])
+            for (int a = 0; a < dim; a++) {
+                h ^= h << 13, h ^= h >> 7, h ^= h << 17;
+                q[3 * i + a] = (double)(h >> 11) / 9007199254740992.0 - 0.5;
+            }
+    double nq = sqrt(dot_mask(q, q, mask, np, dim));
+    for (size_t k = 0; k < 3 * np; k++)
+        q[k] /= nq;
+    int m = 0;
+    double beta = 0;
+    for (int it = 0; it < steps; it++) {
+        pk_dem_kv(c, dim, np, E, mask, q, w);
+        double alpha = dot_mask(q, w, mask, np, dim);
+        for (size_t k = 0; k < 3 * np; k++)
+            w[k] -= alpha * q[k] + beta * qp[k];
+        al[m++] = alpha;
+        beta = sqrt(dot_mask(w, w, mask, np, dim));
+        if (!(beta > 1e-14 * fabs(alpha)) || it + 1 == steps)
+            break;
+        be[m - 1] = beta;
+        for (size_t k = 0; k < 3 * np; k++) {
+            qp[k] = q[k];
+            q[k] = w[k] / beta;
+        }
+    }
+    double lmin = pk_tridiag_min_eig(al, be, m);
+    free(q), free(qp), free(w), free(al), free(be);
+    return lmin;
+}

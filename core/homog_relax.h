@@ -1,0 +1,57 @@
+/* homog_relax.h — dynamic relaxation of the free particles (Meier 2009 §4.4,
+ * spec §2.7): M(ẍ + γẋ) = f with M = 1, central differences (4.38)–(4.41),
+ * optimal Δt and γ from the extreme eigenvalues of the jammed free stiffness
+ * (4.47).  Convergence: |f| <= max(tol·|f⁰|, abs_floor) (4.42 with an
+ * absolute floor, spec H5), capped at max_iter.  The eigenvalue estimates are
+ * taken at the start (Gershgorin + Lanczos, homog_eigen.h) and refreshed
+ * every `refresh` iterations (Gershgorin again, Rayleigh quotient of the
+ * residual for λ_min; rattlers re-detected) — spec H4. */
+#ifndef PK_HOMOG_RELAX_H
+#define PK_HOMOG_RELAX_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dem_contact.h"
+#include "progress.h"
+
+typedef enum pk_dr_stop {
+    PK_DR_CONVERGED = 0,     /* relative tolerance met */
+    PK_DR_CONVERGED_ABS,     /* absolute floor met (incl. nothing to relax) */
+    PK_DR_NOT_NEEDED,        /* no free particle (Taylor) */
+    PK_DR_MAX_ITER,
+    PK_DR_CANCELLED,
+    PK_DR_WALL_TIME
+} pk_dr_stop;
+
+const char *pk_dr_stop_name(pk_dr_stop s);
+/* 1 for the two converged reasons and not_needed */
+int pk_dr_stop_ok(pk_dr_stop s);
+
+typedef struct pk_dr_params {
+    double tol;           /* relative, (4.42); thesis 1e-8 */
+    double abs_floor;     /* absolute force floor */
+    size_t max_iter;
+    int lanczos_steps;    /* for the initial λ_min (e.g. 40) */
+    size_t refresh;       /* iterations between estimate refreshes (e.g. 200) */
+    double skin;          /* Verlet skin (length) */
+} pk_dr_params;
+
+typedef struct pk_dr_stats {
+    pk_dr_stop stop;
+    size_t iterations, rebuilds, refreshes;
+    double f0, f;            /* |f⁰|, final |f| (free DOFs) */
+    double dt, gamma;        /* last parameters used */
+    double lambda_min, lambda_max;
+    int clamped;             /* λ_min <= 0 was clamped (indefinite or no jammed grain) */
+    size_t rattlers;         /* at the last refresh */
+} pk_dr_stats;
+
+/* Relax x (the entries of particles with is_free[i]) at fixed geometry g.
+ * The pair list c is (re)built here as needed.  Returns 0 (see st->stop),
+ * -1 on allocation failure, -2 when a periodic box is too small for F̄. */
+int pk_homog_relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
+                   double E, const uint8_t *is_free, const pk_dr_params *prm, pk_monitor *mon,
+                   pk_dr_stats *st);
+
+#endif

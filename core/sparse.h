@@ -1,0 +1,49 @@
+/* sparse.h — the sparse symmetric solver interface core/ calls and api/
+ * implements (api/sparse_cholmod.c: SuiteSparse CHOLMOD).  core/ stays plain
+ * C17: it assembles a triplet matrix and receives the solver as a vtable
+ * (data flows api → core). */
+#ifndef PK_SPARSE_H
+#define PK_SPARSE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* Symmetric n×n matrix, upper triangle (row <= col) as triplets;
+ * duplicates are summed. */
+typedef struct pk_sparse_sym {
+    size_t n, nnz, cap;
+    int32_t *row, *col;
+    double *val;
+} pk_sparse_sym;
+
+int pk_sparse_sym_add(pk_sparse_sym *A, int32_t r, int32_t c, double v); /* 0 / -1 */
+void pk_sparse_sym_free(pk_sparse_sym *A);
+
+typedef enum pk_sparse_status {
+    PK_SPARSE_OK = 0,          /* positive definite */
+    PK_SPARSE_INDEFINITE,      /* negative pivots (inertia reported) */
+    PK_SPARSE_SINGULAR,        /* zero pivot(s) */
+    PK_SPARSE_FAILED           /* memory or library error */
+} pk_sparse_status;
+
+const char *pk_sparse_status_name(pk_sparse_status s);
+
+typedef struct pk_sparse_info {
+    pk_sparse_status status;
+    size_t npos, nneg, nzero;  /* inertia of the LDLᵀ pivots */
+    double min_abs_pivot, max_abs_pivot;
+} pk_sparse_info;
+
+typedef struct pk_sparse_factor pk_sparse_factor; /* solver-owned */
+
+typedef struct pk_sparse_solver {
+    const char *name;
+    /* Factor A; never NULL-crash: on failure returns NULL with info->status
+     * = FAILED.  A factor is returned for OK and INDEFINITE. */
+    pk_sparse_factor *(*factor)(const pk_sparse_sym *A, pk_sparse_info *info);
+    /* X = A⁻¹B, B and X column-major n × nrhs.  0 / -1. */
+    int (*solve)(pk_sparse_factor *f, size_t nrhs, const double *B, double *X);
+    void (*release)(pk_sparse_factor *f);
+} pk_sparse_solver;
+
+#endif

@@ -1,0 +1,258 @@
+#include "config.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+typedef enum { K_STR, K_INT, K_LONG, K_DOUBLE, K_LEVEL } key_type;
+
+static const struct key {
+    const char *name;
+    key_type type;
+    size_t off, size;
+    double lo, hi;          /* range of numbers */
+    const char *help;
+} keys[] = {
+#define F(m) offsetof(pk_config, m), sizeof(((pk_config *)0)->m)
+    {"bind", K_STR, F(bind), 0, 0, "listen address"},
+    {"port", K_INT, F(port), 0, 65535, "TCP port (0 = any free port)"},
+    {"data", K_STR, F(data), 0, 0, "data directory"},
+    {"workers", K_INT, F(workers), 0, 1024, "concurrent worker processes (0 = accept but run nothing)"},
+    {"max_body_bytes", K_LONG, F(max_body_bytes), 1024, 1e12, "largest request body"},
+    {"max_particles", K_LONG, F(max_particles), 1, 1e12, "cap on a job's limits.max_particles"},
+    {"max_wall_time_s", K_DOUBLE, F(max_wall_time_s), 1, 1e9, "cap on a job's limits.wall_time_s"},
+    {"max_queued", K_INT, F(max_queued), 1, 1e9, "waiting jobs in total (beyond: 503)"},
+    {"max_queued_per_owner", K_INT, F(max_queued_per_owner), 1, 1e9, "waiting jobs per owner (beyond: 429)"},
+    {"max_attempts", K_INT, F(max_attempts), 1, 100, "starts of one job before an interrupted job fails"},
+    {"grace_s", K_DOUBLE, F(grace_s), 0, 86400, "SIGTERM: time running jobs get to finish"},
+    {"log_level", K_LEVEL, F(log_level), 0, 0, "debug | info | warn | error"},
+#undef F
+};
+
+static const char *level_names[] = {"debug", "info", "warn", "error"};
+
+const char *pk_log_level_name(pk_log_level l)
+{
+    return l >= PK_LOG_DEBUG && l <= PK_LOG_ERROR ? level_names[l] : "info";
+}
+
+void pk_config_defaults(pk_config *c)
+{
+    memset(c, 0, sizeof *c);
+    snprintf(c->bind, sizeof c->bind, "127.0.0.1");
+    c->port = 8080;
+    snprintf(c->data, sizeof c->data, "var");
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    c->workers = n > 0 ? (int)n : 1;
+    c->max_body_bytes = 16L << 20;
+    c->max_particles = 20000000;
+    c->max_wall_time_s = 86400;
+    c->max_queued = 1000;
+    c->max_queued_per_owner = 100;
+    c->max_attempts = 3;
+    c->grace_s = 30;
+    c->log_level = PK_LOG_INFO;
+}
+
+static const struct key *find_key(const char *name)
+{
+    for (size_t i = 0; i < sizeof keys / sizeof *keys; i++)
+        if (!strcmp(keys[i].name, name))
+            return &keys[i];
+    return NULL;
+}
+
+int pk_config_set(pk_config *c, const char *key, const char *value, char *err, size_t errlen)
+{
+    const struct key *k = find_key(key);
+    if (!k) {
+        snprintf(err, errlen, "unknown key '%s'", key);
+        return -1;
+    }
+    char *field = (char *)c + k->off;
+    if (k->type == K_STR) {
+        if (!*value || strlen(value) >= k->size) {
+            snprintf(err, errlen, "%s: empty or too long", key);
+            return -1;
+        }
+        memcpy(field, value, strlen(value) + 1);
+        return 0;
+    }
+    if (k->type == K_LEVEL) {
+        for (int l = PK_LOG_DEBUG; l <= PK_LOG_ERROR; l++)
+            if (!strcmp(value, level_names[l])) {
+                c->log_level = (pk_log_level)l;
+                return 0;
+            }
+        snprintf(err, errlen, "%s: '%s' is not debug, info, warn or error", key, value);
+        return -1;
+    }
+    char *end;
+    errno = 0;
+    double v = strtod(value, &end);
+    if (end == value || *end || errno || !isfinite(v) || v < k->lo || v > k->hi ||
+        (k->type != K_DOUBLE && v != floor(v))) {
+        snprintf(err, errlen, "%s: '%s' is not a%s number in [%g, %g]", key, value,
+                 k->type == K_DOUBLE ? "" : "n integer", k->lo, k->hi);
+        return -1;
+    }
+    if (k->type == K_INT)
+        *(int *)field = (int)v;
+    else if (k->type == K_LONG)
+        *(long *)field = (long)v;
+    else
+        *(double *)field = v;
+    return 0;
+}
+
+static char *trim(char *s)
+{
+    while (isspace((unsigned char)*s))
+        s++;
+    char *e = s + strlen(s);
+    while (e > s && isspace((unsigned char)e[-1]))
+        *--e = 0;
+    return s;
+}
+
+int pk_config_load_file(pk_config *c, const char *path, char *err, size_t errlen)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        snprintf(err, errlen, "%s: %s", path, strerror(errno));
+        return -1;
+    }
+    char line[2048], msg[512];
+    int lineno = 0, rc = 0;
+    while (fgets(line, sizeof line, f)) {
+        lineno++;
+        char *hash = strchr(line, '#');
+        if (hash)
+            *hash = 0;
+        char *s = trim(line);
+        if (!*s)
+            continue;
+        char *eq = strchr(s, '=');
+        if (!eq) {
+            snprintf(err, errlen, "%s:%d: expected 'key = value'", path, lineno);
+            rc = -1;
+            break;
+        }
+        *eq = 0;
+        char *key = trim(s), *value = trim(eq + 1);
+        size_t vl = strlen(value);
+        if (vl >= 2 && value[0] == '"' && value[vl - 1] == '"') {
+            value[vl - 1] = 0;
+            value++;
+        }
+        if (pk_config_set(c, key, value, msg, sizeof msg) != 0) {
+            snprintf(err, errlen, "%s:%d: %s", path, lineno, msg);
+            rc = -1;
+            break;
+        }
+    }
+    fclose(f);
+    if (rc == 0)
+        snprintf(c->config_file, sizeof c->config_file, "%s", path);
+    return rc;
+}
+
+int pk_config_load_env(pk_config *c, char *err, size_t errlen)
+{
+    for (size_t i = 0; i < sizeof keys / sizeof *keys; i++) {
+        char var[64], msg[512];
+        size_t j = 0;
+        j += (size_t)snprintf(var, sizeof var, "PACKD_");
+        for (const char *p = keys[i].name; *p && j + 1 < sizeof var; p++)
+            var[j++] = (char)toupper((unsigned char)*p);
+        var[j] = 0;
+        const char *v = getenv(var);
+        if (v && pk_config_set(c, keys[i].name, v, msg, sizeof msg) != 0) {
+            snprintf(err, errlen, "%s: %s", var, msg);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* "--max-body-bytes" -> "max_body_bytes"; NULL if not a flag. */
+static const char *flag_key(const char *arg, char *buf, size_t n)
+{
+    if (strncmp(arg, "--", 2) != 0 || strlen(arg + 2) >= n)
+        return NULL;
+    size_t i = 0;
+    for (const char *p = arg + 2; *p; p++)
+        buf[i++] = *p == '-' ? '_' : *p;
+    buf[i] = 0;
+    return buf;
+}
+
+int pk_config_from_args(pk_config *c, int argc, char **argv, char *err, size_t errlen)
+{
+    pk_config_defaults(c);
+    const char *file = getenv("PACKD_CONFIG");
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help"))
+            return 1;
+        if (!strcmp(argv[i], "--config")) {
+            if (i + 1 >= argc) {
+                snprintf(err, errlen, "--config needs a file");
+                return -1;
+            }
+            file = argv[++i];
+        }
+    }
+    if (file && *file && pk_config_load_file(c, file, err, errlen) != 0)
+        return -1;
+    if (pk_config_load_env(c, err, errlen) != 0)
+        return -1;
+    for (int i = 1; i < argc; i++) {
+        char kb[64], msg[512];
+        if (!strcmp(argv[i], "--config")) {
+            i++;
+            continue;
+        }
+        const char *key = flag_key(argv[i], kb, sizeof kb);
+        if (!key || !find_key(key)) {
+            snprintf(err, errlen, "unknown option '%s'", argv[i]);
+            return -1;
+        }
+        if (i + 1 >= argc) {
+            snprintf(err, errlen, "%s needs a value", argv[i]);
+            return -1;
+        }
+        if (pk_config_set(c, key, argv[++i], msg, sizeof msg) != 0) {
+            snprintf(err, errlen, "%s", msg);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+void pk_config_print_keys(void *file)
+{
+    pk_config d;
+    pk_config_defaults(&d);
+    for (size_t i = 0; i < sizeof keys / sizeof *keys; i++) {
+        const struct key *k = &keys[i];
+        const char *field = (const char *)&d + k->off;
+        char def[128];
+        switch (k->type) {
+        case K_STR: snprintf(def, sizeof def, "%s", field); break;
+        case K_INT: snprintf(def, sizeof def, "%d", *(const int *)field); break;
+        case K_LONG: snprintf(def, sizeof def, "%ld", *(const long *)field); break;
+        case K_DOUBLE: snprintf(def, sizeof def, "%g", *(const double *)field); break;
+        case K_LEVEL: snprintf(def, sizeof def, "%s", pk_log_level_name(d.log_level)); break;
+        }
+        char flag[64];
+        size_t j = 0;
+        for (const char *p = k->name; *p && j + 1 < sizeof flag; p++)
+            flag[j++] = *p == '_' ? '-' : *p;
+        flag[j] = 0;
+        fprintf(file, "  --%-22s %s (default %s)\n", flag, k->help, def);
+    }
+}

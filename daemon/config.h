@@ -1,0 +1,50 @@
+/* config.h — the daemon's configuration: embedded defaults, then a config
+ * file (`key = value` lines, '#' comments), then environment variables
+ * PACKD_<KEY>, then command-line flags --<key-with-dashes> VALUE.
+ * One table of keys (config.c) drives all four, and deploy/packd.conf.example
+ * documents each key. */
+#ifndef PK_CONFIG_H
+#define PK_CONFIG_H
+
+#include <stddef.h>
+
+typedef enum { PK_LOG_DEBUG, PK_LOG_INFO, PK_LOG_WARN, PK_LOG_ERROR } pk_log_level;
+
+typedef struct pk_config {
+    char bind[64];            /* listen address (IPv4 dotted quad) */
+    int port;
+    char data[1024];          /* data directory: queue.db, jobs/, files/ */
+    int workers;              /* concurrent worker processes */
+    long max_body_bytes;      /* largest request body (POST /files, /execution) */
+    long max_particles;       /* cap on limits.max_particles of each job */
+    double max_wall_time_s;   /* cap on limits.wall_time_s; the worker is killed 30 s after */
+    int max_queued;           /* accepted (waiting) jobs in total; beyond: 503 */
+    int max_queued_per_owner; /* accepted jobs per owner; beyond: 429 */
+    int max_attempts;         /* runs of one job interrupted by daemon deaths before it fails */
+    double grace_s;           /* SIGTERM: time running jobs get to finish */
+    pk_log_level log_level;
+    char config_file[1024];   /* the file read, "" if none (kept for SIGHUP) */
+} pk_config;
+
+/* Embedded defaults: 127.0.0.1:8080, data ./var, workers = online cores. */
+void pk_config_defaults(pk_config *c);
+
+/* Set one key from text; 0 on success, -1 with a message in err. */
+int pk_config_set(pk_config *c, const char *key, const char *value, char *err, size_t errlen);
+
+/* Read a config file; 0 on success, -1 with "file:line: message" in err. */
+int pk_config_load_file(pk_config *c, const char *path, char *err, size_t errlen);
+
+/* Apply PACKD_<KEY> variables from the environment; -1 with err on a bad value. */
+int pk_config_load_env(pk_config *c, char *err, size_t errlen);
+
+/* Full load for `packd serve ARGS`: defaults, --config file (or $PACKD_CONFIG),
+ * env, flags.  Returns 0, -1 with err on an error, 1 for --help. */
+int pk_config_from_args(pk_config *c, int argc, char **argv, char *err, size_t errlen);
+
+const char *pk_log_level_name(pk_log_level l);
+
+/* Print the keys with their defaults (for --help). */
+void pk_config_print_keys(void *file);
+
+#endif

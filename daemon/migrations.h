@@ -1,0 +1,16 @@
+/* migrations.h — the queue database schema, versioned with PRAGMA user_version. */
+#ifndef PK_MIGRATIONS_H
+#define PK_MIGRATIONS_H
+
+#include <sqlite3.h>
+#include <stddef.h>
+
+/* Bring the database to the newest schema version, one transaction per step.
+ * Returns the version reached, or -1 with err (e.g. a database newer than
+ * this binary). */
+int pk_migrate(sqlite3 *db, char *err, size_t errlen);
+
+/* The newest schema version this binary knows. */
+int pk_schema_version(void);
+
+#endif

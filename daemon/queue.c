@@ -1,0 +1,567 @@
+#include "queue.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <pthread.h>
+#include <sqlite3.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "migrations.h"
+
+struct pk_queue {
+    sqlite3 *db;
+    pthread_mutex_t mu;
+    pthread_mutex_t ev_mu;
+    pthread_cond_t ev_cond;
+    long long ev_seq;     /* bumped on every inserted event / state change */
+};
+
+
+double pk_queue_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+void pk_uuid4(char out[37])
+{
+    unsigned char b[16];
+    int fd = open("/dev/urandom", O_RDONLY | O_CLOEXEC);
+    ssize_t got = fd >= 0 ? read(fd, b, sizeof b) : -1;
+    if (fd >= 0)
+        close(fd);
+    if (got != (ssize_t)sizeof b) { /* no urandom: time and pid, still unique per daemon */
+        struct timespec ts;
+        clock_gettime(CLOCK_REALTIME, &ts);
+        static unsigned counter;
+        unsigned long long v[2] = {(unsigned long long)ts.tv_sec * 1000000000ULL + ts.tv_nsec,
+                                   ((unsigned long long)getpid() << 32) | __atomic_add_fetch(&counter, 1, __ATOMIC_RELAXED)};
+        memcpy(b, v, sizeof b);
+    }
+    b[6] = (unsigned char)((b[6] & 0x0f) | 0x40);
+    b[8] = (unsigned char)((b[8] & 0x3f) | 0x80);
+    snprintf(out, 37, "%02x%02x%02x%02x-%02x%02x-%02x%02x-%02x%02x-%02x%02x%02x%02x%02x%02x", b[0],
+             b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11], b[12], b[13], b[14],
+             b[15]);
+}
+
+/* Prepare and bind: types "s" text (NULL ok), "i" int, "I" long long, "d" double. */
+static sqlite3_stmt *prep(pk_queue *q, const char *sql, const char *types, ...)
+{
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(q->db, sql, -1, &st, NULL) != SQLITE_OK) {
+        fprintf(stderr, "packd: sql error: %s in %s\n", sqlite3_errmsg(q->db), sql);
+        return NULL;
+    }
+    va_list ap;
+    va_start(ap, types);
+    for (int i = 0; types && types[i]; i++) {
+        switch (types[i]) {
+        case 's': {
+            const char *s = va_arg(ap, const char *);
+            if (s)
+                sqlite3_bind_text(st, i + 1, s, -1, SQLITE_TRANSIENT);
+            else
+                sqlite3_bind_null(st, i + 1);
+            break;
+        }
+        case 'i': sqlite3_bind_int(st, i + 1, va_arg(ap, int)); break;
+        case 'I': sqlite3_bind_int64(st, i + 1, va_arg(ap, long long)); break;
+        case 'd': sqlite3_bind_double(st, i + 1, va_arg(ap, double)); break;
+        }
+    }
+    va_end(ap);
+    return st;
+}
+
+/* Run a statement to completion; returns sqlite3_changes or -1. */
+static int run(pk_queue *q, sqlite3_stmt *st)
+{
+    if (!st)
+        return -1;
+    int rc;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW)
+        ;
+    sqlite3_finalize(st);
+    if (rc != SQLITE_DONE) {
+        fprintf(stderr, "packd: sql step: %s\n", sqlite3_errmsg(q->db));
+        return -1;
+    }
+    return sqlite3_changes(q->db);
+}
+
+static long long scalar(pk_queue *q, sqlite3_stmt *st)
+{
+    long long v = -1;
+    if (st && sqlite3_step(st) == SQLITE_ROW)
+        v = sqlite3_column_int64(st, 0);
+    sqlite3_finalize(st);
+    return v;
+}
+
+/* One row as a JSON object; columns named inputs/summary/data are parsed JSON. */
+static json_t *row_json(sqlite3_stmt *st)
+{
+    json_t *o = json_object();
+    for (int c = 0; c < sqlite3_column_count(st); c++) {
+        const char *name = sqlite3_column_name(st, c);
+        json_t *v;
+        switch (sqlite3_column_type(st, c)) {
+        case SQLITE_INTEGER: v = json_integer(sqlite3_column_int64(st, c)); break;
+        case SQLITE_FLOAT: v = json_real(sqlite3_column_double(st, c)); break;
+        case SQLITE_NULL: v = json_null(); break;
+        default: {
+            const char *t = (const char *)sqlite3_column_text(st, c);
+            if (!strcmp(name, "inputs") || !strcmp(name, "summary") || !strcmp(name, "data")) {
+                v = json_loads(t, JSON_DECODE_ANY, NULL);
+                if (!v)
+                    v = json_string(t);
+            } else {
+                v = json_string(t);
+            }
+        }
+        }
+        json_object_set_new(o, name, v ? v : json_null());
+    }
+    return o;
+}
+
+static json_t *rows(sqlite3_stmt *st)
+{
+    json_t *a = json_array();
+    while (st && sqlite3_step(st) == SQLITE_ROW)
+        json_array_append_new(a, row_json(st));
+    sqlite3_finalize(st);
+    return a;
+}
+
+static json_t *one_row(sqlite3_stmt *st)
+{
+    json_t *a = rows(st), *r = json_array_size(a) ? json_incref(json_array_get(a, 0)) : NULL;
+    json_decref(a);
+    return r;
+}
+
+static void notify(pk_queue *q)
+{
+    pthread_mutex_lock(&q->ev_mu);
+    q->ev_seq++;
+    pthread_cond_broadcast(&q->ev_cond);
+    pthread_mutex_unlock(&q->ev_mu);
+}
+
+static void add_event(pk_queue *q, const char *id, const char *kind, json_t *data)
+{
+    char *text = json_dumps(data, JSON_COMPACT);
+    run(q, prep(q, "INSERT INTO events(job_id, kind, data, created) VALUES (?,?,?,?)", "sssd", id,
+                kind, text ? text : "{}", pk_queue_now()));
+    free(text);
+}
+
+/* The "status" event of a job, from its row (after a change). */
+static void add_status_event(pk_queue *q, const char *id)
+{
+    json_t *d = one_row(prep(q, "SELECT status, progress, message, attempts FROM jobs WHERE id=?",
+                             "s", id));
+    if (d) {
+        add_event(q, id, "status", d);
+        json_decref(d);
+    }
+}
+
+static int begin(pk_queue *q) { return sqlite3_exec(q->db, "BEGIN IMMEDIATE", NULL, NULL, NULL); }
+static void commit(pk_queue *q)
+{
+    if (sqlite3_exec(q->db, "COMMIT", NULL, NULL, NULL) != SQLITE_OK)
+        sqlite3_exec(q->db, "ROLLBACK", NULL, NULL, NULL);
+}
+static void rollback(pk_queue *q) { sqlite3_exec(q->db, "ROLLBACK", NULL, NULL, NULL); }
+
+pk_queue *pk_queue_open(const char *path, char *err, size_t errlen)
+{
+    pk_queue *q = calloc(1, sizeof *q);
+    if (!q) {
+        snprintf(err, errlen, "out of memory");
+        return NULL;
+    }
+    if (sqlite3_open_v2(path, &q->db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX,
+                        NULL) != SQLITE_OK) {
+        snprintf(err, errlen, "%s: %s", path, q->db ? sqlite3_errmsg(q->db) : "cannot open");
+        sqlite3_close(q->db);
+        free(q);
+        return NULL;
+    }
+    /* WAL: readers never block the writer; FULL: a committed job survives a
+     * power loss too; the busy timeout covers other connections (sqlite3 CLI,
+     * backups, a second queue handle in tests). */
+    sqlite3_busy_timeout(q->db, 5000);
+    char *msg = NULL;
+    if (sqlite3_exec(q->db, "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL; PRAGMA foreign_keys=ON;",
+                     NULL, NULL, &msg) != SQLITE_OK ||
+        pk_migrate(q->db, err, errlen) < 0) {
+        if (msg)
+            snprintf(err, errlen, "%s: %s", path, msg);
+        sqlite3_free(msg);
+        sqlite3_close(q->db);
+        free(q);
+        return NULL;
+    }
+    pthread_mutex_init(&q->mu, NULL);
+    pthread_mutex_init(&q->ev_mu, NULL);
+    pthread_cond_init(&q->ev_cond, NULL);
+    return q;
+}
+
+void pk_queue_close(pk_queue *q)
+{
+    if (!q)
+        return;
+    sqlite3_close(q->db);
+    pthread_mutex_destroy(&q->mu);
+    pthread_mutex_destroy(&q->ev_mu);
+    pthread_cond_destroy(&q->ev_cond);
+    free(q);
+}
+
+int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37])
+{
+    int rc = PK_Q_ERROR;
+    pthread_mutex_lock(&q->mu);
+    if (begin(q) != SQLITE_OK)
+        goto out;
+    if (s->idempotency_key) {
+        json_t *k = one_row(prep(q, "SELECT request_sha256, job_id FROM idempotency WHERE owner=? AND key=?",
+                                 "ss", s->owner, s->idempotency_key));
+        if (k) {
+            int same = !strcmp(json_string_value(json_object_get(k, "request_sha256")),
+                               s->request_sha256 ? s->request_sha256 : "");
+            snprintf(id, 37, "%s", json_string_value(json_object_get(k, "job_id")));
+            json_decref(k);
+            rollback(q);
+            rc = same ? PK_Q_EXISTING : PK_Q_KEY_CONFLICT;
+            goto out;
+        }
+    }
+    if (scalar(q, prep(q, "SELECT count(*) FROM jobs WHERE status='accepted'", NULL)) >= s->max_queued) {
+        rollback(q);
+        rc = PK_Q_FULL;
+        goto out;
+    }
+    if (scalar(q, prep(q, "SELECT count(*) FROM jobs WHERE owner=? AND status='accepted'", "s",
+                       s->owner)) >= s->max_queued_per_owner) {
+        rollback(q);
+        rc = PK_Q_OWNER_FULL;
+        goto out;
+    }
+    pk_uuid4(id);
+    double now = pk_queue_now();
+    if (run(q, prep(q, "INSERT INTO jobs(id, process, inputs, owner, status, message, created, updated)"
+                       " VALUES (?,?,?,?,'accepted','queued',?,?)",
+                    "ssssdd", id, s->process, s->inputs_json, s->owner, now, now)) != 1 ||
+        (s->idempotency_key &&
+         run(q, prep(q, "INSERT INTO idempotency(owner, key, request_sha256, job_id, created) VALUES (?,?,?,?,?)",
+                     "ssssd", s->owner, s->idempotency_key, s->request_sha256 ? s->request_sha256 : "",
+                     id, now)) != 1)) {
+        rollback(q);
+        goto out;
+    }
+    add_status_event(q, id);
+    commit(q);
+    rc = PK_Q_OK;
+out:
+    pthread_mutex_unlock(&q->mu);
+    if (rc == PK_Q_OK)
+        notify(q);
+    return rc;
+}
+
+#define JOB_COLUMNS "id, process, inputs, owner, status, progress, message, created, started, " \
+                    "finished, updated, attempts, cancel_requested, worker_pid, rev, summary, "  \
+                    "result_sha256, result_size"
+
+json_t *pk_queue_get(pk_queue *q, const char *id)
+{
+    pthread_mutex_lock(&q->mu);
+    json_t *r = one_row(prep(q, "SELECT " JOB_COLUMNS " FROM jobs WHERE id=?", "s", id));
+    pthread_mutex_unlock(&q->mu);
+    return r;
+}
+
+json_t *pk_queue_list(pk_queue *q, const char *status, const char *process, int limit, int offset,
+                      int *total)
+{
+    pthread_mutex_lock(&q->mu);
+    const char *where = " WHERE (?1 IS NULL OR status=?1) AND (?2 IS NULL OR process=?2)";
+    char sql[512];
+    snprintf(sql, sizeof sql, "SELECT count(*) FROM jobs%s", where);
+    if (total)
+        *total = (int)scalar(q, prep(q, sql, "ss", status, process));
+    snprintf(sql, sizeof sql,
+             "SELECT id, process, status, progress, message, created, started, finished, updated, rev"
+             " FROM jobs%s ORDER BY seq DESC LIMIT ?3 OFFSET ?4", where);
+    json_t *r = rows(prep(q, sql, "ssii", status, process, limit, offset));
+    pthread_mutex_unlock(&q->mu);
+    return r;
+}
+
+json_t *pk_queue_claim(pk_queue *q)
+{
+    json_t *r = NULL;
+    pthread_mutex_lock(&q->mu);
+    if (begin(q) != SQLITE_OK)
+        goto out;
+    json_t *next = one_row(prep(q, "SELECT id FROM jobs WHERE status='accepted' ORDER BY seq LIMIT 1", NULL));
+    if (!next) {
+        rollback(q);
+        goto out;
+    }
+    const char *id = json_string_value(json_object_get(next, "id"));
+    double now = pk_queue_now();
+    /* The status condition makes the claim atomic: a job is running at most once. */
+    if (run(q, prep(q, "UPDATE jobs SET status='running', attempts=attempts+1, started=?, updated=?,"
+                       " message='running', progress=0, rev=rev+1 WHERE id=? AND status='accepted'",
+                    "dds", now, now, id)) == 1) {
+        add_status_event(q, id);
+        r = one_row(prep(q, "SELECT " JOB_COLUMNS " FROM jobs WHERE id=?", "s", id));
+        commit(q);
+    } else {
+        rollback(q);
+    }
+    json_decref(next);
+out:
+    pthread_mutex_unlock(&q->mu);
+    if (r)
+        notify(q);
+    return r;
+}
+
+void pk_queue_set_worker(pk_queue *q, const char *id, int pid)
+{
+    pthread_mutex_lock(&q->mu);
+    run(q, prep(q, "UPDATE jobs SET worker_pid=? WHERE id=?", "is", pid, id));
+    pthread_mutex_unlock(&q->mu);
+}
+
+void pk_queue_progress(pk_queue *q, const char *id, int percent, json_t *data)
+{
+    pthread_mutex_lock(&q->mu);
+    const char *msg = json_string_value(json_object_get(data, "message"));
+    if (begin(q) == SQLITE_OK) {
+        if (run(q, prep(q, "UPDATE jobs SET progress=?, message=coalesce(?, message), updated=?,"
+                           " rev=rev+1 WHERE id=? AND status='running'",
+                        "isds", percent, msg, pk_queue_now(), id)) == 1)
+            add_event(q, id, "progress", data);
+        commit(q);
+    }
+    pthread_mutex_unlock(&q->mu);
+    notify(q);
+}
+
+const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, const char *message,
+                            const char *summary_json, const char *sha256, long long size)
+{
+    const char *ended = "dismissed";
+    double now = pk_queue_now();
+    pthread_mutex_lock(&q->mu);
+    if (begin(q) == SQLITE_OK) {
+        int n = run(q, prep(q, "UPDATE jobs SET status=?, message=?, progress=CASE WHEN ?='successful'"
+                               " THEN 100 ELSE progress END, finished=?, updated=?, summary=?,"
+                               " result_sha256=?, result_size=?, worker_pid=NULL, rev=rev+1"
+                               " WHERE id=? AND status='running'",
+                            "sssddssIs", status, message, status, now, now, summary_json, sha256,
+                            size, id));
+        if (n == 1) {
+            ended = !strcmp(status, "successful") ? "successful" : "failed";
+        } else if (run(q, prep(q, "UPDATE jobs SET finished=?, updated=?, worker_pid=NULL, rev=rev+1,"
+                                  " message='dismissed; worker stopped' WHERE id=? AND"
+                                  " status='dismissed' AND finished IS NULL",
+                               "dds", now, now, id)) != 1) { /* not ours to end */
+            ended = "unchanged";
+            commit(q);
+            goto out;
+        }
+        add_status_event(q, id);
+        commit(q);
+    }
+out:
+    pthread_mutex_unlock(&q->mu);
+    notify(q);
+    return ended;
+}
+
+int pk_queue_dismiss(pk_queue *q, const char *id, char was[16])
+{
+    int rc = -1;
+    pthread_mutex_lock(&q->mu);
+    if (begin(q) != SQLITE_OK)
+        goto out;
+    json_t *r = one_row(prep(q, "SELECT status FROM jobs WHERE id=?", "s", id));
+    if (!r) {
+        rollback(q);
+        goto out;
+    }
+    snprintf(was, 16, "%s", json_string_value(json_object_get(r, "status")));
+    json_decref(r);
+    double now = pk_queue_now();
+    if (!strcmp(was, "running"))
+        run(q, prep(q, "UPDATE jobs SET status='dismissed', cancel_requested=1, message='dismissed;"
+                       " stopping the worker', updated=?, rev=rev+1 WHERE id=?", "ds", now, id));
+    else if (strcmp(was, "dismissed") != 0)
+        run(q, prep(q, "UPDATE jobs SET status='dismissed', message='dismissed', updated=?,"
+                       " finished=coalesce(finished, ?), rev=rev+1 WHERE id=?", "dds", now, now, id));
+    add_status_event(q, id);
+    commit(q);
+    rc = 0;
+out:
+    pthread_mutex_unlock(&q->mu);
+    if (rc == 0)
+        notify(q);
+    return rc;
+}
+
+json_t *pk_queue_cancel_requests(pk_queue *q)
+{
+    pthread_mutex_lock(&q->mu);
+    json_t *r = rows(prep(q, "SELECT id, worker_pid FROM jobs WHERE cancel_requested=1 AND"
+                             " finished IS NULL", NULL));
+    pthread_mutex_unlock(&q->mu);
+    return r;
+}
+
+int pk_queue_recover(pk_queue *q, int max_attempts, int *failed)
+{
+    int requeued = 0;
+    *failed = 0;
+    pthread_mutex_lock(&q->mu);
+    if (begin(q) == SQLITE_OK) {
+        json_t *left = rows(prep(q, "SELECT id, attempts, status FROM jobs WHERE (status='running') OR"
+                                    " (cancel_requested=1 AND finished IS NULL)", NULL));
+        double now = pk_queue_now();
+        size_t i;
+        json_t *r;
+        json_array_foreach(left, i, r) {
+            const char *id = json_string_value(json_object_get(r, "id"));
+            if (strcmp(json_string_value(json_object_get(r, "status")), "running") != 0) {
+                run(q, prep(q, "UPDATE jobs SET finished=?, worker_pid=NULL WHERE id=?", "ds", now, id));
+                continue;
+            }
+            int attempts = (int)json_integer_value(json_object_get(r, "attempts"));
+            if (attempts < max_attempts) {
+                run(q, prep(q, "UPDATE jobs SET status='accepted', worker_pid=NULL, progress=0,"
+                               " message='re-queued after the daemon stopped (attempt ' || attempts || ')',"
+                               " updated=?, rev=rev+1 WHERE id=?", "ds", now, id));
+                requeued++;
+            } else {
+                run(q, prep(q, "UPDATE jobs SET status='failed', worker_pid=NULL, finished=?, updated=?,"
+                               " message='interrupted ' || attempts || ' times by daemon restarts; not"
+                               " retried', rev=rev+1 WHERE id=?", "dds", now, now, id));
+                (*failed)++;
+            }
+            add_status_event(q, id);
+        }
+        json_decref(left);
+        commit(q);
+    }
+    pthread_mutex_unlock(&q->mu);
+    return requeued;
+}
+
+void pk_queue_requeue(pk_queue *q, const char *id, const char *why)
+{
+    pthread_mutex_lock(&q->mu);
+    if (begin(q) == SQLITE_OK) {
+        if (run(q, prep(q, "UPDATE jobs SET status='accepted', attempts=max(attempts-1, 0),"
+                           " worker_pid=NULL, progress=0, message=?, updated=?, rev=rev+1"
+                           " WHERE id=? AND status='running'", "sds", why, pk_queue_now(), id)) == 1)
+            add_status_event(q, id);
+        commit(q);
+    }
+    pthread_mutex_unlock(&q->mu);
+    notify(q);
+}
+
+json_t *pk_queue_events(pk_queue *q, const char *id, long long after, int limit)
+{
+    pthread_mutex_lock(&q->mu);
+    json_t *r = rows(prep(q, "SELECT id, kind, data FROM events WHERE job_id=? AND id>? ORDER BY id"
+                             " LIMIT ?", "sIi", id, after, limit));
+    pthread_mutex_unlock(&q->mu);
+    return r;
+}
+
+long long pk_queue_event_seq(pk_queue *q)
+{
+    pthread_mutex_lock(&q->ev_mu);
+    long long s = q->ev_seq;
+    pthread_mutex_unlock(&q->ev_mu);
+    return s;
+}
+
+long long pk_queue_wait_event(pk_queue *q, long long seen, int timeout_ms)
+{
+    struct timespec until;
+    clock_gettime(CLOCK_REALTIME, &until);
+    until.tv_sec += timeout_ms / 1000;
+    until.tv_nsec += (long)(timeout_ms % 1000) * 1000000L;
+    if (until.tv_nsec >= 1000000000L) {
+        until.tv_sec++;
+        until.tv_nsec -= 1000000000L;
+    }
+    pthread_mutex_lock(&q->ev_mu);
+    while (q->ev_seq == seen)
+        if (pthread_cond_timedwait(&q->ev_cond, &q->ev_mu, &until) == ETIMEDOUT)
+            break;
+    long long s = q->ev_seq;
+    pthread_mutex_unlock(&q->ev_mu);
+    return s;
+}
+
+void pk_queue_wake_all(pk_queue *q) { notify(q); }
+
+json_t *pk_queue_stats(pk_queue *q)
+{
+    pthread_mutex_lock(&q->mu);
+    json_t *by = rows(prep(q, "SELECT status, count(*) AS n, count(finished - started) AS timed,"
+                              " coalesce(sum(finished - started), 0.0) AS secs FROM jobs GROUP BY status", NULL));
+    pthread_mutex_unlock(&q->mu);
+    json_t *jobs = json_object(), *dur = json_object();
+    const char *all[] = {"accepted", "running", "successful", "failed", "dismissed"};
+    for (size_t i = 0; i < 5; i++)
+        json_object_set_new(jobs, all[i], json_integer(0));
+    size_t i;
+    json_t *r;
+    json_array_foreach(by, i, r) {
+        const char *st = json_string_value(json_object_get(r, "status"));
+        json_object_set(jobs, st, json_object_get(r, "n"));
+        json_object_set_new(dur, st, json_pack("{s:O,s:O}", "count", json_object_get(r, "timed"),
+                                               "sum", json_object_get(r, "secs")));
+    }
+    json_decref(by);
+    return json_pack("{s:o,s:o}", "jobs", jobs, "durations", dur);
+}
+
+int pk_queue_add_file(pk_queue *q, const char *id, const char *sha256, long long size,
+                      const char *media_type, const char *owner)
+{
+    pthread_mutex_lock(&q->mu);
+    int n = run(q, prep(q, "INSERT OR IGNORE INTO files(id, sha256, size, media_type, owner, created)"
+                           " VALUES (?,?,?,?,?,?)", "ssIssd", id, sha256, size, media_type, owner,
+                        pk_queue_now()));
+    pthread_mutex_unlock(&q->mu);
+    return n < 0 ? -1 : 0;
+}
+
+json_t *pk_queue_get_file(pk_queue *q, const char *id)
+{
+    pthread_mutex_lock(&q->mu);
+    json_t *r = one_row(prep(q, "SELECT id, sha256, size, media_type, created FROM files WHERE id=?",
+                             "s", id));
+    pthread_mutex_unlock(&q->mu);
+    return r;
+}

@@ -1,0 +1,101 @@
+/* queue.h — the durable job queue: one SQLite file (WAL, busy timeout,
+ * migrations.c) is the source of truth for jobs, inputs, states, progress,
+ * idempotency keys, uploads and the events SSE listeners resume from.
+ *
+ * One connection per pk_queue, serialised by a mutex: every function is one
+ * short transaction and safe to call from any thread.  Job rows come back as
+ * JSON objects with the column names as keys (inputs/summary parsed). */
+#ifndef PK_QUEUE_H
+#define PK_QUEUE_H
+
+#include <jansson.h>
+#include <stddef.h>
+
+typedef struct pk_queue pk_queue;
+
+enum {
+    PK_Q_OK = 0,          /* new job created */
+    PK_Q_EXISTING = 1,    /* idempotency key seen with the same request: same job */
+    PK_Q_FULL = -2,       /* max_queued waiting jobs */
+    PK_Q_OWNER_FULL = -3, /* max_queued_per_owner waiting jobs of this owner */
+    PK_Q_KEY_CONFLICT = -4, /* idempotency key reused with another request */
+    PK_Q_ERROR = -1,
+};
+
+pk_queue *pk_queue_open(const char *path, char *err, size_t errlen);
+void pk_queue_close(pk_queue *q);
+
+/* Current time in seconds since the epoch (what the queue stores). */
+double pk_queue_now(void);
+
+typedef struct pk_submit {
+    const char *process, *inputs_json, *owner;
+    const char *idempotency_key;   /* may be NULL */
+    const char *request_sha256;    /* fingerprint of the request (with a key) */
+    int max_queued, max_queued_per_owner;
+} pk_submit;
+
+/* Submit a job; fills id (37 bytes). Returns a PK_Q_* code. */
+int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37]);
+
+/* The job row, or NULL if unknown. */
+json_t *pk_queue_get(pk_queue *q, const char *id);
+
+/* Newest first; status/process may be NULL (any). */
+json_t *pk_queue_list(pk_queue *q, const char *status, const char *process, int limit, int offset,
+                      int *total);
+
+/* Move the oldest accepted job to running (attempts + 1).  Returns the job
+ * row (new ref) or NULL when none waits. */
+json_t *pk_queue_claim(pk_queue *q);
+void pk_queue_set_worker(pk_queue *q, const char *id, int pid);
+
+/* A running job's progress (0..100) and the worker's progress object. */
+void pk_queue_progress(pk_queue *q, const char *id, int percent, json_t *data);
+
+/* End a running job: status "successful" or "failed".  A job already
+ * dismissed (cancelled) keeps its status; its final event notes the stop.
+ * Returns the status the job ends with (static string), or "unchanged" when
+ * the job was not running (already final: nothing is touched). */
+const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, const char *message,
+                            const char *summary_json, const char *sha256, long long size);
+
+/* DELETE /jobs/{id}: accepted/running -> dismissed (running ones get
+ * cancel_requested, the supervisor stops their worker); finished ->
+ * dismissed.  *was receives the previous status.  Returns 0, -1 if unknown. */
+int pk_queue_dismiss(pk_queue *q, const char *id, char was[16]);
+
+/* Running jobs whose worker must be stopped (cancel_requested). */
+json_t *pk_queue_cancel_requests(pk_queue *q);
+
+/* Daemon start: jobs left running by a dead daemon go back to accepted, or
+ * fail after max_attempts starts.  Returns how many were re-queued. */
+int pk_queue_recover(pk_queue *q, int max_attempts, int *failed);
+
+/* SIGTERM past the grace period: give the start back and re-queue. */
+void pk_queue_requeue(pk_queue *q, const char *id, const char *why);
+
+/* Events of a job after event id `after` (oldest first, at most limit):
+ * [{"id", "kind", "data"}]. */
+json_t *pk_queue_events(pk_queue *q, const char *id, long long after, int limit);
+
+/* Block until an event newer than `seen` (from pk_queue_event_seq) may exist
+ * or timeout_ms passes; returns the current sequence. */
+long long pk_queue_event_seq(pk_queue *q);
+long long pk_queue_wait_event(pk_queue *q, long long seen, int timeout_ms);
+/* Wake every waiter (shutdown). */
+void pk_queue_wake_all(pk_queue *q);
+
+/* Metrics: {"jobs": {status: n}, "durations": {status: {"count", "sum"}},
+ *           "waiting", "running"}. */
+json_t *pk_queue_stats(pk_queue *q);
+
+/* Uploaded files. */
+int pk_queue_add_file(pk_queue *q, const char *id, const char *sha256, long long size,
+                      const char *media_type, const char *owner);
+json_t *pk_queue_get_file(pk_queue *q, const char *id);
+
+/* A random RFC 4122 version 4 UUID (37 bytes with NUL). */
+void pk_uuid4(char out[37]);
+
+#endif

@@ -1,0 +1,57 @@
+/* GET /jobs/{id}/results (document) and /jobs/{id}/results/{output} (file). */
+#include <stdio.h>
+#include <string.h>
+
+#include "http.h"
+#include "http_status_info.h"
+
+/* The row of a successful job, or NULL after replying with the problem. */
+static json_t *successful_job(pk_req *r, enum MHD_Result *rc)
+{
+    json_t *row = pk_queue_get(r->svc->q, r->seg[1]);
+    if (!row) {
+        *rc = pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
+        return NULL;
+    }
+    const char *st = json_string_value(json_object_get(row, "status"));
+    if (strcmp(st, "successful") != 0) {
+        char d[400];
+        snprintf(d, sizeof d, "the job is %s: %s", st, json_string_value(json_object_get(row, "message")));
+        *rc = pk_send_problem(r, 404, PK_PROBLEM_RESULT_NOT_READY, "Result not ready", d,
+                              json_pack("{s:s,s:s}", "jobID", r->seg[1], "jobStatus", st), 0);
+        json_decref(row);
+        return NULL;
+    }
+    return row;
+}
+
+enum MHD_Result route_results(pk_req *r)
+{
+    enum MHD_Result rc;
+    json_t *row = successful_job(r, &rc);
+    if (!row)
+        return rc;
+    json_t *doc = pk_results_document(row);
+    json_decref(row);
+    return pk_send_json(r, 200, doc, NULL);
+}
+
+enum MHD_Result route_result_file(pk_req *r)
+{
+    if (strcmp(r->seg[3], "result") != 0)
+        return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output",
+                               "outputs: result", NULL, 0);
+    enum MHD_Result rc;
+    json_t *row = successful_job(r, &rc);
+    if (!row)
+        return rc;
+    pk_config cfg = pk_service_config(r->svc);
+    char dir[1200], path[1300], name[200];
+    pk_job_dir(cfg.data, r->seg[1], dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/result.h5", dir);
+    snprintf(name, sizeof name, "%s.h5", r->seg[1]);
+    rc = pk_send_file(r, path, PK_RESULT_MEDIA_TYPE,
+                      json_string_value(json_object_get(row, "result_sha256")), name);
+    json_decref(row);
+    return rc;
+}

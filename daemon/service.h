@@ -1,0 +1,26 @@
+/* service.h — the state one `packd serve` shares between its HTTP threads,
+ * the supervisor thread and the signal loop. */
+#ifndef PK_SERVICE_H
+#define PK_SERVICE_H
+
+#include <pthread.h>
+
+#include "config.h"
+#include "queue.h"
+#include "supervisor.h"
+
+typedef struct pk_service {
+    pthread_mutex_t mu;          /* guards cfg (SIGHUP replaces it) */
+    pk_config cfg;
+    pk_queue *q;
+    pk_supervisor *sup;
+    int draining;                /* SIGTERM received: refuse new jobs (atomic) */
+    int stopping;                /* streams must end now (atomic) */
+    double started;
+    unsigned long long responses[600]; /* by HTTP status (atomic) */
+} pk_service;
+
+/* A copy of the current configuration. */
+pk_config pk_service_config(pk_service *s);
+
+#endif

@@ -1,0 +1,115 @@
+#!/bin/sh
+# test_homogenize.sh — the 'homogenize' process end to end: pack an RVE with
+# `packd run`, homogenize it under the three boundary conditions and the
+# load presets, read the H5MD result back, and refuse bad jobs clearly.
+set -u
+PACKD=${PACKD:-build/packd}
+SRC=${PACKD_SRC:-$PWD}
+EX="$SRC/examples/homogenize"
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+pass() { echo "PASS $1"; }
+fail() { echo "FAIL $1${2:+: $2}"; }
+check() { # name, condition command...
+    name=$1
+    shift
+    if "$@"; then pass "$name"; else fail "$name"; fi
+}
+cd "$T" || exit 1
+
+# 1. the RVE, then the example exactly as shipped (its rve path is relative to the cwd)
+"$PACKD" run "$EX/rve-rsa-2d.json" -o rve-2d.h5 >pack.json 2>pack.err
+check pack_rve grep -q '"complete": true' pack.json
+if "$PACKD" run "$EX/homogenize-periodic-2d.json" -o per.h5 >per.json 2>per.err &&
+    grep -q '"complete": true' per.json; then
+    pass example_homogenize_periodic_2d
+else
+    fail example_homogenize_periodic_2d "$(cat per.err)"
+fi
+h5dump -H per.h5 >per.dump 2>&1
+check h5md_layout sh -c "grep -q 'GROUP \"h5md\"' per.dump && grep -q 'DATASET \"radius\"' per.dump &&
+    grep -q 'GROUP \"homogenize\"' per.dump && grep -q 'DATASET \"1111\"' per.dump &&
+    grep -q 'DATASET \"stop_code\"' per.dump && grep -q 'DATASET \"fluctuation\"' per.dump"
+
+# 2. per-step figures read back: compression gives σ̄ < 0, σ̄ symmetric (frictionless),
+#    J = det F̄, Ā major-symmetric, every step converged, Σf = 0
+"$PACKD" inspect per.h5 >per.insp
+check per_step_observables python3 -c "
+import json; o = json.load(open('per.insp'))['observables']
+g = lambda k: o['homogenize/' + k]
+n = g('steps'); assert n == 20 and len(g('P/11')) == n
+for k in range(n):
+    assert g('sigma/11')[k] < 0 and g('sigma/22')[k] < 0
+    assert abs(g('sigma/12')[k] - g('sigma/21')[k]) <= 1e-12 * abs(g('sigma/11')[k])
+    assert abs(g('J')[k] - g('F/11')[k] * g('F/22')[k]) < 1e-15
+    assert g('dr/stop_code')[k] in (0, 1)
+    assert g('sum_force')[k] < 1e-9
+    for a in ('11','12','21','22'):
+        for b in ('11','12','21','22'):
+            A = g('tangent/A/' + a + b)[k]; B = g('tangent/A/' + b + a)[k]
+            assert abs(A - B) <= 1e-9 * abs(g('tangent/A/1111')[k]), (a, b, A, B)
+assert abs(g('F/11')[-1] - 0.98) < 1e-15
+assert g('final_state/position')['shape'] == [2 * g('rve_particles')] # inspect abbreviates long arrays
+"
+
+# 3. the three boundary conditions on the same RVE: energy ranking of §9.3
+#    (Taylor stiffest, periodic softest) and σ̄11 ranking under compression
+for bc in taylor restricted_taylor periodic; do
+    python3 -c "
+import json; j = json.load(open('$EX/homogenize-periodic-2d.json'))
+j['inputs']['boundary_condition'] = '$bc'; j['inputs']['tangent'] = False
+j['inputs']['output'] = {}
+json.dump(j, open('$bc.json', 'w'))"
+    "$PACKD" run "$bc.json" -o "$bc.h5" >"$bc.out" 2>"$bc.err" || fail "run_$bc" "$(cat "$bc.err")"
+done
+check bc_ranking_energy_and_stress python3 -c "
+import json
+s = {bc: json.load(open(bc + '.out')) for bc in ('taylor', 'restricted_taylor', 'periodic')}
+e = [s[b]['energy_density'] for b in ('taylor', 'restricted_taylor', 'periodic')]
+p = [-s[b]['sigma'][0] for b in ('taylor', 'restricted_taylor', 'periodic')]
+assert e[0] > e[1] > e[2], e
+assert p[0] > p[1] > p[2], p
+assert all(s[b]['complete'] for b in s)"
+
+# 4. presets: simple shear with pre-compression, cyclic shear (isochoric J = 0.99²)
+cat >cyc.json <<'JOB'
+{"process": "homogenize", "inputs": {"rve": {"file": "rve-2d.h5"}, "boundary_condition": "restricted_taylor",
+ "load": {"type": "cyclic_shear", "precompression": 0.01, "pre_steps": 2, "amplitude": 0.04, "steps": 8},
+ "contact": {"E_n": 50}, "initial_state": {"policy": "radius_inflation", "value": 0.3}}}
+JOB
+"$PACKD" run cyc.json -o cyc.h5 >cyc.out 2>cyc.err
+"$PACKD" inspect cyc.h5 >cyc.insp 2>/dev/null
+check cyclic_shear_path python3 -c "
+import json; o = json.load(open('cyc.insp'))['observables']
+F12 = o['homogenize/F/12']; J = o['homogenize/J']
+assert len(F12) == 10
+want = [0, 0, 0.02, 0.04, 0.02, 0, -0.02, -0.04, -0.02, 0]
+assert all(abs(a - b) < 1e-12 for a, b in zip(F12, want)), F12
+assert all(abs(j - 0.99 ** 2) < 1e-12 for j in J[2:]), J"
+
+# 5. bad jobs: refused with the pointer, or a clear run-time error
+cat >det.json <<'JOB'
+{"process": "homogenize", "inputs": {"rve": {"file": "rve-2d.h5"}, "boundary_condition": "taylor",
+ "load": {"type": "list", "F": [[1, 0, 0, 1], [1, 2, 1, 1]]}}}
+JOB
+out=$("$PACKD" validate det.json 2>/dev/null)
+rc=$?
+check refuse_det_le_zero sh -c "test $rc -eq 1 && printf '%s' '$out' | grep -q '/inputs/load/F/1'"
+cat >loose.json <<'JOB'
+{"process": "homogenize", "inputs": {"rve": {"file": "rve-2d.h5"}, "boundary_condition": "taylor",
+ "load": {"type": "list", "F": [[0.999, 0, 0, 1]]}, "tangent": true}}
+JOB
+"$PACKD" run loose.json -o loose.h5 >/dev/null 2>loose.err
+rc=$?
+check refuse_tangent_without_jammed_contacts sh -c "test $rc -ne 0 && grep -q 'no jammed contact' loose.err && ! test -e loose.h5"
+python3 -c "
+import json; j = json.load(open('$SRC/examples/din-a16-3d-walled.json')); j['inputs']['count'] = 30
+j['inputs'].pop('phi', None); json.dump(j, open('walled.json', 'w'))" 2>/dev/null
+"$PACKD" run walled.json -o walled.h5 >/dev/null 2>&1
+cat >perwall.json <<'JOB'
+{"process": "homogenize", "inputs": {"rve": {"file": "walled.h5"}, "boundary_condition": "periodic",
+ "load": {"type": "uniaxial_compression", "axis": 3, "strain": 0.01, "steps": 1}}}
+JOB
+"$PACKD" run perwall.json -o perwall.h5 >/dev/null 2>perwall.err
+rc=$?
+check refuse_periodic_on_walled_box sh -c "test $rc -ne 0 && grep -q 'periodic on every axis' perwall.err"

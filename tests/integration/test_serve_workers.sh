@@ -1,0 +1,106 @@
+#!/bin/sh
+# test_serve_workers.sh — packd serve's worker processes: cancellation of a
+# running job (live SSE), a worker killed with SIGKILL fails only its job,
+# result-not-ready, a full queue answers 503 + Retry-After, kill -9 of the
+# daemon with a job running then restart completes the job, SIGTERM re-queues
+# what did not finish in the grace period, SIGHUP reloads the config file.
+. "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
+
+slow_body 60 >"$T/slow.json"   # runs until cancelled (60 s safety net)
+slow_body 3 >"$T/slow3.json"   # ends by its own wall-time limit after 3 s
+
+printf 'workers = 1\nmax_queued = 1\nlog_level = info\n' >"$T/packd.conf"
+start_daemon w1 --config "$T/packd.conf" || { fail serve_starts; exit 1; }
+
+# 1. cancel a running job: the worker is gone within the limit, SSE shows
+#    live progress and the final status, then ends
+S=$(submit "$T/slow.json")
+wait_status "$S" running 20
+c -N "$B/jobs/$S/events" >"$T/live.txt" &
+sse=$!
+i=0
+while [ -z "$(worker_pid "$S")" ] && [ $i -lt $((50 * SLOW)) ]; do sleep 0.1; i=$((i + 1)); done
+W=$(worker_pid "$S")
+sleep $((1 * SLOW)) # let it report progress
+# Limit: SIGTERM within 0.2 s (supervisor poll), the cancel flag is honoured
+# within 1 s; a worker still saving its (discarded) result gets SIGKILL 2 s
+# after SIGTERM.  So 3 s, scaled for the sanitized build.
+t0=$(date +%s%N)
+code=$(c -o "$T/del.json" -w '%{http_code}' -X DELETE "$B/jobs/$S")
+while [ -n "$W" ] && kill -0 "$W" 2>/dev/null && [ $(( ($(date +%s%N) - t0) / 1000000 )) -lt $((5000 * SLOW)) ]; do
+    sleep 0.05
+done
+ms=$(( ($(date +%s%N) - t0) / 1000000 ))
+check cancel_dismissed test "$code $(jget "$T/del.json" 'd["status"]')" = "200 dismissed"
+check cancel_worker_stopped sh -c "[ -n '$W' ] && ! kill -0 '$W' 2>/dev/null && [ $ms -le $((3000 * SLOW)) ]"
+echo "cancel: worker gone ${ms} ms after DELETE"
+i=0
+while kill -0 $sse 2>/dev/null && [ $i -lt $((50 * SLOW)) ]; do sleep 0.1; i=$((i + 1)); done
+check sse_live_progress_then_dismissed sh -c "! kill -0 $sse 2>/dev/null && grep -q '^event: progress' '$T/live.txt' && grep -q '\"status\":\"running\"' '$T/live.txt' && tail -3 '$T/live.txt' | grep -q '\"status\":\"dismissed\"'"
+problem() { # name, code, curl args... (status + problem+json)
+    name=$1
+    want=$2
+    shift 2
+    got=$(c -D "$T/p.h" -o "$T/p.json" -w '%{http_code}' "$@")
+    if [ "$got" = "$want" ] && grep -qi '^content-type: application/problem+json' "$T/p.h"; then pass "$name"; else fail "$name" "got $got"; fi
+}
+problem result_of_dismissed_not_ready 404 "$B/jobs/$S/results"
+
+# 2. a worker killed with SIGKILL fails its job; the daemon serves on
+K=$(submit "$T/slow.json")
+wait_status "$K" running 20
+problem error_result_not_ready 404 "$B/jobs/$K/results/result"
+check error_result_not_ready_type grep -q 'result-not-ready' "$T/p.json"
+# 3. ...meanwhile the queue (max_queued = 1) takes one more, then says 503
+Q=$(submit "$T/fast.json")
+problem error_503_queue_full 503 -H 'Content-Type: application/json' --data-binary "@$T/fast.json" "$B/processes/pack/execution"
+check error_503_retry_after grep -qi '^retry-after: [0-9]' "$T/p.h"
+i=0
+while [ -z "$(worker_pid "$K")" ] && [ $i -lt $((50 * SLOW)) ]; do sleep 0.1; i=$((i + 1)); done
+kill -9 "$(worker_pid "$K")"
+wait_status "$K" failed 20
+check worker_sigkill_fails_job sh -c "grep -q 'signal 9' '$T/st.json'"
+check daemon_serves_after_worker_crash test "$(kill -0 "$DPID" && c -o /dev/null -w '%{http_code}' "$B/healthz")" = 200
+check next_job_runs_after_crash wait_status "$Q" successful 60
+
+# 4. SIGHUP reloads the configuration file (max_queued 1 -> 5)
+printf 'workers = 1\nmax_queued = 5\nlog_level = info\n' >"$T/packd.conf"
+kill -HUP "$DPID"
+sleep 0.5
+check sighup_reload grep -q 'configuration reloaded' "$LOG"
+
+# 5. kill -9 of the daemon with a job running; restart; the job completes
+R=$(submit "$T/slow3.json")
+wait_status "$R" running 20
+i=0
+while [ -z "$(worker_pid "$R")" ] && [ $i -lt $((50 * SLOW)) ]; do sleep 0.1; i=$((i + 1)); done
+old_worker=$(worker_pid "$R")
+kill -9 "$DPID"
+sleep 0.5
+# dead = gone, or a zombie left to an init that does not reap (containers)
+check worker_dies_with_daemon sh -c "[ -n '$old_worker' ] && ! ps -o stat= -p '$old_worker' | grep -qv Z"
+start_daemon w1 --config "$T/packd.conf" || fail restart
+check restarted_job_completes wait_status "$R" successful 60
+check restart_logged_recovery grep -q '"requeued":1' "$LOG"
+c "$B/jobs/$R/results" >"$T/rr.json"
+check restarted_job_result test "$(jget "$T/rr.json" 'd["summary"]["value"]["termination_reason"]')" = wall_time
+
+# 6. SIGTERM: running job gets grace_s (1 s here), then is re-queued; the
+#    daemon exits 0; after a restart the job completes
+kill -9 "$DPID"
+start_daemon w2 --workers 1 --grace-s 1 || fail restart2
+G=$(submit "$T/slow3.json")
+wait_status "$G" running 20
+kill -TERM "$DPID"
+i=0
+while kill -0 "$DPID" 2>/dev/null && [ $i -lt $((100 * SLOW)) ]; do sleep 0.1; i=$((i + 1)); done
+wait "$DPID"
+check sigterm_clean_exit sh -c "[ $? -eq 0 ] && grep -q 'job re-queued at shutdown' '$LOG' && grep -q '\"msg\":\"stopped\"' '$LOG'"
+start_daemon w2 --workers 1 || fail restart3
+check sigterm_requeued_job_completes wait_status "$G" successful 60
+check logs_are_json_lines python3 -c "
+import json,sys
+for f in sys.argv[1:]:
+    for line in open(f):
+        o = json.loads(line); assert {'ts','level','msg'} <= o.keys(), line
+" "$T"/*.log

@@ -1,0 +1,107 @@
+/* homog_fixture.h — jammed test RVEs and committed states shared by the
+ * homogenization unit tests (static helpers; include once per test binary).
+ * Needs check.h included first. */
+#ifndef PK_HOMOG_FIXTURE_H
+#define PK_HOMOG_FIXTURE_H
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "homog_bc.h"
+#include "homog_tensor.h"
+#include "rng.h"
+
+static pk_homog_opts opts(double rmean)
+{
+    pk_homog_opts o = {.E_n = 1.0, .affine_predictor = 1};
+    o.dr.tol = 1e-12;
+    o.dr.abs_floor = 1e-13; /* above the round-off of forces (~1e-16·E·L·√N) */
+    o.dr.max_iter = 400000;
+    o.dr.lanczos_steps = 40;
+    o.dr.refresh = 200;
+    o.dr.skin = 0.3 * rmean;
+    return o;
+}
+
+static void diagF(double F[9], double a, double b, double c)
+{
+    memset(F, 0, 9 * sizeof *F);
+    F[0] = a, F[4] = b, F[8] = c;
+}
+
+/* Jammed periodic packing: n grains, radii in [0.8, 1.2], overlapping at
+ * φ_nominal, relaxed to equilibrium (DR tol 1e-12). */
+static void make_jammed(int dim, size_t n, double phi, uint64_t seed, pk_box *b, pk_particles *p)
+{
+    pk_rng rng;
+    pk_rng_seed(&rng, seed, 0);
+    pk_particles_init(p, dim, n);
+    double meas = 0;
+    double *r = malloc(n * sizeof *r);
+    for (size_t i = 0; i < n; i++) {
+        r[i] = pk_rng_range(&rng, 0.8, 1.2);
+        meas += pk_ball_measure(dim, r[i]);
+    }
+    double L = pow(meas / phi, 1.0 / dim);
+    memset(b, 0, sizeof *b);
+    b->dim = dim;
+    for (int k = 0; k < dim; k++)
+        b->L[k] = L, b->periodic[k] = true;
+    for (size_t i = 0; i < n; i++) {
+        double x[3] = {0, 0, 0};
+        for (int k = 0; k < dim; k++)
+            x[k] = pk_rng_range(&rng, 0, L);
+        pk_particles_push(p, x, r[i], 0);
+    }
+    free(r);
+    pk_homog_rve rve;
+    char err[128];
+    CHECK(pk_homog_rve_build(b, p, PK_BC_PERIODIC, 1.0, &rve, err, sizeof err) == 0);
+    pk_homog_opts o = opts(1.0);
+    pk_homog_state s0, tr = {0};
+    pk_homog_state_init(&rve, &o, &s0);
+    double I[9];
+    pk_m3_identity(I);
+    pk_homog_step st;
+    CHECK(pk_homog_eval(&rve, &o, &s0, I, &tr, &st, NULL) == 0);
+    CHECK_MSG(pk_dr_stop_ok(st.dr.stop), "jamming relaxation: %s after %zu iterations",
+              pk_dr_stop_name(st.dr.stop), st.dr.iterations);
+    for (size_t i = 0; i < n; i++) {
+        memcpy(&p->x[3 * i], &tr.x[3 * i], 3 * sizeof(double));
+        pk_box_wrap(b, &p->x[3 * i]);
+    }
+    pk_homog_state_free(&s0);
+    pk_homog_state_free(&tr);
+    pk_homog_rve_free(&rve);
+}
+
+/* One committed state per BC after a first load step F0. */
+typedef struct fixture {
+    pk_homog_rve rve;
+    pk_homog_opts o;
+    pk_homog_state s;
+    pk_homog_step st;
+} fixture;
+
+static void fixture_make(fixture *fx, const pk_box *b, const pk_particles *p, pk_homog_bc bc,
+                         const double F0[9])
+{
+    char err[128];
+    CHECK(pk_homog_rve_build(b, p, bc, 1.0, &fx->rve, err, sizeof err) == 0);
+    fx->o = opts(1.0);
+    pk_homog_state s0;
+    memset(&fx->s, 0, sizeof fx->s);
+    pk_homog_state_init(&fx->rve, &fx->o, &s0);
+    CHECK(pk_homog_eval(&fx->rve, &fx->o, &s0, F0, &fx->s, &fx->st, NULL) == 0);
+    CHECK(pk_dr_stop_ok(fx->st.dr.stop));
+    pk_homog_state_free(&s0);
+}
+
+static void fixture_free(fixture *fx)
+{
+    pk_homog_rve_free(&fx->rve);
+    pk_homog_state_free(&fx->s);
+}
+
+#endif

@@ -1,0 +1,201 @@
+/* test_homog_tangent.c — Ā = dP̄/dF̄ by static condensation (Meier 2009 ch. 6,
+ * spec §4), with the CHOLMOD solver injected from api/. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "homog_fixture.h"
+#include "homog_tangent.h"
+#include "sparse_cholmod.h"
+
+/* The solver reports inertia: SPD solves, singular and indefinite flagged. */
+static void test_sparse_solver_status(void)
+{
+    pk_sparse_sym A = {.n = 3};
+    pk_sparse_sym_add(&A, 0, 0, 4), pk_sparse_sym_add(&A, 0, 1, 1), pk_sparse_sym_add(&A, 1, 1, 3);
+    pk_sparse_sym_add(&A, 1, 2, 1), pk_sparse_sym_add(&A, 2, 2, 2), pk_sparse_sym_add(&A, 2, 2, 0.5);
+    pk_sparse_info info;
+    pk_sparse_factor *f = pk_sparse_cholmod.factor(&A, &info);
+    CHECK(f && info.status == PK_SPARSE_OK && info.npos == 3);
+    double b[3] = {1, 2, 3}, x[3];
+    CHECK(f && pk_sparse_cholmod.solve(f, 1, b, x) == 0);
+    /* residual of A x = b with A = [[4,1,0],[1,3,1],[0,1,2.5]] */
+    CHECK_NEAR(4 * x[0] + x[1], 1, 1e-14);
+    CHECK_NEAR(x[0] + 3 * x[1] + x[2], 2, 1e-14);
+    CHECK_NEAR(x[1] + 2.5 * x[2], 3, 1e-14);
+    pk_sparse_cholmod.release(f);
+    pk_sparse_sym_free(&A);
+
+    pk_sparse_sym S = {.n = 2}; /* [[1,1],[1,1]]: singular */
+    pk_sparse_sym_add(&S, 0, 0, 1), pk_sparse_sym_add(&S, 0, 1, 1), pk_sparse_sym_add(&S, 1, 1, 1);
+    f = pk_sparse_cholmod.factor(&S, &info);
+    CHECK(!f && info.status == PK_SPARSE_SINGULAR);
+    pk_sparse_sym_free(&S);
+
+    pk_sparse_sym D = {.n = 2}; /* diag(1, −2): indefinite, inertia (1, 1, 0) */
+    pk_sparse_sym_add(&D, 0, 0, 1), pk_sparse_sym_add(&D, 1, 1, -2);
+    f = pk_sparse_cholmod.factor(&D, &info);
+    CHECK(info.status == PK_SPARSE_INDEFINITE && info.nneg == 1 && info.npos == 1);
+    pk_sparse_cholmod.release(f);
+    pk_sparse_sym_free(&D);
+}
+
+/* Remark 6.1 analytically: A_1111 = A_2222 = E√N/(√N−1), all else 0
+ * (basis erratum of (6.10)).  Exact formula: tolerance 1e-12 relative. */
+static void test_square_lattice_tangent(void)
+{
+    for (int m = 2; m <= 10; m += 2) {
+        size_t n = (size_t)(m * m);
+        double *X = calloc(3 * n, sizeof *X), *r = malloc(n * sizeof *r);
+        uint8_t *fx = malloc(n);
+        for (size_t i = 0; i < n; i++) {
+            X[3 * i] = 2.0 * (double)(i % (size_t)m) + 5, X[3 * i + 1] = 2.0 * (double)(i / (size_t)m) - 3;
+            r[i] = 1, fx[i] = 1;
+        }
+        pk_homog_rve rve;
+        pk_homog_rve_from_arrays(2, PK_BC_TAYLOR, n, X, r, fx, 0, NULL, 4.0 * (m - 1) * (m - 1), &rve);
+        pk_homog_opts o = opts(1);
+        o.E_n = 50;
+        pk_homog_state s0;
+        pk_homog_state_init(&rve, &o, &s0);
+        double A[81];
+        pk_tangent_info info;
+        CHECK(pk_homog_tangent(&rve, &o, &s0, &pk_sparse_cholmod, A, &info) == 0);
+        double want = o.E_n * m / (m - 1.0);
+        for (int I = 0; I < 9; I++)
+            for (int J = 0; J < 9; J++) {
+                double w = (I == J && (I == 0 || I == 4)) ? want : 0; /* 1111, 2222 */
+                CHECK_NEAR(A[9 * I + J], w, 1e-12 * want);
+            }
+        pk_homog_state_free(&s0);
+        pk_homog_rve_free(&rve);
+        free(X), free(r), free(fx);
+    }
+}
+
+/* Ā vs central differences of P̄ (each perturbed state relaxed from the same
+ * committed state, fixed topology checked) for every BC, 2D and 3D; major
+ * symmetry.  h = 1e-6, DR tol 1e-12: FD truncation O(h²·|A'|), P̄ error from
+ * the relaxation residual ~1e-13 → relative error ≪ 1e-6 (required). */
+static void test_tangent_vs_finite_differences(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        pk_box b;
+        pk_particles p;
+        make_jammed(dim, dim == 2 ? 90 : 50, dim == 2 ? 0.88 : 0.68, 21, &b, &p);
+        for (int bc = 0; bc < 3; bc++) {
+            fixture fx;
+            double F0[9];
+            diagF(F0, 0.994, 1.0, 1.0);
+            F0[3] = -0.004;
+            fixture_make(&fx, &b, &p, (pk_homog_bc)bc, F0);
+            double A[81];
+            pk_tangent_info info;
+            int rc = pk_homog_tangent(&fx.rve, &fx.o, &fx.s, &pk_sparse_cholmod, A, &info);
+            CHECK_MSG(rc == 0, "dim %d bc %d: rc %d block %s", dim, bc, rc,
+                      pk_sparse_status_name(info.block.status));
+            double An = 0;
+            for (int k = 0; k < 81; k++)
+                An = fmax(An, fabs(A[k]));
+            double worst = 0, asym = 0;
+            const double h = 1e-6;
+            pk_homog_state tp = {0}, tm = {0};
+            pk_homog_step sp, sm;
+            int skipped = 0;
+            for (int c = 0; c < dim; c++)
+                for (int d = 0; d < dim; d++) {
+                    double Fp[9], Fm[9];
+                    memcpy(Fp, F0, sizeof Fp);
+                    memcpy(Fm, F0, sizeof Fm);
+                    Fp[3 * c + d] += h, Fm[3 * c + d] -= h;
+                    pk_homog_eval(&fx.rve, &fx.o, &fx.s, Fp, &tp, &sp, NULL);
+                    pk_homog_eval(&fx.rve, &fx.o, &fx.s, Fm, &tm, &sm, NULL);
+                    /* fixed topology of the jammed network (rattlers, which drift
+                     * to ε → 0⁺ and may switch, carry no force and are not in Ā) */
+                    double Aw[81];
+                    pk_tangent_info ip, im;
+                    pk_homog_tangent(&fx.rve, &fx.o, &tp, &pk_sparse_cholmod, Aw, &ip);
+                    pk_homog_tangent(&fx.rve, &fx.o, &tm, &pk_sparse_cholmod, Aw, &im);
+                    if (ip.jammed_contacts != info.jammed_contacts ||
+                        im.jammed_contacts != info.jammed_contacts) {
+                        skipped++;
+                        continue;
+                    }
+                    for (int a = 0; a < dim; a++)
+                        for (int e = 0; e < dim; e++) {
+                            double fd = (sp.P[3 * a + e] - sm.P[3 * a + e]) / (2 * h);
+                            double an = A[(3 * a + e) * 9 + 3 * c + d];
+                            worst = fmax(worst, fabs(fd - an) / An);
+                            asym = fmax(asym, fabs(an - A[(3 * c + d) * 9 + 3 * a + e]) / An);
+                        }
+                }
+            CHECK(skipped <= 1); /* at most one F̄ component hits a switching contact */
+            CHECK_MSG(worst < 1e-6, "dim %d %s: FD rel. error %g", dim,
+                      pk_homog_bc_name((pk_homog_bc)bc), worst);
+            CHECK_MSG(asym < 1e-12, "major symmetry defect %g", asym);
+            printf("  dim %d %-17s |A| %.4g  FD rel. error %.2e  symmetry %.1e  free dofs %zu  skipped %d\n",
+                   dim, pk_homog_bc_name((pk_homog_bc)bc), An, worst, asym, info.free_dofs,
+                   skipped);
+            pk_homog_state_free(&tp);
+            pk_homog_state_free(&tm);
+            fixture_free(&fx);
+        }
+        pk_particles_free(&p);
+    }
+}
+
+/* §9.3 at the tangent level: more constraints, stiffer — Taylor ≥ restricted
+ * Taylor ≥ periodic for the compression modulus Ā_1111 of one RVE. */
+static void test_constraint_ranking(void)
+{
+    pk_box b;
+    pk_particles p;
+    make_jammed(2, 150, 0.88, 31, &b, &p);
+    double a1111[3];
+    for (int bc = 0; bc < 3; bc++) {
+        fixture fx;
+        double F0[9];
+        diagF(F0, 0.995, 0.995, 1);
+        fixture_make(&fx, &b, &p, (pk_homog_bc)bc, F0);
+        double A[81];
+        pk_tangent_info info;
+        CHECK(pk_homog_tangent(&fx.rve, &fx.o, &fx.s, &pk_sparse_cholmod, A, &info) == 0);
+        a1111[bc] = A[0];
+        fixture_free(&fx);
+    }
+    CHECK_MSG(a1111[0] > a1111[1] && a1111[1] > a1111[2], "A1111: T %g RT %g P %g", a1111[0],
+              a1111[1], a1111[2]);
+    pk_particles_free(&p);
+}
+
+/* A free block with a rigid mode is reported, not inverted: periodic RVE
+ * without the pinned grain. */
+static void test_singular_block_reported(void)
+{
+    pk_box b;
+    pk_particles p;
+    make_jammed(2, 60, 0.88, 41, &b, &p);
+    fixture fx;
+    double F0[9];
+    diagF(F0, 0.995, 0.995, 1);
+    fixture_make(&fx, &b, &p, PK_BC_PERIODIC, F0);
+    fx.rve.fixed[0] = 0; /* unpin: translation is free */
+    double A[81] = {0};
+    pk_tangent_info info;
+    CHECK(pk_homog_tangent(&fx.rve, &fx.o, &fx.s, &pk_sparse_cholmod, A, &info) == 1);
+    CHECK(info.block.status == PK_SPARSE_SINGULAR);
+    CHECK(A[0] == 0); /* untouched */
+    fixture_free(&fx);
+    pk_particles_free(&p);
+}
+
+int main(void)
+{
+    RUN(test_sparse_solver_status);
+    RUN(test_square_lattice_tangent);
+    RUN(test_tangent_vs_finite_differences);
+    RUN(test_constraint_ranking);
+    RUN(test_singular_block_reported);
+    return check_summary();
+}
