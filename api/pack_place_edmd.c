@@ -52,7 +52,7 @@ static void read_params(const pk_pack_job *job, const pk_pack_plan *plan, pk_edm
         prm->rescale = json_is_true(rs);
     prm->rescale_tol = num(o, "rescale_tolerance", prm->rescale_tol);
     prm->skin = num(o, "skin", prm->skin);
-    prm->equal_masses = strcmp(str(o, "masses", "volume"), "equal") == 0;
+    prm->equal_masses = strcmp(str(o, "masses", "equal"), "equal") == 0;
     prm->max_events = (uint64_t)num(o, "max_events", 0);
 }
 

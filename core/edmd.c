@@ -263,8 +263,9 @@ static double setup(edmd_state *s, const pk_particles *p, const pk_edmd_params *
     for (size_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++)
             s->x0[3 * i + k] = k >= dim ? 0 : p->x[3 * i + k];
-    /* skins: a fraction of the radius at the reference time, capped at twice
-     * the mean so coarse grains do not list hundreds of fines */
+    /* skins: a fraction of the radius at the reference time, at least the
+     * mean radius (fines would rebuild their lists all the time) and at most
+     * twice the mean (coarse grains would list hundreds of fines) */
     double t_ref = isfinite(t_end) ? t_end : 0;
     double rho_mean = 0, rho_max = 0;
     for (size_t i = 0; i < n; i++) {
@@ -287,7 +288,7 @@ static double setup(edmd_state *s, const pk_particles *p, const pk_edmd_params *
     for (size_t i = 0; i < n; i++) {
         double r = s->a[i] + s->g[i] * t_ref;
         s->rref[i] = r;
-        s->skin[i] = prm->skin * fmin(r, 2 * rho_mean);
+        s->skin[i] = prm->skin * fmin(fmax(r, rho_mean), 2 * rho_mean);
         if (0.5 * s->skin[i] > room)
             s->skin[i] = 2 * room;
         s->sig_hi = fmax(s->sig_hi, r + 0.5 * s->skin[i]);

@@ -105,7 +105,11 @@ int edmd_nlist_rebuild(edmd_state *s, size_t i)
     L->n = 0;
     edmd_sync(s, i);
     set_sphere(s, i);
-    if (pk_grid_update(&s->grid, &s->bs, i) != 0)
+    /* remove + insert, not pk_grid_update: a sphere that outgrew the grid's
+     * top level but stayed in its cell would keep the level's old radius
+     * bound, and queries would miss it */
+    pk_grid_remove(&s->grid, i);
+    if (pk_grid_insert(&s->grid, &s->bs, i) != 0)
         return -1;
     visit_ctx c = {s, (int32_t)i, 1, 0};
     pk_grid_query(&s->grid, &s->bs, &s->bs.x[3 * i], s->bs.r[i], 0.0, visit, &c);

@@ -20,7 +20,7 @@ void pk_edmd_params_default(pk_edmd_params *prm)
         .rescale = 1,
         .rescale_tol = 0.1,
         .skin = 0.6,
-        .equal_masses = 0,
+        .equal_masses = 1,
         .seed = 1,
     };
 }

@@ -140,7 +140,7 @@ static int direct_spheres(filler *F)
     }
     for (size_t i = 0; i < m->nnode && rc == 0; i++)
         if (isfinite(ls[i]))
-            rc = add_sphere(F, &m->x[3 * i], clamp_radius(F, ls[i] / 4));
+            rc = add_sphere(F, &m->x[3 * i], clamp_radius(F, ls[i]));
     free(ls);
     pk_mesh_edges_free(&el);
     return rc;

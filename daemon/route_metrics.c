@@ -83,7 +83,7 @@ enum MHD_Result route_healthz(pk_req *r)
 {
     pk_service *svc = r->svc;
     json_t *st = pk_queue_stats(svc->q); /* a real query: the database answers */
-    int db_ok = json_object_size(json_object_get(st, "jobs")) > 0;
+    int db_ok = json_is_true(json_object_get(st, "ok"));
     json_decref(st);
     int draining = __atomic_load_n(&svc->draining, __ATOMIC_RELAXED);
     int ready = db_ok && !draining;

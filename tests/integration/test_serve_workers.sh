@@ -7,7 +7,7 @@
 . "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
 
 slow_body 60 >"$T/slow.json"   # runs until cancelled (60 s safety net)
-slow_body 3 >"$T/slow3.json"   # ends by its own wall-time limit after 3 s
+slow_body 6 >"$T/slow6.json"   # ends by its own wall-time limit after 6 s
 
 printf 'workers = 1\nmax_queued = 1\nlog_level = info\n' >"$T/packd.conf"
 start_daemon w1 --config "$T/packd.conf" || { fail serve_starts; exit 1; }
@@ -69,9 +69,14 @@ kill -HUP "$DPID"
 sleep 0.5
 check sighup_reload grep -q 'configuration reloaded' "$LOG"
 
-# 5. kill -9 of the daemon with a job running; restart; the job completes
-R=$(submit "$T/slow3.json")
+# 5. kill -9 of the daemon with a job running; restart; the job completes,
+#    and so do the jobs that were waiting (two: the reloaded max_queued = 5
+#    takes them where max_queued = 1 refused the second)
+R=$(submit "$T/slow6.json")
 wait_status "$R" running 20
+A1=$(submit "$T/fast.json")
+A2=$(submit "$T/fast.json")
+check sighup_reload_applied sh -c "[ -n '$A1' ] && [ -n '$A2' ] && [ '$(status_of "$A2")' = accepted ]"
 i=0
 while [ -z "$(worker_pid "$R")" ] && [ $i -lt $((50 * SLOW)) ]; do sleep 0.1; i=$((i + 1)); done
 old_worker=$(worker_pid "$R")
@@ -82,6 +87,10 @@ check worker_dies_with_daemon sh -c "[ -n '$old_worker' ] && ! ps -o stat= -p '$
 start_daemon w1 --config "$T/packd.conf" || fail restart
 check restarted_job_completes wait_status "$R" successful 60
 check restart_logged_recovery grep -q '"requeued":1' "$LOG"
+ok=0
+wait_status "$A1" successful 60 && wait_status "$A2" successful 60 && ok=1
+check accepted_jobs_survive_kill9 test $ok = 1
+
 c "$B/jobs/$R/results" >"$T/rr.json"
 check restarted_job_result test "$(jget "$T/rr.json" 'd["summary"]["value"]["termination_reason"]')" = wall_time
 
@@ -89,7 +98,7 @@ check restarted_job_result test "$(jget "$T/rr.json" 'd["summary"]["value"]["ter
 #    daemon exits 0; after a restart the job completes
 kill -9 "$DPID"
 start_daemon w2 --workers 1 --grace-s 1 || fail restart2
-G=$(submit "$T/slow3.json")
+G=$(submit "$T/slow6.json")
 wait_status "$G" running 20
 kill -TERM "$DPID"
 i=0
