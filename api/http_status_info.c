@@ -57,9 +57,13 @@ json_t *pk_results_document(json_t *row)
     const char *id = json_string_value(json_object_get(row, "id"));
     char href[128];
     snprintf(href, sizeof href, "/jobs/%s/results/result", id);
+    char xdmf[128];
+    snprintf(xdmf, sizeof xdmf, "/jobs/%s/results/xdmf", id);
     json_t *summary = json_object_get(row, "summary");
-    return json_pack("{s:{s:O},s:{s:s,s:s,s:O,s:O}}", "summary", "value",
-                     json_is_object(summary) ? summary : json_object(), "result", "href", href,
-                     "type", PK_RESULT_MEDIA_TYPE, "size", json_object_get(row, "result_size"),
-                     "sha256", json_object_get(row, "result_sha256"));
+    return json_pack("{s:{s:o},s:{s:s,s:s,s:O,s:O},s:{s:s,s:s}}", "summary", "value",
+                     json_is_object(summary) ? json_incref(summary) : json_object(), "result",
+                     "href", href, "type", PK_RESULT_MEDIA_TYPE, "size",
+                     json_object_get(row, "result_size"), "sha256",
+                     json_object_get(row, "result_sha256"), "xdmf", "href", xdmf, "type",
+                     "application/xml");
 }

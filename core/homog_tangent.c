@@ -6,17 +6,9 @@
 
 #include "dem_contact.h"
 #include "dem_rattler.h"
+#include "homog_stiffness.h"
 #include "homog_tensor.h"
 #include "progress.h"
-
-/* H = ∂²φ/∂l∂l = E/|l| [R n⊗n − ε 1] = −k (4.12)₁ */
-static void pair_hessian(double E, double len, double eps, const double *l, double H[9])
-{
-    double R = eps + len, c = E / len;
-    for (int a = 0; a < 3; a++)
-        for (int b = 0; b < 3; b++)
-            H[3 * a + b] = c * (R * l[a] * l[b] / (len * len) - (a == b ? eps : 0));
-}
 
 int pk_homog_tangent(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homog_state *s,
                      const pk_sparse_solver *solver, double A[81], pk_tangent_info *info)
@@ -73,7 +65,7 @@ int pk_homog_tangent(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_h
         info->jammed_contacts++;
         const double *l = &c.l[3 * p];
         double H[9], q[3], G[3];
-        pair_hessian(E, c.len[p], c.eps[p], l, H);
+        pk_homog_pair_hessian(E, c.len[p], c.eps[p], l, H);
         /* G = F⁻¹(l − x_j[free] + x_i[free]) */
         for (int a = 0; a < 3; a++)
             q[a] = l[a] - (is_free[j] ? s->x[3 * j + a] : 0) + (is_free[i] ? s->x[3 * i + a] : 0);
@@ -83,18 +75,10 @@ int pk_homog_tangent(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_h
                 for (int cc = 0; cc < dim; cc++)
                     for (int d = 0; d < dim; d++)
                         AFF[(3 * a + b) * 9 + 3 * cc + d] += H[3 * a + cc] * G[b] * G[d];
-        /* K_II blocks: K_ii += H, K_jj += H, K_ij = −H; B rows ±H G */
+        /* K_II blocks; B rows ±H G */
         int32_t di = dof[i], dj = dof[j];
-        for (int a = 0; a < dim; a++)
-            for (int b = 0; b < dim; b++) {
-                double h = H[3 * a + b];
-                if (di >= 0 && a <= b && pk_sparse_sym_add(&K, di + a, di + b, h) != 0)
-                    rc = -1;
-                if (dj >= 0 && a <= b && pk_sparse_sym_add(&K, dj + a, dj + b, h) != 0)
-                    rc = -1;
-                if (di >= 0 && dj >= 0 && pk_sparse_sym_add(&K, di + a, dj + b, -h) != 0)
-                    rc = -1;
-            }
+        if (pk_homog_add_pair_K(&K, dim, di, dj, H) != 0)
+            rc = -1;
         for (int al = 0; al < dim; al++)
             for (int ga = 0; ga < dim; ga++)
                 for (int de = 0; de < dim; de++) {

@@ -7,6 +7,7 @@
 
 #include "cli.h"
 #include "process.h"
+#include "xdmf.h"
 
 static volatile sig_atomic_t cancel_requested;
 
@@ -42,11 +43,13 @@ static int print_progress(const pk_progress *p, void *ctx)
 
 int cmd_run(int argc, char **argv)
 {
-    const char *job_path = NULL, *out_path = NULL;
+    const char *job_path = NULL, *out_path = NULL, *xdmf_path = NULL;
     int progress_fd = -1;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "-o") && i + 1 < argc)
             out_path = argv[++i];
+        else if (!strcmp(argv[i], "--xdmf") && i + 1 < argc)
+            xdmf_path = argv[++i];
         else if (!strcmp(argv[i], "--progress"))
             progress_fd = 2;
         else if (!strcmp(argv[i], "--progress-fd") && i + 1 < argc)
@@ -61,7 +64,8 @@ int cmd_run(int argc, char **argv)
         }
     }
     if (!job_path || !out_path) {
-        fprintf(stderr, "usage: packd run JOB.json -o OUT.h5 [--progress] [--progress-fd N]\n");
+        fprintf(stderr, "usage: packd run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--progress] "
+                        "[--progress-fd N]\n");
         return 64;
     }
     json_t *job = cli_load_json(job_path);
@@ -95,6 +99,14 @@ int cmd_run(int argc, char **argv)
         status = 2;
     } else {
         json_object_set_new(summary, "output", json_string(out_path));
+        if (xdmf_path) {
+            /* the XML names the HDF5 file as it sits beside it */
+            const char *base = strrchr(out_path, '/');
+            if (pk_xdmf_write(out_path, base ? base + 1 : out_path, xdmf_path, err, sizeof err) != 0)
+                fprintf(stderr, "packd run: %s\n", err);
+            else
+                json_object_set_new(summary, "xdmf", json_string(xdmf_path));
+        }
         json_dumpf(summary, stdout, JSON_INDENT(2) | JSON_REAL_PRECISION(10));
         putchar('\n');
         status = 0;

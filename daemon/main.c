@@ -15,7 +15,8 @@ static const struct {
     int (*fn)(int, char **);
     const char *usage;
 } commands[] = {
-    {"run", cmd_run, "run JOB.json -o OUT.h5 [--progress] [--progress-fd N]   run a job, write its result"},
+    {"run", cmd_run, "run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--progress] [--progress-fd N]\n"
+                     "                                                    run a job, write its result"},
     {"validate", cmd_validate, "validate JOB.json                                 check a job, print its plan or errors"},
     {"inspect", cmd_inspect, "inspect OUT.h5 [--full]                          print a result file's summary as JSON"},
     {"serve", cmd_serve, "serve [--config F] [--bind A] [--port N] [--data DIR] run the job service"},

@@ -1,9 +1,12 @@
 /* GET /jobs/{id}/results (document) and /jobs/{id}/results/{output} (file). */
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "http.h"
 #include "http_status_info.h"
+#include "sha256.h"
+#include "xdmf.h"
 
 /* The row of a successful job, or NULL after replying with the problem. */
 static json_t *successful_job(pk_req *r, enum MHD_Result *rc)
@@ -36,11 +39,15 @@ enum MHD_Result route_results(pk_req *r)
     return pk_send_json(r, 200, doc, NULL);
 }
 
+/* Outputs: "result" (the HDF5 file) and "xdmf" (its XDMF 3 description for
+ * ParaView, made on first request; it names the HDF5 file as the download's
+ * file name "<id>.h5", so both saved side by side open together). */
 enum MHD_Result route_result_file(pk_req *r)
 {
-    if (strcmp(r->seg[3], "result") != 0)
+    int want_xdmf = strcmp(r->seg[3], "xdmf") == 0;
+    if (strcmp(r->seg[3], "result") != 0 && !want_xdmf)
         return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output",
-                               "outputs: result", NULL, 0);
+                               "outputs: result, xdmf", NULL, 0);
     enum MHD_Result rc;
     json_t *row = successful_job(r, &rc);
     if (!row)
@@ -50,6 +57,24 @@ enum MHD_Result route_result_file(pk_req *r)
     pk_job_dir(cfg.data, r->seg[1], dir, sizeof dir);
     snprintf(path, sizeof path, "%s/result.h5", dir);
     snprintf(name, sizeof name, "%s.h5", r->seg[1]);
+    if (want_xdmf) {
+        char xpath[1300], xname[200], err[512];
+        snprintf(xpath, sizeof xpath, "%s/result.xdmf", dir);
+        snprintf(xname, sizeof xname, "%s.xdmf", r->seg[1]);
+        if (access(xpath, R_OK) != 0 && pk_xdmf_write(path, name, xpath, err, sizeof err) != 0) {
+            json_decref(row);
+            return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error", err, NULL, 0);
+        }
+        char hex[65];
+        if (pk_sha256_file_hex(xpath, hex) != 0) {
+            json_decref(row);
+            return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error",
+                                   "cannot read the XDMF file", NULL, 0);
+        }
+        rc = pk_send_file(r, xpath, "application/xml", hex, xname);
+        json_decref(row);
+        return rc;
+    }
     rc = pk_send_file(r, path, PK_RESULT_MEDIA_TYPE,
                       json_string_value(json_object_get(row, "result_sha256")), name);
     json_decref(row);

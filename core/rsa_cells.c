@@ -1,0 +1,161 @@
+#include "rsa_cells.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_CELLS ((uint64_t)1 << 31)
+
+/* Cells per axis with edge h >= c·(1 + 1e-9): the margin keeps round-off of
+ * the cell coordinate from putting two centres closer than c two cells apart. */
+static int64_t axis_cells(double span, double c)
+{
+    double m = floor(span / (c * (1 + 1e-9)));
+    return m < 1 ? 1 : (m > 1e9 ? (int64_t)1e9 : (int64_t)m);
+}
+
+uint64_t pk_rsa_cells_count(const pk_box *b, double r, double gap, const double *lo,
+                            const double *span)
+{
+    double c = 2 * r + gap;
+    if (!b || b->dim < 2 || b->dim > 3 || !(c > 0))
+        return 0;
+    uint64_t total = 1;
+    for (int k = 0; k < b->dim; k++) {
+        if (!(span[k] >= 0))
+            return 0;
+        int64_t m = axis_cells(span[k], c);
+        if (b->periodic[k] && m < 3)
+            return 0; /* ±1 neighbours must be distinct cells */
+        if (total > MAX_CELLS / (uint64_t)m)
+            return 0;
+        total *= (uint64_t)m;
+    }
+    (void)lo;
+    return total;
+}
+
+int pk_rsa_cells_init(pk_rsa_cells *C, const pk_box *b, double r, double gap, const double *lo,
+                      const double *span)
+{
+    memset(C, 0, sizeof *C);
+    uint64_t nc = pk_rsa_cells_count(b, r, gap, lo, span);
+    if (nc == 0)
+        return -1;
+    double s = r + r + gap; /* as pk_grid: (r_i + r_j) + gap */
+    C->dim = b->dim;
+    C->s2 = s * s;
+    for (int k = 0; k < PK_MAXDIM; k++) {
+        C->n[k] = 1;
+        C->inv_h[k] = 0;
+        if (k >= b->dim)
+            continue;
+        C->periodic[k] = b->periodic[k];
+        C->L[k] = b->L[k];
+        C->quarter[k] = 0.25 * b->L[k];
+        C->lo[k] = lo[k];
+        C->n[k] = axis_cells(span[k], 2 * r + gap);
+        C->inv_h[k] = span[k] > 0 ? (double)C->n[k] / span[k] : 0;
+    }
+    C->ncell = nc;
+    C->cell = malloc(nc * sizeof *C->cell);
+    if (!C->cell)
+        return -1;
+    for (uint64_t i = 0; i < nc; i++) {
+        C->cell[i].n = 0;
+        C->cell[i].more = -1;
+    }
+    return 0;
+}
+
+void pk_rsa_cells_free(pk_rsa_cells *C)
+{
+    free(C->cell);
+    free(C->extra);
+    memset(C, 0, sizeof *C);
+}
+
+/* Neighbour coordinates along axis k of coordinate i: periodic axes wrap
+ * (n >= 3, so the three are distinct), walled axes clip. */
+static inline int axis_around(const pk_rsa_cells *C, int k, int64_t i, int64_t out[3])
+{
+    int m = 0;
+    for (int64_t d = -1; d <= 1; d++) {
+        int64_t j = i + d;
+        if (j < 0 || j >= C->n[k]) {
+            if (!C->periodic[k])
+                continue;
+            j = j < 0 ? j + C->n[k] : j - C->n[k];
+        }
+        out[m++] = j;
+    }
+    return m;
+}
+
+int pk_rsa_cells_around(const pk_rsa_cells *C, const double *x, uint64_t out[27])
+{
+    int64_t a[3][3] = {{0}};
+    int m[3] = {1, 1, 1};
+    for (int k = 0; k < C->dim; k++)
+        m[k] = axis_around(C, k, pk_rsa_cells_coord(C, k, x[k]), a[k]);
+    int cnt = 0;
+    for (int z = 0; z < m[2]; z++)
+        for (int y = 0; y < m[1]; y++)
+            for (int xx = 0; xx < m[0]; xx++)
+                out[cnt++] = ((uint64_t)a[2][z] * (uint64_t)C->n[1] + (uint64_t)a[1][y]) *
+                                 (uint64_t)C->n[0] + (uint64_t)a[0][xx];
+    return cnt;
+}
+
+int pk_rsa_cells_insert(pk_rsa_cells *C, const double *x)
+{
+    pk_rsa_cell2 *c = &C->cell[pk_rsa_cells_of(C, x)];
+    double p[3] = {x[0], x[1], C->dim == 3 ? x[2] : 0};
+    if (c->n < 2) {
+        memcpy(c->x[c->n], p, sizeof p);
+    } else {
+        if (C->nextra == C->capextra) {
+            size_t cap = C->capextra ? 2 * C->capextra : 1024;
+            pk_rsa_extra *e = realloc(C->extra, cap * sizeof *e);
+            if (!e)
+                return -1;
+            C->extra = e;
+            C->capextra = cap;
+        }
+        pk_rsa_extra *e = &C->extra[C->nextra];
+        memcpy(e->x, p, sizeof p);
+        e->next = c->more;
+        c->more = (int32_t)C->nextra++;
+    }
+    c->n++;
+    return 0;
+}
+
+static inline int cell_hits(const pk_rsa_cells *C, const pk_rsa_cell2 *c, const double *x)
+{
+    int n = c->n;
+    if (n == 0)
+        return 0;
+    if (pk_rsa_cells_close(C, c->x[0], x))
+        return 1;
+    if (n == 1)
+        return 0;
+    if (pk_rsa_cells_close(C, c->x[1], x))
+        return 1;
+    for (int32_t e = c->more; e >= 0; e = C->extra[e].next)
+        if (pk_rsa_cells_close(C, C->extra[e].x, x))
+            return 1;
+    return 0;
+}
+
+void pk_rsa_cells_filter(const pk_rsa_cells *C, const double *pos, size_t n, uint8_t *keep)
+{
+    uint64_t nb[27];
+    for (size_t i = 0; i < n; i++) {
+        const double *x = &pos[3 * i];
+        int m = pk_rsa_cells_around(C, x, nb);
+        int hit = 0;
+        for (int q = 0; q < m && !hit; q++)
+            hit = cell_hits(C, &C->cell[nb[q]], x);
+        keep[i] = (uint8_t)!hit;
+    }
+}
