@@ -189,8 +189,12 @@ int pk_grid_update(pk_grid *g, const pk_particles *p, size_t i)
 {
     if (i < g->cap && g->level[i] >= 0) {
         int l = level_of(g, p->r[i]);
-        if (l == g->level[i] && cell_of(g, &g->lv[l], &p->x[3 * i]) == g->cell[i])
+        if (l == g->level[i] && cell_of(g, &g->lv[l], &p->x[3 * i]) == g->cell[i]) {
+            /* same cell, but a grown grain must still raise its level's bound */
+            if (p->r[i] > g->lv[l].r_hi)
+                g->lv[l].r_hi = p->r[i];
             return 0;
+        }
     }
     return pk_grid_insert(g, p, i);
 }

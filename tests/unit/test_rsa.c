@@ -332,6 +332,12 @@ static void test_grid_query_matches_brute_force(void)
                 p.r[i] *= 1.5;
                 pk_grid_update(&grid, &p, i);
             }
+            /* grow some in place beyond the init range (a growing EDMD grain):
+             * its level's bound must follow even though its cell is unchanged */
+            for (size_t i = 2; i < n; i += 7) {
+                p.r[i] *= 2.5;
+                pk_grid_update(&grid, &p, i);
+            }
             for (size_t i = 1; i < n; i += 10)
                 pk_grid_remove(&grid, i);
             size_t *found = malloc(n * sizeof *found), *want = malloc(n * sizeof *want);
