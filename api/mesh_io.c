@@ -519,13 +519,31 @@ static int ends_with(const char *s, const char *suffix)
     return n >= k && strcmp(s + n - k, suffix) == 0;
 }
 
+/* Gmsh by name (.msh) or by content ($MeshFormat first): uploaded files
+ * (the service stores them under their SHA-256) have no extension. */
+static int is_gmsh(const char *file)
+{
+    if (ends_with(file, ".msh"))
+        return 1;
+    FILE *f = fopen(file, "r");
+    char line[64] = "";
+    int yes = 0;
+    if (f) {
+        while (fgets(line, sizeof line, f) && line[strspn(line, " \t\r\n")] == 0)
+            ;
+        yes = strncmp(line + strspn(line, " \t"), "$MeshFormat", 11) == 0;
+        fclose(f);
+    }
+    return yes;
+}
+
 int pk_mesh_from_json(json_t *j, size_t max_tets, pk_mesh *m, pk_mesh_report *rep, char *err,
                       size_t errlen)
 {
     const char *file = json_string_value(json_object_get(j, "file"));
     int rc;
     if (file)
-        rc = ends_with(file, ".msh") ? pk_mesh_read_msh(file, max_tets, m, err, errlen)
+        rc = is_gmsh(file) ? pk_mesh_read_msh(file, max_tets, m, err, errlen)
                                      : pk_mesh_read_tetgen(file, max_tets, m, err, errlen);
     else {
         if (max_tets && json_array_size(json_object_get(j, "tets")) > max_tets) {

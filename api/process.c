@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "homog_job.h"
+#include "input_links.h"
 #include "pack_job.h"
 
 static const pk_process pack_process = {
@@ -74,7 +75,8 @@ size_t pk_job_validate(json_t *job, const pk_process **proc, pk_schema_errors *e
         return errs->n - before;
     }
     size_t mark = errs->n;
-    pk_process_validate_inputs(p, json_object_get(job, "inputs"), errs);
+    if (pk_input_links_refuse(json_object_get(job, "inputs"), errs) == 0)
+        pk_process_validate_inputs(p, json_object_get(job, "inputs"), errs);
     prefix_inputs(errs, mark);
     if (errs->n == before)
         *proc = p;

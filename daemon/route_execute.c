@@ -2,11 +2,13 @@
  * same code path as `packd validate`), apply the server's caps, queue the job:
  * 201 + Location + statusInfo.  Idempotency-Key: the same key and request
  * return the same job; the same key with another request is 422. */
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "http.h"
+#include "input_refs.h"
 #include "http_process_doc.h"
 #include "http_status_info.h"
 #include "log.h"
@@ -70,7 +72,11 @@ enum MHD_Result route_execute(pk_req *r)
     pk_config cfg = pk_service_config(svc);
     pk_process_apply_caps(p, inputs, cfg.max_particles, cfg.max_wall_time_s);
     pk_schema_errors errs = {0};
-    if (pk_process_validate_inputs(p, inputs, &errs) > 0) {
+    /* {"href": "/files/…"} and {"href": "/jobs/…/results/result"} → {"file": path} */
+    char data_abs[PATH_MAX];
+    const char *data = realpath(cfg.data, data_abs) ? data_abs : cfg.data;
+    if (pk_resolve_input_refs(inputs, data, svc->q, &errs) > 0 ||
+        pk_process_validate_inputs(p, inputs, &errs) > 0) {
         for (size_t i = 0; i < errs.n; i++) { /* pointers relative to the body */
             char ptr[sizeof errs.items[i].pointer + 8];
             snprintf(ptr, sizeof ptr, "/inputs%s", errs.items[i].pointer);
