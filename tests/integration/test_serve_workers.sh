@@ -8,13 +8,14 @@
 
 slow_body 60 >"$T/slow.json"   # runs until cancelled (60 s safety net)
 slow_body 6 >"$T/slow6.json"   # ends by its own wall-time limit after 6 s
+edmd_slow_body 60 >"$T/slow-edmd.json" # an EDMD job that runs until cancelled
 
 printf 'workers = 1\nmax_queued = 1\nlog_level = info\n' >"$T/packd.conf"
 start_daemon w1 --config "$T/packd.conf" || { fail serve_starts; exit 1; }
 
-# 1. cancel a running job: the worker is gone within the limit, SSE shows
-#    live progress and the final status, then ends
-S=$(submit "$T/slow.json")
+# 1. cancel a running EDMD job: the worker is gone within the limit, SSE
+#    shows live progress and the final status, then ends
+S=$(submit "$T/slow-edmd.json")
 wait_status "$S" running 20
 c -N "$B/jobs/$S/events" >"$T/live.txt" &
 sse=$!
