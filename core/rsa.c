@@ -4,6 +4,7 @@
 
 #include "grid.h"
 #include "rng.h"
+#include "rsa_batch.h"
 #include "rsa_voxels.h"
 
 /* Draws come from a voxel set (rsa_voxels.h) built for a run of sizes
@@ -127,14 +128,10 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
     pk_progress pg = {.stage = "rsa", .total = n, .eta_s = -1};
 
     segment sg = {.on = 0, .retry_below = prm->plain_draws ? 0 : INFINITY};
+    const size_t min_run = prm->batch_min_run ? prm->batch_min_run : PK_RSA_BATCH_MIN_RUN;
+    size_t no_batch_below = prm->plain_draws || prm->no_batch ? SIZE_MAX : 0;
     for (size_t i = 0; i < n; i++) {
         double r = 0.5 * diameters[i];
-        if (sg.on && r < sg.vox.r_valid && end_segment(&sg, &grid, out) != 0) {
-            st->reason = PK_STOP_ERROR;
-            break;
-        }
-        if (!sg.on && r < sg.retry_below)
-            begin_segment(&sg, b, diameters, i, n, gap, out);
         /* Draw range per axis: walls keep the grain Δd/2 away (spec §2.1). */
         double lo[PK_MAXDIM] = {0, 0, 0}, span[PK_MAXDIM] = {0, 0, 0};
         int fits = 1;
@@ -153,6 +150,36 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
             st->reason = PK_STOP_NO_ROOM;
             break;
         }
+        size_t run = 1;
+        while (i >= no_batch_below && i + run < n && diameters[i + run] == diameters[i])
+            run++;
+        if (i >= no_batch_below && run >= min_run &&
+            pk_rsa_batch_usable(b, r, gap, lo, span, run)) {
+            if (sg.on && end_segment(&sg, &grid, out) != 0) {
+                st->reason = PK_STOP_ERROR;
+                break;
+            }
+            size_t first = out->n;
+            pk_stop_reason why = pk_rsa_batch_run(b, r, &species[i], run, lo, span, prm, &grid,
+                                                  &rng, mon, &pg, box_measure, &solid, out, st);
+            for (size_t j = first; why == PK_STOP_COMPLETE && i + run < n && j < out->n; j++)
+                if (pk_grid_insert(&grid, out, j) != 0)
+                    why = PK_STOP_ERROR; /* later (smaller) grains see the run's grains */
+            if (why != PK_STOP_COMPLETE) {
+                st->reason = why;
+                break;
+            }
+            i += run - 1;
+            continue;
+        }
+        if (i >= no_batch_below)
+            no_batch_below = i + run; /* the rest of this run goes one at a time too */
+        if (sg.on && r < sg.vox.r_valid && end_segment(&sg, &grid, out) != 0) {
+            st->reason = PK_STOP_ERROR;
+            break;
+        }
+        if (!sg.on && r < sg.retry_below)
+            begin_segment(&sg, b, diameters, i, n, gap, out);
         uint64_t failed = 0, vid = 0;
         double x[PK_MAXDIM] = {0, 0, 0};
         int saturated = 0;

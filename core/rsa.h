@@ -7,7 +7,10 @@
  * `max_failed_draws` consecutive rejections of one grain the run stops with
  * what it has placed (Titscher's N^F failure criterion).  When the draws come
  * from the voxels not yet covered (rsa_voxels.h) and none is left, the box is
- * provably full for the next grain: the run stops as PK_STOP_SATURATED. */
+ * provably full for the next grain: the run stops as PK_STOP_SATURATED.
+ * Long runs of equal diameters (monodisperse jobs, discrete size classes) are
+ * placed in batches of attempts (rsa_batch.h): the same packing as plain draws
+ * one at a time, with cache-friendly tests. */
 #ifndef PK_RSA_H
 #define PK_RSA_H
 
@@ -41,6 +44,12 @@ typedef struct pk_rsa_params {
                                     reference path of the tests); 0: draws from the
                                     voxels not yet covered where that pays (same
                                     statistics, see rsa_voxels.h) */
+    int no_batch;                /* 1: runs of equal diameters also go one grain at a
+                                    time; 0 (default, with plain_draws = 0): runs of at
+                                    least batch_min_run equal grains take the batched
+                                    path (rsa_batch.h), bit-identical to plain draws */
+    uint32_t batch_attempts;     /* attempts per batch; 0 = adaptive (tests fix it) */
+    uint32_t batch_min_run;      /* 0 = PK_RSA_BATCH_MIN_RUN */
 } pk_rsa_params;
 
 typedef struct pk_rsa_stats {

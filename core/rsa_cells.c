@@ -13,8 +13,7 @@ static int64_t axis_cells(double span, double c)
     return m < 1 ? 1 : (m > 1e9 ? (int64_t)1e9 : (int64_t)m);
 }
 
-uint64_t pk_rsa_cells_count(const pk_box *b, double r, double gap, const double *lo,
-                            const double *span)
+uint64_t pk_rsa_cells_count(const pk_box *b, double r, double gap, const double *span)
 {
     double c = 2 * r + gap;
     if (!b || b->dim < 2 || b->dim > 3 || !(c > 0))
@@ -26,11 +25,10 @@ uint64_t pk_rsa_cells_count(const pk_box *b, double r, double gap, const double 
         int64_t m = axis_cells(span[k], c);
         if (b->periodic[k] && m < 3)
             return 0; /* ±1 neighbours must be distinct cells */
-        if (total > MAX_CELLS / (uint64_t)m)
+        if (total > MAX_CELLS / (uint64_t)(m + 2))
             return 0;
-        total *= (uint64_t)m;
+        total *= (uint64_t)(m + 2);
     }
-    (void)lo;
     return total;
 }
 
@@ -38,25 +36,42 @@ int pk_rsa_cells_init(pk_rsa_cells *C, const pk_box *b, double r, double gap, co
                       const double *span)
 {
     memset(C, 0, sizeof *C);
-    uint64_t nc = pk_rsa_cells_count(b, r, gap, lo, span);
+    uint64_t nc = pk_rsa_cells_count(b, r, gap, span);
     if (nc == 0)
         return -1;
     double s = r + r + gap; /* as pk_grid: (r_i + r_j) + gap */
     C->dim = b->dim;
     C->s2 = s * s;
     for (int k = 0; k < PK_MAXDIM; k++) {
-        C->n[k] = 1;
-        C->inv_h[k] = 0;
+        C->n[k] = C->np[k] = 1;
+        C->quarter[k] = INFINITY;
         if (k >= b->dim)
             continue;
         C->periodic[k] = b->periodic[k];
         C->L[k] = b->L[k];
-        C->quarter[k] = 0.25 * b->L[k];
+        if (b->periodic[k])
+            C->quarter[k] = 0.25 * b->L[k];
         C->lo[k] = lo[k];
         C->n[k] = axis_cells(span[k], 2 * r + gap);
+        C->np[k] = C->n[k] + 2;
         C->inv_h[k] = span[k] > 0 ? (double)C->n[k] / span[k] : 0;
     }
     C->ncell = nc;
+    for (int k = 0; k < PK_MAXDIM; k++) {
+        int per = k < b->dim && b->periodic[k];
+        C->calm_lo[k] = per ? (C->n[k] >= 4 ? 1 : INT64_MAX) : INT64_MIN;
+        C->calm_hi[k] = per ? C->n[k] - 2 : INT64_MAX;
+    }
+    /* neighbour offsets by distance class (faces, edges, corners): a rejected
+     * attempt usually meets its overlap early */
+    C->noff = 0;
+    int zr = b->dim == 3 ? 1 : 0;
+    for (int cls = 1; cls <= b->dim; cls++)
+        for (int dz = -zr; dz <= zr; dz++)
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++)
+                    if (abs(dx) + abs(dy) + abs(dz) == cls)
+                        C->off[C->noff++] = ((int64_t)dz * C->np[1] + dy) * C->np[0] + dx;
     C->cell = malloc(nc * sizeof *C->cell);
     if (!C->cell)
         return -1;
@@ -74,44 +89,37 @@ void pk_rsa_cells_free(pk_rsa_cells *C)
     memset(C, 0, sizeof *C);
 }
 
-/* Neighbour coordinates along axis k of coordinate i: periodic axes wrap
- * (n >= 3, so the three are distinct), walled axes clip. */
-static inline int axis_around(const pk_rsa_cells *C, int k, int64_t i, int64_t out[3])
-{
-    int m = 0;
-    for (int64_t d = -1; d <= 1; d++) {
-        int64_t j = i + d;
-        if (j < 0 || j >= C->n[k]) {
-            if (!C->periodic[k])
-                continue;
-            j = j < 0 ? j + C->n[k] : j - C->n[k];
-        }
-        out[m++] = j;
-    }
-    return m;
-}
-
 int pk_rsa_cells_around(const pk_rsa_cells *C, const double *x, uint64_t out[27])
 {
     int64_t a[3][3] = {{0}};
     int m[3] = {1, 1, 1};
-    for (int k = 0; k < C->dim; k++)
-        m[k] = axis_around(C, k, pk_rsa_cells_coord(C, k, x[k]), a[k]);
+    for (int k = 0; k < C->dim; k++) {
+        int64_t i = pk_rsa_cells_coord(C, k, x[k]);
+        m[k] = 0;
+        for (int64_t d = -1; d <= 1; d++) {
+            int64_t j = i + d;
+            if (j < 0 || j >= C->n[k]) {
+                if (!C->periodic[k])
+                    continue;
+                j = j < 0 ? j + C->n[k] : j - C->n[k];
+            }
+            a[k][m[k]++] = j + 1;
+        }
+    }
     int cnt = 0;
     for (int z = 0; z < m[2]; z++)
         for (int y = 0; y < m[1]; y++)
             for (int xx = 0; xx < m[0]; xx++)
-                out[cnt++] = ((uint64_t)a[2][z] * (uint64_t)C->n[1] + (uint64_t)a[1][y]) *
-                                 (uint64_t)C->n[0] + (uint64_t)a[0][xx];
+                out[cnt++] = ((uint64_t)a[2][z] * (uint64_t)C->np[1] + (uint64_t)a[1][y]) *
+                                 (uint64_t)C->np[0] + (uint64_t)a[0][xx];
     return cnt;
 }
 
-int pk_rsa_cells_insert(pk_rsa_cells *C, const double *x)
+static int store(pk_rsa_cells *C, uint64_t lin, const double *p)
 {
-    pk_rsa_cell2 *c = &C->cell[pk_rsa_cells_of(C, x)];
-    double p[3] = {x[0], x[1], C->dim == 3 ? x[2] : 0};
+    pk_rsa_cell2 *c = &C->cell[lin];
     if (c->n < 2) {
-        memcpy(c->x[c->n], p, sizeof p);
+        memcpy(c->x[c->n], p, 3 * sizeof *p);
     } else {
         if (C->nextra == C->capextra) {
             size_t cap = C->capextra ? 2 * C->capextra : 1024;
@@ -122,11 +130,37 @@ int pk_rsa_cells_insert(pk_rsa_cells *C, const double *x)
             C->capextra = cap;
         }
         pk_rsa_extra *e = &C->extra[C->nextra];
-        memcpy(e->x, p, sizeof p);
+        memcpy(e->x, p, 3 * sizeof *p);
         e->next = c->more;
         c->more = (int32_t)C->nextra++;
     }
     c->n++;
+    return 0;
+}
+
+int pk_rsa_cells_insert(pk_rsa_cells *C, const double *x)
+{
+    double p[3] = {x[0], x[1], C->dim == 3 ? x[2] : 0};
+    /* padded coordinates: the real one, plus the ghost on the far side of a
+     * periodic axis when the cell touches the seam */
+    int64_t a[3][2] = {{0}};
+    int m[3] = {1, 1, 1};
+    for (int k = 0; k < C->dim; k++) {
+        int64_t i = pk_rsa_cells_coord(C, k, x[k]);
+        a[k][0] = i + 1;
+        if (C->periodic[k] && i == 0)
+            a[k][m[k]++] = C->n[k] + 1;
+        else if (C->periodic[k] && i == C->n[k] - 1)
+            a[k][m[k]++] = 0;
+    }
+    for (int z = 0; z < m[2]; z++)
+        for (int y = 0; y < m[1]; y++)
+            for (int xx = 0; xx < m[0]; xx++) {
+                uint64_t lin = ((uint64_t)a[2][z] * (uint64_t)C->np[1] + (uint64_t)a[1][y]) *
+                                   (uint64_t)C->np[0] + (uint64_t)a[0][xx];
+                if (store(C, lin, p) != 0)
+                    return -1;
+            }
     return 0;
 }
 
@@ -147,15 +181,47 @@ static inline int cell_hits(const pk_rsa_cells *C, const pk_rsa_cell2 *c, const 
     return 0;
 }
 
-void pk_rsa_cells_filter(const pk_rsa_cells *C, const double *pos, size_t n, uint8_t *keep)
+/* Away from seams: d as is (pk_rsa_cells_key), the z term +0 in 2D. */
+static inline int near_direct(const double *a, const double *x, double s2)
 {
-    uint64_t nb[27];
+    double d0 = a[0] - x[0], d1 = a[1] - x[1], d2 = a[2] - x[2];
+    return d0 * d0 + d1 * d1 + d2 * d2 < s2;
+}
+
+static inline int cell_hits_direct(const pk_rsa_cells *C, const pk_rsa_cell2 *c, const double *x)
+{
+    int n = c->n;
+    if (n == 0)
+        return 0;
+    if (near_direct(c->x[0], x, C->s2))
+        return 1;
+    if (n == 1)
+        return 0;
+    if (near_direct(c->x[1], x, C->s2))
+        return 1;
+    for (int32_t e = c->more; e >= 0; e = C->extra[e].next)
+        if (near_direct(C->extra[e].x, x, C->s2))
+            return 1;
+    return 0;
+}
+
+void pk_rsa_cells_filter(const pk_rsa_cells *C, const double *pos, const uint32_t *key, size_t n,
+                         uint8_t *keep)
+{
+    const int noff = C->noff;
     for (size_t i = 0; i < n; i++) {
         const double *x = &pos[3 * i];
-        int m = pk_rsa_cells_around(C, x, nb);
-        int hit = 0;
-        for (int q = 0; q < m && !hit; q++)
-            hit = cell_hits(C, &C->cell[nb[q]], x);
+        const pk_rsa_cell2 *c0 = &C->cell[pk_rsa_cells_index(key[i])];
+        int hit;
+        if (key[i] & PK_RSA_CELLS_SEAM) {
+            hit = cell_hits(C, c0, x);
+            for (int q = 0; q < noff && !hit; q++)
+                hit = cell_hits(C, c0 + C->off[q], x);
+        } else {
+            hit = cell_hits_direct(C, c0, x);
+            for (int q = 0; q < noff && !hit; q++)
+                hit = cell_hits_direct(C, c0 + C->off[q], x);
+        }
         keep[i] = (uint8_t)!hit;
     }
 }

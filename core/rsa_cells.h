@@ -15,6 +15,7 @@
 #define PK_RSA_CELLS_H
 
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "box.h"
@@ -33,28 +34,40 @@ typedef struct pk_rsa_extra {
 
 typedef struct pk_rsa_cells {
     int dim;
-    int periodic[PK_MAXDIM];
-    double L[PK_MAXDIM], quarter[PK_MAXDIM]; /* quarter = L/4: beyond it the image may shift */
+    double L[PK_MAXDIM];
+    double quarter[PK_MAXDIM];  /* L/4 on periodic axes (beyond it the image may
+                                   shift), +inf on walled and unused axes */
     double lo[PK_MAXDIM];       /* lower end of the draw range per axis */
     double inv_h[PK_MAXDIM];
-    int64_t n[PK_MAXDIM];       /* cells per axis (1 on unused axes) */
-    uint64_t ncell;
+    int periodic[PK_MAXDIM];
+    int64_t n[PK_MAXDIM];       /* real cells per axis (1 on unused axes) */
+    int64_t np[PK_MAXDIM];      /* with the ghost layer: n + 2 on used axes */
+    uint64_t ncell;             /* padded cells */
     double s2;                  /* (r + r + Δd)², the squared contact distance */
+    int64_t calm_lo[PK_MAXDIM], calm_hi[PK_MAXDIM]; /* seam-free coordinates: 1..n-2 on
+                                   periodic axes with n >= 4, none on other periodic
+                                   axes, all on walled ones */
+    int noff;
+    int64_t off[26];            /* neighbour offsets in the padded array, faces first */
     pk_rsa_cell2 *cell;
     pk_rsa_extra *extra;
     size_t nextra, capextra;
 } pk_rsa_cells;
 
+/* A ghost layer surrounds the real cells: on periodic axes it holds copies of
+ * the opposite face's centres (original coordinates: the predicate finds the
+ * image), on walled axes it stays empty — so every test reads the cell and
+ * its fixed index offsets, with no wrap or clip. */
+
 /* Cells a store for grains of radius r (gap Δd) over the draw range starting at
- * lo[] with spans span[] would hold; 0 if it cannot serve the box (a periodic
- * axis with fewer than 3 cells). */
-uint64_t pk_rsa_cells_count(const pk_box *b, double r, double gap, const double *lo,
-                            const double *span);
+ * lo[] with spans span[] would hold (ghosts included); 0 if it cannot serve the
+ * box (a periodic axis with fewer than 3 cells, or too many cells). */
+uint64_t pk_rsa_cells_count(const pk_box *b, double r, double gap, const double *span);
 int pk_rsa_cells_init(pk_rsa_cells *C, const pk_box *b, double r, double gap, const double *lo,
                       const double *span);
 void pk_rsa_cells_free(pk_rsa_cells *C);
 
-/* Cell coordinate along axis k (clamped: round-off at the range ends). */
+/* Real cell coordinate along axis k (clamped: round-off at the range ends). */
 static inline int64_t pk_rsa_cells_coord(const pk_rsa_cells *C, int k, double xk)
 {
     double f = (xk - C->lo[k]) * C->inv_h[k];
@@ -62,38 +75,56 @@ static inline int64_t pk_rsa_cells_coord(const pk_rsa_cells *C, int k, double xk
     return i >= C->n[k] ? C->n[k] - 1 : i;
 }
 
-static inline uint64_t pk_rsa_cells_of(const pk_rsa_cells *C, const double *x)
+#define PK_RSA_CELLS_SEAM 0x80000000u
+
+/* Padded index of the real cell holding x, with PK_RSA_CELLS_SEAM set when a
+ * neighbour may need a periodic image: the cell touches a periodic seam, or
+ * its axis has fewer than 4 cells.  Otherwise every neighbour is nearer than
+ * 2h <= L/2 on each periodic axis, where nearbyint(d/L) = 0: the test may take
+ * d as is.  (ncell < 2^31: the flag never collides with an index.) */
+static inline uint32_t pk_rsa_cells_key(const pk_rsa_cells *C, const double *x)
 {
-    uint64_t lin = (uint64_t)pk_rsa_cells_coord(C, 0, x[0]);
-    lin += (uint64_t)C->n[0] * (uint64_t)pk_rsa_cells_coord(C, 1, x[1]);
-    if (C->dim == 3)
-        lin += (uint64_t)C->n[0] * (uint64_t)C->n[1] * (uint64_t)pk_rsa_cells_coord(C, 2, x[2]);
-    return lin;
+    int64_t i0 = pk_rsa_cells_coord(C, 0, x[0]), i1 = pk_rsa_cells_coord(C, 1, x[1]), i2 = -1;
+    int seam = i0 < C->calm_lo[0] || i0 > C->calm_hi[0] || i1 < C->calm_lo[1] ||
+               i1 > C->calm_hi[1];
+    if (C->dim == 3) {
+        i2 = pk_rsa_cells_coord(C, 2, x[2]);
+        seam |= i2 < C->calm_lo[2] || i2 > C->calm_hi[2];
+    }
+    uint64_t lin = ((uint64_t)(i2 + 1) * (uint64_t)C->np[1] + (uint64_t)(i1 + 1)) *
+                       (uint64_t)C->np[0] + (uint64_t)(i0 + 1);
+    return (uint32_t)lin | (seam ? PK_RSA_CELLS_SEAM : 0);
 }
 
-/* 1 if centres a and b are closer than contact: pk_grid's predicate (grid.c
- * scan) for two grains of this size.  For |d| <= L/4, nearbyint(d/L) = 0 and
- * d - L·0 = d exactly, so skipping the image there changes no bit. */
+/* 1 if centres a and b (z = 0 in 2D) are closer than contact: pk_grid's
+ * predicate (grid.c scan) bit for bit — same difference, image
+ * d -= L·nearbyint(d/L) on periodic axes, same sum order (in 2D the extra
+ * z term is +0, exact).  For |d| <= L/4, nearbyint(d/L) = 0 and d - L·0 = d,
+ * so skipping the image there changes no bit. */
 static inline int pk_rsa_cells_close(const pk_rsa_cells *C, const double *a, const double *b)
 {
-    double d2 = 0;
-    for (int k = 0; k < C->dim; k++) {
-        double d = a[k] - b[k];
-        if (C->periodic[k] && fabs(d) > C->quarter[k])
-            d -= C->L[k] * nearbyint(d / C->L[k]);
-        d2 += d * d;
-    }
-    return d2 < C->s2;
+    double d0 = a[0] - b[0], d1 = a[1] - b[1], d2 = a[2] - b[2];
+    if (fabs(d0) > C->quarter[0])
+        d0 -= C->L[0] * nearbyint(d0 / C->L[0]);
+    if (fabs(d1) > C->quarter[1])
+        d1 -= C->L[1] * nearbyint(d1 / C->L[1]);
+    if (fabs(d2) > C->quarter[2])
+        d2 -= C->L[2] * nearbyint(d2 / C->L[2]);
+    return d0 * d0 + d1 * d1 + d2 * d2 < C->s2;
 }
 
-/* Neighbour cells of the cell holding x (itself included), each once. */
+/* Real neighbour cells (padded indices) of the cell holding x, itself
+ * included, each once: periodic axes wrap, walled axes clip. */
 int pk_rsa_cells_around(const pk_rsa_cells *C, const double *x, uint64_t out[27]);
 
-/* Store a centre.  0, or -1 when out of memory. */
+/* Store a centre (and its ghost copies).  0, or -1 when out of memory. */
 int pk_rsa_cells_insert(pk_rsa_cells *C, const double *x);
 
-/* For each of the n points pos[3i..] (any order; sorted by cell is fast):
- * keep[i] = 1 if no stored centre is closer than contact, else 0. */
-void pk_rsa_cells_filter(const pk_rsa_cells *C, const double *pos, size_t n, uint8_t *keep);
+/* For each of the n points pos[3i..] (z = 0 in 2D) with keys key[i]
+ * (pk_rsa_cells_key; any order, sorted by key is fast): keep[i] = 1 if no
+ * stored centre is closer than contact, else 0. */
+static inline uint64_t pk_rsa_cells_index(uint32_t key) { return key & ~PK_RSA_CELLS_SEAM; }
+void pk_rsa_cells_filter(const pk_rsa_cells *C, const double *pos, const uint32_t *key, size_t n,
+                         uint8_t *keep);
 
 #endif

@@ -1,0 +1,235 @@
+/* test_rsa_batch.c — the batched path for runs of equal grains (core/rsa_batch.h)
+ * against plain draws one grain at a time (pk_rsa_params.plain_draws): same
+ * seed → the same packing bit for bit (memcmp of positions, radii, species),
+ * the same number of draws and the same stop reason, for 2D and 3D, periodic,
+ * walled and mixed axes, with Δd, with grains already present, with several
+ * size classes in a row (the rng must be rewound exactly after each run),
+ * across batch sizes from 1 attempt to adaptive. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "rsa.h"
+#include "rng.h"
+#include "rsa_cells.h"
+
+typedef struct setup {
+    pk_box box;
+    double delta_d;
+    uint64_t max_failed;
+    size_t n;
+    double *d;
+    int32_t *sp;
+    size_t nfixed;              /* grains present before the run */
+    double fixed[4][4];         /* x, y, z, r */
+} setup;
+
+/* Runs RSA; batch = 0: plain reference; else batched with that many attempts
+ * per batch (SIZE_MAX: adaptive). */
+static void place(const setup *u, size_t batch, uint32_t min_run, pk_particles *p,
+                  pk_rsa_stats *st)
+{
+    pk_particles_init(p, u->box.dim, u->n + u->nfixed);
+    for (size_t k = 0; k < u->nfixed; k++)
+        pk_particles_push(p, u->fixed[k], u->fixed[k][3], 9);
+    pk_rsa_params prm = {.delta_d = u->delta_d, .max_failed_draws = u->max_failed, .seed = 21,
+                         .plain_draws = batch == 0,
+                         .batch_attempts = batch == SIZE_MAX ? 0 : (uint32_t)batch,
+                         .batch_min_run = min_run};
+    CHECK(pk_rsa_place(&u->box, u->d, u->sp, u->n, &prm, NULL, p, st) == 0);
+}
+
+static int same(const pk_particles *a, const pk_particles *b)
+{
+    return a->n == b->n && memcmp(a->x, b->x, 3 * a->n * sizeof(double)) == 0 &&
+           memcmp(a->r, b->r, a->n * sizeof(double)) == 0 &&
+           memcmp(a->species, b->species, a->n * sizeof(int32_t)) == 0;
+}
+
+/* The reference once, then the batched path at each batch size. */
+static void compare(const char *name, const setup *u, uint32_t min_run, size_t expect_placed)
+{
+    static const size_t sizes[] = {1, 7, 1000, 4096, SIZE_MAX};
+    pk_particles ref;
+    pk_rsa_stats sr;
+    place(u, 0, min_run, &ref, &sr);
+    printf("  %s: plain placed %zu of %zu, %llu draws, %s\n", name, sr.placed, u->n,
+           (unsigned long long)sr.draws, pk_stop_reason_name(sr.reason));
+    if (expect_placed)
+        CHECK_MSG(sr.placed == expect_placed, "%s: placed %zu", name, sr.placed);
+    for (size_t q = 0; q < sizeof sizes / sizeof *sizes; q++) {
+        /* B = 1 costs a batch per attempt: only on the small cases */
+        if (sizes[q] == 1 && sr.draws > 300000)
+            continue;
+        pk_particles p;
+        pk_rsa_stats sb;
+        place(u, sizes[q], min_run, &p, &sb);
+        CHECK_MSG(same(&p, &ref), "%s, B = %zu: packing differs (%zu vs %zu grains)", name,
+                  sizes[q], p.n, ref.n);
+        CHECK_MSG(sb.draws == sr.draws && sb.reason == sr.reason && sb.placed == sr.placed,
+                  "%s, B = %zu: draws %llu/%llu reason %d/%d", name, sizes[q],
+                  (unsigned long long)sb.draws, (unsigned long long)sr.draws, sb.reason,
+                  sr.reason);
+        pk_particles_free(&p);
+    }
+    pk_particles_free(&ref);
+}
+
+static void mono(setup *u, int dim, const int periodic[3], double phi, double d, size_t n)
+{
+    memset(u, 0, sizeof *u);
+    double L = dim == 3 ? cbrt((double)n * pk_ball_measure(3, 0.5 * d) / phi)
+                        : sqrt((double)n * pk_ball_measure(2, 0.5 * d) / phi);
+    u->box = (pk_box){.dim = dim, .L = {L, L, dim == 3 ? L : 0}};
+    for (int k = 0; k < dim; k++)
+        u->box.periodic[k] = periodic[k];
+    u->n = n;
+    u->max_failed = 1000000;
+    u->d = malloc(n * sizeof *u->d);
+    u->sp = calloc(n, sizeof *u->sp);
+    for (size_t i = 0; i < n; i++)
+        u->d[i] = d;
+}
+
+static void unset(setup *u)
+{
+    free(u->d);
+    free(u->sp);
+}
+
+/* Monodisperse at φ = 0.30 (3D) / 0.45 (2D), the default run threshold:
+ * what the bench and monodisperse jobs take. */
+static void test_mono_matches_plain(void)
+{
+    setup u;
+    mono(&u, 3, (int[3]){1, 1, 1}, 0.30, 1.0, 3000);
+    compare("3D periodic", &u, 0, 3000);
+    unset(&u);
+    mono(&u, 2, (int[3]){0, 0, 0}, 0.45, 1.0, 2000);
+    u.delta_d = 0.05;
+    compare("2D walled, dd 0.05", &u, 0, 2000);
+    unset(&u);
+    /* with Δd: φ_eff = 0.2·(0.9/0.8)³ = 0.28 */
+    mono(&u, 3, (int[3]){1, 0, 1}, 0.20, 0.8, 2500);
+    u.delta_d = 0.1;
+    compare("3D mixed axes, dd 0.1", &u, 0, 2500);
+    unset(&u);
+    mono(&u, 2, (int[3]){1, 1, 0}, 0.45, 1.0, 2000);
+    compare("2D periodic", &u, 0, 2000);
+    unset(&u);
+}
+
+/* Three size classes in a row (discrete grading) around present grains, 3D
+ * walled with Δd: each class is a batched run; obstacles come from the grid. */
+static void test_classes_and_present_grains(void)
+{
+    setup u;
+    memset(&u, 0, sizeof u);
+    u.box = (pk_box){.dim = 3, .L = {18, 16, 17}, .periodic = {false, true, false}};
+    u.delta_d = 0.08;
+    u.max_failed = 1000000;
+    size_t cls[3] = {150, 700, 2200};
+    double dia[3] = {2.0, 1.2, 0.7};
+    u.n = cls[0] + cls[1] + cls[2];
+    u.d = malloc(u.n * sizeof *u.d);
+    u.sp = malloc(u.n * sizeof *u.sp);
+    for (size_t i = 0, c = 0; c < 3; c++)
+        for (size_t k = 0; k < cls[c]; k++, i++) {
+            u.d[i] = dia[c];
+            u.sp[i] = (int32_t)c;
+        }
+    u.nfixed = 2;
+    u.fixed[0][0] = 5, u.fixed[0][1] = 8, u.fixed[0][2] = 6, u.fixed[0][3] = 3.0;
+    u.fixed[1][0] = 12, u.fixed[1][1] = 1, u.fixed[1][2] = 12, u.fixed[1][3] = 2.5;
+    compare("3 classes + 2 present grains", &u, 1, u.n);
+    unset(&u);
+}
+
+/* Every grain its own size (continuous sizes), each grain a run of one. */
+static void test_distinct_sizes(void)
+{
+    setup u;
+    memset(&u, 0, sizeof u);
+    u.box = (pk_box){.dim = 2, .L = {30, 25}, .periodic = {true, false}};
+    u.delta_d = 0.03;
+    u.max_failed = 100000;
+    u.n = 400;
+    u.d = malloc(u.n * sizeof *u.d);
+    u.sp = calloc(u.n, sizeof *u.sp);
+    for (size_t i = 0; i < u.n; i++)
+        u.d[i] = 2.0 * pow(0.3, (double)i / (double)(u.n - 1));
+    compare("2D distinct sizes, runs of 1", &u, 1, u.n);
+    unset(&u);
+}
+
+/* More grains than fit: both paths stop after N^F consecutive failures at the
+ * same attempt (the batch that crosses it is cut there). */
+static void test_failure_stop_matches(void)
+{
+    setup u;
+    mono(&u, 2, (int[3]){0, 0, 0}, 0.80, 1.0, 1200); /* φ 0.8 > RSA saturation 0.547 */
+    u.max_failed = 3000;
+    compare("2D overfull, N_F 3000", &u, 0, 0);
+    pk_particles p;
+    pk_rsa_stats st;
+    place(&u, SIZE_MAX, 0, &p, &st);
+    CHECK(st.reason == PK_STOP_MAX_FAILED_DRAWS && st.placed < u.n && st.placed > 500);
+    pk_particles_free(&p);
+    unset(&u);
+}
+
+/* The store's answers against brute force (minimum image, all pairs), for
+ * points near periodic seams, walls and in the interior.  (Bit equality with
+ * pk_grid's predicate is what the comparisons with the plain path prove.) */
+static void test_cells_predicate_and_neighbours(void)
+{
+    pk_box b = {.dim = 3, .L = {17.3, 19.1, 6.4}, .periodic = {true, true, false}};
+    double r = 0.45, gap = 0.1, lo[3] = {0, 0, r + 0.5 * gap};
+    double span[3] = {17.3, 19.1, 6.4 - 2 * lo[2]};
+    pk_rsa_cells C;
+    CHECK(pk_rsa_cells_init(&C, &b, r, gap, lo, span) == 0);
+    pk_rng g;
+    pk_rng_seed(&g, 3, 3);
+    double pts[400][3];
+    for (int i = 0; i < 400; i++)
+        for (int k = 0; k < 3; k++)
+            pts[i][k] = lo[k] + span[k] * pk_rng_uniform(&g);
+    for (int i = 0; i < 200; i++)
+        CHECK(pk_rsa_cells_insert(&C, pts[i]) == 0);
+    int wrong = 0, near = 0;
+    uint8_t keep[200];
+    uint32_t key[200];
+    int seam = 0;
+    for (int q = 0; q < 200; q++) {
+        key[q] = pk_rsa_cells_key(&C, pts[200 + q]);
+        for (int k = 0; k < 3; k++) {
+            int64_t i = pk_rsa_cells_coord(&C, k, pts[200 + q][k]);
+            seam += i == 0 || i == C.n[k] - 1;
+        }
+    }
+    CHECK(seam > 20); /* points next to seams and walls are among them */
+    pk_rsa_cells_filter(&C, pts[200], key, 200, keep);
+    for (int q = 200; q < 400; q++) {
+        int hit = 0;
+        for (int i = 0; i < 200; i++) {
+            double s = r + r + gap, d2 = pk_box_dist2(&b, pts[i], pts[q]);
+            hit |= d2 < s * s;
+            near += d2 < 4 * s * s;
+        }
+        wrong += keep[q - 200] == hit;
+    }
+    CHECK_MSG(wrong == 0, "%d of 200 filter answers differ from brute force", wrong);
+    CHECK(near > 50); /* the test points do meet neighbours */
+    pk_rsa_cells_free(&C);
+}
+
+int main(void)
+{
+    RUN(test_cells_predicate_and_neighbours);
+    RUN(test_mono_matches_plain);
+    RUN(test_classes_and_present_grains);
+    RUN(test_distinct_sizes);
+    RUN(test_failure_stop_matches);
+    return check_summary();
+}
