@@ -102,6 +102,9 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
     job->refresh = (size_t)num(dr, "refresh", 200);
     const char *pred = json_string_value(json_object_get(dr, "predictor"));
     job->affine_predictor = !(pred && !strcmp(pred, "none"));
+    const char *solver = json_string_value(json_object_get(dr, "solver"));
+    job->newton = solver && !strcmp(solver, "newton");
+    job->newton_max_iter = (size_t)num(dr, "newton_max_iter", 50);
     job->tangent = json_is_true(json_object_get(inputs, "tangent"));
     json_t *out = json_object_get(inputs, "output");
     job->out_micro = json_is_true(json_object_get(out, "micro_state"));

@@ -21,6 +21,8 @@ typedef struct pk_homog_job {
     int lanczos_steps;
     size_t refresh;
     int affine_predictor;
+    int newton;                /* relaxation.solver = newton */
+    size_t newton_max_iter;
     int tangent;
     int out_micro, out_contacts;
     double radius_factor;      /* initial_state radius_inflation */

@@ -33,7 +33,8 @@ static void tensor_series(json_t *parent, const char *name, int dim, int skew_on
 static const char *const scalar_series[] = {
     "J", "energy", "energy_density", "contacts", "contacts_formed", "contacts_broken",
     "coordination", "rattlers", "max_overlap_ratio", "sum_force", "reaction_defect", NULL};
-static const char *const dr_series[] = {"iterations", "residual", "residual_initial", "stop_code",
+static const char *const dr_series[] = {"newton_iterations", "newton_exit_code", "iterations",
+                                        "residual", "residual_initial", "stop_code",
                                         "dt", "gamma", "lambda_min", "lambda_max",
                                         "lambda_min_clamped", NULL};
 
@@ -52,6 +53,10 @@ json_t *pk_homog_record_new(int dim, int with_tangent)
     json_object_set_new(dr, "stop_names",
                         json_string("0 converged, 1 converged_absolute, 2 not_needed, 3 max_iter, "
                                     "4 cancelled, 5 wall_time"));
+    json_object_set_new(dr, "newton_exit_names",
+                        json_string("-1 not used, 0 converged, 1 rattler_polish, "
+                                    "2 block_not_positive_definite, 3 line_search_failed, "
+                                    "4 iteration_cap, 5 stalled"));
     json_object_set_new(r, "dr", dr);
     if (with_tangent) {
         json_t *t = json_object();
@@ -115,6 +120,8 @@ int pk_homog_record_step(json_t *rec, int dim, const pk_homog_step *st)
     rc |= put(rec, "sum_force", json_real(st->sum_force));
     rc |= put(rec, "reaction_defect", json_real(st->reaction_defect));
     json_t *dr = json_object_get(rec, "dr");
+    rc |= put(dr, "newton_iterations", json_integer((json_int_t)st->newton.iterations));
+    rc |= put(dr, "newton_exit_code", json_integer(st->used_newton ? (json_int_t)st->newton.exit : -1));
     rc |= put(dr, "iterations", json_integer((json_int_t)st->dr.iterations));
     rc |= put(dr, "residual", json_real(st->dr.f));
     rc |= put(dr, "residual_initial", json_real(st->dr.f0));

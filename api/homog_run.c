@@ -28,6 +28,8 @@ static void opts_of(const pk_homog_job *job, const pk_homog_rve *rve, pk_homog_o
     o->dr.lanczos_steps = job->lanczos_steps;
     o->dr.refresh = job->refresh;
     o->dr.skin = 0.3 * rmean;
+    o->newton = job->newton ? &pk_sparse_cholmod : NULL;
+    o->newton_max_iter = job->newton_max_iter;
 }
 
 static const char *eval_error(int rc)

@@ -47,13 +47,6 @@ double pk_edmd_exit_time(const double q[3], const double v[3], double rho0, doub
     return 0;                        /* B < 0 with A <= 0 is impossible inside; rebuild now */
 }
 
-void edmd_position(const edmd_state *s, size_t i, double t, double x[3])
-{
-    double dt = t - s->t0[i];
-    for (int k = 0; k < 3; k++)
-        x[k] = s->x0[3 * i + k] + s->v[3 * i + k] * dt;
-}
-
 /* Keeps periodic coordinates in [0, L) so that a displacement between two
  * grains (each within a list skin of its synced position) is within 1.5 L
  * and one conditional shift gives the minimum image. */

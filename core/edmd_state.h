@@ -49,7 +49,6 @@ typedef struct edmd_state {
 } edmd_state;
 
 /* edmd_predict.c */
-void edmd_position(const edmd_state *s, size_t i, double t, double x[3]);
 void edmd_sync(edmd_state *s, size_t i);               /* x0 ← x(t), t0 ← t */
 void edmd_predict(edmd_state *s, size_t i);            /* refresh i's event and heap slot */
 double edmd_wall_time(const edmd_state *s, size_t i, int *code);

@@ -162,7 +162,16 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     }
     for (size_t i = 0; i < n; i++)
         is_free[i] = !rve->fixed[i];
-    rc = pk_homog_relax(&c, &g, trial->x, rve->r, n, o->E_n, is_free, &o->dr, mon, &out->dr);
+    size_t nfree = 0;
+    for (size_t i = 0; i < n; i++)
+        nfree += is_free[i];
+    if (o->newton && nfree) {
+        out->used_newton = 1;
+        rc = pk_homog_newton(&c, &g, trial->x, rve->r, n, o->E_n, is_free, &o->dr, o->newton,
+                             o->newton_max_iter, mon, &out->dr, &out->newton);
+    } else {
+        rc = pk_homog_relax(&c, &g, trial->x, rve->r, n, o->E_n, is_free, &o->dr, mon, &out->dr);
+    }
     if (rc != 0)
         goto done;
 

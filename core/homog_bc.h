@@ -20,6 +20,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "homog_newton.h"
 #include "homog_relax.h"
 #include "homog_rve.h"
 #include "progress.h"
@@ -36,6 +37,10 @@ typedef struct pk_homog_opts {
     double E_n;           /* normal contact stiffness (4.3) */
     int affine_predictor; /* 1: start free grains from x = F̄ⁿ⁺¹(F̄ⁿ)⁻¹xⁿ (Ξ fixed); 0: thesis */
     pk_dr_params dr;
+    /* Equilibrium solver: NULL = dynamic relaxation (the thesis); a sparse
+     * solver = Newton–Raphson with DR fallback (homog_newton.h). */
+    const pk_sparse_solver *newton;
+    size_t newton_max_iter;
 } pk_homog_opts;
 
 typedef struct pk_homog_step {
@@ -49,7 +54,9 @@ typedef struct pk_homog_step {
     double max_overlap_ratio;  /* max ε_ij / min(r_i, r_j) (spec H3) */
     size_t contacts, formed, broken, rattlers;
     double coordination;       /* 2·contacts / particles */
-    pk_dr_stats dr;
+    pk_dr_stats dr;            /* DR part (all of it without Newton) */
+    int used_newton;
+    pk_newton_stats newton;
 } pk_homog_step;
 
 /* State at F̄ = 1 (x = X) with its contact set.  0 / -1 (memory). */

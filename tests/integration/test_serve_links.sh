@@ -32,6 +32,22 @@ code=$(c -o "$T/nojob.out" -w '%{http_code}' -H 'Content-Type: application/json'
     "$B/processes/pack/execution")
 check unknown_job_link_422 sh -c "test '$code' = 422 && grep -q 'does not exist' '$T/nojob.out'"
 
+# a finished pack job's result as the RVE of a homogenize job (CI pipelines chain jobs this way)
+body_of "$SRC/examples/homogenize/rve-rsa-2d.json" >"$T/rve.json"
+R=$(submit "$T/rve.json")
+wait_status "$R" successful 60
+body_of "$SRC/examples/homogenize/homogenize-periodic-2d.json" "
+i['rve'] = {'href': '/jobs/$R/results/result'}
+i['load']['steps'] = 4
+i['output'] = {}" >"$T/homog.json"
+c -D "$T/h.h" -o "$T/h.json" -H 'Content-Type: application/json' --data-binary "@$T/homog.json" \
+    "$B/processes/homogenize/execution"
+H=$(member "$T/h.json" jobID)
+check homogenize_by_job_link_accepted grep -q '^HTTP/1.1 201' "$T/h.h"
+check homogenize_by_job_link_successful wait_status "$H" successful 180
+c -o "$T/hres.json" "$B/jobs/$H/results"
+check homogenize_result_document test "$(jget "$T/hres.json" 'd["result"]["href"] == "/jobs/'"$H"'/results/result"')" = True
+
 # packd validate: a job file must name files by path
 python3 -c "
 import json; j=json.load(open('$SRC/examples/tetfill-cylinder.json')); j['inputs']['domain']['mesh']={'href': '$HREF'}
