@@ -17,24 +17,6 @@ void pk_rng_seed(pk_rng *g, uint64_t seed, uint64_t stream)
         g->s[i] = splitmix64(&x);
 }
 
-static inline uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
-
-uint64_t pk_rng_next(pk_rng *g)
-{
-    uint64_t *s = g->s;
-    uint64_t result = rotl(s[1] * 5, 7) * 9;
-    uint64_t t = s[1] << 17;
-    s[2] ^= s[0];
-    s[3] ^= s[1];
-    s[1] ^= s[2];
-    s[0] ^= s[3];
-    s[2] ^= t;
-    s[3] = rotl(s[3], 45);
-    return result;
-}
-
-double pk_rng_uniform(pk_rng *g) { return (double)(pk_rng_next(g) >> 11) * 0x1.0p-53; }
-
 double pk_rng_range(pk_rng *g, double a, double b) { return a + (b - a) * pk_rng_uniform(g); }
 
 double pk_rng_normal(pk_rng *g)

@@ -10,9 +10,26 @@
 typedef struct { uint64_t s[4]; } pk_rng;
 
 void pk_rng_seed(pk_rng *g, uint64_t seed, uint64_t stream);
-uint64_t pk_rng_next(pk_rng *g);
+/* Next 64 random bits.  Inline: hot loops (RSA's batched draws) call it
+ * directly, and there is one generator in packd, not a copy per caller. */
+static inline uint64_t pk_rng_rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
+
+static inline uint64_t pk_rng_next(pk_rng *g)
+{
+    uint64_t *s = g->s;
+    uint64_t result = pk_rng_rotl(s[1] * 5, 7) * 9;
+    uint64_t t = s[1] << 17;
+    s[2] ^= s[0];
+    s[3] ^= s[1];
+    s[1] ^= s[2];
+    s[0] ^= s[3];
+    s[2] ^= t;
+    s[3] = pk_rng_rotl(s[3], 45);
+    return result;
+}
+
 /* Uniform in [0,1) with 53 random bits. */
-double pk_rng_uniform(pk_rng *g);
+static inline double pk_rng_uniform(pk_rng *g) { return (double)(pk_rng_next(g) >> 11) * 0x1.0p-53; }
 /* Uniform in [a,b). */
 double pk_rng_range(pk_rng *g, double a, double b);
 /* Standard normal (Box–Muller, no cached second value: stream stays simple). */

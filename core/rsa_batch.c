@@ -1,4 +1,5 @@
 #include "rsa_batch.h"
+#include "rng.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -18,26 +19,6 @@
  * a huge box keep the per-grain path). */
 #define CELLS_PER_GRAIN 64
 #define CELLS_FREE 65536
-
-/* xoshiro256** as core/rng.c (pk_rng_next, pk_rng_uniform), inlined for the
- * draw loop; test_rsa_batch compares against the one-at-a-time path, so any
- * drift between the two copies fails that test. */
-static inline uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
-
-static inline uint64_t next64(uint64_t *s)
-{
-    uint64_t result = rotl(s[1] * 5, 7) * 9;
-    uint64_t t = s[1] << 17;
-    s[2] ^= s[0];
-    s[3] ^= s[1];
-    s[1] ^= s[2];
-    s[0] ^= s[3];
-    s[2] ^= t;
-    s[3] = rotl(s[3], 45);
-    return result;
-}
-
-static inline double unit(uint64_t *s) { return (double)(next64(s) >> 11) * 0x1.0p-53; }
 
 int pk_rsa_batch_usable(const pk_box *b, double r, double gap, const double *lo,
                         const double *span, size_t m)
@@ -140,7 +121,7 @@ static int batch_hits(const pk_rsa_cells *C, const scratch *w, uint64_t hmask, c
 /* Steps 1–2 for B attempts: draw, sort by cell bucket, filter against the
  * store.  Returns the number of survivors. */
 static size_t draw_and_filter(const pk_rsa_cells *C, scratch *w, size_t B, int dim,
-                              const double *lo, const double *span, uint64_t *s, int shift,
+                              const double *lo, const double *span, pk_rng *rng, int shift,
                               uint32_t nbucket)
 {
     memset(w->count, 0, (nbucket + 1) * sizeof *w->count);
@@ -149,9 +130,9 @@ static size_t draw_and_filter(const pk_rsa_cells *C, scratch *w, size_t B, int d
     for (size_t a = 0; a < B; a++) {
         /* rsa.c's plain draw: x[k] = lo[k] + span[k]·u, k = 0, 1 (, 2), z = 0 in 2D */
         double *x = &w->pos[3 * a];
-        x[0] = lo0 + sp0 * unit(s);
-        x[1] = lo1 + sp1 * unit(s);
-        x[2] = dim == 3 ? lo2 + sp2 * unit(s) : 0;
+        x[0] = lo0 + sp0 * pk_rng_uniform(rng);
+        x[1] = lo1 + sp1 * pk_rng_uniform(rng);
+        x[2] = dim == 3 ? lo2 + sp2 * pk_rng_uniform(rng) : 0;
         uint32_t key = pk_rsa_cells_key(C, x);
         w->key[a] = key;
         w->count[(pk_rsa_cells_index(key) >> shift) + 1]++;
@@ -220,7 +201,7 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
             break;
         }
         pk_rng start = *rng;
-        size_t S = draw_and_filter(&C, &w, B, b->dim, lo, span, rng->s, shift, nbucket);
+        size_t S = draw_and_filter(&C, &w, B, b->dim, lo, span, rng, shift, nbucket);
 
         /* step 3: attempt order */
         uint64_t hmask = 63;
@@ -266,7 +247,7 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
         if (used < B) { /* rewind the stream to just after the last attempt used */
             *rng = start;
             for (size_t q = 0; q < used * (size_t)b->dim; q++)
-                next64(rng->s);
+                pk_rng_next(rng);
         }
         p_surv = fmax((double)S / (double)B, 1e-6);
         p_acc = fmax((double)acc / (double)used, 1e-6);
