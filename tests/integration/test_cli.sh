@@ -5,13 +5,7 @@ set -u
 PACKD=${PACKD:-build/packd}
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
-pass() { echo "PASS $1"; }
-fail() { echo "FAIL $1${2:+: $2}"; }
-check() { # name, condition command...
-    name=$1
-    shift
-    if "$@"; then pass "$name"; else fail "$name"; fi
-}
+. "${PACKD_SRC:-.}/tests/integration/check.inc"
 
 # 1. every example runs, ends complete, and h5dump reads the H5MD layout
 for ex in examples/*.json; do

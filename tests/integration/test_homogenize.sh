@@ -8,13 +8,7 @@ SRC=${PACKD_SRC:-$PWD}
 EX="$SRC/examples/homogenize"
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
-pass() { echo "PASS $1"; }
-fail() { echo "FAIL $1${2:+: $2}"; }
-check() { # name, condition command...
-    name=$1
-    shift
-    if "$@"; then pass "$name"; else fail "$name"; fi
-}
+. "${PACKD_SRC:-.}/tests/integration/check.inc"
 cd "$T" || exit 1
 
 # 1. the RVE, then the example exactly as shipped (its rve path is relative to the cwd)

@@ -9,8 +9,7 @@ SRC=${PACKD_SRC:-.}
 M="$SRC/tests/data/meshes"
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
-pass() { echo "PASS $1"; }
-fail() { echo "FAIL $1${2:+: $2}"; }
+. "${PACKD_SRC:-.}/tests/integration/check.inc"
 
 # job FILE MESH-JSON [TETFILL-OPTIONS-JSON [EXTRA-MEMBERS]]
 job() {
