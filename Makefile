@@ -43,15 +43,13 @@ BENCH_BIN  := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 .PHONY: all deps test sanitize bench run clean check-schemas
 .SECONDARY:
 
-all: $(BUILD)/packd
+all: $(DEPS_OK) $(BUILD)/packd
 
-# Install missing Debian packages once (deploy/install-deps.sh is idempotent).
+# Install missing Debian packages once per build directory
+# (deploy/install-deps.sh checks each package and installs only what is missing).
 $(DEPS_OK): deploy/install-deps.sh
 	@mkdir -p $(@D)
-	@if ! pkg-config --exists $(PKGS) || ! command -v h5dump >/dev/null || ! command -v curl >/dev/null || [ ! -f /usr/include/suitesparse/cholmod.h ]; then \
-	    echo "packd: installing missing packages (deploy/install-deps.sh)"; \
-	    sh deploy/install-deps.sh || exit 1; \
-	fi
+	@sh deploy/install-deps.sh || exit 1
 	@touch $@
 
 deps: $(DEPS_OK)
@@ -89,16 +87,16 @@ $(BUILD)/bench/%: bench/%.c $(LIB_OBJ)
 	@mkdir -p $(@D)
 	$(CC) $(EXT_CFLAGS) -Idaemon -o $@ $< $(LIB_OBJ) $(EXT_LIBS)
 
-test: $(BUILD)/packd $(UNIT_BIN)
+test: $(DEPS_OK) $(BUILD)/packd $(UNIT_BIN)
 	@sh tests/run.sh $(BUILD)
 
 sanitize:
 	$(MAKE) BUILD=build-san OPT=-O1 SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all" test
 
-bench: $(BUILD)/packd $(BENCH_BIN)
+bench: $(DEPS_OK) $(BUILD)/packd $(BENCH_BIN)
 	@for b in $(BENCH_BIN); do echo "== $$b"; $$b || exit 1; done
 
-run: $(BUILD)/packd
+run: $(DEPS_OK) $(BUILD)/packd
 	$(BUILD)/packd serve
 
 # Cross-check schemas and examples with an independent validator (python3-jsonschema).

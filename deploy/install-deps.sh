@@ -1,7 +1,13 @@
 #!/bin/sh
 # install-deps.sh — install the Debian packages packd needs, only when missing.
-# Safe to run repeatedly; called by `make` when pkg-config cannot find a library.
+# Safe to run repeatedly (it only checks when nothing is missing); `make` runs it once per
+# build directory.
 set -eu
+if ! command -v dpkg-query >/dev/null 2>&1 || ! command -v apt-get >/dev/null 2>&1; then
+    echo "install-deps: not a Debian system; install the equivalents of these by hand:" >&2
+    echo "  libmicrohttpd jansson sqlite3 hdf5 (+ h5dump) suitesparse/cholmod curl python3-jsonschema" >&2
+    exit 0
+fi
 PKGS="build-essential pkg-config libmicrohttpd-dev libjansson-dev libsqlite3-dev libhdf5-dev hdf5-tools curl python3 python3-jsonschema libsuitesparse-dev procps"
 missing=""
 for p in $PKGS; do
