@@ -189,6 +189,7 @@ static json_t *observables(const tetfill_setup *S, const pk_tetfill_stats *ts,
     json_object_set_new(o, "pairs_over_bound", json_integer((json_int_t)ms->pairs_over_bound));
     json_object_set_new(o, "contacts", json_integer((json_int_t)ms->contacts));
     json_object_set_new(o, "coordination_mean", json_real(ms->z_mean));
+    json_object_set_new(o, "coordination_touching", json_real(ms->z_touching));
     json_object_set_new(o, "coordination_histogram", ints_json(ms->z_hist, PK_TETFILL_ZHIST));
     json_object_set_new(o, "fabric", reals_json(ms->fabric, 9));
     json_object_set_new(o, "fabric_eigenvalues", reals_json(ms->fabric_eig, 3));

@@ -79,9 +79,9 @@ static int sweep_case(const char *path, double R)
             pk_tetfill_measure(&m, &p, prm.r_min, prm.eps, &o) != 0)
             return -1;
         printf("bench=tetfill case=sweep_R%g stage=%s tets=%zu spheres=%zu n_per_tet=%.2f "
-               "phi=%.4f z=%.3f F1=%.4f F2=%.4f F3=%.4f passes=%d seconds=%.3f\n",
+               "phi=%.4f z=%.3f z_touching=%.3f F1=%.4f F2=%.4f F3=%.4f passes=%d seconds=%.3f\n",
                R, dens ? "saturated" : "steps1-6", m.ntet, p.n, (double)p.n / (double)m.ntet,
-               o.phi, o.z_mean, o.fabric_eig[0], o.fabric_eig[1], o.fabric_eig[2], st.passes,
+               o.phi, o.z_mean, o.z_touching, o.fabric_eig[0], o.fabric_eig[1], o.fabric_eig[2], st.passes,
                st.seconds);
         fflush(stdout);
         pk_tetfill_measures_free(&o);

@@ -12,11 +12,14 @@
 
 #define MAX_NB 16      /* neighbours list capacity (spheres + planes) */
 #define MAX_PLANES 3   /* boundary planes offered as virtual spheres per locus */
+#ifndef TETFILL_RETIRE
+#define TETFILL_RETIRE 16 /* failed visits in a row that retire a tet from step 7b */
+#endif
 
 void pk_tetfill_defaults(pk_tetfill_params *prm)
 {
     *prm = (pk_tetfill_params){.eps = 1e-4, .z_min = 3, .vertex_weight = 0.5, .densify = 1,
-                               .neighbours = 8, .max_combos = 30, .max_passes = 20};
+                               .neighbours = 8, .max_combos = 30, .max_passes = 1000};
 }
 
 typedef struct nb_sphere {
@@ -331,16 +334,24 @@ static int try_locus(filler *F, const double q[3], int void_only)
     F->st->loci++;
     F->k = prm->neighbours;
     F->nnb = 0;
-    double reach = 2 * prm->r_max;
-    for (int attempt = 0; attempt < 4; attempt++) {
+    /* q inside a sphere: the cheap first-hit test of the grid */
+    if (void_only && pk_grid_overlaps(&F->g, F->p, q, 0))
+        return 2;
+    /* The k nearest by surface distance within 2 r_max (at least 4, reach
+     * doubled up to 3 times).  A query of reach ρ reports every sphere with
+     * surface distance < ρ, so once it holds k of them they are the k nearest:
+     * start small and double — a 2 r_max query scans ~(4 r_max / h)³ cells of
+     * each fine level, the cost of the whole filler at large R. */
+    double full = 2 * prm->r_max, reach = fmin(prm->r_min, full);
+    for (int attempt = 0; attempt < 64; attempt++) {
         F->nnb = 0;
         pk_grid_query(&F->g, F->p, q, 0, reach, visit_nearest, F);
-        if (F->nnb >= 4)
+        if (F->nnb >= F->k || (reach >= full && F->nnb >= 4) || reach >= 8 * full)
             break;
-        reach *= 2;
+        reach = reach < full ? fmin(2 * reach, full) : 2 * reach;
     }
     double pq[MAX_PLANES][3], pn[MAX_PLANES][3], pd[MAX_PLANES];
-    int np = pk_mesh_boundary_planes(&F->L, q, reach, MAX_PLANES, pq, pn, pd);
+    int np = pk_mesh_boundary_planes(&F->L, q, fmax(reach, full), MAX_PLANES, pq, pn, pd);
     for (int i = 0; i < np; i++) {
         nb_sphere s = {.s = pd[i], .r = F->Rv, .virt = 1};
         for (int k = 0; k < 3; k++)
@@ -350,8 +361,6 @@ static int try_locus(filler *F, const double q[3], int void_only)
     int n = F->nnb, tried = 0;
     if (n < 4)
         return 0;
-    if (void_only && F->nb[0].s < 0)
-        return 2;
     for (int a = 0; a < n - 3; a++)
         for (int b = a + 1; b < n - 2; b++)
             for (int c = b + 1; c < n - 1; c++)
@@ -390,7 +399,10 @@ static int try_locus(filler *F, const double q[3], int void_only)
                             return rc;
                         }
                     }
-                    if (too_big && prm->z_min <= 3) {
+                    /* not in 7b: there it never succeeds (every three-sphere
+                     * sphere of the cube sweeps comes from steps 4–6) and cost
+                     * 40 % of the run */
+                    if (too_big && prm->z_min <= 3 && !void_only) {
                         int rc = try_three(F, q, s);
                         if (rc != 0) {
                             if (rc > 0)
@@ -402,6 +414,19 @@ static int try_locus(filler *F, const double q[3], int void_only)
     return 0;
 }
 
+/* Fisher–Yates shuffle of a[0..n). */
+static void shuffle(filler *F, size_t *a, size_t n)
+{
+    for (size_t i = n; i > 1; i--) {
+        size_t j = (size_t)(pk_rng_uniform(&F->rng) * (double)i);
+        if (j >= i)
+            j = i - 1;
+        size_t s = a[i - 1];
+        a[i - 1] = a[j];
+        a[j] = s;
+    }
+}
+
 static size_t *shuffled(filler *F, size_t n)
 {
     size_t *o = malloc((n ? n : 1) * sizeof *o);
@@ -409,14 +434,7 @@ static size_t *shuffled(filler *F, size_t n)
         return NULL;
     for (size_t i = 0; i < n; i++)
         o[i] = i;
-    for (size_t i = n; i > 1; i--) {
-        size_t j = (size_t)(pk_rng_uniform(&F->rng) * (double)i);
-        if (j >= i)
-            j = i - 1;
-        size_t s = o[i - 1];
-        o[i - 1] = o[j];
-        o[j] = s;
-    }
+    shuffle(F, o, n);
     return o;
 }
 
@@ -477,43 +495,69 @@ static int geometric_loci(filler *F)
     return rc < 0 ? -1 : 0;
 }
 
-/* Step 7b: random loci, one per tet per pass. */
+/* One locus in tet t's empty space: up to 8 uniform draws until one is in no
+ * sphere, then the geometric procedure.  1 added, 0/2 not, -1 error. */
+static int void_locus(filler *F, const int32_t *t)
+{
+    const pk_mesh *m = F->m;
+    int rc = 2;
+    for (int draw = 0; draw < 8 && rc == 2; draw++) {
+        double u[3] = {pk_rng_uniform(&F->rng), pk_rng_uniform(&F->rng), pk_rng_uniform(&F->rng)};
+        for (int a = 0; a < 2; a++) /* sorted: uniform barycentric coordinates */
+            for (int b = 0; b < 2 - a; b++)
+                if (u[b] > u[b + 1]) {
+                    double s = u[b];
+                    u[b] = u[b + 1];
+                    u[b + 1] = s;
+                }
+        double l[4] = {u[0], u[1] - u[0], u[2] - u[1], 1 - u[2]}, q[3] = {0, 0, 0};
+        for (int k = 0; k < 4; k++)
+            for (int j = 0; j < 3; j++)
+                q[j] += l[k] * m->x[3 * (size_t)t[k] + j];
+        rc = try_locus(F, q, 1);
+    }
+    return rc;
+}
+
+/* Step 7b: passes over the active tets, one random void locus per tet per
+ * pass.  A tet retires after TETFILL_RETIRE visits in a row that add nothing,
+ * so the total work is at most (spheres added + TETFILL_RETIRE·tets) visits —
+ * linear — and the passes end by themselves when every tet is retired (the
+ * paper's "until no more sphere can be added"), or after two passes that add
+ * nothing (Jerier's code), max_passes, or the stop target. */
 static int densify(filler *F)
 {
     const pk_mesh *m = F->m;
+    size_t *act = shuffled(F, m->ntet), nact = m->ntet;
+    uint8_t *fails = calloc(m->ntet ? m->ntet : 1, 1);
     int idle = 0, rc = 0;
-    for (int pass = 0; pass < F->prm->max_passes && idle < 2 && !F->stop && rc >= 0; pass++) {
-        size_t before = F->p->n;
-        size_t *o = shuffled(F, m->ntet);
-        if (!o)
-            return -1;
-        for (size_t i = 0; i < m->ntet && rc >= 0 && !F->stop; i++) {
-            const int32_t *t = &m->t[4 * o[i]];
-            rc = 2;
-            for (int draw = 0; draw < 8 && rc == 2; draw++) { /* a locus in the void */
-                double u[3] = {pk_rng_uniform(&F->rng), pk_rng_uniform(&F->rng),
-                               pk_rng_uniform(&F->rng)};
-                for (int a = 0; a < 2; a++) /* sorted: uniform barycentric coordinates */
-                    for (int b = 0; b < 2 - a; b++)
-                        if (u[b] > u[b + 1]) {
-                            double s = u[b];
-                            u[b] = u[b + 1];
-                            u[b + 1] = s;
-                        }
-                double l[4] = {u[0], u[1] - u[0], u[2] - u[1], 1 - u[2]}, q[3] = {0, 0, 0};
-                for (int k = 0; k < 4; k++)
-                    for (int j = 0; j < 3; j++)
-                        q[j] += l[k] * m->x[3 * (size_t)t[k] + j];
-                rc = try_locus(F, q, 1);
-            }
+    if (!act || !fails) {
+        free(act);
+        free(fails);
+        return -1;
+    }
+    for (int pass = 0; pass < F->prm->max_passes && idle < 2 && nact && !F->stop && rc >= 0;
+         pass++) {
+        size_t before = F->p->n, w = 0, i = 0;
+        if (pass)
+            shuffle(F, act, nact);
+        for (; i < nact && rc >= 0 && !F->stop; i++) {
+            size_t t = act[i];
+            rc = void_locus(F, &m->t[4 * t]);
+            fails[t] = rc == 1 ? 0 : (uint8_t)(fails[t] + 1);
+            if (fails[t] < TETFILL_RETIRE)
+                act[w++] = t;
             if ((i & 255) == 0)
                 tick(F, 0);
         }
-        free(o);
+        while (i < nact) /* stopped mid-pass: keep the rest */
+            act[w++] = act[i++];
+        nact = w;
         F->st->passes = pass + 1;
-        /* a pass that adds under 0.1 % of the spheres counts as idle */
-        idle = (double)(F->p->n - before) < 1e-3 * (double)(F->p->n - F->first) ? idle + 1 : 0;
+        idle = F->p->n == before ? idle + 1 : 0;
     }
+    free(act);
+    free(fails);
     return rc < 0 ? -1 : 0;
 }
 

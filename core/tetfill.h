@@ -14,12 +14,16 @@
  *   4–6  the geometric procedure (tetfill_tangent.h) at loci: face
  *        barycentres, tet barycentres, and the points between barycentre and
  *        nodes (weight `vertex_weight`, paper: midway = 0.5);
- *   7b   densification ("in search of void spaces"): passes over the tets,
- *        one random locus per tet per pass, until a pass adds nothing twice
- *        in a row, `max_passes`, or the stop target.  (The paper locates the
- *        voids with a Delaunay triangulation of the centres; packd uses random
- *        loci per mesh tet instead — same solve, same acceptance — which keeps
- *        the cost linear and needs no triangulation.)
+ *   7b   densification ("in search of void spaces"): passes over the active
+ *        tets, one random locus in the empty space per tet per pass; a tet
+ *        retires after 16 visits in a row that add nothing, so the work is
+ *        linear (<= spheres added + 16·tets visits) and the passes end by
+ *        themselves at saturation ("until no more sphere can be added"), or
+ *        after two passes that add nothing, `max_passes`, or the stop target.
+ *        (The paper locates the voids with a Delaunay triangulation of the
+ *        centres; packd uses random loci per mesh tet instead — same solve,
+ *        same acceptance — which keeps the cost linear and needs no
+ *        triangulation.  The three-sphere fallback below is not tried in 7b.)
  *
  * Each locus: the `neighbours` spheres nearest by surface distance (a
  * core/grid.h query), plus the boundary planes in reach as virtual spheres
@@ -67,7 +71,7 @@ typedef struct pk_tetfill_params {
 } pk_tetfill_params;
 
 /* Defaults: ε = 1e-4 (YADE), z_min = 3, w = 0.5, neighbours 8, 30 combos,
- * 20 passes, densify on. */
+ * 1000 passes (7b ends at saturation well before), densify on. */
 void pk_tetfill_defaults(pk_tetfill_params *prm);
 
 typedef struct pk_tetfill_stats {

@@ -60,6 +60,8 @@ static int visit_pair(size_t j, const double dx[PK_MAXDIM], double d2, void *vct
         if (-g > c->bound)
             o->pairs_over_bound++;
     }
+    if (g <= 0 && d > 0)
+        o->contacts_touching++;
     if (g <= c->tau && d > 0) {
         o->contacts++;
         c->z[c->i]++;
@@ -145,6 +147,7 @@ int pk_tetfill_measure(const pk_mesh *m, const pk_particles *p, double r_min, do
             o->z_hist[z[i] < PK_TETFILL_ZHIST ? z[i] : PK_TETFILL_ZHIST - 1]++;
         o->overlap_mean = o->pairs_overlapping ? c.osum / (double)o->pairs_overlapping : 0;
         o->z_mean = p->n ? 2.0 * (double)o->contacts / (double)p->n : 0;
+        o->z_touching = p->n ? 2.0 * (double)o->contacts_touching / (double)p->n : 0;
         for (int k = 0; k < 9; k++)
             o->fabric[k] = o->contacts ? o->fabric[k] / (double)o->contacts : 0;
         pk_sym3_eigenvalues(o->fabric, o->fabric_eig);

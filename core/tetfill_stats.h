@@ -1,7 +1,8 @@
 /* tetfill_stats.h — characterisation of a filled mesh (Jerier §3.1, spec §4.4):
  * overlaps, coordination (Eq. 15), fabric tensor (Eq. 17) and eigenvalues,
  * solid fraction overall and per mesh region, spheres per tet, boundary
- * clearance.  Contacts: gap <= τ = max(ε r_min, 1e-9 r_min). */
+ * clearance.  Contacts: gap <= τ = max(ε r_min, 1e-9 r_min) (z_mean, the
+ * histogram and the fabric); z_touching counts gap <= 0 only. */
 #ifndef PK_TETFILL_STATS_H
 #define PK_TETFILL_STATS_H
 
@@ -21,6 +22,12 @@ typedef struct pk_tetfill_measures {
     size_t pairs_overlapping, pairs_over_bound;   /* bound: ε r_min (1 + 1e-9) */
     size_t contacts;
     double z_mean;             /* 2 N_c / N */
+    size_t contacts_touching;  /* pairs with gap <= 0 exactly (no tolerance) */
+    double z_touching;         /* 2 N_c / N with those: the count of Jerier's
+                                * SpherePadder (distance <= 0) and of a DEM
+                                * code that detects contacts by overlap; a
+                                * tangency solved in floating point lands on
+                                * either side of 0, so about half count */
     int64_t z_hist[PK_TETFILL_ZHIST];
     double fabric[9];          /* F_αβ (Eq. 17), row-major */
     double fabric_eig[3];      /* ascending */

@@ -67,6 +67,7 @@ h5dump -H "$T/cyl.h5" >"$T/cyl.dump" 2>&1
 h5dump -a /particles/grains/box/boundary "$T/cyl.h5" >"$T/bnd" 2>&1
 if grep -q 'DATASET "mesh_nodes"' "$T/cyl.dump" && grep -q 'DATASET "mesh_tets"' "$T/cyl.dump" &&
     grep -q 'DATASET "fabric_eigenvalues"' "$T/cyl.dump" && grep -q 'DATASET "coordination_histogram"' "$T/cyl.dump" &&
+    grep -q 'DATASET "coordination_touching"' "$T/cyl.dump" &&
     grep -q '"none", "none", "none"' "$T/bnd"; then
     pass tetfill_result_layout
 else
