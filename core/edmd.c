@@ -32,6 +32,7 @@ static void state_free(edmd_state *s)
     free(s->hpos);
     free(s->skin);
     free(s->rref);
+    free(s->ncoll_nl);
 }
 
 static int state_alloc(edmd_state *s, size_t n)
@@ -52,9 +53,11 @@ static int state_alloc(edmd_state *s, size_t n)
     s->hpos = calloc(c, sizeof *s->hpos);
     s->skin = calloc(c, sizeof *s->skin);
     s->rref = calloc(c, sizeof *s->rref);
+    s->ncoll_nl = calloc(c, sizeof *s->ncoll_nl);
     s->nl = calloc(c, sizeof *s->nl);
     if (!s->x0 || !s->v || !s->t0 || !s->a || !s->g || !s->m || !s->ev_t || !s->ev_partner ||
-        !s->ev_stamp || !s->ev_kind || !s->ncoll || !s->heap || !s->hpos || !s->skin || !s->rref || !s->nl)
+        !s->ev_stamp || !s->ev_kind || !s->ncoll || !s->heap || !s->hpos || !s->skin || !s->rref || !s->ncoll_nl ||
+        !s->nl)
         return -1;
     return pk_particles_init(&s->bs, s->dim, c);
 }
@@ -260,12 +263,17 @@ static double setup(edmd_state *s, const pk_particles *p, const pk_edmd_params *
             s->v[3 * i + k] = sc * pk_rng_normal(&rng);
     }
     remove_drift(s);
-    for (size_t i = 0; i < n; i++)
+    for (size_t i = 0; i < n; i++) { /* wrapped: edmd_min_image_near needs |Δx| < L */
         for (int k = 0; k < 3; k++)
             s->x0[3 * i + k] = k >= dim ? 0 : p->x[3 * i + k];
-    /* skins: a fraction of the radius at the reference time, at least the
-     * mean radius (fines would rebuild their lists all the time) and at most
-     * twice the mean (coarse grains would list hundreds of fines) */
+        pk_box_wrap(&s->box, &s->x0[3 * i]);
+    }
+    /* skins: a fraction of the radius at the reference time, at most twice
+     * the mean (coarse grains would list hundreds of fines); grains below the
+     * mean get 2ρ̄ − r, up to 2ρ̄ for the finest: fines fly as fast as the
+     * coarse and rattle in their pores, so with a small skin they rebuild all
+     * the time, while their lists (few grains of their size) stay short
+     * (Fuller-like case, N = 2000: list events 1.55 → 1.19 per collision) */
     double t_ref = isfinite(t_end) ? t_end : 0;
     double rho_mean = 0, rho_max = 0;
     for (size_t i = 0; i < n; i++) {
@@ -288,7 +296,7 @@ static double setup(edmd_state *s, const pk_particles *p, const pk_edmd_params *
     for (size_t i = 0; i < n; i++) {
         double r = s->a[i] + s->g[i] * t_ref;
         s->rref[i] = r;
-        s->skin[i] = prm->skin * fmin(fmax(r, rho_mean), 2 * rho_mean);
+        s->skin[i] = prm->skin * fmin(fmax(r, 2 * rho_mean - r), 2 * rho_mean);
         if (0.5 * s->skin[i] > room)
             s->skin[i] = 2 * room;
         s->sig_hi = fmax(s->sig_hi, r + 0.5 * s->skin[i]);
@@ -316,6 +324,8 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
     size_t *perm = NULL;
     s->box = *b;
     s->dim = b->dim;
+    for (int k = 0; k < 3; k++)
+        s->half_L[k] = k < b->dim && b->periodic[k] ? 0.5 * b->L[k] : INFINITY;
     s->n = p->n;
     int rc = -1;
     if (state_alloc(s, s->n) != 0)
@@ -362,7 +372,7 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
     pk_edmd_criterion crit = PK_EDMD_CRIT_NONE;
 
     for (;;) {
-        size_t i = (size_t)s->heap[0];
+        size_t i = (size_t)s->heap[0].i;
         double te = s->ev_t[i];
         if (te >= t_stop - t_base) {
             double tt = fmax(t_stop - t_base, s->t);

@@ -18,7 +18,7 @@ double edmd_collide_pair(edmd_state *s, size_t i, size_t j)
     double n[3] = {0, 0, 0};
     for (int k = 0; k < s->dim; k++)
         n[k] = s->x0[3 * j + k] - s->x0[3 * i + k];
-    pk_box_min_image(&s->box, n);
+    edmd_min_image_near(s, n);
     double dist = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (!(dist > 0))
         return 0;

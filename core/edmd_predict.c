@@ -4,21 +4,21 @@
 
 #include "edmd_state.h"
 
-double pk_edmd_pair_time(const double dp[3], const double dv[3], double R, double G,
-                         int *overlap)
+/* Root of A τ² − 2(−B) τ + C = 0 for the quadratic of pk_edmd_pair_time.
+ * bound: the caller only wants roots below it; pairs that provably collide
+ * no earlier are dismissed (INFINITY) without the sqrt and the division —
+ * for A >= 0, B < 0 the root C/(−B + √D) >= C/(−2B) as √D <= −B. */
+static inline double pair_root(double A, double B, double C, double bound)
 {
-    double A = dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2] - G * G;
-    double B = dp[0] * dv[0] + dp[1] * dv[1] + dp[2] * dv[2] - R * G;
-    double C = dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2] - R * R;
-    if (overlap)
-        *overlap = C < -1e-9 * R * R;
     if (C > 0) {
-        double D = B * B - A * C;
         if (A < 0) {                 /* growth outruns the relative speed: one positive root */
-            double sq = sqrt(D);
+            double sq = sqrt(B * B - A * C);
             return B < 0 ? C / (-B + sq) : (B + sq) / -A;
         }
-        if (B >= 0 || D < 0)
+        if (B >= 0 || C >= -2 * B * bound)
+            return INFINITY;
+        double D = B * B - A * C;
+        if (D < 0)
             return INFINITY;
         return C / (-B + sqrt(D)); /* also A = 0: −C/(2B) */
     }
@@ -28,6 +28,17 @@ double pk_edmd_pair_time(const double dp[3], const double dv[3], double R, doubl
     if (A < 0)
         return (B + sqrt(fmax(B * B - A * C, 0))) / -A;
     return INFINITY;
+}
+
+double pk_edmd_pair_time(const double dp[3], const double dv[3], double R, double G,
+                         int *overlap)
+{
+    double A = dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2] - G * G;
+    double B = dp[0] * dv[0] + dp[1] * dv[1] + dp[2] * dv[2] - R * G;
+    double C = dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2] - R * R;
+    if (overlap)
+        *overlap = C < -1e-9 * R * R;
+    return pair_root(A, B, C, INFINITY);
 }
 
 double pk_edmd_exit_time(const double q[3], const double v[3], double rho0, double g,
@@ -65,18 +76,6 @@ void edmd_sync(edmd_state *s, size_t i)
             s->x0[3 * i + k] = x;
         }
     s->t0[i] = s->t;
-}
-
-static inline void min_image_near(const edmd_state *s, double d[3])
-{
-    for (int k = 0; k < s->dim; k++)
-        if (s->box.periodic[k]) {
-            double L = s->box.L[k];
-            if (d[k] > 0.5 * L)
-                d[k] -= L;
-            else if (d[k] < -0.5 * L)
-                d[k] += L;
-        }
 }
 
 /* Earliest wall contact of i from now (i synced); code = 2k + side. */
@@ -124,7 +123,7 @@ void edmd_predict(edmd_state *s, size_t i)
         double q[3] = {0, 0, 0};
         for (int k = 0; k < s->dim; k++)
             q[k] = xi[k] - s->bs.x[3 * i + k];
-        pk_box_min_image(&s->box, q);
+        edmd_min_image_near(s, q);
         best = pk_edmd_exit_time(q, vi, ri, gi, s->bs.r[i]);
         if (best < INFINITY)
             kind = EV_NLIST;
@@ -135,26 +134,30 @@ void edmd_predict(edmd_state *s, size_t i)
         kind = EV_WALL;
         partner = code;
     }
+    /* x0/v carry 0 beyond dim (2D), so all three components are computed */
+    const double xi0 = xi[0], xi1 = xi[1], xi2 = xi[2];
+    const double vi0 = vi[0], vi1 = vi[1], vi2 = vi[2];
     const edmd_nlist *L = &s->nl[i];
     for (uint32_t q = 0; q < L->n; q++) {
         size_t j = (size_t)L->nb[q];
-        double dtj = t - s->t0[j];
-        double dp[3] = {0, 0, 0}, dv[3] = {0, 0, 0};
-        for (int k = 0; k < s->dim; k++) {
-            dp[k] = xi[k] - (s->x0[3 * j + k] + s->v[3 * j + k] * dtj);
-            dv[k] = vi[k] - s->v[3 * j + k];
-        }
-        min_image_near(s, dp);
-        double R = ri + s->a[j] + s->g[j] * t;
-        int ov = 0;
-        double tau = pk_edmd_pair_time(dp, dv, R, gi + s->g[j], &ov);
-        if (ov) {
+        const double dtj = t - s->t0[j];
+        const double *xj = &s->x0[3 * j], *vj = &s->v[3 * j];
+        double dp[3] = {xi0 - (xj[0] + vj[0] * dtj), xi1 - (xj[1] + vj[1] * dtj),
+                        xi2 - (xj[2] + vj[2] * dtj)};
+        const double dv0 = vi0 - vj[0], dv1 = vi1 - vj[1], dv2 = vi2 - vj[2];
+        edmd_min_image_near(s, dp);
+        const double R = ri + s->a[j] + s->g[j] * t, G = gi + s->g[j];
+        const double A = dv0 * dv0 + dv1 * dv1 + dv2 * dv2 - G * G;
+        const double B = dp[0] * dv0 + dp[1] * dv1 + dp[2] * dv2 - R * G;
+        const double C = dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2] - R * R;
+        if (C < -1e-9 * R * R) { /* overlap by more than round-off: record it */
             double d = sqrt(dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2]);
             double rel = (R - d) / R;
             s->n_overlap++;
             if (rel > s->max_overlap_rel)
                 s->max_overlap_rel = rel;
         }
+        double tau = pair_root(A, B, C, best);
         if (tau < best) {
             best = tau;
             kind = EV_PAIR;

@@ -1,64 +1,70 @@
-/* edmd_queue.c — the event queue: a binary heap holding each particle's one
- * pending event (keyed by ev_t), with positions for O(log N) re-keying. */
+/* edmd_queue.c — the event queue: a 4-ary heap holding each particle's one
+ * pending event.  Each node carries its key (the event time) inline, so a
+ * sift compares neighbouring memory instead of chasing ev_t[] of random
+ * particles; 4 children per node halve the depth (fewer cache lines per
+ * re-key).  hpos[i] is the node of particle i, for O(log N) re-keying. */
 #include <stdlib.h>
 
 #include "edmd_state.h"
 
-static inline int before(const edmd_state *s, int32_t a, int32_t b)
+enum { ARITY = 4 };
+
+static inline void place(edmd_state *s, size_t k, edmd_hnode e)
 {
-    return s->ev_t[a] < s->ev_t[b];
+    s->heap[k] = e;
+    s->hpos[e.i] = (int32_t)k;
 }
 
 static void sift_up(edmd_state *s, size_t k)
 {
-    int32_t e = s->heap[k];
+    edmd_hnode e = s->heap[k];
     while (k > 0) {
-        size_t p = (k - 1) / 2;
-        if (!before(s, e, s->heap[p]))
+        size_t p = (k - 1) / ARITY;
+        if (!(e.t < s->heap[p].t))
             break;
-        s->heap[k] = s->heap[p];
-        s->hpos[s->heap[k]] = (int32_t)k;
+        place(s, k, s->heap[p]);
         k = p;
     }
-    s->heap[k] = e;
-    s->hpos[e] = (int32_t)k;
+    place(s, k, e);
 }
 
 static void sift_down(edmd_state *s, size_t k)
 {
-    int32_t e = s->heap[k];
+    edmd_hnode e = s->heap[k];
+    const size_t n = s->hn;
     for (;;) {
-        size_t c = 2 * k + 1;
-        if (c >= s->hn)
+        size_t c = ARITY * k + 1;
+        if (c >= n)
             break;
-        if (c + 1 < s->hn && before(s, s->heap[c + 1], s->heap[c]))
-            c++;
-        if (!before(s, s->heap[c], e))
+        size_t end = c + ARITY < n ? c + ARITY : n, m = c;
+        for (size_t q = c + 1; q < end; q++)
+            if (s->heap[q].t < s->heap[m].t)
+                m = q;
+        if (!(s->heap[m].t < e.t))
             break;
-        s->heap[k] = s->heap[c];
-        s->hpos[s->heap[k]] = (int32_t)k;
-        k = c;
+        place(s, k, s->heap[m]);
+        k = m;
     }
-    s->heap[k] = e;
-    s->hpos[e] = (int32_t)k;
+    place(s, k, e);
 }
 
 int edmd_queue_init(edmd_state *s)
 {
     s->hn = s->n;
-    for (size_t i = 0; i < s->n; i++) {
-        s->heap[i] = (int32_t)i;
-        s->hpos[i] = (int32_t)i;
-    }
-    for (size_t k = s->hn / 2; k-- > 0;)
-        sift_down(s, k);
+    for (size_t i = 0; i < s->n; i++)
+        place(s, i, (edmd_hnode){s->ev_t[i], (int32_t)i});
+    for (size_t k = s->hn / ARITY + 1; k-- > 0;)
+        if (k < s->hn)
+            sift_down(s, k);
     return 0;
 }
 
 void edmd_queue_update(edmd_state *s, size_t i)
 {
     size_t k = (size_t)s->hpos[i];
-    if (k > 0 && before(s, (int32_t)i, s->heap[(k - 1) / 2]))
+    double t = s->ev_t[i], old = s->heap[k].t;
+    s->heap[k].t = t;
+    if (t < old)
         sift_up(s, k);
     else
         sift_down(s, k);
@@ -67,6 +73,8 @@ void edmd_queue_update(edmd_state *s, size_t i)
 void edmd_queue_shift(edmd_state *s, double dt)
 {
     /* a uniform shift keeps the heap order */
-    for (size_t i = 0; i < s->n; i++)
+    for (size_t i = 0; i < s->n; i++) {
         s->ev_t[i] -= dt;
+        s->heap[i].t -= dt;
+    }
 }

@@ -15,8 +15,14 @@ typedef struct edmd_nlist {
     uint32_t n, cap;
 } edmd_nlist;
 
+typedef struct edmd_hnode {
+    double t;                 /* event time (copy of ev_t[i]) */
+    int32_t i;                /* particle */
+} edmd_hnode;
+
 typedef struct edmd_state {
     pk_box box;
+    double half_L[3];         /* L/2 on periodic axes, +inf otherwise */
     int dim;
     size_t n;
     /* kinematics */
@@ -31,7 +37,8 @@ typedef struct edmd_state {
     uint32_t *ev_stamp;       /* partner's ncoll at prediction time */
     uint8_t *ev_kind;
     uint32_t *ncoll;          /* velocity changes of each particle (validity counter) */
-    int32_t *heap, *hpos;     /* binary heap of particle indices keyed by ev_t */
+    edmd_hnode *heap;         /* 4-ary heap of (ev_t, particle) */
+    int32_t *hpos;            /* node of each particle in the heap */
     size_t hn;
     /* neighbour lists */
     edmd_nlist *nl;
@@ -39,6 +46,7 @@ typedef struct edmd_state {
     pk_grid grid;             /* on the bounding spheres */
     double *skin;             /* per-particle skin s_i */
     double *rref;             /* radius at the reference time (target size) */
+    uint32_t *ncoll_nl;       /* ncoll[i] at i's last list build (ballistic test) */
     double sig_hi;            /* expected largest bounding sphere (grid cell size) */
     /* physics accumulators */
     double K;                 /* kinetic energy ½Σm v² */
@@ -47,6 +55,21 @@ typedef struct edmd_state {
     uint64_t n_overlap;
     double max_overlap_rel;
 } edmd_state;
+
+/* Minimum image of a displacement between two synced grains (periodic
+ * coordinates kept in [0, L) by edmd_sync, bounding-sphere centres wrapped):
+ * |d_k| < L, so one conditional shift replaces the general rounding.  Fixed
+ * three axes, no periodicity test: half_L is +inf on walled axes and beyond
+ * dim (edmd_minimage_init). */
+static inline void edmd_min_image_near(const edmd_state *s, double d[3])
+{
+    for (int k = 0; k < 3; k++) {
+        if (d[k] > s->half_L[k])
+            d[k] -= s->box.L[k];
+        else if (d[k] < -s->half_L[k])
+            d[k] += s->box.L[k];
+    }
+}
 
 /* edmd_predict.c */
 void edmd_sync(edmd_state *s, size_t i);               /* x0 ← x(t), t0 ← t */

@@ -253,7 +253,9 @@ static inline int scan(const pk_grid *g, const pk_particles *p, const double *x,
                         double d2 = 0;
                         for (int k = 0; k < dim; k++) {
                             d[k] = xj[k] - x[k];
-                            if (g->box.periodic[k])
+                            /* |d| <= L/2 is already the minimum image: skip
+                             * the division (same result, fewer instructions) */
+                            if (g->box.periodic[k] && fabs(d[k]) > 0.5 * g->box.L[k])
                                 d[k] -= g->box.L[k] * nearbyint(d[k] / g->box.L[k]);
                             d2 += d[k] * d[k];
                         }
