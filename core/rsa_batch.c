@@ -34,8 +34,9 @@ typedef struct scratch {
     double *spos;       /* [cap][3] attempts in bucket order */
     uint32_t *sidx;     /* attempt index of each sorted entry */
     uint32_t *skey;     /* its cell key */
-    uint8_t *keep;      /* survives step 2 (sorted order) */
-    int32_t *slot;      /* survivor number of attempt a, -1 = rejected in step 2 */
+    uint32_t *kept;     /* sorted positions of the survivors of step 2 */
+    uint64_t *sbit;     /* bit a: attempt a survived step 2 */
+    int32_t *slot;      /* survivor number of attempt a (set where sbit is) */
     double *surv;       /* [cap][3] survivors in sorted order */
     uint8_t *taken;     /* survivor accepted in step 3 */
     uint32_t *count;    /* [MAX_BUCKETS + 1] */
@@ -52,7 +53,8 @@ static void scratch_free(scratch *w)
     free(w->spos);
     free(w->sidx);
     free(w->skey);
-    free(w->keep);
+    free(w->kept);
+    free(w->sbit);
     free(w->slot);
     free(w->surv);
     free(w->taken);
@@ -86,7 +88,8 @@ static int scratch_reserve(scratch *w, size_t B)
     w->spos = grow(w->spos, 3 * B * sizeof *w->spos, &fail);
     w->sidx = grow(w->sidx, B * sizeof *w->sidx, &fail);
     w->skey = grow(w->skey, B * sizeof *w->skey, &fail);
-    w->keep = grow(w->keep, B, &fail);
+    w->kept = grow(w->kept, B * sizeof *w->kept, &fail);
+    w->sbit = grow(w->sbit, (B / 64 + 1) * sizeof *w->sbit, &fail);
     w->slot = grow(w->slot, B * sizeof *w->slot, &fail);
     w->surv = grow(w->surv, 3 * B * sizeof *w->surv, &fail);
     w->taken = grow(w->taken, B, &fail);
@@ -105,12 +108,23 @@ static inline uint64_t hash_cell(uint64_t lin, uint64_t mask)
     return (lin * 0x9E3779B97F4A7C15ull) >> 20 & mask;
 }
 
-/* Step 3's test: is survivor x within contact of a survivor accepted earlier
- * in this batch? */
-static int batch_hits(const pk_rsa_cells *C, const scratch *w, uint64_t hmask, const double *x)
+/* Step 3's test: is survivor x (key: pk_rsa_cells_key) within contact of a
+ * survivor accepted earlier in this batch?  Off the seams the neighbours are
+ * the fixed offsets of the filter; ghost cells never match a stored cell. */
+static int batch_hits(const pk_rsa_cells *C, const scratch *w, uint64_t hmask, const double *x,
+                      uint32_t key)
 {
     uint64_t nb[27];
-    int m = pk_rsa_cells_around(C, x, nb);
+    int m;
+    if (C->cell[pk_rsa_cells_index(key)].seam) {
+        m = pk_rsa_cells_around(C, x, nb);
+    } else {
+        const int64_t *off = C->off[pk_rsa_cells_octant(key)];
+        nb[0] = pk_rsa_cells_index(key);
+        for (int q = 0; q < C->noff; q++)
+            nb[q + 1] = (uint64_t)((int64_t)nb[0] + off[q]);
+        m = C->noff + 1;
+    }
     for (int q = 0; q < m; q++)
         for (int32_t j = w->head[hash_cell(nb[q], hmask)]; j >= 0; j = w->hnext[j])
             if (w->hcell[j] == nb[q] && pk_rsa_cells_close(C, &w->surv[3 * (size_t)j], x))
@@ -127,16 +141,24 @@ static size_t draw_and_filter(const pk_rsa_cells *C, scratch *w, size_t B, int d
     memset(w->count, 0, (nbucket + 1) * sizeof *w->count);
     const double lo0 = lo[0], lo1 = lo[1], lo2 = lo[2], sp0 = span[0], sp1 = span[1];
     const double sp2 = dim == 3 ? span[2] : 0;
+    /* local copies: the stores below cannot alias them, so the generator state
+     * and the store's geometry stay in registers */
+    pk_rng g = *rng;
+    const pk_rsa_cells K = *C;
+    double *restrict pos = w->pos;
+    uint32_t *restrict keys = w->key, *restrict count = w->count;
     for (size_t a = 0; a < B; a++) {
         /* rsa.c's plain draw: x[k] = lo[k] + span[k]·u, k = 0, 1 (, 2), z = 0 in 2D */
-        double *x = &w->pos[3 * a];
-        x[0] = lo0 + sp0 * pk_rng_uniform(rng);
-        x[1] = lo1 + sp1 * pk_rng_uniform(rng);
-        x[2] = dim == 3 ? lo2 + sp2 * pk_rng_uniform(rng) : 0;
-        uint32_t key = pk_rsa_cells_key(C, x);
-        w->key[a] = key;
-        w->count[(pk_rsa_cells_index(key) >> shift) + 1]++;
+        double x[3];
+        x[0] = lo0 + sp0 * pk_rng_uniform(&g);
+        x[1] = lo1 + sp1 * pk_rng_uniform(&g);
+        x[2] = dim == 3 ? lo2 + sp2 * pk_rng_uniform(&g) : 0;
+        memcpy(&pos[3 * a], x, sizeof x);
+        uint32_t key = pk_rsa_cells_key(&K, x);
+        keys[a] = key;
+        count[(pk_rsa_cells_index(key) >> shift) + 1]++;
     }
+    *rng = g;
     for (uint32_t k = 0; k < nbucket; k++)
         w->count[k + 1] += w->count[k];
     for (size_t a = 0; a < B; a++) {
@@ -146,14 +168,14 @@ static size_t draw_and_filter(const pk_rsa_cells *C, scratch *w, size_t B, int d
         w->sidx[t] = (uint32_t)a;
         w->skey[t] = key;
     }
-    pk_rsa_cells_filter(C, w->spos, w->skey, B, w->keep);
-    memset(w->slot, 0xff, B * sizeof *w->slot);
-    size_t S = 0;
-    for (size_t t = 0; t < B; t++)
-        if (w->keep[t]) {
-            memcpy(&w->surv[3 * S], &w->spos[3 * t], 3 * sizeof(double));
-            w->slot[w->sidx[t]] = (int32_t)S++;
-        }
+    size_t S = pk_rsa_cells_filter(C, w->spos, w->skey, B, w->kept);
+    memset(w->sbit, 0, (B / 64 + 1) * sizeof *w->sbit);
+    for (size_t j = 0; j < S; j++) {
+        uint32_t t = w->kept[j], a = w->sidx[t];
+        memcpy(&w->surv[3 * j], &w->spos[3 * (size_t)t], 3 * sizeof(double));
+        w->slot[a] = (int32_t)j;
+        w->sbit[a >> 6] |= (uint64_t)1 << (a & 63);
+    }
     return S;
 }
 
@@ -210,21 +232,40 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
         memset(w.head, 0xff, (hmask + 1) * sizeof *w.head);
         memset(w.taken, 0, S);
         size_t used = B, acc = 0;
-        for (size_t a = 0; a < B; a++) {
-            int32_t j = w.slot[a];
-            const double *x = j >= 0 ? &w.surv[3 * (size_t)j] : NULL;
-            int ok = x && !batch_hits(&C, &w, hmask, x) &&
+        const uint64_t max_failed = prm->max_failed_draws;
+        size_t a = 0; /* next attempt of the walk */
+        for (;;) {
+            /* attempts rejected in step 2 count as failures: jump to the next survivor */
+            size_t a0 = a, wd = a >> 6;
+            uint64_t bits = wd < (B + 63) / 64 ? w.sbit[wd] & (~(uint64_t)0 << (a & 63)) : 0;
+            while (!bits && ++wd < (B + 63) / 64)
+                bits = w.sbit[wd];
+            a = bits ? 64 * wd + (size_t)__builtin_ctzll(bits) : B;
+            if ((uint64_t)(a - a0) >= max_failed - failed) {
+                used = a0 + (size_t)(max_failed - failed);
+                failed = max_failed;
+                reason = PK_STOP_MAX_FAILED_DRAWS;
+                break;
+            }
+            failed += a - a0;
+            if (a == B)
+                break;
+            size_t cur = a++;
+            int32_t j = w.slot[cur];
+            const double *x = &w.surv[3 * (size_t)j];
+            uint32_t key = pk_rsa_cells_key(&C, x);
+            int ok = !batch_hits(&C, &w, hmask, x, key) &&
                      (grid_empty || !pk_grid_overlaps(grid, out, x, r));
             if (!ok) {
-                if (++failed >= prm->max_failed_draws) {
-                    used = a + 1;
+                if (++failed >= max_failed) {
+                    used = cur + 1;
                     reason = PK_STOP_MAX_FAILED_DRAWS;
                     break;
                 }
                 continue;
             }
             if (pk_particles_push(out, x, r, species[placed]) == (size_t)-1) {
-                used = a + 1;
+                used = cur + 1;
                 reason = PK_STOP_ERROR;
                 break;
             }
@@ -233,12 +274,12 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
             acc++;
             *solid += ball;
             w.taken[j] = 1;
-            uint64_t lin = pk_rsa_cells_index(pk_rsa_cells_key(&C, x)), h = hash_cell(lin, hmask);
+            uint64_t lin = pk_rsa_cells_index(key), h = hash_cell(lin, hmask);
             w.hcell[j] = lin;
             w.hnext[j] = w.head[h];
             w.head[h] = j;
             if (placed == m) {
-                used = a + 1;
+                used = cur + 1;
                 break;
             }
         }

@@ -8,8 +8,10 @@
  *      arithmetic, as the one-at-a-time loop of rsa.c (plain draws);
  *   2. test them against the grains accepted before the batch — a read-only
  *      dense cell store (rsa_cells.h) — in cell order, so neighbouring tests
- *      share cache lines; the order is free because the store does not change;
- *   3. walk the batch in attempt order: a survivor of 2 is accepted iff no
+ *      share cache lines, and per attempt the neighbour cells on the near side
+ *      of its cell first; the order is free because the store does not change;
+ *   3. walk the survivors of 2 in attempt order (a bitmap over the batch; the
+ *      attempts in between are failures): a survivor is accepted iff no
  *      survivor accepted earlier in this batch (small hash of cells) and no
  *      grain placed before the run (pk_grid) is within contact; failures since
  *      the last acceptance count towards N^F exactly as one at a time; the

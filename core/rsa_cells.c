@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define MAX_CELLS ((uint64_t)1 << 31)
+#define MAX_CELLS ((uint64_t)1 << 28) /* the index field of a key (rsa_cells.h) */
 
 /* Cells per axis with edge h >= c·(1 + 1e-9): the margin keeps round-off of
  * the cell coordinate from putting two centres closer than c two cells apart. */
@@ -32,6 +32,8 @@ uint64_t pk_rsa_cells_count(const pk_box *b, double r, double gap, const double 
     return total;
 }
 
+static void set_offsets(pk_rsa_cells *C);
+
 int pk_rsa_cells_init(pk_rsa_cells *C, const pk_box *b, double r, double gap, const double *lo,
                       const double *span)
 {
@@ -55,31 +57,68 @@ int pk_rsa_cells_init(pk_rsa_cells *C, const pk_box *b, double r, double gap, co
         C->n[k] = axis_cells(span[k], 2 * r + gap);
         C->np[k] = C->n[k] + 2;
         C->inv_h[k] = span[k] > 0 ? (double)C->n[k] / span[k] : 0;
+        C->inv_h2[k] = span[k] > 0 ? (double)(2 * C->n[k]) / span[k] : 0;
+        C->jmax[k] = 2 * C->n[k] - 1;
     }
     C->ncell = nc;
+    uint64_t stride = 1;
     for (int k = 0; k < PK_MAXDIM; k++) {
-        int per = k < b->dim && b->periodic[k];
-        C->calm_lo[k] = per ? (C->n[k] >= 4 ? 1 : INT64_MAX) : INT64_MIN;
-        C->calm_hi[k] = per ? C->n[k] - 2 : INT64_MAX;
+        C->stride[k] = stride;
+        C->base += k < b->dim ? stride : 0; /* +1 per used axis: the ghost layer */
+        stride *= (uint64_t)C->np[k];
     }
-    /* neighbour offsets by distance class (faces, edges, corners): a rejected
-     * attempt usually meets its overlap early */
-    C->noff = 0;
-    int zr = b->dim == 3 ? 1 : 0;
-    for (int cls = 1; cls <= b->dim; cls++)
-        for (int dz = -zr; dz <= zr; dz++)
-            for (int dy = -1; dy <= 1; dy++)
-                for (int dx = -1; dx <= 1; dx++)
-                    if (abs(dx) + abs(dy) + abs(dz) == cls)
-                        C->off[C->noff++] = ((int64_t)dz * C->np[1] + dy) * C->np[0] + dx;
-    C->cell = malloc(nc * sizeof *C->cell);
+    set_offsets(C);
+    /* one record = one cache line */
+    C->cell = aligned_alloc(64, nc * sizeof *C->cell);
     if (!C->cell)
         return -1;
     for (uint64_t i = 0; i < nc; i++) {
         C->cell[i].n = 0;
         C->cell[i].more = -1;
     }
+    /* seam flags (rsa_cells.h) of the padded cells; ghosts are never a query's own cell */
+    uint64_t i = 0;
+    for (int64_t z = 0; z < C->np[2]; z++)
+        for (int64_t y = 0; y < C->np[1]; y++)
+            for (int64_t x = 0; x < C->np[0]; x++, i++) {
+                int64_t c[3] = {x - 1, y - 1, z - 1}; /* real coordinates */
+                int seam = 0;
+                for (int k = 0; k < C->dim; k++)
+                    seam |= C->periodic[k] && (C->n[k] < 4 || c[k] <= 0 || c[k] >= C->n[k] - 1);
+                C->cell[i].seam = seam;
+            }
     return 0;
+}
+
+/* Rank of neighbour offset d (components -1..0..1) for a point in octant oct:
+ * sides the point is near first, then by number of nonzero components (faces
+ * before edges before corners). */
+static int offset_rank(int dim, const int d[3], unsigned oct)
+{
+    int far = 0, nz = 0;
+    for (int k = 0; k < dim; k++) {
+        int up = oct >> k & 1;
+        nz += d[k] != 0;
+        far += d[k] == (up ? -1 : 1);
+    }
+    return far * 4 + nz;
+}
+
+static void set_offsets(pk_rsa_cells *C)
+{
+    int zr = C->dim == 3 ? 1 : 0;
+    for (unsigned oct = 0; oct < 8; oct++) {
+        int cnt = 0;
+        for (int rank = 1; rank < 16; rank++)
+            for (int dz = -zr; dz <= zr; dz++)
+                for (int dy = -1; dy <= 1; dy++)
+                    for (int dx = -1; dx <= 1; dx++) {
+                        int d[3] = {dx, dy, dz};
+                        if ((dx || dy || dz) && offset_rank(C->dim, d, oct) == rank)
+                            C->off[oct][cnt++] = ((int64_t)dz * C->np[1] + dy) * C->np[0] + dx;
+                    }
+        C->noff = cnt;
+    }
 }
 
 void pk_rsa_cells_free(pk_rsa_cells *C)
@@ -205,23 +244,47 @@ static inline int cell_hits_direct(const pk_rsa_cells *C, const pk_rsa_cell2 *c,
     return 0;
 }
 
-void pk_rsa_cells_filter(const pk_rsa_cells *C, const double *pos, const uint32_t *key, size_t n,
-                         uint8_t *keep)
+/* Stores larger than this outgrow the per-core caches: the filter fetches the
+ * 3^dim records around the attempt PREFETCH_AHEAD places on while it tests
+ * this one (sorted attempts still jump between planes of cells). */
+#define PREFETCH_BYTES ((uint64_t)4 << 20)
+#define PREFETCH_AHEAD 8
+
+size_t pk_rsa_cells_filter(const pk_rsa_cells *C, const double *pos, const uint32_t *key, size_t n,
+                           uint32_t *kept)
 {
+    size_t cnt = 0;
     const int noff = C->noff;
+    int64_t row[9]; /* first record of each row of 3 around a cell */
+    int nrow = 0;
+    for (int64_t dz = -(C->dim == 3); dz <= (C->dim == 3); dz++)
+        for (int64_t dy = -1; dy <= 1; dy++)
+            row[nrow++] = dz * (int64_t)C->stride[2] + dy * (int64_t)C->stride[1] - 1;
+    const size_t ahead = C->ncell * sizeof *C->cell > PREFETCH_BYTES ? PREFETCH_AHEAD : n;
     for (size_t i = 0; i < n; i++) {
+        if (i + ahead < n) {
+            const pk_rsa_cell2 *p = &C->cell[pk_rsa_cells_index(key[i + ahead])];
+            for (int r = 0; r < nrow; r++) {
+                __builtin_prefetch(p + row[r]);
+                __builtin_prefetch(p + row[r] + 1);
+                __builtin_prefetch(p + row[r] + 2);
+            }
+        }
         const double *x = &pos[3 * i];
         const pk_rsa_cell2 *c0 = &C->cell[pk_rsa_cells_index(key[i])];
+        const int64_t *off = C->off[pk_rsa_cells_octant(key[i])];
         int hit;
-        if (key[i] & PK_RSA_CELLS_SEAM) {
+        if (c0->seam) {
             hit = cell_hits(C, c0, x);
             for (int q = 0; q < noff && !hit; q++)
-                hit = cell_hits(C, c0 + C->off[q], x);
+                hit = cell_hits(C, c0 + off[q], x);
         } else {
             hit = cell_hits_direct(C, c0, x);
             for (int q = 0; q < noff && !hit; q++)
-                hit = cell_hits_direct(C, c0 + C->off[q], x);
+                hit = cell_hits_direct(C, c0 + off[q], x);
         }
-        keep[i] = (uint8_t)!hit;
+        kept[cnt] = (uint32_t)i;
+        cnt += !hit; /* branch-free: most points are rejected */
     }
+    return cnt;
 }

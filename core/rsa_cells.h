@@ -24,7 +24,8 @@ typedef struct pk_rsa_cell2 {
     double x[2][3];             /* inline centres (z = 0 in 2D) */
     int32_t n;                  /* centres in this cell */
     int32_t more;               /* first overflow entry (n > 2), -1 = none */
-    int64_t pad_;               /* one record = one 64-byte line */
+    int32_t seam;               /* 1: a neighbour may need a periodic image (below) */
+    int32_t pad_;               /* one record = one 64-byte line */
 } pk_rsa_cell2;
 
 typedef struct pk_rsa_extra {
@@ -39,16 +40,20 @@ typedef struct pk_rsa_cells {
                                    shift), +inf on walled and unused axes */
     double lo[PK_MAXDIM];       /* lower end of the draw range per axis */
     double inv_h[PK_MAXDIM];
+    double inv_h2[PK_MAXDIM];   /* 2·inv_h: half cells (the key's octant) */
+    uint64_t jmax[PK_MAXDIM];   /* 2n - 1: last half cell */
     int periodic[PK_MAXDIM];
     int64_t n[PK_MAXDIM];       /* real cells per axis (1 on unused axes) */
     int64_t np[PK_MAXDIM];      /* with the ghost layer: n + 2 on used axes */
     uint64_t ncell;             /* padded cells */
     double s2;                  /* (r + r + Δd)², the squared contact distance */
-    int64_t calm_lo[PK_MAXDIM], calm_hi[PK_MAXDIM]; /* seam-free coordinates: 1..n-2 on
-                                   periodic axes with n >= 4, none on other periodic
-                                   axes, all on walled ones */
+    uint64_t stride[PK_MAXDIM]; /* padded index = base + sum_k i_k·stride[k] */
+    uint64_t base;
     int noff;
-    int64_t off[26];            /* neighbour offsets in the padded array, faces first */
+    int64_t off[8][26];         /* neighbour offsets in the padded array per octant of
+                                   the cell (bit k: upper half along axis k), the near
+                                   sides first: a rejected attempt usually meets its
+                                   overlap in the first few cells */
     pk_rsa_cell2 *cell;
     pk_rsa_extra *extra;
     size_t nextra, capextra;
@@ -75,26 +80,39 @@ static inline int64_t pk_rsa_cells_coord(const pk_rsa_cells *C, int k, double xk
     return i >= C->n[k] ? C->n[k] - 1 : i;
 }
 
-#define PK_RSA_CELLS_SEAM 0x80000000u
+#define PK_RSA_CELLS_OCT_SHIFT 28
+#define PK_RSA_CELLS_INDEX_MASK 0x0fffffffu
 
-/* Padded index of the real cell holding x, with PK_RSA_CELLS_SEAM set when a
- * neighbour may need a periodic image: the cell touches a periodic seam, or
- * its axis has fewer than 4 cells.  Otherwise every neighbour is nearer than
- * 2h <= L/2 on each periodic axis, where nearbyint(d/L) = 0: the test may take
- * d as is.  (ncell < 2^31: the flag never collides with an index.) */
+/* Coordinate in half cells along axis k: i = j >> 1 is the cell coordinate
+ * (truncation of f = 2·(xk - lo)·inv_h; clamped into 0..2n-1), j & 1 the
+ * half of the cell.  (It may differ from pk_rsa_cells_coord by one cell when
+ * x is within round-off of a face: harmless, h >= c·(1 + 1e-9).) */
+static inline uint64_t pk_rsa_cells_half(const pk_rsa_cells *C, int k, double xk)
+{
+    double f = (xk - C->lo[k]) * C->inv_h2[k];
+    uint64_t j = (uint64_t)(int64_t)f;
+    if (j > C->jmax[k]) /* rare: round-off at the range ends */
+        j = f < 0 ? 0 : C->jmax[k];
+    return j;
+}
+
+/* Padded index of the real cell holding x (bits 0..27) and the octant of x in
+ * it (bits 28..30, bit k: upper half along axis k; which neighbours to test
+ * first).  (ncell < 2^28: the fields never collide.) */
 static inline uint32_t pk_rsa_cells_key(const pk_rsa_cells *C, const double *x)
 {
-    int64_t i0 = pk_rsa_cells_coord(C, 0, x[0]), i1 = pk_rsa_cells_coord(C, 1, x[1]), i2 = -1;
-    int seam = i0 < C->calm_lo[0] || i0 > C->calm_hi[0] || i1 < C->calm_lo[1] ||
-               i1 > C->calm_hi[1];
-    if (C->dim == 3) {
-        i2 = pk_rsa_cells_coord(C, 2, x[2]);
-        seam |= i2 < C->calm_lo[2] || i2 > C->calm_hi[2];
-    }
-    uint64_t lin = ((uint64_t)(i2 + 1) * (uint64_t)C->np[1] + (uint64_t)(i1 + 1)) *
-                       (uint64_t)C->np[0] + (uint64_t)(i0 + 1);
-    return (uint32_t)lin | (seam ? PK_RSA_CELLS_SEAM : 0);
+    uint64_t j0 = pk_rsa_cells_half(C, 0, x[0]), j1 = pk_rsa_cells_half(C, 1, x[1]), j2 = 0;
+    if (C->dim == 3)
+        j2 = pk_rsa_cells_half(C, 2, x[2]);
+    uint64_t lin = C->base + (j0 >> 1) + (j1 >> 1) * C->stride[1] + (j2 >> 1) * C->stride[2];
+    uint32_t oct = (uint32_t)((j0 & 1) | (j1 & 1) << 1 | (j2 & 1) << 2);
+    return (uint32_t)lin | oct << PK_RSA_CELLS_OCT_SHIFT;
 }
+
+/* A real cell's seam flag is set when a neighbour may need a periodic image:
+ * the cell touches a periodic seam, or its axis has fewer than 4 cells.
+ * Otherwise every neighbour is nearer than 2h <= L/2 on each periodic axis,
+ * where nearbyint(d/L) = 0: the test may take d as is. */
 
 /* 1 if centres a and b (z = 0 in 2D) are closer than contact: pk_grid's
  * predicate (grid.c scan) bit for bit — same difference, image
@@ -120,11 +138,16 @@ int pk_rsa_cells_around(const pk_rsa_cells *C, const double *x, uint64_t out[27]
 /* Store a centre (and its ghost copies).  0, or -1 when out of memory. */
 int pk_rsa_cells_insert(pk_rsa_cells *C, const double *x);
 
-/* For each of the n points pos[3i..] (z = 0 in 2D) with keys key[i]
- * (pk_rsa_cells_key; any order, sorted by key is fast): keep[i] = 1 if no
- * stored centre is closer than contact, else 0. */
-static inline uint64_t pk_rsa_cells_index(uint32_t key) { return key & ~PK_RSA_CELLS_SEAM; }
-void pk_rsa_cells_filter(const pk_rsa_cells *C, const double *pos, const uint32_t *key, size_t n,
-                         uint8_t *keep);
+/* For the n points pos[3i..] (z = 0 in 2D) with keys key[i] (pk_rsa_cells_key;
+ * any order, sorted by key is fast): writes the indices i of the points no
+ * stored centre is within contact of, ascending, to kept[] and returns their
+ * number. */
+static inline uint64_t pk_rsa_cells_index(uint32_t key) { return key & PK_RSA_CELLS_INDEX_MASK; }
+static inline unsigned pk_rsa_cells_octant(uint32_t key)
+{
+    return key >> PK_RSA_CELLS_OCT_SHIFT & 7u;
+}
+size_t pk_rsa_cells_filter(const pk_rsa_cells *C, const double *pos, const uint32_t *key, size_t n,
+                           uint32_t *kept);
 
 #endif

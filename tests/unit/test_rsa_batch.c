@@ -198,8 +198,8 @@ static void test_cells_predicate_and_neighbours(void)
     for (int i = 0; i < 200; i++)
         CHECK(pk_rsa_cells_insert(&C, pts[i]) == 0);
     int wrong = 0, near = 0;
-    uint8_t keep[200];
-    uint32_t key[200];
+    uint8_t keep[200] = {0};
+    uint32_t key[200], kept[200];
     int seam = 0;
     for (int q = 0; q < 200; q++) {
         key[q] = pk_rsa_cells_key(&C, pts[200 + q]);
@@ -209,7 +209,13 @@ static void test_cells_predicate_and_neighbours(void)
         }
     }
     CHECK(seam > 20); /* points next to seams and walls are among them */
-    pk_rsa_cells_filter(&C, pts[200], key, 200, keep);
+    size_t nkept = pk_rsa_cells_filter(&C, pts[200], key, 200, kept);
+    int ascending = 1;
+    for (size_t j = 0; j < nkept; j++) {
+        ascending &= j == 0 || kept[j] > kept[j - 1];
+        keep[kept[j]] = 1;
+    }
+    CHECK(ascending);
     for (int q = 200; q < 400; q++) {
         int hit = 0;
         for (int i = 0; i < 200; i++) {
