@@ -94,6 +94,13 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
               : bc && !strcmp(bc, "restricted_taylor") ? PK_BC_RESTRICTED_TAYLOR
                                                      : PK_BC_PERIODIC;
     job->E_n = num(json_object_get(inputs, "contact"), "E_n", 1);
+    json_t *fr = json_object_get(inputs, "friction");
+    job->friction = json_is_object(fr);
+    if (job->friction) {
+        job->fric.E_t = num(fr, "E_t", job->E_n);
+        job->fric.tan_rho = tan(num(fr, "rho_deg", 0) * M_PI / 180);
+        job->fric.h = num(fr, "h", 0);
+    }
     json_t *dr = json_object_get(inputs, "relaxation");
     job->tol = num(dr, "tol", 1e-8);
     job->abs_tol = num(dr, "abs_tol", 1e-13);
@@ -168,6 +175,15 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
     if (rc) {
         pk_schema_errors_add(errs, "/load", "memory", "out of memory for the load path");
     }
+    if (job->friction && job->tangent)
+        pk_schema_errors_add(errs, "/tangent", "semantic",
+                             "no tangent with friction: the consistent tangent of the return map is not "
+                             "implemented (ch. 7 derives none); use finite differences of the stress");
+    if (job->friction && job->newton)
+        pk_schema_errors_add(errs, "/relaxation/solver", "semantic",
+                             "friction needs solver \"dr\" (Newton has no frictional stiffness)");
+    if (job->friction && job->fdim == 3)
+        pk_schema_errors_add(errs, "/friction", "semantic", "friction is 2D only (Meier 2009 ch. 7)");
     /* every step: finite, det F̄ >= margin (spec H13) */
     for (size_t k = 0; k < job->nstep && errs->n - before < 20; k++) {
         const double *F = &job->F[9 * k];

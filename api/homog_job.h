@@ -16,6 +16,8 @@ typedef struct pk_homog_job {
     char rve_file[1024];
     pk_homog_bc bc;
     double E_n;
+    int friction;              /* "friction" given */
+    pk_fric_law fric;          /* E_t, tan ρ, h (E_t defaults to E_n) */
     double tol, abs_tol;
     size_t max_iter;
     int lanczos_steps;

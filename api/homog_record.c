@@ -32,7 +32,8 @@ static void tensor_series(json_t *parent, const char *name, int dim, int skew_on
 
 static const char *const scalar_series[] = {
     "J", "energy", "energy_density", "contacts", "contacts_formed", "contacts_broken",
-    "coordination", "rattlers", "max_overlap_ratio", "sum_force", "reaction_defect", NULL};
+    "coordination", "rattlers", "max_overlap_ratio", "sum_force", "reaction_defect",
+    "energy_tangential", "dissipation", "contacts_sliding", NULL};
 static const char *const dr_series[] = {"newton_iterations", "newton_exit_code", "iterations",
                                         "residual", "residual_initial", "stop_code",
                                         "dt", "gamma", "lambda_min", "lambda_max",
@@ -116,6 +117,9 @@ int pk_homog_record_step(json_t *rec, int dim, const pk_homog_step *st)
     rc |= put(rec, "contacts_broken", json_integer((json_int_t)st->broken));
     rc |= put(rec, "coordination", json_real(st->coordination));
     rc |= put(rec, "rattlers", json_integer((json_int_t)st->rattlers));
+    rc |= put(rec, "energy_tangential", json_real(st->energy_t));
+    rc |= put(rec, "dissipation", json_real(st->dissipation));
+    rc |= put(rec, "contacts_sliding", json_integer((json_int_t)st->sliding));
     rc |= put(rec, "max_overlap_ratio", json_real(st->max_overlap_ratio));
     rc |= put(rec, "sum_force", json_real(st->sum_force));
     rc |= put(rec, "reaction_defect", json_real(st->reaction_defect));

@@ -30,12 +30,14 @@ static void opts_of(const pk_homog_job *job, const pk_homog_rve *rve, pk_homog_o
     o->dr.skin = 0.3 * rmean;
     o->newton = job->newton ? &pk_sparse_cholmod : NULL;
     o->newton_max_iter = job->newton_max_iter;
+    o->friction = job->friction ? &job->fric : NULL;
 }
 
 static const char *eval_error(int rc)
 {
     return rc == -2 ? "the periodic box is too small for this F̄ (an image contact could be missed)"
            : rc == -3 ? "det F̄ <= 0"
+           : rc == -4 ? "friction is 2D only (Meier 2009 ch. 7) and this RVE is 3D"
                       : "out of memory";
 }
 
@@ -231,6 +233,13 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
     json_object_set_new(rec, "rve_particles", json_integer((json_int_t)rve.n));
     json_object_set_new(rec, "rve_volume", json_real(rve.V));
     json_object_set_new(rec, "E_n", json_real(job.E_n));
+    if (job.friction) {
+        json_t *fj = json_object();
+        json_object_set_new(fj, "E_t", json_real(job.fric.E_t));
+        json_object_set_new(fj, "tan_rho", json_real(job.fric.tan_rho));
+        json_object_set_new(fj, "h", json_real(job.fric.h));
+        json_object_set_new(rec, "friction", fj);
+    }
     json_object_set_new(rec, "radius_factor", json_real(job.radius_factor));
     json_object_set_new(rec, "precompression", json_real(job.precompress));
 

@@ -198,6 +198,20 @@ int pk_dem_pairs_stale(const pk_dem_pairs *c, const double *x, int dim)
     return 0;
 }
 
+void pk_dem_branch(const pk_dem_geom *g, const double *xi, const double *xj, double l[3])
+{
+    if (g->periodic) {
+        double ds[3];
+        ref_diff(g, xi, xj, ds);
+        pk_m3_vec(g->F, ds, l);
+    } else {
+        for (int k = 0; k < 3; k++)
+            l[k] = xj[k] - xi[k];
+    }
+    if (g->dim == 2)
+        l[2] = 0;
+}
+
 size_t pk_dem_eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
                    size_t np, double E, double *f, double *energy, double S[9])
 {
@@ -211,16 +225,7 @@ size_t pk_dem_eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const
     for (size_t p = 0; p < c->n; p++) {
         size_t i = (size_t)c->i[p], j = (size_t)c->j[p];
         double *l = &c->l[3 * p];
-        if (g->periodic) {
-            double ds[3];
-            ref_diff(g, &x[3 * i], &x[3 * j], ds);
-            pk_m3_vec(g->F, ds, l);
-        } else {
-            for (int k = 0; k < 3; k++)
-                l[k] = x[3 * j + k] - x[3 * i + k];
-        }
-        if (dim == 2)
-            l[2] = 0;
+        pk_dem_branch(g, &x[3 * i], &x[3 * j], l);
         double len = sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
         double eps = r[i] + r[j] - len; /* (4.1) */
         c->len[p] = len;

@@ -26,6 +26,9 @@ typedef struct pk_dem_geom {
  * inverse.  Returns det F (0 = singular, geometry unchanged). */
 double pk_dem_geom_set_F(pk_dem_geom *g, const double F[9]);
 
+/* Branch vector l = x_j − x_i (minimum image under F̄L when periodic). */
+void pk_dem_branch(const pk_dem_geom *g, const double *xi, const double *xj, double l[3]);
+
 typedef struct pk_dem_pairs {
     size_t n, cap;
     int32_t *i, *j;      /* candidate pairs, i < j */

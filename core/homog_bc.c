@@ -12,6 +12,8 @@ void pk_homog_state_free(pk_homog_state *s)
 {
     free(s->x);
     free(s->keys);
+    free(s->u);
+    pk_fric_hist_free(&s->hist);
     memset(s, 0, sizeof *s);
 }
 
@@ -25,6 +27,16 @@ int pk_homog_state_copy(pk_homog_state *dst, const pk_homog_state *src)
     if (!k)
         return -1;
     dst->keys = k;
+    double *u = realloc(dst->u, (src->n ? src->n : 1) * sizeof *u);
+    if (!u)
+        return -1;
+    dst->u = u;
+    if (src->u)
+        memcpy(dst->u, src->u, src->n * sizeof *u);
+    else
+        memset(dst->u, 0, (src->n ? src->n : 1) * sizeof *u);
+    if (pk_fric_hist_copy(&dst->hist, &src->hist) != 0)
+        return -1;
     dst->n = src->n;
     dst->ncontact = src->ncontact;
     memcpy(dst->F, src->F, sizeof dst->F);
@@ -78,7 +90,8 @@ int pk_homog_state_init(const pk_homog_rve *rve, const pk_homog_opts *o, pk_homo
     s->n = rve->n;
     pk_m3_identity(s->F);
     s->x = malloc(3 * (rve->n ? rve->n : 1) * sizeof *s->x);
-    if (!s->x)
+    s->u = calloc(rve->n ? rve->n : 1, sizeof *s->u);
+    if (!s->x || !s->u)
         return -1;
     memcpy(s->x, rve->X, 3 * rve->n * sizeof *s->x);
     pk_dem_geom g;
@@ -131,6 +144,8 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     double J = pk_dem_geom_set_F(&g, Fm);
     if (!(J > 0))
         return -3;
+    if (o->friction && dim != 2)
+        return -4;
     if (pk_homog_state_copy(trial, committed) != 0)
         return -1;
     memcpy(trial->F, Fm, sizeof Fm);
@@ -155,6 +170,9 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     double *f = malloc(3 * (n ? n : 1) * sizeof *f);
     uint8_t *rat = malloc(n ? n : 1);
     pk_dem_pairs c = {0};
+    pk_fric_ctx fc = {.law = o->friction, .x_n = committed->x, .u_n = committed->u,
+                      .hist_n = &committed->hist};
+    pk_fric_totals ftot = {0};
     int rc = 0;
     if (!is_free || !f || !rat) {
         rc = -1;
@@ -165,7 +183,12 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     size_t nfree = 0;
     for (size_t i = 0; i < n; i++)
         nfree += is_free[i];
-    if (o->newton && nfree) {
+    if (o->friction) {
+        geom_of(rve, &fc.g_n);
+        pk_dem_geom_set_F(&fc.g_n, committed->F);
+        rc = pk_homog_relax_fric(&c, &g, trial->x, rve->r, n, o->E_n, is_free, &o->dr, &fc,
+                                 trial->u, mon, &out->dr, &ftot);
+    } else if (o->newton && nfree) {
         out->used_newton = 1;
         rc = pk_homog_newton(&c, &g, trial->x, rve->r, n, o->E_n, is_free, &o->dr, o->newton,
                              o->newton_max_iter, mon, &out->dr, &out->newton);
@@ -179,6 +202,16 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     double S[9];
     double phi;
     out->contacts = pk_dem_eval(&c, &g, trial->x, rve->r, n, o->E_n, f, &phi, S);
+    if (o->friction) { /* tangential forces (7.19) in f and S; σ̄ by (7.26) */
+        if (pk_dem_fric_eval(&c, &fc, trial->x, trial->u, rve->r, n, o->E_n, f, NULL, S, &ftot) != 0 ||
+            pk_fric_hist_collect(&c, &fc, &trial->hist) != 0) {
+            rc = -1;
+            goto done;
+        }
+        out->energy_t = ftot.energy;
+        out->dissipation = ftot.dissipation;
+        out->sliding = ftot.sliding;
+    }
     memcpy(out->F, Fm, sizeof Fm);
     out->J = J;
     out->energy = phi;
@@ -232,6 +265,7 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     }
     diff_keys(committed, trial, &out->formed, &out->broken);
 done:
+    pk_fric_pairs_free(&fc.w);
     pk_dem_pairs_free(&c);
     free(is_free);
     free(f);

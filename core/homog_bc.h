@@ -20,6 +20,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "dem_friction.h"
 #include "homog_newton.h"
 #include "homog_relax.h"
 #include "homog_rve.h"
@@ -31,6 +32,8 @@ typedef struct pk_homog_state {
     double *x;            /* [n][3] spatial centres */
     size_t ncontact;
     uint64_t *keys;       /* sorted contact keys (i << 32 | j), i < j */
+    double *u;            /* [n] rotations as r_i θ_i (friction; 0 otherwise) */
+    pk_fric_hist hist;    /* per-contact slip history (friction) */
 } pk_homog_state;
 
 typedef struct pk_homog_opts {
@@ -41,6 +44,10 @@ typedef struct pk_homog_opts {
      * solver = Newton–Raphson with DR fallback (homog_newton.h). */
     const pk_sparse_solver *newton;
     size_t newton_max_iter;
+    /* Inter-particle friction (ch. 7, 2D): NULL = frictionless.  With
+     * friction the equilibrium solver is always DR (newton is ignored; the
+     * job layer refuses the combination) and rotations are relaxed. */
+    const pk_fric_law *friction;
 } pk_homog_opts;
 
 typedef struct pk_homog_step {
@@ -50,6 +57,9 @@ typedef struct pk_homog_step {
     double J;
     double energy;             /* Φ_n (4.7) */
     double energy_density;     /* Φ̄ = Φ_n / V (5.1) */
+    double energy_t;           /* Φ_t (7.6), friction */
+    double dissipation;        /* Σ Δλ f_n tan ρ of this step (7.13), friction */
+    size_t sliding;            /* contacts on the Coulomb limit, friction */
     double sum_force;          /* |Σ_i f_i| (global equilibrium) */
     double max_overlap_ratio;  /* max ε_ij / min(r_i, r_j) (spec H3) */
     size_t contacts, formed, broken, rattlers;
@@ -69,7 +79,7 @@ int pk_homog_commit(pk_homog_state *committed, const pk_homog_state *trial);
 
 /* Evaluate F̄ from the committed state into *trial (committed is not
  * touched).  Returns 0 (check out->dr.stop), -1 memory, -2 periodic box too
- * small for this F̄, -3 det F̄ <= 0 or not finite. */
+ * small for this F̄, -3 det F̄ <= 0 or not finite, -4 friction asked in 3D. */
 int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homog_state *committed,
                   const double F[9], pk_homog_state *trial, pk_homog_step *out, pk_monitor *mon);
 

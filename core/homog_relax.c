@@ -49,9 +49,82 @@ static void optimal_params(pk_dr_stats *st)
  * relaxation).  A non-positive λ_min (indefinite block under large overlaps,
  * or no jammed grain) falls back to the residual's Rayleigh quotient on the
  * free grains, and only then to a tiny share of λ_max (flagged). */
+/* Forces at (x, u): normal (4.10) plus, with friction, tangential (7.19) and
+ * couples gu (7.23).  -1 on allocation failure. */
+typedef struct relax_sys {
+    pk_dem_pairs *c;
+    const pk_dem_geom *g;
+    const double *r;
+    size_t np;
+    double E;
+    const uint8_t *is_free;
+    pk_fric_ctx *fc; /* NULL: frictionless */
+    int fric_active;
+} relax_sys;
+
+static int forces(const relax_sys *s, const double *x, const double *u, double *f, double *gu,
+                  pk_fric_totals *tot)
+{
+    pk_dem_eval(s->c, s->g, x, s->r, s->np, s->E, f, NULL, NULL);
+    if (!s->fc)
+        return 0;
+    return pk_dem_fric_eval(s->c, s->fc, x, u, s->r, s->np, s->E, f, gu, NULL, tot);
+}
+
+static double resid_norm(const relax_sys *s, const double *f, const double *gu)
+{
+    double a = free_norm(f, s->is_free, s->np, s->g->dim), b = 0;
+    if (s->fc)
+        for (size_t i = 0; i < s->np; i++)
+            b += gu[i] * gu[i];
+    return sqrt(a * a + b);
+}
+
+/* Rayleigh quotient vᵀKv/vᵀv of the frictional system along the residual v,
+ * by a forward difference of the force (K = −∂F/∂z); restores the pair data
+ * at (x, u).  0 when not available. */
+static double fric_rayleigh(const relax_sys *s, double *x, double *u, const double *f,
+                            const double *gu, double *work)
+{
+    const int dim = s->g->dim;
+    size_t np = s->np;
+    double vv = 0, rmean = 0;
+    for (size_t i = 0; i < np; i++) {
+        rmean += s->r[i] / (double)np;
+        vv += gu[i] * gu[i];
+        if (s->is_free[i])
+            for (int a = 0; a < dim; a++)
+                vv += f[3 * i + a] * f[3 * i + a];
+    }
+    if (!(vv > 0))
+        return 0;
+    double eta = 1e-7 * rmean / sqrt(vv); /* a step of 1e-7 r̄ */
+    double *f2 = work, *g2 = work + 3 * np;
+    for (size_t i = 0; i < np; i++) {
+        u[i] += eta * gu[i];
+        if (s->is_free[i])
+            for (int a = 0; a < dim; a++)
+                x[3 * i + a] += eta * f[3 * i + a];
+    }
+    int rc = forces(s, x, u, f2, g2, NULL);
+    double num = 0;
+    for (size_t i = 0; i < np; i++) {
+        u[i] -= eta * gu[i];
+        num -= (g2[i] - gu[i]) * gu[i];
+        if (s->is_free[i])
+            for (int a = 0; a < dim; a++) {
+                x[3 * i + a] -= eta * f[3 * i + a];
+                num -= (f2[3 * i + a] - f[3 * i + a]) * f[3 * i + a];
+            }
+    }
+    if (rc != 0 || forces(s, x, u, f2, g2, NULL) != 0)
+        return NAN;
+    return num / (eta * vv);
+}
+
 static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *is_free,
                     const double *f, uint8_t *rat, uint8_t *mask, double *work, int lanczos,
-                    pk_dr_stats *st)
+                    pk_dr_stats *st, const relax_sys *sys, double *x, double *u, const double *gu)
 {
     size_t nr = pk_dem_rattlers(c, dim, np, is_free, rat);
     if (nr == (size_t)-1)
@@ -72,6 +145,14 @@ static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t
     double rq = pk_homog_rayleigh(c, dim, np, E, m, f, work);
     if (rq > 0 && (rq < lmin || !(lmin > 0)))
         lmin = rq;
+    if (sys->fric_active) {
+        st->lambda_max += pk_dem_fric_gershgorin(c, sys->fc, np);
+        double fq = fric_rayleigh(sys, x, u, f, gu, work);
+        if (isnan(fq))
+            return -1;
+        if (fq > 0 && (fq < lmin || !(lmin > 0)))
+            lmin = fq;
+    }
     const double floor_share = 1e-8; /* λ_min/λ_max below this counts as singular */
     st->clamped = !(lmin > floor_share * st->lambda_max);
     st->lambda_min = st->clamped ? floor_share * st->lambda_max : fmin(lmin, st->lambda_max);
@@ -79,9 +160,9 @@ static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t
     return 0;
 }
 
-int pk_homog_relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
-                   double E, const uint8_t *is_free, const pk_dr_params *prm, pk_monitor *mon,
-                   pk_dr_stats *st)
+static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
+                 double E, const uint8_t *is_free, const pk_dr_params *prm, pk_fric_ctx *fc,
+                 double *u, pk_monitor *mon, pk_dr_stats *st, pk_fric_totals *tot)
 {
     const int dim = g->dim;
     memset(st, 0, sizeof *st);
@@ -92,15 +173,16 @@ int pk_homog_relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doubl
     if (rc != 0)
         return rc;
     double *f = malloc(3 * np * sizeof *f), *v = calloc(3 * np, sizeof *v);
-    double *work = malloc(3 * np * sizeof *work);
+    double *work = malloc(4 * (np ? np : 1) * sizeof *work);
+    double *gu = calloc(np ? np : 1, sizeof *gu), *vu = calloc(np ? np : 1, sizeof *vu);
     uint8_t *rat = malloc(np ? np : 1), *mask = malloc(np ? np : 1);
-    if (!f || !v || !work || !rat || !mask) {
+    relax_sys sys = {c, g, r, np, E, is_free, fc, fc && pk_fric_law_active(fc->law)};
+    if (!f || !v || !work || !gu || !vu || !rat || !mask || forces(&sys, x, u, f, gu, tot) != 0) {
         rc = -1;
         goto out;
     }
-    pk_dem_eval(c, g, x, r, np, E, f, NULL, NULL);
-    st->f0 = st->f = free_norm(f, is_free, np, dim);
-    if (nfree == 0) {
+    st->f0 = st->f = resid_norm(&sys, f, gu);
+    if (nfree == 0 && !sys.fric_active) {
         st->stop = PK_DR_NOT_NEEDED;
         goto out;
     }
@@ -109,7 +191,7 @@ int pk_homog_relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doubl
         st->stop = PK_DR_CONVERGED_ABS;
         goto out;
     }
-    if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st) != 0) {
+    if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu) != 0) {
         rc = -1;
         goto out;
     }
@@ -129,6 +211,11 @@ int pk_homog_relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doubl
                 x[3 * i + a] += dt * *vi;                                      /* (4.40) */
             }
         }
+        if (sys.fric_active) /* the rotations, same scheme (unit pseudo-mass of u = rθ) */
+            for (size_t i = 0; i < np; i++) {
+                vu[i] = k == 0 ? 0.5 * dt * gu[i] : ((2 - gm * dt) * vu[i] + 2 * dt * gu[i]) / (2 + gm * dt);
+                u[i] += dt * vu[i];
+            }
         st->iterations = k + 1;
         if (pk_dem_pairs_stale(c, x, dim)) {
             rc = pk_dem_pairs_build(c, g, x, r, np, prm->skin);
@@ -136,8 +223,11 @@ int pk_homog_relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doubl
                 goto out;
             st->rebuilds++;
         }
-        pk_dem_eval(c, g, x, r, np, E, f, NULL, NULL);
-        st->f = free_norm(f, is_free, np, dim);
+        if (forces(&sys, x, u, f, gu, tot) != 0) {
+            rc = -1;
+            goto out;
+        }
+        st->f = resid_norm(&sys, f, gu);
         if (st->f <= target) {
             st->stop = st->f <= prm->tol * st->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
             break;
@@ -148,18 +238,19 @@ int pk_homog_relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doubl
         }
         if (!isfinite(st->f) || st->f > 1e3 * fbest) {
             /* diverging: the spectrum moved (new contacts) — fresh estimates, restart at rest */
-            if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st) != 0) {
+            if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu) != 0) {
                 rc = -1;
                 goto out;
             }
             memset(v, 0, 3 * np * sizeof *v);
+            memset(vu, 0, np * sizeof *vu);
             fbest = st->f;
             st->refreshes++;
             continue;
         }
         fbest = fmin(fbest, st->f);
         if (prm->refresh && st->iterations % prm->refresh == 0) {
-            if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st) != 0) {
+            if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu) != 0) {
                 rc = -1;
                 goto out;
             }
@@ -179,7 +270,24 @@ out:
     free(f);
     free(v);
     free(work);
+    free(gu);
+    free(vu);
     free(rat);
     free(mask);
     return rc;
+}
+
+int pk_homog_relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
+                   double E, const uint8_t *is_free, const pk_dr_params *prm, pk_monitor *mon,
+                   pk_dr_stats *st)
+{
+    return relax(c, g, x, r, np, E, is_free, prm, NULL, NULL, mon, st, NULL);
+}
+
+int pk_homog_relax_fric(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
+                        size_t np, double E, const uint8_t *is_free, const pk_dr_params *prm,
+                        pk_fric_ctx *fc, double *u, pk_monitor *mon, pk_dr_stats *st,
+                        pk_fric_totals *tot)
+{
+    return relax(c, g, x, r, np, E, is_free, prm, fc, u, mon, st, tot);
 }

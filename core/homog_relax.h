@@ -13,6 +13,7 @@
 #include <stdint.h>
 
 #include "dem_contact.h"
+#include "dem_friction.h"
 #include "progress.h"
 
 typedef enum pk_dr_stop {
@@ -53,5 +54,20 @@ typedef struct pk_dr_stats {
 int pk_homog_relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
                    double E, const uint8_t *is_free, const pk_dr_params *prm, pk_monitor *mon,
                    pk_dr_stats *st);
+
+/* The same with inter-particle friction (2D, dem_friction.h): relaxes the
+ * free centres and EVERY rotation u_i = r_i θ_i (Remark 7.3: all grains
+ * rotate freely, Taylor included), starting from and reading only the
+ * committed state in fc.  u [np] in/out.  The residual is the norm of the
+ * free forces and all couples m_i/r_i (7.24).  λ_max adds the tangential
+ * row sums; λ_min is the smaller of the normal Lanczos estimate and a
+ * finite-difference Rayleigh quotient of the residual through the full
+ * (frictional) force.  An inactive law (tan ρ = h = 0) carries no tangential
+ * force and leaves the frictionless iteration unchanged.  tot (may be NULL)
+ * gets the tangential totals at the final state. */
+int pk_homog_relax_fric(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
+                        size_t np, double E, const uint8_t *is_free, const pk_dr_params *prm,
+                        pk_fric_ctx *fc, double *u, pk_monitor *mon, pk_dr_stats *st,
+                        pk_fric_totals *tot);
 
 #endif

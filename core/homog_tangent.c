@@ -18,6 +18,8 @@ int pk_homog_tangent(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_h
     const double E = o->E_n;
     double t0 = pk_wall_seconds();
     memset(info, 0, sizeof *info);
+    if (o->friction) /* no frictional tangent (none derived in ch. 7); see -3 */
+        return -3;
     pk_dem_geom g = {.dim = dim, .periodic = rve->periodic};
     memcpy(g.L, rve->L, sizeof g.L);
     if (!(pk_dem_geom_set_F(&g, s->F) > 0))

@@ -28,7 +28,8 @@ typedef struct pk_tangent_info {
 /* Tangent at the (relaxed) state s.  Returns 0 with A filled when the free
  * block is positive definite (or empty); 1 when it is singular or
  * indefinite (A untouched; see info->block); -1 memory / solver failure;
- * -2 periodic box too small for F̄. */
+ * -2 periodic box too small for F̄; -3 friction is on (the frictional
+ * tangent of the return mapping is not implemented: refused). */
 int pk_homog_tangent(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homog_state *s,
                      const pk_sparse_solver *solver, double A[81], pk_tangent_info *info);
 

@@ -124,3 +124,35 @@ JOB
 "$PACKD" run perwall.json -o perwall.h5 >/dev/null 2>perwall.err
 rc=$?
 check refuse_periodic_on_walled_box sh -c "test $rc -ne 0 && grep -q 'periodic on every axis' perwall.err"
+
+# 6. friction (ch. 7) through the process, Taylor (the thesis' setting): ρ = h = 0 gives the
+#    frictionless stresses exactly; ρ = 30° with h = E records dissipation >= 0 and a non-zero
+#    tangential energy; friction + tangent is refused with the pointer
+for fr in none zero rho30; do
+    python3 -c "
+import json; j = json.load(open('taylor.json'))
+j['inputs']['load'] = {'type': 'cyclic_shear', 'precompression': 0.01, 'pre_steps': 1, 'amplitude': 0.01, 'steps': 4}
+f = {'none': None, 'zero': {'rho_deg': 0}, 'rho30': {'rho_deg': 30, 'h': 1.0}}['$fr']
+if f is not None: j['inputs']['friction'] = f
+json.dump(j, open('fr_$fr.json', 'w'))"
+    "$PACKD" run "fr_$fr.json" -o "fr_$fr.h5" >"fr_$fr.out" 2>"fr_$fr.err" || fail "run_friction_$fr" "$(cat "fr_$fr.err")"
+    "$PACKD" inspect "fr_$fr.h5" >"fr_$fr.insp" 2>/dev/null
+done
+check friction_zero_reproduces_frictionless python3 -c "
+import json
+a = json.load(open('fr_none.insp'))['observables']; b = json.load(open('fr_zero.insp'))['observables']
+for k in ('P/11', 'P/12', 'P/21', 'P/22'):
+    assert a['homogenize/' + k] == b['homogenize/' + k], k
+assert all(d == 0 for d in b['homogenize/dissipation'])"
+check friction_dissipates python3 -c "
+import json; o = json.load(open('fr_rho30.insp'))['observables']
+d = o['homogenize/dissipation']; e = o['homogenize/energy_tangential']
+assert all(x >= 0 for x in d) and sum(d) > 0 and max(e) > 0, (d, e)
+assert all(c in (0, 1) for c in o['homogenize/dr/stop_code'])
+assert json.load(open('fr_rho30.out'))['complete']"
+python3 -c "
+import json; j = json.load(open('fr_rho30.json')); j['inputs']['tangent'] = True
+json.dump(j, open('fr_tangent.json', 'w'))"
+out=$("$PACKD" validate fr_tangent.json 2>/dev/null)
+rc=$?
+check refuse_friction_with_tangent sh -c "test $rc -eq 1 && printf '%s' '$out' | grep -q '/inputs/tangent'"
