@@ -15,18 +15,31 @@ static void comp4_name(char *buf, int a, int b, int c, int d)
     comp_name(buf + 2, 3, c, d);
 }
 
-/* obj[name] = [] for every dim×dim component */
-static void tensor_series(json_t *parent, const char *name, int dim, int skew_only)
+/* The recorded components of a dim×dim tensor (all, or a < b for the skew
+ * part): their names "ab" and row-major indices into a 3×3 array.  One list
+ * serves the series set-up and every step, so the two can never disagree. */
+static int tensor_components(int dim, int skew_only, char names[9][8], int idx[9])
 {
-    json_t *t = json_object();
+    int n = 0;
     for (int a = 0; a < dim; a++)
         for (int b = 0; b < dim; b++) {
             if (skew_only && b <= a)
                 continue;
-            char c[8];
-            comp_name(c, sizeof c, a, b);
-            json_object_set_new(t, c, json_array());
+            comp_name(names[n], sizeof names[n], a, b);
+            idx[n++] = 3 * a + b;
         }
+    return n;
+}
+
+/* obj[name] = {component: []} */
+static void tensor_series(json_t *parent, const char *name, int dim, int skew_only)
+{
+    char names[9][8];
+    int idx[9];
+    int n = tensor_components(dim, skew_only, names, idx);
+    json_t *t = json_object();
+    for (int k = 0; k < n; k++)
+        json_object_set_new(t, names[k], json_array());
     json_object_set_new(parent, name, t);
 }
 
@@ -89,16 +102,13 @@ static int put(json_t *obj, const char *key, json_t *v)
 
 static int put_tensor(json_t *rec, const char *name, int dim, const double T[9], int skew_only)
 {
+    char names[9][8];
+    int idx[9];
+    int n = tensor_components(dim, skew_only, names, idx);
     json_t *t = json_object_get(rec, name);
     int rc = 0;
-    for (int a = 0; a < dim; a++)
-        for (int b = 0; b < dim; b++) {
-            if (skew_only && b <= a)
-                continue;
-            char c[8];
-            comp_name(c, sizeof c, a, b);
-            rc |= put(t, c, json_real(T[3 * a + b]));
-        }
+    for (int k = 0; k < n; k++)
+        rc |= put(t, names[k], json_real(T[idx[k]]));
     return rc;
 }
 
