@@ -13,6 +13,48 @@ void pk_homog_job_free(pk_homog_job *job)
     free(job->F);
     job->F = NULL;
     job->nstep = 0;
+    free(job->E_n_species);
+    job->E_n_species = NULL;
+    job->n_species = 0;
+}
+
+/* contact.E_n_species: square and symmetric (E_n,ij = E_n,ji: one contact,
+ * one spring); the schema checks the entries are positive numbers. */
+static void species_stiffness(json_t *m, pk_homog_job *job, pk_schema_errors *errs)
+{
+    size_t n = json_array_size(m);
+    if (!n)
+        return;
+    job->E_n_species = malloc(n * n * sizeof *job->E_n_species);
+    if (!job->E_n_species) {
+        pk_schema_errors_add(errs, "/contact/E_n_species", "memory", "out of memory");
+        return;
+    }
+    job->n_species = n;
+    for (size_t a = 0; a < n; a++) {
+        json_t *row = json_array_get(m, a);
+        if (json_array_size(row) != n) {
+            char ptr[64];
+            snprintf(ptr, sizeof ptr, "/contact/E_n_species/%zu", a);
+            pk_schema_errors_add(errs, ptr, "semantic",
+                                 "row %zu has %zu entries: the matrix must be %zu × %zu", a,
+                                 json_array_size(row), n, n);
+            return;
+        }
+        for (size_t b = 0; b < n; b++)
+            job->E_n_species[a * n + b] = json_number_value(json_array_get(row, b));
+    }
+    for (size_t a = 0; a < n; a++)
+        for (size_t b = a + 1; b < n; b++)
+            if (job->E_n_species[a * n + b] != job->E_n_species[b * n + a]) {
+                char ptr[64];
+                snprintf(ptr, sizeof ptr, "/contact/E_n_species/%zu/%zu", a, b);
+                pk_schema_errors_add(errs, ptr, "semantic",
+                                     "E_n_species must be symmetric: [%zu][%zu] = %g but [%zu][%zu] = %g",
+                                     a, b, job->E_n_species[a * n + b], b, a,
+                                     job->E_n_species[b * n + a]);
+                return;
+            }
 }
 
 static double num(json_t *o, const char *key, double dflt)
@@ -94,6 +136,7 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
               : bc && !strcmp(bc, "restricted_taylor") ? PK_BC_RESTRICTED_TAYLOR
                                                      : PK_BC_PERIODIC;
     job->E_n = num(json_object_get(inputs, "contact"), "E_n", 1);
+    species_stiffness(json_object_get(json_object_get(inputs, "contact"), "E_n_species"), job, errs);
     json_t *fr = json_object_get(inputs, "friction");
     job->friction = json_is_object(fr);
     if (job->friction) {

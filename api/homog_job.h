@@ -16,6 +16,8 @@ typedef struct pk_homog_job {
     char rve_file[1024];
     pk_homog_bc bc;
     double E_n;
+    double *E_n_species;       /* [n_species²] row-major, NULL = uniform E_n */
+    size_t n_species;
     int friction;              /* "friction" given */
     pk_fric_law fric;          /* E_t, tan ρ, h (E_t defaults to E_n) */
     double tol, abs_tol;

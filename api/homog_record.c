@@ -68,9 +68,8 @@ json_t *pk_homog_record_new(int dim, int with_tangent)
                         json_string("0 converged, 1 converged_absolute, 2 not_needed, 3 max_iter, "
                                     "4 cancelled, 5 wall_time"));
     json_object_set_new(dr, "newton_exit_names",
-                        json_string("-1 not used, 0 converged, 1 rattler_polish, "
-                                    "2 block_not_positive_definite, 3 line_search_failed, "
-                                    "4 iteration_cap, 5 stalled"));
+                        json_string("-1 not used, 0 converged, 1 block_not_positive_definite, "
+                                    "2 trust_region_collapsed, 3 iteration_cap, 4 stalled"));
     json_object_set_new(r, "dr", dr);
     if (with_tangent) {
         json_t *t = json_object();

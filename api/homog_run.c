@@ -31,6 +31,8 @@ static void opts_of(const pk_homog_job *job, const pk_homog_rve *rve, pk_homog_o
     o->newton = job->newton ? &pk_sparse_cholmod : NULL;
     o->newton_max_iter = job->newton_max_iter;
     o->friction = job->friction ? &job->fric : NULL;
+    o->E_n_species = job->E_n_species;
+    o->n_species = job->n_species;
 }
 
 static const char *eval_error(int rc)
@@ -50,6 +52,7 @@ static int final_state_json(const pk_homog_rve *rve, const pk_homog_opts *o,
     memcpy(g.L, rve->L, sizeof g.L);
     pk_dem_geom_set_F(&g, s->F);
     pk_dem_pairs c = {0};
+    pk_homog_pairs_setup(&c, rve, o);
     uint8_t *fr = malloc(rve->n ? rve->n : 1), *rat = malloc(rve->n ? rve->n : 1);
     int rc = (!fr || !rat) ? -1 : pk_dem_pairs_build(&c, &g, s->x, rve->r, rve->n, o->dr.skin);
     if (rc == 0) {
@@ -147,6 +150,12 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
     }
     if (pk_homog_rve_build(&box, &p, job.bc, job.radius_factor, &rve, err, errlen) != 0)
         goto out;
+    for (size_t i = 0; job.E_n_species && i < p.n; i++)
+        if (p.species[i] < 0 || (size_t)p.species[i] >= job.n_species) {
+            snprintf(err, errlen, "/contact/E_n_species: grain %zu has species %d but the matrix "
+                     "covers species 0..%zu", i, (int)p.species[i], job.n_species - 1);
+            goto out;
+        }
     pk_homog_opts o;
     opts_of(&job, &rve, &o);
     if (pk_homog_state_init(&rve, &o, &com) != 0) {

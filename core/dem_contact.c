@@ -26,7 +26,17 @@ void pk_dem_pairs_free(pk_dem_pairs *c)
     free(c->len);
     free(c->eps);
     free(c->xb);
+    free(c->kf);
     memset(c, 0, sizeof *c);
+}
+
+void pk_dem_pairs_stiffness(pk_dem_pairs *c, const int32_t *kclass, const double *kmat,
+                            size_t nclass, double kref)
+{
+    c->kclass = kmat && nclass && kref > 0 ? kclass : NULL;
+    c->kmat = kmat;
+    c->nclass = nclass;
+    c->kref = kref;
 }
 
 static int pairs_push(pk_dem_pairs *c, int32_t i, int32_t j)
@@ -48,12 +58,17 @@ static int pairs_push(pk_dem_pairs *c, int32_t i, int32_t j)
         double *ne = realloc(c->eps, cap * sizeof *ne);
         if (ne)
             c->eps = ne;
-        if (!ni || !nj || !nl || !nn || !ne)
+        double *nk = c->kclass ? realloc(c->kf, cap * sizeof *nk) : c->kf;
+        if (nk)
+            c->kf = nk;
+        if (!ni || !nj || !nl || !nn || !ne || (c->kclass && !nk))
             return -1;
         c->cap = cap;
     }
     c->i[c->n] = i;
     c->j[c->n] = j;
+    if (c->kclass)
+        c->kf[c->n] = c->kmat[(size_t)c->kclass[i] * c->nclass + (size_t)c->kclass[j]] / c->kref;
     c->n++;
     return 0;
 }
@@ -103,6 +118,11 @@ int pk_dem_pairs_build(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, c
     const int dim = g->dim;
     c->n = 0;
     c->skin = skin;
+    if (c->kclass && !c->kf && c->cap) { /* classes set after an earlier build */
+        c->kf = malloc(c->cap * sizeof *c->kf);
+        if (!c->kf)
+            return -1;
+    }
     if (c->np != np || !c->xb) {
         free(c->xb);
         c->xb = malloc(3 * (np ? np : 1) * sizeof *c->xb);
@@ -233,8 +253,9 @@ size_t pk_dem_eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const
         if (!(eps >= 0) || !(len > 0)) /* (4.2); coincident centres carry no direction */
             continue;
         nc++;
-        phi += 0.5 * E * eps * eps; /* (4.3), each contact once (4.7) */
-        double fn = E * eps;        /* f_ij = −E ε n_ij on i (4.8) */
+        double k = pk_dem_pair_E(c, p, E);
+        phi += 0.5 * k * eps * eps; /* (4.3), each contact once (4.7) */
+        double fn = k * eps;        /* f_ij = −E ε n_ij on i (4.8) */
         for (int a = 0; a < dim; a++) {
             double fa = -fn * l[a] / len;
             if (f) {
@@ -278,7 +299,7 @@ void pk_dem_kv(const pk_dem_pairs *c, int dim, size_t np, double E, const uint8_
         for (int a = 0; a < dim; a++)
             d[a] = (mj ? v[3 * j + a] : 0) - (mi ? v[3 * i + a] : 0);
         /* (K v)_i = Σ_j k_ij (v_j − v_i) by (4.14) */
-        kblock_apply(dim, E, c->len[p], c->eps[p], &c->l[3 * p], d, kd);
+        kblock_apply(dim, pk_dem_pair_E(c, p, E), c->len[p], c->eps[p], &c->l[3 * p], d, kd);
         for (int a = 0; a < dim; a++) {
             if (mi)
                 out[3 * i + a] += kd[a];
@@ -298,7 +319,8 @@ double pk_dem_gershgorin(const pk_dem_pairs *c, int dim, size_t np, double E, co
             continue;
         size_t i = (size_t)c->i[p], j = (size_t)c->j[p];
         const double *l = &c->l[3 * p];
-        double len = c->len[p], eps = c->eps[p], R = eps + len, cc = E / len;
+        double len = c->len[p], eps = c->eps[p], R = eps + len;
+        double cc = pk_dem_pair_E(c, p, E) / len;
         for (int a = 0; a < dim; a++) {
             double s = 0; /* Σ_b |k_ab| */
             for (int b = 0; b < dim; b++)

@@ -38,9 +38,29 @@ typedef struct pk_dem_pairs {
     double *xb;          /* [np][3] positions at the last build (skin test) */
     size_t np;
     double skin;
+    /* Pair-specific stiffness (E_n,ij of (4.3)): when kclass != NULL, pair
+     * (i, j) has E_n,ij = kmat[kclass[i]·nclass + kclass[j]] and the build
+     * fills kf[p] = E_n,ij / kref, the factor on the E the evaluators are
+     * given; otherwise every pair has E.  Set with pk_dem_pairs_stiffness
+     * before the first build; the arrays stay the caller's. */
+    const int32_t *kclass;
+    const double *kmat;
+    size_t nclass;
+    double kref;
+    double *kf;          /* [n] per-candidate factor, NULL when uniform */
 } pk_dem_pairs;
 
 void pk_dem_pairs_free(pk_dem_pairs *c);
+
+/* Pair-specific stiffness by class (see above); kclass == NULL = uniform. */
+void pk_dem_pairs_stiffness(pk_dem_pairs *c, const int32_t *kclass, const double *kmat,
+                            size_t nclass, double kref);
+
+/* E_n of candidate pair p when the evaluators are given E. */
+static inline double pk_dem_pair_E(const pk_dem_pairs *c, size_t p, double E)
+{
+    return c->kf ? E * c->kf[p] : E;
+}
 
 /* Rebuild the candidate list: every pair whose spatial distance can be below
  * r_i + r_j + skin.  -1 on allocation failure, -2 when a periodic box is too

@@ -155,7 +155,7 @@ int pk_dem_fric_eval(const pk_dem_pairs *c, pk_fric_ctx *fc, const double *x, co
         double du = (u[i] - fc->u_n[i]) + (u[j] - fc->u_n[j]);
         /* (7.5): rotation part + translation part −|lⁿ| tⁿ·nⁿ⁺¹ */
         double gamma = g_n + du * len / (r[i] + r[j]) - lnl * (tnx * nx + tny * ny);
-        double fn = E_n * eps;
+        double fn = pk_dem_pair_E(c, p, E_n) * eps;
         pk_fric_point pt;
         int slip = pk_fric_return_map(law, fn, gamma, gpl_n, al_n, &pt);
         double ct = (lnl / len) * (tnx * tx + tny * ty); /* (7.20) */

@@ -76,6 +76,12 @@ static int collect_keys(const pk_dem_pairs *c, pk_homog_state *s)
     return 0;
 }
 
+void pk_homog_pairs_setup(pk_dem_pairs *c, const pk_homog_rve *rve, const pk_homog_opts *o)
+{
+    pk_dem_pairs_stiffness(c, o->E_n_species ? rve->species : NULL, o->E_n_species, o->n_species,
+                           o->E_n);
+}
+
 static void geom_of(const pk_homog_rve *rve, pk_dem_geom *g)
 {
     memset(g, 0, sizeof *g);
@@ -98,6 +104,7 @@ int pk_homog_state_init(const pk_homog_rve *rve, const pk_homog_opts *o, pk_homo
     geom_of(rve, &g);
     pk_dem_geom_set_F(&g, s->F);
     pk_dem_pairs c = {0};
+    pk_homog_pairs_setup(&c, rve, o);
     int rc = pk_dem_pairs_build(&c, &g, s->x, rve->r, rve->n, o->dr.skin);
     if (rc == 0) {
         pk_dem_eval(&c, &g, s->x, rve->r, rve->n, o->E_n, NULL, NULL, NULL);
@@ -170,6 +177,7 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     double *f = malloc(3 * (n ? n : 1) * sizeof *f);
     uint8_t *rat = malloc(n ? n : 1);
     pk_dem_pairs c = {0};
+    pk_homog_pairs_setup(&c, rve, o);
     pk_fric_ctx fc = {.law = o->friction, .x_n = committed->x, .u_n = committed->u,
                       .hist_n = &committed->hist};
     pk_fric_totals ftot = {0};

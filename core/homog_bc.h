@@ -38,6 +38,11 @@ typedef struct pk_homog_state {
 
 typedef struct pk_homog_opts {
     double E_n;           /* normal contact stiffness (4.3) */
+    /* Pair-specific normal stiffness (E_n,ij of (4.3)) by species: an
+     * n_species × n_species symmetric matrix of absolute stiffnesses, row
+     * major; NULL = E_n for every pair.  Every RVE species must be < n_species. */
+    const double *E_n_species;
+    size_t n_species;
     int affine_predictor; /* 1: start free grains from x = F̄ⁿ⁺¹(F̄ⁿ)⁻¹xⁿ (Ξ fixed); 0: thesis */
     pk_dr_params dr;
     /* Equilibrium solver: NULL = dynamic relaxation (the thesis); a sparse
@@ -49,6 +54,10 @@ typedef struct pk_homog_opts {
      * job layer refuses the combination) and rotations are relaxed. */
     const pk_fric_law *friction;
 } pk_homog_opts;
+
+/* Give a contact list the RVE's stiffness classes (uniform when
+ * o->E_n_species is NULL); call before its first build. */
+void pk_homog_pairs_setup(pk_dem_pairs *c, const pk_homog_rve *rve, const pk_homog_opts *o);
 
 typedef struct pk_homog_step {
     double F[9], P[9], sigma[9], sigma_skew[9];

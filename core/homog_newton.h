@@ -1,13 +1,13 @@
 /* homog_newton.h — Newton–Raphson equilibrium of the free particles with the
  * stiffness the tangent needs anyway (issue 6; not in the thesis, which uses
- * dynamic relaxation only).  Per iteration: rattlers detected, the jammed free
- * stiffness K (4.11)–(4.14) factorised by the injected sparse solver, step
- * Δx = K⁻¹f, backtracking line search on the potential Φ_n (Armijo) with the
- * contact set re-evaluated at every trial point.  Falls back to dynamic
- * relaxation (same convergence target) when the block is singular or
- * indefinite, the line search fails, the residual stalls (contacts switching
- * on and off make the problem non-smooth) or the cap is reached, and polishes the
- * rattlers (which carry no stiffness) by DR. */
+ * dynamic relaxation only).  Per iteration: rattlers detected, the free
+ * stiffness K assembled (exact (4.11)–(4.14) between jammed grains,
+ * Gauss–Newton E n⊗n on rattler contacts plus a tiny shift, so rattlers are
+ * solved in the same system) and factorised by the injected sparse solver,
+ * then a dogleg trust-region step on the potential Φ_n (the contact set may
+ * change inside a step).  An indefinite exact block switches to Gauss–Newton;
+ * a collapsed trust region, a stalled residual or the iteration cap hand the
+ * rest to dynamic relaxation with the same convergence target. */
 #ifndef PK_HOMOG_NEWTON_H
 #define PK_HOMOG_NEWTON_H
 
@@ -16,17 +16,16 @@
 
 typedef enum pk_newton_exit {
     PK_NEWTON_CONVERGED = 0,     /* no DR needed */
-    PK_NEWTON_RATTLER_POLISH,    /* jammed set converged, DR finished the rattlers */
-    PK_NEWTON_BLOCK_NOT_PD,      /* singular / indefinite block → DR */
-    PK_NEWTON_LINE_SEARCH,       /* no descent → DR */
+    PK_NEWTON_BLOCK_NOT_PD,      /* even the Gauss–Newton block is not positive definite → DR */
+    PK_NEWTON_TRUST_REGION,      /* trust region collapsed without an acceptable step → DR */
     PK_NEWTON_CAP,               /* iteration cap → DR */
-    PK_NEWTON_STALLED            /* residual not halved in 4 steps (contact chatter) → DR */
+    PK_NEWTON_STALLED            /* residual not halved in 8 steps (contact chatter) → DR */
 } pk_newton_exit;
 
 const char *pk_newton_exit_name(pk_newton_exit e);
 
 typedef struct pk_newton_stats {
-    size_t iterations, cuts;     /* Newton steps, line-search halvings */
+    size_t iterations, cuts;     /* Newton steps, rejected trust-region trials */
     pk_newton_exit exit;
 } pk_newton_stats;
 

@@ -20,6 +20,7 @@ void pk_homog_rve_free(pk_homog_rve *rve)
     free(rve->X);
     free(rve->r);
     free(rve->grain);
+    free(rve->species);
     free(rve->fixed);
     free(rve->hull);
     memset(rve, 0, sizeof *rve);
@@ -30,9 +31,10 @@ static int rve_alloc(pk_homog_rve *rve, size_t cap)
     rve->X = calloc(3 * cap, sizeof *rve->X);
     rve->r = calloc(cap, sizeof *rve->r);
     rve->grain = calloc(cap, sizeof *rve->grain);
+    rve->species = calloc(cap, sizeof *rve->species);
     rve->fixed = calloc(cap, 1);
     rve->hull = calloc(cap, 1);
-    if (!rve->X || !rve->r || !rve->grain || !rve->fixed || !rve->hull) {
+    if (!rve->X || !rve->r || !rve->grain || !rve->species || !rve->fixed || !rve->hull) {
         pk_homog_rve_free(rve);
         return -1;
     }
@@ -158,6 +160,8 @@ int pk_homog_rve_build(const pk_box *b, const pk_particles *p, pk_homog_bc bc,
                                   : build_unfolded(b, p, radius_factor, rve, err, errlen);
     if (rc != 0)
         return -1;
+    for (size_t i = 0; i < rve->n; i++)
+        rve->species[i] = p->species ? p->species[rve->grain[i]] : 0;
     rve->dim = b->dim;
     rve->bc = bc;
     rve->V = pk_box_measure(b);

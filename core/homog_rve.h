@@ -37,6 +37,7 @@ typedef struct pk_homog_rve {
     double *X;          /* [n][3] reference centres */
     double *r;          /* [n] radii (after any inflation) */
     int32_t *grain;     /* [n] index of the source grain */
+    int32_t *species;   /* [n] species (size class) of the source grain: selects E_n,ij */
     uint8_t *fixed;     /* [n] 1 = position prescribed, x = F̄X */
     uint8_t *hull;      /* [n] 1 = in the boundary set 𝓑 */
     int periodic;       /* contacts by minimum image across L */

@@ -34,7 +34,7 @@ int pk_homog_assemble_K(const pk_dem_pairs *c, int dim, double E, const int32_t 
         if ((skip && (skip[i] || skip[j])) || (dof[i] < 0 && dof[j] < 0))
             continue;
         double H[9];
-        pk_homog_pair_hessian(E, c->len[p], c->eps[p], &c->l[3 * p], H);
+        pk_homog_pair_hessian(pk_dem_pair_E(c, p, E), c->len[p], c->eps[p], &c->l[3 * p], H);
         if (pk_homog_add_pair_K(K, dim, dof[i], dof[j], H) != 0)
             return -1;
     }

@@ -25,6 +25,7 @@ int pk_homog_tangent(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_h
     if (!(pk_dem_geom_set_F(&g, s->F) > 0))
         return -1;
     pk_dem_pairs c = {0};
+    pk_homog_pairs_setup(&c, rve, o);
     int rc = pk_dem_pairs_build(&c, &g, s->x, rve->r, n, o->dr.skin);
     if (rc != 0)
         return rc;
@@ -67,7 +68,7 @@ int pk_homog_tangent(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_h
         info->jammed_contacts++;
         const double *l = &c.l[3 * p];
         double H[9], q[3], G[3];
-        pk_homog_pair_hessian(E, c.len[p], c.eps[p], l, H);
+        pk_homog_pair_hessian(pk_dem_pair_E(&c, p, E), c.len[p], c.eps[p], l, H);
         /* G = F⁻¹(l − x_j[free] + x_i[free]) */
         for (int a = 0; a < 3; a++)
             q[a] = l[a] - (is_free[j] ? s->x[3 * j + a] : 0) + (is_free[i] ? s->x[3 * i + a] : 0);

@@ -40,6 +40,17 @@ void pk_sparse_sym_free(pk_sparse_sym *A)
     memset(A, 0, sizeof *A);
 }
 
+void pk_sparse_sym_mv(const pk_sparse_sym *A, const double *x, double *y)
+{
+    memset(y, 0, A->n * sizeof *y);
+    for (size_t k = 0; k < A->nnz; k++) {
+        int32_t r = A->row[k], c = A->col[k];
+        y[r] += A->val[k] * x[c];
+        if (r != c)
+            y[c] += A->val[k] * x[r];
+    }
+}
+
 const char *pk_sparse_status_name(pk_sparse_status s)
 {
     switch (s) {

@@ -18,6 +18,8 @@ typedef struct pk_sparse_sym {
 
 int pk_sparse_sym_add(pk_sparse_sym *A, int32_t r, int32_t c, double v); /* 0 / -1 */
 void pk_sparse_sym_free(pk_sparse_sym *A);
+/* y = A x (A symmetric, stored as its upper triangle). */
+void pk_sparse_sym_mv(const pk_sparse_sym *A, const double *x, double *y);
 
 typedef enum pk_sparse_status {
     PK_SPARSE_OK = 0,          /* positive definite */

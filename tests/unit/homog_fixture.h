@@ -12,7 +12,7 @@
 #include "homog_tensor.h"
 #include "rng.h"
 
-static pk_homog_opts opts(double rmean)
+static inline pk_homog_opts opts(double rmean)
 {
     pk_homog_opts o = {.E_n = 1.0, .affine_predictor = 1};
     o.dr.tol = 1e-12;
@@ -24,7 +24,7 @@ static pk_homog_opts opts(double rmean)
     return o;
 }
 
-static void diagF(double F[9], double a, double b, double c)
+static inline void diagF(double F[9], double a, double b, double c)
 {
     memset(F, 0, 9 * sizeof *F);
     F[0] = a, F[4] = b, F[8] = c;
@@ -32,7 +32,7 @@ static void diagF(double F[9], double a, double b, double c)
 
 /* Jammed periodic packing: n grains, radii in [0.8, 1.2], overlapping at
  * φ_nominal, relaxed to equilibrium (DR tol 1e-12). */
-static void make_jammed(int dim, size_t n, double phi, uint64_t seed, pk_box *b, pk_particles *p)
+static inline void make_jammed(int dim, size_t n, double phi, uint64_t seed, pk_box *b, pk_particles *p)
 {
     pk_rng rng;
     pk_rng_seed(&rng, seed, 0);
@@ -84,12 +84,13 @@ typedef struct fixture {
     pk_homog_step st;
 } fixture;
 
-static void fixture_make(fixture *fx, const pk_box *b, const pk_particles *p, pk_homog_bc bc,
-                         const double F0[9])
+/* Committed state after F0 with options o (e.g. a species stiffness). */
+static inline void fixture_make_opts(fixture *fx, const pk_box *b, const pk_particles *p, pk_homog_bc bc,
+                              const double F0[9], const pk_homog_opts *o)
 {
     char err[128];
     CHECK(pk_homog_rve_build(b, p, bc, 1.0, &fx->rve, err, sizeof err) == 0);
-    fx->o = opts(1.0);
+    fx->o = *o;
     pk_homog_state s0;
     memset(&fx->s, 0, sizeof fx->s);
     pk_homog_state_init(&fx->rve, &fx->o, &s0);
@@ -98,7 +99,14 @@ static void fixture_make(fixture *fx, const pk_box *b, const pk_particles *p, pk
     pk_homog_state_free(&s0);
 }
 
-static void fixture_free(fixture *fx)
+static inline void fixture_make(fixture *fx, const pk_box *b, const pk_particles *p, pk_homog_bc bc,
+                         const double F0[9])
+{
+    pk_homog_opts o = opts(1.0);
+    fixture_make_opts(fx, b, p, bc, F0, &o);
+}
+
+static inline void fixture_free(fixture *fx)
 {
     pk_homog_rve_free(&fx->rve);
     pk_homog_state_free(&fx->s);
