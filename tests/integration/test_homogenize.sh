@@ -125,6 +125,28 @@ JOB
 rc=$?
 check refuse_periodic_on_walled_box sh -c "test $rc -ne 0 && grep -q 'periodic on every axis' perwall.err"
 
+# 5b. pair-specific stiffness by species: a matrix of E_n everywhere is the uniform model exactly;
+#     a matrix that misses a species of the RVE is refused at run time, naming the field
+python3 -c "
+import json; j = json.load(open('$EX/homogenize-periodic-2d.json'))
+j['inputs']['load'] = {'type': 'uniaxial_compression', 'axis': 1, 'strain': 0.004, 'steps': 2}
+E = j['inputs'].setdefault('contact', {}).setdefault('E_n', 1)
+json.dump(j, open('uni.json', 'w'))
+j['inputs']['contact']['E_n_species'] = [[E] * 3 for _ in range(3)]
+json.dump(j, open('uni_sp.json', 'w'))
+j['inputs']['contact']['E_n_species'] = [[E] * 2 for _ in range(2)]
+json.dump(j, open('small_sp.json', 'w'))"
+"$PACKD" run uni.json -o uni.h5 >/dev/null 2>&1
+"$PACKD" run uni_sp.json -o uni_sp.h5 >/dev/null 2>uni_sp.err
+"$PACKD" inspect uni.h5 >uni.insp 2>/dev/null
+"$PACKD" inspect uni_sp.h5 >uni_sp.insp 2>/dev/null
+check species_matrix_uniform_is_exact python3 -c "
+import json; a = json.load(open('uni.insp'))['observables']; b = json.load(open('uni_sp.insp'))['observables']
+assert a['homogenize/P/11'] == b['homogenize/P/11'] and a['homogenize/P/22'] == b['homogenize/P/22'], (a['homogenize/P/11'], b['homogenize/P/11'])"
+"$PACKD" run small_sp.json -o small_sp.h5 >/dev/null 2>small_sp.err
+rc=$?
+check refuse_species_outside_matrix sh -c "test $rc -ne 0 && grep -q '/contact/E_n_species' small_sp.err && ! test -e small_sp.h5"
+
 # 6. friction (ch. 7) through the process, Taylor (the thesis' setting): ρ = h = 0 gives the
 #    frictionless stresses exactly; ρ = 30° with h = E records dissipation >= 0 and a non-zero
 #    tangential energy; friction + tangent is refused with the pointer
