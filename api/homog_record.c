@@ -47,7 +47,8 @@ static const char *const scalar_series[] = {
     "J", "energy", "energy_density", "contacts", "contacts_formed", "contacts_broken",
     "coordination", "rattlers", "max_overlap_ratio", "sum_force", "reaction_defect",
     "energy_tangential", "dissipation", "contacts_sliding", NULL};
-static const char *const dr_series[] = {"newton_iterations", "newton_exit_code", "iterations",
+static const char *const dr_series[] = {"newton_iterations", "newton_steps", "newton_exit_code",
+                                        "iterations",
                                         "residual", "residual_initial", "stop_code",
                                         "dt", "gamma", "lambda_min", "lambda_max",
                                         "lambda_min_clamped", NULL};
@@ -69,7 +70,7 @@ json_t *pk_homog_record_new(int dim, int with_tangent)
                                     "4 cancelled, 5 wall_time"));
     json_object_set_new(dr, "newton_exit_names",
                         json_string("-1 not used, 0 converged, 1 block_not_positive_definite, "
-                                    "2 trust_region_collapsed, 3 iteration_cap, 4 stalled"));
+                                    "2 line_search_failed, 3 iteration_cap, 4 stalled"));
     json_object_set_new(r, "dr", dr);
     if (with_tangent) {
         json_t *t = json_object();
@@ -134,6 +135,7 @@ int pk_homog_record_step(json_t *rec, int dim, const pk_homog_step *st)
     rc |= put(rec, "reaction_defect", json_real(st->reaction_defect));
     json_t *dr = json_object_get(rec, "dr");
     rc |= put(dr, "newton_iterations", json_integer((json_int_t)st->newton.iterations));
+    rc |= put(dr, "newton_steps", json_integer((json_int_t)st->newton.steps));
     rc |= put(dr, "newton_exit_code", json_integer(st->used_newton ? (json_int_t)st->newton.exit : -1));
     rc |= put(dr, "iterations", json_integer((json_int_t)st->dr.iterations));
     rc |= put(dr, "residual", json_real(st->dr.f));

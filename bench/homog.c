@@ -49,6 +49,7 @@ static pk_homog_opts opts(double tol)
  * Relaxation by Newton (DR when it stalls); time reported as 'jam'.  A tiled
  * small packing is no substitute: stable in its own cell, it is a saddle
  * for the long-wavelength modes of the big one. */
+#define DENSE_PHI 0.90
 static void make_rve(size_t n, int near_jamming, pk_homog_rve *rve, pk_homog_state *relaxed)
 {
     pk_rng rng;
@@ -61,14 +62,14 @@ static void make_rve(size_t n, int near_jamming, pk_homog_rve *rve, pk_homog_sta
         r[i] = pk_rng_range(&rng, 0.8, 1.2);
         meas += M_PI * r[i] * r[i];
     }
-    double L = sqrt(meas / (near_jamming ? 0.80 : 0.86));
+    double L = sqrt(meas / (near_jamming ? 0.80 : DENSE_PHI));
     pk_box b = {.dim = 2, .L = {L, L, 0}, .periodic = {true, true, false}};
     for (size_t i = 0; i < n; i++) {
         double x[3] = {pk_rng_range(&rng, 0, L), pk_rng_range(&rng, 0, L), 0};
         pk_particles_push(&p, x, r[i], 0);
     }
     free(r);
-    double tpack = 0, phi_pack = 0.86;
+    double tpack = 0, phi_pack = DENSE_PHI;
     if (near_jamming) {
         pk_edmd_params ep;
         pk_edmd_params_default(&ep);
@@ -95,8 +96,9 @@ static void make_rve(size_t n, int near_jamming, pk_homog_rve *rve, pk_homog_sta
     double t0 = pk_wall_seconds();
     pk_homog_eval(rve, &o, &s0, F, relaxed, &st, NULL);
     printf("bench=homog case=jam_2d rve=%s n=%zu phi_packed=%.4f edmd_seconds=%.3f "
-           "newton_iterations=%zu dr_iterations=%zu seconds=%.3f exit=%s stop=%s\n",
+           "factorisations=%zu qn_steps=%zu dr_iterations=%zu seconds=%.3f exit=%s stop=%s\n",
            near_jamming ? "near_jamming" : "dense", n, phi_pack, tpack, st.newton.iterations,
+           st.newton.steps,
            st.dr.iterations, pk_wall_seconds() - t0, pk_newton_exit_name(st.newton.exit),
            pk_dr_stop_name(st.dr.stop));
     pk_homog_state_free(&s0);
@@ -137,9 +139,10 @@ static double step_case(size_t n, int near_jamming)
                kind, n, sd.dr.iterations, tdr, rate, pk_dr_stop_name(sd.dr.stop), sd.contacts,
                sd.rattlers, d / Pn);
     }
-    printf("bench=homog case=periodic_step_newton_2d rve=%s n=%zu newton_iterations=%zu dr_iterations=%zu "
+    printf("bench=homog case=periodic_step_newton_2d rve=%s n=%zu factorisations=%zu qn_steps=%zu "
+           "dr_iterations=%zu "
            "seconds=%.3f exit=%s stop=%s contacts=%zu rattlers=%zu speedup_vs_dr=%.2f\n",
-           kind, n, sn.newton.iterations, sn.dr.iterations, tnw, pk_newton_exit_name(sn.newton.exit),
+           kind, n, sn.newton.iterations, sn.newton.steps, sn.dr.iterations, tnw, pk_newton_exit_name(sn.newton.exit),
            pk_dr_stop_name(sn.dr.stop), sn.contacts, sn.rattlers, tdr > 0 ? tdr / tnw : -1);
     double A[81];
     pk_tangent_info ti;

@@ -14,22 +14,28 @@
 /* Levenberg–Marquardt shifts (× E) tried on an indefinite block. */
 #define MIN_SHIFT 1e-6
 #define MAX_SHIFT 1e2
-/* Accept a step when it achieves this share of the predicted decrease. */
-#define ACCEPT_RATIO 1e-4
+/* Armijo: accept a step achieving this share of the linear decrease. */
+#define ARMIJO 1e-4
 /* Below this relative size the energy difference is round-off: judge the
  * step by the residual instead (near convergence f·Δx ~ |f|²/λ is ~1e-18 Φ). */
 #define ENERGY_ROUNDOFF 1e-11
-/* Accepted steps without halving the residual before giving up to DR. */
-#define STALL_STEPS 8
-/* Trust-region shrinks per Newton step before the region is declared collapsed. */
-#define MAX_SHRINKS 40
+/* Factorisations without halving the residual before giving up to DR. */
+#define STALL_FACTORS 6
+/* Quasi-Newton steps per factorisation: at most, and the window within which
+ * the residual must halve before the preconditioner is refreshed. */
+#define MAX_INNER 60
+#define REFRESH_WINDOW 12
+/* Line-search halvings before the direction is given up. */
+#define MAX_CUTS 30
+/* L-BFGS memory (pairs). */
+#define MEMORY 8
 
 const char *pk_newton_exit_name(pk_newton_exit e)
 {
     switch (e) {
     case PK_NEWTON_CONVERGED: return "converged";
     case PK_NEWTON_BLOCK_NOT_PD: return "block_not_positive_definite";
-    case PK_NEWTON_TRUST_REGION: return "trust_region_collapsed";
+    case PK_NEWTON_LINE_SEARCH: return "line_search_failed";
     case PK_NEWTON_CAP: return "iteration_cap";
     case PK_NEWTON_STALLED: return "stalled";
     }
@@ -107,62 +113,93 @@ static int assemble(const pk_dem_pairs *c, int dim, double E, const int32_t *dof
     return 0;
 }
 
-/* Dogleg point of the trust region |p| <= radius (Nocedal & Wright §4.1)
- * between the Cauchy point pc = (f·f / f·Kf) f and the Newton point pn. */
-static void dogleg(const double *f, const double *Kf, const double *pn, size_t n, double radius,
-                   double *p)
+/* L-BFGS memory in DOF space: ring of (s, y, 1/s·y). */
+typedef struct qn_memory {
+    size_t nd, count, head;
+    double *s, *y, rho[MEMORY], alpha[MEMORY];
+} qn_memory;
+
+static void qn_push(qn_memory *q, const double *sv, const double *yv)
 {
-    double nn = sqrt(dot(pn, pn, n));
-    if (nn <= radius) {
-        memcpy(p, pn, n * sizeof *p);
-        return;
+    double sy = dot(sv, yv, q->nd);
+    if (!(sy > 1e-14 * sqrt(dot(sv, sv, q->nd) * dot(yv, yv, q->nd))))
+        return; /* curvature condition fails (non-convex region): skip the pair */
+    memcpy(&q->s[q->head * q->nd], sv, q->nd * sizeof *sv);
+    memcpy(&q->y[q->head * q->nd], yv, q->nd * sizeof *yv);
+    q->rho[q->head] = 1 / sy;
+    q->head = (q->head + 1) % MEMORY;
+    if (q->count < MEMORY)
+        q->count++;
+}
+
+/* d = −H g by the two-loop recursion with H₀ = M⁻¹ (Nocedal & Wright Alg.
+ * 7.4): M the factorised stiffness, so the first step is Newton's. */
+static int qn_direction(qn_memory *q, const pk_sparse_solver *solver, pk_sparse_factor *fac,
+                        const double *gv, double *qv, double *d)
+{
+    size_t nd = q->nd;
+    memcpy(qv, gv, nd * sizeof *qv);
+    for (size_t k = 0; k < q->count; k++) {
+        size_t i = (q->head + MEMORY - 1 - k) % MEMORY;
+        q->alpha[i] = q->rho[i] * dot(&q->s[i * nd], qv, nd);
+        for (size_t e = 0; e < nd; e++)
+            qv[e] -= q->alpha[i] * q->y[i * nd + e];
     }
-    double ff = dot(f, f, n), fKf = dot(f, Kf, n);
-    double tc = fKf > 0 ? ff / fKf : INFINITY;
-    double nc = tc * sqrt(ff);
-    if (nc >= radius) {
-        double s = radius / sqrt(ff);
-        for (size_t k = 0; k < n; k++)
-            p[k] = s * f[k];
-        return;
+    if (solver->solve(fac, 1, qv, d) != 0)
+        return -1;
+    for (size_t k = q->count; k-- > 0;) {
+        size_t i = (q->head + MEMORY - 1 - k) % MEMORY;
+        double beta = q->rho[i] * dot(&q->y[i * nd], d, nd);
+        for (size_t e = 0; e < nd; e++)
+            d[e] += q->s[i * nd + e] * (q->alpha[i] - beta);
     }
-    /* |pc + τ(pn − pc)| = radius, τ in [0, 1] */
-    double a = 0, b = 0, cc = nc * nc - radius * radius;
-    for (size_t k = 0; k < n; k++) {
-        double d = pn[k] - tc * f[k];
-        a += d * d;
-        b += 2 * tc * f[k] * d;
-    }
-    double tau = a > 0 ? (-b + sqrt(fmax(0, b * b - 4 * a * cc))) / (2 * a) : 0;
-    for (size_t k = 0; k < n; k++)
-        p[k] = tc * f[k] + tau * (pn[k] - tc * f[k]);
+    for (size_t e = 0; e < nd; e++)
+        d[e] = -d[e];
+    return 0;
 }
 
 typedef struct newton_work {
-    double *x0, *f, *ft, *xt, *rhs, *pn, *p, *Kf, *Kp;
+    double *x0, *f, *ft, *xt, *g, *gt, *d, *qv, *sv, *yv;
+    qn_memory mem;
     uint8_t *rat;
     int32_t *dof;
     pk_sparse_sym K;
 } newton_work;
 
-static int work_alloc(newton_work *w, size_t np)
+static int work_alloc(newton_work *w, size_t np, int dim)
 {
-    size_t n3 = 3 * (np ? np : 1), n1 = np ? np : 1;
+    size_t n3 = 3 * (np ? np : 1), n1 = np ? np : 1, nd = (size_t)dim * n1;
     memset(w, 0, sizeof *w);
-    double **v[] = {&w->x0, &w->f, &w->ft, &w->xt, &w->rhs, &w->pn, &w->p, &w->Kf, &w->Kp};
-    for (size_t k = 0; k < sizeof v / sizeof *v; k++)
-        if (!(*v[k] = malloc(n3 * sizeof **v[k])))
+    double **v3[] = {&w->x0, &w->f, &w->ft, &w->xt};
+    double **vd[] = {&w->g, &w->gt, &w->d, &w->qv, &w->sv, &w->yv};
+    for (size_t k = 0; k < sizeof v3 / sizeof *v3; k++)
+        if (!(*v3[k] = malloc(n3 * sizeof **v3[k])))
             return -1;
+    for (size_t k = 0; k < sizeof vd / sizeof *vd; k++)
+        if (!(*vd[k] = malloc(nd * sizeof **vd[k])))
+            return -1;
+    w->mem.s = malloc(MEMORY * nd * sizeof *w->mem.s);
+    w->mem.y = malloc(MEMORY * nd * sizeof *w->mem.y);
     w->rat = malloc(n1);
     w->dof = malloc(n1 * sizeof *w->dof);
-    return w->rat && w->dof ? 0 : -1;
+    return w->mem.s && w->mem.y && w->rat && w->dof ? 0 : -1;
 }
 
 static void work_free(newton_work *w)
 {
-    free(w->x0), free(w->f), free(w->ft), free(w->xt), free(w->rhs), free(w->pn), free(w->p), free(w->Kf),
-        free(w->Kp), free(w->rat), free(w->dof);
+    free(w->x0), free(w->f), free(w->ft), free(w->xt), free(w->g), free(w->gt), free(w->d),
+        free(w->qv), free(w->sv), free(w->yv), free(w->mem.s), free(w->mem.y), free(w->rat),
+        free(w->dof);
     pk_sparse_sym_free(&w->K);
+}
+
+/* g = −f on the DOFs (the gradient of Φ_n). */
+static void gather_gradient(const double *f, const int32_t *dof, size_t np, int dim, double *gv)
+{
+    for (size_t i = 0; i < np; i++)
+        if (dof[i] >= 0)
+            for (int a = 0; a < dim; a++)
+                gv[dof[i] + a] = -f[3 * i + a];
 }
 
 int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
@@ -177,7 +214,7 @@ int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doub
     if (rc != 0)
         return rc;
     newton_work w;
-    if (work_alloc(&w, np) != 0) {
+    if (work_alloc(&w, np, dim) != 0) {
         rc = -1;
         goto out;
     }
@@ -186,21 +223,22 @@ int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doub
     pk_dem_eval(c, g, x, r, np, E, w.f, &phi, NULL);
     double f0 = norm_on(w.f, is_free, np, dim), fn = f0;
     double target = fmax(prm->tol * f0, prm->abs_floor);
-    double radius = -1, best = fn;
+    double best = fn;
     size_t best_it = 0;
-    double mu = 0; /* Levenberg–Marquardt shift, kept (decaying) across steps */
+    double mu = 0; /* Levenberg–Marquardt shift, kept (decaying) across factorisations */
+    size_t nd = 0;
+    for (size_t i = 0; i < np; i++)
+        w.dof[i] = is_free[i] ? (int32_t)(dim * nd++) : -1;
+    nd *= (size_t)dim;
+    w.mem.nd = nd;
     ns->exit = PK_NEWTON_CAP;
-    for (;;) {
-        if (fn <= target) {
-            ns->exit = PK_NEWTON_CONVERGED;
-            break;
-        }
+    while (fn > target) {
         if (ns->iterations >= max_newton)
             break;
         if (fn < 0.5 * best) {
             best = fn;
             best_it = ns->iterations;
-        } else if (ns->iterations >= best_it + STALL_STEPS) {
+        } else if (ns->iterations >= best_it + STALL_FACTORS) {
             ns->exit = PK_NEWTON_STALLED;
             break;
         }
@@ -208,10 +246,6 @@ int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doub
             rc = -1;
             goto out;
         }
-        size_t nd = 0;
-        for (size_t i = 0; i < np; i++)
-            w.dof[i] = is_free[i] ? (int32_t)(dim * nd++) : -1;
-        nd *= (size_t)dim;
         w.K.nnz = 0;
         w.K.n = nd;
         if (assemble(c, dim, E, w.dof, w.rat, mu, np, &w.K) != 0) {
@@ -234,79 +268,103 @@ int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doub
             ns->exit = PK_NEWTON_BLOCK_NOT_PD;
             break;
         }
-        for (size_t i = 0; i < np; i++)
-            if (w.dof[i] >= 0)
-                for (int a = 0; a < dim; a++)
-                    w.rhs[w.dof[i] + a] = w.f[3 * i + a];
-        int srv = solver->solve(fac, 1, w.rhs, w.pn);
-        solver->release(fac);
-        if (srv != 0) {
-            rc = -1;
-            goto out;
-        }
-        pk_sparse_sym_mv(&w.K, w.rhs, w.Kf);
-        /* Newton first: a trial costs one evaluation, a factorisation ~30 */
-        radius = fmax(radius, sqrt(dot(w.pn, w.pn, nd)));
-        /* Trust region on the potential Φ_n: the contact set changes inside
-         * the Newton step of a packing near jamming (soft modes give steps of
-         * a fraction of a radius for a 1e-3 strain), so the quadratic model
-         * is trusted only as far as it predicted the energy well. */
-        int accepted = 0;
-        double phit = phi, ftn = fn;
-        for (int shrink = 0; shrink < MAX_SHRINKS && !accepted; shrink++) {
-            dogleg(w.rhs, w.Kf, w.pn, nd, radius, w.p);
-            pk_sparse_sym_mv(&w.K, w.p, w.Kp);
-            double plen = sqrt(dot(w.p, w.p, nd));
-            double pred = dot(w.rhs, w.p, nd) - 0.5 * dot(w.p, w.Kp, nd);
-            memcpy(w.xt, x, 3 * np * sizeof *x);
-            for (size_t i = 0; i < np; i++)
-                if (w.dof[i] >= 0)
-                    for (int a = 0; a < dim; a++)
-                        w.xt[3 * i + a] += w.p[w.dof[i] + a];
-            rc = eval_at(c, g, w.xt, r, np, E, prm, w.ft, &phit);
-            if (rc != 0)
-                goto out;
-            ftn = norm_on(w.ft, is_free, np, dim);
-            double rho;
-            if (pred <= ENERGY_ROUNDOFF * fabs(phi))
-                rho = ftn < fn ? 1 : 0; /* energy change lost in round-off */
-            else
-                rho = (phi - phit) / pred;
-            if (rho < 0.25)
-                radius = 0.25 * plen;
-            else if (rho > 0.75 && plen >= 0.99 * radius)
-                radius *= 2;
-            if (rho > ACCEPT_RATIO)
-                accepted = 1;
-            else
-                ns->cuts++;
-        }
         ns->iterations++;
         mu = mu > 10 * MIN_SHIFT * E ? 0.1 * mu : 0;
-        if (!accepted) {
-            rc = eval_at(c, g, x, r, np, E, prm, w.f, &phi); /* back to the last point */
-            if (rc != 0)
-                goto out;
-            ns->exit = PK_NEWTON_TRUST_REGION;
-            break;
-        }
-        memcpy(x, w.xt, 3 * np * sizeof *x);
-        memcpy(w.f, w.ft, 3 * np * sizeof *w.f);
-        phi = phit;
-        fn = ftn;
-        if (mon) {
-            pk_progress pr = {.stage = "newton", .fraction = -1, .phi = -1, .eta_s = -1,
-                              .done = ns->iterations};
-            int t = pk_monitor_tick(mon, &pr, 0);
-            if (t) {
-                st->stop = t == 1 ? PK_DR_CANCELLED : PK_DR_WALL_TIME;
-                st->f0 = f0;
-                st->f = fn;
+        /* Quasi-Newton steps preconditioned by this factor: exact Newton first,
+         * then L-BFGS corrections as contacts open and close, until the
+         * residual stops halving within the window (refresh the factor). */
+        w.mem.count = w.mem.head = 0;
+        gather_gradient(w.f, w.dof, np, dim, w.g);
+        double f_window = fn;
+        size_t window_start = 0;
+        int failed_first = 0;
+        for (size_t inner = 0; inner < MAX_INNER && fn > target; inner++) {
+            if (qn_direction(&w.mem, solver, fac, w.g, w.qv, w.d) != 0) {
+                solver->release(fac);
+                rc = -1;
                 goto out;
             }
+            double gd = dot(w.g, w.d, nd);
+            if (!(gd < 0)) { /* memory spoilt the direction: plain preconditioned step */
+                w.mem.count = w.mem.head = 0;
+                if (qn_direction(&w.mem, solver, fac, w.g, w.qv, w.d) != 0) {
+                    solver->release(fac);
+                    rc = -1;
+                    goto out;
+                }
+                gd = dot(w.g, w.d, nd);
+                if (!(gd < 0))
+                    break;
+            }
+            double s = 1, phit = phi, ftn = fn;
+            int ok = 0;
+            for (int cut = 0; cut < MAX_CUTS; cut++, s *= 0.5) {
+                memcpy(w.xt, x, 3 * np * sizeof *x);
+                for (size_t i = 0; i < np; i++)
+                    if (w.dof[i] >= 0)
+                        for (int a = 0; a < dim; a++)
+                            w.xt[3 * i + a] += s * w.d[w.dof[i] + a];
+                rc = eval_at(c, g, w.xt, r, np, E, prm, w.ft, &phit);
+                if (rc != 0) {
+                    solver->release(fac);
+                    goto out;
+                }
+                ftn = norm_on(w.ft, is_free, np, dim);
+                double lin = -s * gd; /* predicted decrease to first order */
+                if (lin <= ENERGY_ROUNDOFF * fabs(phi))
+                    ok = ftn < fn; /* energy change lost in round-off */
+                else
+                    ok = phit <= phi - ARMIJO * lin;
+                if (ok)
+                    break;
+                ns->cuts++;
+            }
+            if (!ok) {
+                failed_first = inner == 0;
+                break;
+            }
+            gather_gradient(w.ft, w.dof, np, dim, w.gt);
+            for (size_t e = 0; e < nd; e++) {
+                w.sv[e] = s * w.d[e];
+                w.yv[e] = w.gt[e] - w.g[e];
+            }
+            qn_push(&w.mem, w.sv, w.yv);
+            memcpy(w.g, w.gt, nd * sizeof *w.g);
+            memcpy(x, w.xt, 3 * np * sizeof *x);
+            memcpy(w.f, w.ft, 3 * np * sizeof *w.f);
+            phi = phit;
+            fn = ftn;
+            ns->steps++;
+            if (fn < 0.5 * f_window) {
+                f_window = fn;
+                window_start = inner;
+            } else if (inner >= window_start + REFRESH_WINDOW) {
+                break;
+            }
+            if (mon) {
+                pk_progress pr = {.stage = "newton", .fraction = -1, .phi = -1, .eta_s = -1,
+                                  .done = ns->steps};
+                int t = pk_monitor_tick(mon, &pr, 0);
+                if (t) {
+                    solver->release(fac);
+                    st->stop = t == 1 ? PK_DR_CANCELLED : PK_DR_WALL_TIME;
+                    st->f0 = f0;
+                    st->f = fn;
+                    goto out;
+                }
+            }
+        }
+        solver->release(fac);
+        rc = eval_at(c, g, x, r, np, E, prm, w.f, &phi); /* contacts of the current point */
+        if (rc != 0)
+            goto out;
+        if (failed_first) {
+            ns->exit = PK_NEWTON_LINE_SEARCH;
+            break;
         }
     }
-    if (ns->exit == PK_NEWTON_CONVERGED) {
+    if (fn <= target) {
+        ns->exit = PK_NEWTON_CONVERGED;
         st->stop = fn <= prm->tol * f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
         st->f0 = f0;
         st->f = fn;
