@@ -2,7 +2,9 @@
  *   bench=rsa case=NAME n=N placed=N seconds=S rate=PLACEMENTS_PER_S draws_per_grain=X
  * and a final line with the rate ratio 1e6/1e4 (flat = the placer scales).
  * The monodisperse cases without suffix take the default path (batched runs of
- * equal grains, rsa_batch.h: the packing of plain draws, bit for bit); *_plain
+ * equal grains, rsa_batch.h, drawing from the open region once most draws
+ * fail, rsa_region.h); *_batch_plain the batched path with plain draws all
+ * along (batch_plain_draws: the packing of plain draws, bit for bit); *_plain
  * runs the reference (one uniform draw at a time, pk_rsa_params.plain_draws)
  * and *_voxels the per-grain voxel-pruned path (no_batch) for the ratios;
  * 1e6 plain and voxels are left out (a minute / 20 s). */
@@ -15,7 +17,7 @@
 #include "process.h"
 #include "rsa.h"
 
-enum path { PLAIN, VOXELS, BATCHED };
+enum path { PLAIN, VOXELS, BATCH_PLAIN, BATCHED };
 
 static double mono(const char *name, int dim, size_t n, double phi, enum path path)
 {
@@ -30,7 +32,8 @@ static double mono(const char *name, int dim, size_t n, double phi, enum path pa
     pk_particles p;
     pk_particles_init(&p, dim, n);
     pk_rsa_params prm = {.delta_d = 0, .max_failed_draws = 1000000, .seed = 1,
-                         .plain_draws = path == PLAIN, .no_batch = path == VOXELS};
+                         .plain_draws = path == PLAIN, .no_batch = path == VOXELS,
+                         .batch_plain_draws = path == BATCH_PLAIN};
     pk_rsa_stats st;
     pk_rsa_place(&b, d, sp, n, &prm, NULL, &p, &st);
     double rate = (double)st.placed / st.seconds;
@@ -83,12 +86,16 @@ int main(int argc, char **argv)
     double p5 = mono("mono3d_phi030_1e5_plain", 3, 100000, 0.30, PLAIN);
     double v4 = mono("mono3d_phi030_1e4_voxels", 3, 10000, 0.30, VOXELS);
     double v5 = mono("mono3d_phi030_1e5_voxels", 3, 100000, 0.30, VOXELS);
+    double b5 = mono("mono3d_phi030_1e5_batch_plain", 3, 100000, 0.30, BATCH_PLAIN);
+    double b6 = mono("mono3d_phi030_1e6_batch_plain", 3, 1000000, 0.30, BATCH_PLAIN);
     double r4 = mono("mono3d_phi030_1e4", 3, 10000, 0.30, BATCHED);
     double r5 = mono("mono3d_phi030_1e5", 3, 100000, 0.30, BATCHED);
     double r6 = mono("mono3d_phi030_1e6", 3, 1000000, 0.30, BATCHED);
     printf("bench=rsa case=speedup rate_ratio_batched_over_plain_1e4=%.3f "
            "rate_ratio_batched_over_plain_1e5=%.3f rate_ratio_batched_over_voxels_1e4=%.3f "
            "rate_ratio_batched_over_voxels_1e5=%.3f\n", r4 / p4, r5 / p5, r4 / v4, r5 / v5);
+    printf("bench=rsa case=region rate_ratio_over_batch_plain_1e5=%.3f "
+           "rate_ratio_over_batch_plain_1e6=%.3f\n", r5 / b5, r6 / b6);
     printf("bench=rsa case=scaling rate_ratio_1e6_over_1e4=%.3f rate_ratio_1e5_over_1e4=%.3f\n",
            r6 / r4, r5 / r4);
     return 0;

@@ -9,8 +9,9 @@
  * from the voxels not yet covered (rsa_voxels.h) and none is left, the box is
  * provably full for the next grain: the run stops as PK_STOP_SATURATED.
  * Long runs of equal diameters (monodisperse jobs, discrete size classes) are
- * placed in batches of attempts (rsa_batch.h): the same packing as plain draws
- * one at a time, with cache-friendly tests. */
+ * placed in batches of attempts (rsa_batch.h) with cache-friendly tests; late
+ * in such a run the draws come from the space not yet known to be excluded
+ * (rsa_region.h). */
 #ifndef PK_RSA_H
 #define PK_RSA_H
 
@@ -48,6 +49,11 @@ typedef struct pk_rsa_params {
                                     time; 0 (default, with plain_draws = 0): runs of at
                                     least batch_min_run equal grains take the batched
                                     path (rsa_batch.h), bit-identical to plain draws */
+    int batch_plain_draws;       /* 1: the batched path draws as plain_draws does all
+                                    along (bit-identical to it: the tests' reference);
+                                    0 (default): once most draws fail, it draws from the
+                                    space not yet known excluded (rsa_region.h; same
+                                    statistics, fewer draws, another packing per seed) */
     uint32_t batch_attempts;     /* attempts per batch; 0 = adaptive (tests fix it) */
     uint32_t batch_min_run;      /* 0 = PK_RSA_BATCH_MIN_RUN */
 } pk_rsa_params;

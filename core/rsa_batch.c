@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "rsa_cells.h"
+#include "rsa_region.h"
 
 /* Batch size: enough attempts that the cell-ordered tests share cache lines
  * (B_MIN), few enough survivors that step 3's hash stays in cache
@@ -19,6 +20,22 @@
  * a huge box keep the per-grain path). */
 #define CELLS_PER_GRAIN 64
 #define CELLS_FREE 65536
+/* Draws come from the open region (rsa_region.h) once a batch accepted fewer
+ * than this fraction of its draws and at least REGION_MIN_LEFT grains remain:
+ * from there on plain draws are mostly wasted (φ ≈ 0.2 of 0.3 for equal
+ * spheres), marking exclusion balls pays. */
+#define REGION_SWITCH_ACC 0.2
+#define REGION_MIN_LEFT 256
+/* Region cells per store cell and axis: edge ≈ c/2, fine voxels ≈ c/8 in 3D
+ * (c/16 in 2D).  Halving the edge again (or 16 steps of the mark table) saved
+ * fewer draws than the marks cost more (callgrind, 3D φ = 0.30).  At most
+ * REGION_CELLS_PER_GRAIN region cells per grain of the run (12 bytes each). */
+#define REGION_SPLIT 2
+#define REGION_CELLS_PER_GRAIN 64
+/* Obstacles of other sizes (grains placed before the run) are marked only
+ * while their exclusion radius is at most this many contact distances (the
+ * cost grows with its square; unmarked obstacles only cost draws). */
+#define REGION_MAX_OBSTACLE 3.0
 
 int pk_rsa_batch_usable(const pk_box *b, double r, double gap, const double *lo,
                         const double *span, size_t m)
@@ -30,6 +47,11 @@ int pk_rsa_batch_usable(const pk_box *b, double r, double gap, const double *lo,
 typedef struct scratch {
     size_t cap;
     double *pos;        /* [cap][3] attempts in attempt order */
+    uint32_t *rpos;     /* region draws: list position, then cell, of each draw */
+    uint8_t *rbit;      /* its fine voxel, RBIT_CHEAP when rejected at once */
+    uint32_t *rsort;    /* draw numbers by list position */
+    uint32_t *ord;      /* [cap + 1] draw number of each attempt in its batch
+                           (region draws: certain rejections make no attempt) */
     uint32_t *key;      /* bucket of each attempt */
     double *spos;       /* [cap][3] attempts in bucket order */
     uint32_t *sidx;     /* attempt index of each sorted entry */
@@ -49,6 +71,10 @@ typedef struct scratch {
 static void scratch_free(scratch *w)
 {
     free(w->pos);
+    free(w->ord);
+    free(w->rpos);
+    free(w->rbit);
+    free(w->rsort);
     free(w->key);
     free(w->spos);
     free(w->sidx);
@@ -84,6 +110,10 @@ static int scratch_reserve(scratch *w, size_t B)
         hb <<= 1;
     int fail = 0;
     w->pos = grow(w->pos, 3 * B * sizeof *w->pos, &fail);
+    w->ord = grow(w->ord, (B + 1) * sizeof *w->ord, &fail);
+    w->rpos = grow(w->rpos, B * sizeof *w->rpos, &fail);
+    w->rbit = grow(w->rbit, B, &fail);
+    w->rsort = grow(w->rsort, B * sizeof *w->rsort, &fail);
     w->key = grow(w->key, B * sizeof *w->key, &fail);
     w->spos = grow(w->spos, 3 * B * sizeof *w->spos, &fail);
     w->sidx = grow(w->sidx, B * sizeof *w->sidx, &fail);
@@ -132,13 +162,48 @@ static int batch_hits(const pk_rsa_cells *C, const scratch *w, uint64_t hmask, c
     return 0;
 }
 
-/* Steps 1–2 for B attempts: draw, sort by cell bucket, filter against the
- * store.  Returns the number of survivors. */
+#define RBIT_CHEAP 0xff
+
+/* Region draws, step 1a: pick B (cell, fine voxel) pairs in draw order, then
+ * look their marks up in list order (a counting sort by list position: the
+ * list and the marks are read as streams, not at random — that is what keeps
+ * large runs fast), flagging the certain rejections.  w->rpos[d] becomes the
+ * cell of draw d. */
+static void region_pick(const pk_rsa_region *reg, scratch *w, size_t B, pk_rng *g)
+{
+    int sh = 0;
+    while (((reg->nlist - 1) >> sh) >= MAX_BUCKETS)
+        sh++;
+    const uint32_t nb = (uint32_t)((reg->nlist - 1) >> sh) + 1;
+    uint32_t *count = w->count;
+    memset(count, 0, (nb + 1) * sizeof *count);
+    for (size_t d = 0; d < B; d++) {
+        unsigned bit;
+        uint32_t q = pk_rsa_region_pick(reg, g, &bit);
+        w->rpos[d] = q;
+        w->rbit[d] = (uint8_t)bit;
+        count[(q >> sh) + 1]++;
+    }
+    for (uint32_t k = 0; k < nb; k++)
+        count[k + 1] += count[k];
+    for (size_t d = 0; d < B; d++)
+        w->rsort[count[w->rpos[d] >> sh]++] = (uint32_t)d;
+    for (size_t t = 0; t < B; t++) {
+        uint32_t d = w->rsort[t], cell = reg->list[w->rpos[d]];
+        w->rpos[d] = cell;
+        if (reg->covered[cell] >> w->rbit[d] & 1)
+            w->rbit[d] = RBIT_CHEAP;
+    }
+}
+
+/* Steps 1–2 for B draws: draw, sort by cell bucket, filter against the
+ * store.  Plain draws make B attempts; region draws (reg != NULL) skip the
+ * certain rejections: *A attempts, w->ord[a] the draw number of attempt a,
+ * w->ord[*A] = B.  Returns the number of survivors. */
 static size_t draw_and_filter(const pk_rsa_cells *C, scratch *w, size_t B, int dim,
                               const double *lo, const double *span, pk_rng *rng, int shift,
-                              uint32_t nbucket)
+                              uint32_t nbucket, const pk_rsa_region *reg, size_t *A)
 {
-    memset(w->count, 0, (nbucket + 1) * sizeof *w->count);
     const double lo0 = lo[0], lo1 = lo[1], lo2 = lo[2], sp0 = span[0], sp1 = span[1];
     const double sp2 = dim == 3 ? span[2] : 0;
     /* local copies: the stores below cannot alias them, so the generator state
@@ -146,37 +211,110 @@ static size_t draw_and_filter(const pk_rsa_cells *C, scratch *w, size_t B, int d
     pk_rng g = *rng;
     const pk_rsa_cells K = *C;
     double *restrict pos = w->pos;
-    uint32_t *restrict keys = w->key, *restrict count = w->count;
-    for (size_t a = 0; a < B; a++) {
-        /* rsa.c's plain draw: x[k] = lo[k] + span[k]·u, k = 0, 1 (, 2), z = 0 in 2D */
-        double x[3];
-        x[0] = lo0 + sp0 * pk_rng_uniform(&g);
-        x[1] = lo1 + sp1 * pk_rng_uniform(&g);
-        x[2] = dim == 3 ? lo2 + sp2 * pk_rng_uniform(&g) : 0;
-        memcpy(&pos[3 * a], x, sizeof x);
-        uint32_t key = pk_rsa_cells_key(&K, x);
-        keys[a] = key;
-        count[(pk_rsa_cells_index(key) >> shift) + 1]++;
+    uint32_t *restrict keys = w->key, *restrict ord = w->ord;
+    size_t a = 0;
+    if (reg) {
+        region_pick(reg, w, B, &g);
+        for (size_t d = 0; d < B; d++) {
+            double x[3];
+            if (w->rbit[d] == RBIT_CHEAP)
+                continue;
+            pk_rsa_region_point(reg, w->rpos[d], w->rbit[d], &g, x);
+            memcpy(&pos[3 * a], x, sizeof x);
+            uint32_t key = pk_rsa_cells_key(&K, x);
+            keys[a] = key;
+            ord[a++] = (uint32_t)d;
+        }
+        ord[a] = (uint32_t)B;
+    } else {
+        for (; a < B; a++) {
+            /* rsa.c's plain draw: x[k] = lo[k] + span[k]·u, k = 0, 1 (, 2), z = 0 in 2D */
+            double x[3];
+            x[0] = lo0 + sp0 * pk_rng_uniform(&g);
+            x[1] = lo1 + sp1 * pk_rng_uniform(&g);
+            x[2] = dim == 3 ? lo2 + sp2 * pk_rng_uniform(&g) : 0;
+            memcpy(&pos[3 * a], x, sizeof x);
+            uint32_t key = pk_rsa_cells_key(&K, x);
+            keys[a] = key;
+        }
     }
     *rng = g;
+    *A = a;
+    /* the counts of the cell buckets, after the draws (region_pick uses them too) */
+    memset(w->count, 0, (nbucket + 1) * sizeof *w->count);
+    for (size_t q = 0; q < a; q++)
+        w->count[(pk_rsa_cells_index(w->key[q]) >> shift) + 1]++;
+    B = a; /* from here on: attempts */
     for (uint32_t k = 0; k < nbucket; k++)
         w->count[k + 1] += w->count[k];
-    for (size_t a = 0; a < B; a++) {
-        uint32_t key = w->key[a];
+    for (size_t q = 0; q < B; q++) {
+        uint32_t key = w->key[q];
         uint32_t t = w->count[pk_rsa_cells_index(key) >> shift]++;
-        memcpy(&w->spos[3 * (size_t)t], &w->pos[3 * a], 3 * sizeof(double));
-        w->sidx[t] = (uint32_t)a;
+        memcpy(&w->spos[3 * (size_t)t], &w->pos[3 * q], 3 * sizeof(double));
+        w->sidx[t] = (uint32_t)q;
         w->skey[t] = key;
     }
     size_t S = pk_rsa_cells_filter(C, w->spos, w->skey, B, w->kept);
     memset(w->sbit, 0, (B / 64 + 1) * sizeof *w->sbit);
     for (size_t j = 0; j < S; j++) {
-        uint32_t t = w->kept[j], a = w->sidx[t];
+        uint32_t t = w->kept[j], q = w->sidx[t];
         memcpy(&w->surv[3 * j], &w->spos[3 * (size_t)t], 3 * sizeof(double));
-        w->slot[a] = (int32_t)j;
-        w->sbit[a >> 6] |= (uint64_t)1 << (a & 63);
+        w->slot[q] = (int32_t)j;
+        w->sbit[q >> 6] |= (uint64_t)1 << (q & 63);
     }
     return S;
+}
+
+/* Mark the exclusion balls of the grains placed so far (the run's with radius
+ * c, earlier obstacles with r + r_j + Δd when not too wide) and list the cells
+ * left open.  -1 when out of memory (the run then keeps plain draws).  Marks
+ * are optional for correctness: a cancel request cuts the marking short. */
+static int region_start(pk_rsa_region *reg, const pk_rsa_cells *C, const pk_box *b, double r,
+                        double gap, const double *lo, const double *span,
+                        const pk_particles *out, size_t first, size_t m, pk_monitor *mon,
+                        pk_progress *pg)
+{
+    const double c = 2 * r + gap;
+    uint64_t cells = 1;
+    for (int k = 0; k < b->dim; k++)
+        cells *= REGION_SPLIT * (uint64_t)C->n[k];
+    if (cells > REGION_CELLS_PER_GRAIN * (uint64_t)m + CELLS_FREE)
+        return -1; /* a sparse run: not worth the memory */
+    int64_t n[PK_MAXDIM];
+    for (int k = 0; k < PK_MAXDIM; k++)
+        n[k] = k < b->dim ? REGION_SPLIT * C->n[k] : 1;
+    if (pk_rsa_region_init(reg, b, n, lo, span, c) != 0)
+        return -1;
+    for (size_t j = 0; j < first; j++) { /* obstacles of other sizes */
+        double rad = r + out->r[j] + gap;
+        if (rad <= REGION_MAX_OBSTACLE * c)
+            pk_rsa_region_cover(reg, &out->x[3 * j], rad);
+        if ((j & 0xfff) == 0xfff && pk_monitor_tick(mon, pg, 0))
+            break;
+    }
+    /* the run's grains from the store, in cell order: neighbouring marks share
+     * cache lines (in placement order each mark would miss on large runs) */
+    for (int64_t z = 0; z < C->n[2]; z++)
+        for (int64_t y = 0; y < C->n[1] && !(mon && mon->cancelled); y++) {
+            pk_monitor_tick(mon, pg, 0);
+            const pk_rsa_cell2 *row =
+                &C->cell[C->base + (uint64_t)z * C->stride[2] + (uint64_t)y * C->stride[1]];
+            for (int64_t x = 0; x < C->n[0]; x++) {
+                const pk_rsa_cell2 *cl = &row[x];
+                for (int q = 0; q < cl->n && q < 2; q++)
+                    pk_rsa_region_mark(reg, cl->x[q]);
+                for (int32_t e = cl->more; e >= 0; e = C->extra[e].next)
+                    pk_rsa_region_mark(reg, C->extra[e].x);
+            }
+        }
+    pk_rsa_region_compact(reg);
+    return 0;
+}
+
+/* Draw number of attempt a (plain draws: every draw is an attempt). */
+static inline size_t draw_of(const scratch *w, int region, size_t a)
+{
+    return region ? w->ord[a] : a;
 }
 
 pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *species, size_t m,
@@ -198,12 +336,27 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
     for (int l = 0; l < grid->nlevel; l++)
         grid_empty &= grid->lv[l].count == 0;
     const double ball = pk_ball_measure(b->dim, r);
+    const size_t first = out->n;
+    pk_rsa_region reg;
+    memset(&reg, 0, sizeof reg);
+    int region = 0, region_allowed = !prm->batch_plain_draws;
+    uint64_t cheap_since = 0; /* certain rejections since the last compaction */
 
     pk_stop_reason reason = PK_STOP_COMPLETE;
     size_t placed = 0;
     uint64_t failed = 0;
     double p_surv = 1, p_acc = 1; /* running estimates from the last batch */
     while (placed < m) {
+        if (!region && region_allowed && p_acc < REGION_SWITCH_ACC &&
+            m - placed >= REGION_MIN_LEFT) {
+            region_allowed = 0;
+            region = region_start(&reg, &C, b, r, prm->delta_d, lo, span, out, first, m, mon,
+                                  pg) == 0;
+        }
+        if (region && reg.nlist == 0) {
+            reason = PK_STOP_SATURATED; /* every fine voxel lies in an exclusion ball */
+            break;
+        }
         size_t B = prm->batch_attempts;
         if (!B) {
             double want = SURVIVORS / p_surv, finish = 2.0 * (double)(m - placed) / p_acc;
@@ -213,9 +366,9 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
         pg->done = st->placed;
         pg->fraction = (double)st->placed / (double)(st->requested ? st->requested : 1);
         pg->phi = *solid / box_measure;
-        int c = pk_monitor_tick(mon, pg, 0);
-        if (c) {
-            reason = c == 2 ? PK_STOP_WALL_TIME : PK_STOP_CANCELLED;
+        int cc = pk_monitor_tick(mon, pg, 0);
+        if (cc) {
+            reason = cc == 2 ? PK_STOP_WALL_TIME : PK_STOP_CANCELLED;
             break;
         }
         if (scratch_reserve(&w, B) != 0) {
@@ -223,7 +376,9 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
             break;
         }
         pk_rng start = *rng;
-        size_t S = draw_and_filter(&C, &w, B, b->dim, lo, span, rng, shift, nbucket);
+        size_t A;
+        size_t S = draw_and_filter(&C, &w, B, b->dim, lo, span, rng, shift, nbucket,
+                                   region ? &reg : NULL, &A);
 
         /* step 3: attempt order */
         uint64_t hmask = 63;
@@ -233,24 +388,28 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
         memset(w.taken, 0, S);
         size_t used = B, acc = 0;
         const uint64_t max_failed = prm->max_failed_draws;
-        size_t a = 0; /* next attempt of the walk */
+        const size_t nword = (A + 63) / 64;
+        size_t a = 0;      /* next attempt of the walk */
+        size_t next_d = 0; /* its first draw not yet counted */
         for (;;) {
-            /* attempts rejected in step 2 count as failures: jump to the next survivor */
-            size_t a0 = a, wd = a >> 6;
-            uint64_t bits = wd < (B + 63) / 64 ? w.sbit[wd] & (~(uint64_t)0 << (a & 63)) : 0;
-            while (!bits && ++wd < (B + 63) / 64)
+            /* draws rejected at once or in step 2 count as failures: jump to the next survivor */
+            size_t wd = a >> 6;
+            uint64_t bits = wd < nword ? w.sbit[wd] & (~(uint64_t)0 << (a & 63)) : 0;
+            while (!bits && ++wd < nword)
                 bits = w.sbit[wd];
-            a = bits ? 64 * wd + (size_t)__builtin_ctzll(bits) : B;
-            if ((uint64_t)(a - a0) >= max_failed - failed) {
-                used = a0 + (size_t)(max_failed - failed);
+            a = bits ? 64 * wd + (size_t)__builtin_ctzll(bits) : A;
+            size_t d = a < A ? draw_of(&w, region, a) : B;
+            if ((uint64_t)(d - next_d) >= max_failed - failed) {
+                used = next_d + (size_t)(max_failed - failed);
                 failed = max_failed;
                 reason = PK_STOP_MAX_FAILED_DRAWS;
                 break;
             }
-            failed += a - a0;
-            if (a == B)
+            failed += d - next_d;
+            if (a == A)
                 break;
             size_t cur = a++;
+            next_d = d + 1;
             int32_t j = w.slot[cur];
             const double *x = &w.surv[3 * (size_t)j];
             uint32_t key = pk_rsa_cells_key(&C, x);
@@ -258,14 +417,14 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
                      (grid_empty || !pk_grid_overlaps(grid, out, x, r));
             if (!ok) {
                 if (++failed >= max_failed) {
-                    used = cur + 1;
+                    used = next_d;
                     reason = PK_STOP_MAX_FAILED_DRAWS;
                     break;
                 }
                 continue;
             }
             if (pk_particles_push(out, x, r, species[placed]) == (size_t)-1) {
-                used = cur + 1;
+                used = next_d;
                 reason = PK_STOP_ERROR;
                 break;
             }
@@ -279,30 +438,42 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
             w.hnext[j] = w.head[h];
             w.head[h] = j;
             if (placed == m) {
-                used = cur + 1;
+                used = next_d;
                 break;
             }
         }
         st->draws += used;
         st->placed += acc;
-        if (used < B) { /* rewind the stream to just after the last attempt used */
+        if (used < B && !region) { /* rewind the stream to just after the last attempt used */
             *rng = start;
             for (size_t q = 0; q < used * (size_t)b->dim; q++)
                 pk_rng_next(rng);
         }
+        /* (region draws use a varying number of outputs: the stream stays
+         * where the batch left it — deterministic, not rewound) */
         p_surv = fmax((double)S / (double)B, 1e-6);
         p_acc = fmax((double)acc / (double)used, 1e-6);
         if (reason != PK_STOP_COMPLETE || placed == m)
             break;
-        /* step 4: the store grows between batches only (sorted order: streaming) */
+        /* step 4: the store grows between batches only (sorted order: streaming);
+         * the region marks the new grains' exclusion balls */
         for (size_t j = 0; j < S; j++)
-            if (w.taken[j] && pk_rsa_cells_insert(&C, &w.surv[3 * j]) != 0) {
-                reason = PK_STOP_ERROR;
-                break;
+            if (w.taken[j]) {
+                if (pk_rsa_cells_insert(&C, &w.surv[3 * j]) != 0) {
+                    reason = PK_STOP_ERROR;
+                    break;
+                }
+                if (region)
+                    pk_rsa_region_mark(&reg, &w.surv[3 * j]);
             }
         if (reason != PK_STOP_COMPLETE)
             break;
+        if (region && (cheap_since += B - A) >= reg.nlist) {
+            pk_rsa_region_compact(&reg); /* amortised: no dearer than the draws it saves */
+            cheap_since = 0;
+        }
     }
+    pk_rsa_region_free(&reg);
     scratch_free(&w);
     pk_rsa_cells_free(&C);
     return reason;

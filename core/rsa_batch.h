@@ -18,9 +18,17 @@
  *      walk stops at the acceptance that completes the run (or the N^F-th
  *      failure), and the rng is rewound to just after that attempt;
  *   4. add the batch's accepted grains to the store.
- * The outcome — positions, order, draw count, rng state, stop reason except
- * for cancellation timing — is bit for bit that of plain draws one at a time
- * (tests/unit/test_rsa_batch.c compares them with memcmp). */
+ * With pk_rsa_params.batch_plain_draws the outcome — positions, order, draw
+ * count, rng state, stop reason except for cancellation timing — is bit for
+ * bit that of plain draws one at a time (tests/unit/test_rsa_batch.c compares
+ * them with memcmp).  By default, once a batch accepts fewer than a fifth of
+ * its draws, step 1 draws from the space not yet known to be excluded
+ * (rsa_region.h): attempts landing in a marked fine voxel fail at once and
+ * never reach step 2, accepted grains mark their exclusion balls in step 4.
+ * Same law of the packing (uniform over the open space at every acceptance;
+ * tests/unit/test_rsa_region.c checks it statistically), far fewer draws,
+ * but another packing per seed than plain draws; the same seed still gives
+ * the same packing, and the rng is not rewound after such a batch. */
 #ifndef PK_RSA_BATCH_H
 #define PK_RSA_BATCH_H
 

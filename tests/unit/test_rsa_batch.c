@@ -4,7 +4,10 @@
  * the same number of draws and the same stop reason, for 2D and 3D, periodic,
  * walled and mixed axes, with Δd, with grains already present, with several
  * size classes in a row (the rng must be rewound exactly after each run),
- * across batch sizes from 1 attempt to adaptive. */
+ * across batch sizes from 1 attempt to adaptive.  The batched runs here keep
+ * plain draws all along (pk_rsa_params.batch_plain_draws); the default, which
+ * later draws from the open region only, is compared with the plain path
+ * statistically in test_rsa_region.c. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -34,7 +37,7 @@ static void place(const setup *u, size_t batch, uint32_t min_run, pk_particles *
     for (size_t k = 0; k < u->nfixed; k++)
         pk_particles_push(p, u->fixed[k], u->fixed[k][3], 9);
     pk_rsa_params prm = {.delta_d = u->delta_d, .max_failed_draws = u->max_failed, .seed = 21,
-                         .plain_draws = batch == 0,
+                         .plain_draws = batch == 0, .batch_plain_draws = 1,
                          .batch_attempts = batch == SIZE_MAX ? 0 : (uint32_t)batch,
                          .batch_min_run = min_run};
     CHECK(pk_rsa_place(&u->box, u->d, u->sp, u->n, &prm, NULL, p, st) == 0);

@@ -1,0 +1,330 @@
+#include "rsa_region.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Quantisation steps per axis and cell of the mark table (rsa_region.h).
+ * With cells of half the store's edge (h ≈ c/2): delta = √3·h/(2·8) ≈ 0.054 c,
+ * under half a fine voxel (c/8); 512 entries of (2·2 + 1)³ words, 0.5 MB. */
+#define TABLE_STEPS 8
+/* Cells a mark reaches on each side (the ball radius c over the cell edge,
+ * rounded up, at most this; farther marks are left out, which is safe). */
+#define MAX_REACH 2
+#define NOT_MADE 0xff
+
+int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, const double *lo,
+                       const double *span, double c)
+{
+    memset(R, 0, sizeof *R);
+    if (!b || b->dim < 2 || b->dim > 3 || !(c > 0))
+        return -1;
+    R->dim = b->dim;
+    R->S = b->dim == 3 ? 4 : 8; /* S^dim = 64: one word per cell */
+    uint64_t nc = 1;
+    double lmax = 0;
+    for (int k = 0; k < PK_MAXDIM; k++) {
+        R->n[k] = R->nf[k] = 1;
+        R->hf[k] = R->inv_hf[k] = 1;
+        if (k >= b->dim)
+            continue;
+        if (n[k] < 1 || !(span[k] > 0))
+            return -1;
+        R->periodic[k] = b->periodic[k];
+        R->n[k] = n[k];
+        R->nf[k] = (int64_t)R->S * n[k];
+        R->lo[k] = lo[k];
+        R->hf[k] = span[k] / (double)R->nf[k];
+        R->inv_hf[k] = (double)R->nf[k] / span[k];
+        R->h[k] = span[k] / (double)n[k];
+        R->inv_h[k] = (double)n[k] / span[k];
+        nc *= (uint64_t)n[k];
+        lmax = fmax(lmax, b->L[k]);
+    }
+    if (nc > UINT32_MAX)
+        return -1;
+    /* far above the round-off of coordinates and fine-voxel faces, far below
+     * any length that matters to the statistics (as rsa_voxels.c) */
+    R->margin = 1e-9 * c + 1e-12 * lmax;
+    R->ncell = nc;
+    R->c = c;
+    R->Q = TABLE_STEPS;
+    double diag2 = 0;
+    for (int k = 0; k < b->dim; k++)
+        diag2 += R->h[k] * R->h[k];
+    R->delta = 0.5 / R->Q * sqrt(diag2);
+    double hmin = INFINITY;
+    for (int k = 0; k < b->dim; k++)
+        hmin = fmin(hmin, R->h[k]);
+    R->D = c <= hmin ? 1 : MAX_REACH;
+    for (int k = 0; k < b->dim; k++)
+        if (b->periodic[k] && n[k] < 2 * R->D + 1)
+            return -1; /* the cells around a grain must be distinct */
+    size_t ne = b->dim == 3 ? (size_t)R->Q * R->Q * R->Q : (size_t)R->Q * R->Q;
+    R->entry = (size_t)(2 * R->D + 1) * (size_t)(2 * R->D + 1) * (b->dim == 3 ? (size_t)(2 * R->D + 1) : 1);
+    R->tab = malloc(ne * R->entry * sizeof *R->tab);
+    R->tidx = malloc(ne * R->entry);
+    R->tcnt = malloc(ne);
+    R->toff = malloc(R->entry * sizeof *R->toff);
+    R->covered = calloc(nc, sizeof *R->covered);
+    R->list = malloc(nc * sizeof *R->list);
+    if (!R->covered || !R->list || !R->tab || !R->tidx || !R->tcnt || !R->toff) {
+        pk_rsa_region_free(R);
+        return -1;
+    }
+    for (uint64_t i = 0; i < nc; i++)
+        R->list[i] = (uint32_t)i;
+    memset(R->tcnt, NOT_MADE, ne);
+    const int D = R->D, W = 2 * D + 1, zr = b->dim == 3;
+    for (int dz = 0; dz < (zr ? W : 1); dz++)
+        for (int dy = 0; dy < W; dy++)
+            for (int dx = 0; dx < W; dx++)
+                R->toff[(dz * W + dy) * W + dx] =
+                    ((zr ? dz - D : 0) * R->n[1] + dy - D) * R->n[0] + dx - D;
+    R->nlist = nc;
+    return 0;
+}
+
+void pk_rsa_region_free(pk_rsa_region *R)
+{
+    free(R->covered);
+    free(R->list);
+    free(R->tab);
+    free(R->tidx);
+    free(R->tcnt);
+    free(R->toff);
+    memset(R, 0, sizeof *R);
+}
+
+void pk_rsa_region_compact(pk_rsa_region *R)
+{
+    uint64_t k = 0;
+    for (uint64_t i = 0; i < R->nlist; i++) {
+        uint32_t c = R->list[i];
+        R->list[k] = c;
+        k += R->covered[c] != ~(uint64_t)0;
+    }
+    R->nlist = k;
+}
+
+/* Fine voxels j along axis k whose interval [a, a + hf] lies within
+ * [x - w, x + w]: j from ceil((x - w - lo)/hf) to floor((x + w - lo)/hf) - 1,
+ * unwrapped on periodic axes, clipped on walled ones.  Returns 0 if none. */
+static int inside_range(const pk_rsa_region *R, int k, double x, double w, int64_t *j0,
+                        int64_t *j1)
+{
+    *j0 = (int64_t)ceil((x - w - R->lo[k]) * R->inv_hf[k]);
+    *j1 = (int64_t)floor((x + w - R->lo[k]) * R->inv_hf[k]) - 1;
+    if (!R->periodic[k]) {
+        if (*j0 < 0)
+            *j0 = 0;
+        if (*j1 > R->nf[k] - 1)
+            *j1 = R->nf[k] - 1;
+    } else if (*j1 - *j0 >= R->nf[k]) {
+        *j1 = *j0 + R->nf[k] - 1; /* the whole axis once */
+    }
+    return *j0 <= *j1;
+}
+
+/* Squared distance from x to the far face of fine voxel j along axis k. */
+static inline double far2(const pk_rsa_region *R, int k, int64_t j, double x)
+{
+    double a = R->lo[k] + R->hf[k] * (double)j;
+    double d = fmax(x - a, a + R->hf[k] - x);
+    return d * d;
+}
+
+/* Cell and in-cell index of (unwrapped) fine voxel j along axis k. */
+static inline void split(const pk_rsa_region *R, int k, int64_t j, int64_t *cell, int *l)
+{
+    int64_t q = j >= 0 ? j / R->S : -((-j + R->S - 1) / R->S);
+    *l = (int)(j - q * R->S);
+    if (q < 0)
+        q += R->n[k];
+    else if (q >= R->n[k])
+        q -= R->n[k];
+    *cell = q;
+}
+
+/* A fine voxel is marked when its farthest corner is within rad - margin of x:
+ * the ball is convex, so the whole voxel is inside.  Rows along x: per fine
+ * (z, y) row the covered x voxels are one interval (inside_range with
+ * w = sqrt(rem)), split into the ≤ few cells it crosses. */
+void pk_rsa_region_cover(pk_rsa_region *R, const double *x, double rad)
+{
+    const double Rad = rad - R->margin;
+    if (!(Rad > 0))
+        return;
+    const double R2 = Rad * Rad;
+    const int S = R->S, dim = R->dim;
+    for (int k = 0; k < dim; k++)
+        if (R->periodic[k] && !(Rad < R->hf[k] * (double)R->nf[k]))
+            return; /* wider than the box: marks are optional, skip (split wraps once) */
+    int64_t z0 = 0, z1 = 0, y0, y1;
+    if (dim == 3 && !inside_range(R, 2, x[2], Rad, &z0, &z1))
+        return;
+    if (!inside_range(R, 1, x[1], Rad, &y0, &y1))
+        return;
+    for (int64_t jz = z0; jz <= z1; jz++) {
+        double fz = dim == 3 ? far2(R, 2, jz, x[2]) : 0;
+        int64_t cz = 0;
+        int lz = 0;
+        if (dim == 3)
+            split(R, 2, jz, &cz, &lz);
+        for (int64_t jy = y0; jy <= y1; jy++) {
+            double rem = R2 - fz - far2(R, 1, jy, x[1]);
+            if (!(rem > 0))
+                continue;
+            int64_t x0, x1, cy;
+            int ly;
+            if (!inside_range(R, 0, x[0], sqrt(rem), &x0, &x1))
+                continue;
+            split(R, 1, jy, &cy, &ly);
+            const unsigned shift = (unsigned)((lz * S + ly) * S);
+            uint64_t *row = &R->covered[(uint64_t)(cz * R->n[1] + cy) * (uint64_t)R->n[0]];
+            int64_t cx;
+            int lx0, lx1;
+            split(R, 0, x0, &cx, &lx0);
+            int64_t left = x1 - x0 + 1; /* fine voxels still to mark */
+            while (left > 0) {
+                lx1 = lx0 + (int)(left < S - lx0 ? left : S - lx0) - 1;
+                uint64_t bits = ((uint64_t)2 << lx1) - ((uint64_t)1 << lx0);
+                row[cx] |= bits << shift;
+                left -= lx1 - lx0 + 1;
+                lx0 = 0;
+                if (++cx == R->n[0])
+                    cx = 0;
+            }
+        }
+    }
+}
+
+/* Table entry e: centre p (offset from its cell's lower corner, per axis), the
+ * marks of the cells d = -D..D per axis, word ((dz+D)·W + dy+D)·W + dx+D,
+ * W = 2D + 1 (dz = 0 in 2D). */
+static void make_entry(pk_rsa_region *R, size_t e, const double *p)
+{
+    const int S = R->S, dim = R->dim, zr = dim == 3, D = R->D, W = 2 * D + 1;
+    uint64_t *w = &R->tab[e * R->entry];
+    memset(w, 0, R->entry * sizeof *w);
+    const double rad = R->c - R->margin - R->delta;
+    if (!(rad > 0))
+        return;
+    const int nj = W * S;       /* fine voxels j = -D·S .. (D+1)·S - 1 per axis */
+    double f[3][(2 * MAX_REACH + 1) * 8]; /* squared distance to the far face of fine voxel j */
+    for (int k = 0; k < dim; k++)
+        for (int j = 0; j < nj; j++) {
+            double a = R->hf[k] * (double)(j - D * S);
+            double d = p[k] - a > a + R->hf[k] - p[k] ? p[k] - a : a + R->hf[k] - p[k];
+            f[k][j] = d * d;
+        }
+    const double r2 = rad * rad;
+    for (int jz = 0; jz < (zr ? nj : 1); jz++) {
+        double fz = zr ? f[2][jz] : 0;
+        int dz = jz / S, lz = jz % S; /* dz: cell D + d */
+        for (int jy = 0; jy < nj; jy++) {
+            double rem = r2 - fz - f[1][jy];
+            if (!(rem > 0))
+                continue;
+            int dy = jy / S, ly = jy % S;
+            /* the far faces' distances are V-shaped in jx: the covered ones are
+             * an interval around the centre's fine voxel */
+            int jc = (int)(p[0] * R->inv_hf[0]) + D * S;
+            jc = jc < 0 ? 0 : (jc >= nj ? nj - 1 : jc);
+            int j0 = jc, j1 = jc - 1;
+            while (j0 > 0 && f[0][j0 - 1] <= rem)
+                j0--;
+            if (f[0][jc] <= rem)
+                for (j1 = jc; j1 + 1 < nj && f[0][j1 + 1] <= rem;)
+                    j1++;
+            else
+                j0 = jc + 1; /* not even the centre's own: none (V-shape) */
+            uint64_t *row = &w[((zr ? dz : 0) * W + dy) * W];
+            const unsigned shift = (unsigned)((lz * S + ly) * S);
+            for (int jx = j0; jx <= j1;) { /* one cell's part of the interval at a time */
+                int cx = jx / S, l0 = jx - cx * S, l1 = j1 - cx * S < S - 1 ? j1 - cx * S : S - 1;
+                row[cx] |= (((uint64_t)2 << l1) - ((uint64_t)1 << l0)) << shift;
+                jx += l1 - l0 + 1;
+            }
+        }
+    }
+    /* keep the nonzero words only, with their cell numbers */
+    uint8_t *idx = &R->tidx[e * R->entry];
+    int cnt = 0;
+    for (size_t q = 0; q < R->entry; q++)
+        if (w[q]) {
+            w[cnt] = w[q];
+            idx[cnt++] = (uint8_t)q;
+        }
+    R->tcnt[e] = (uint8_t)cnt;
+}
+
+void pk_rsa_region_mark(pk_rsa_region *R, const double *x)
+{
+    const int dim = R->dim, Q = R->Q, D = R->D, W = 2 * D + 1;
+    int64_t i[3] = {0, 0, 0};
+    size_t e = 0;
+    double p[3] = {0, 0, 0};
+    for (int k = dim - 1; k >= 0; k--) {
+        double f = (x[k] - R->lo[k]) * R->inv_h[k];
+        int64_t ik = f < 0 ? 0 : (int64_t)f;
+        if (ik > R->n[k] - 1)
+            ik = R->n[k] - 1;
+        double t = f - (double)ik; /* in [0, 1) up to round-off at the range ends */
+        int q = t <= 0 ? 0 : (int)(t * Q);
+        if (q > Q - 1)
+            q = Q - 1;
+        i[k] = ik;
+        e = e * (size_t)Q + (size_t)q;
+        p[k] = ((double)q + 0.5) / Q * R->h[k];
+    }
+    if (R->tcnt[e] == NOT_MADE)
+        make_entry(R, e, p);
+    const uint64_t *w = &R->tab[e * R->entry];
+    const uint8_t *idx = &R->tidx[e * R->entry];
+    const int cnt = R->tcnt[e];
+    int inner = 1;
+    for (int k = 0; k < dim; k++)
+        inner &= i[k] >= D && i[k] < R->n[k] - D;
+    if (inner) { /* the common case: no wrap, no wall — fixed offsets */
+        uint64_t *base = &R->covered[(uint64_t)(i[2] * R->n[1] + i[1]) * (uint64_t)R->n[0] +
+                                     (uint64_t)i[0]];
+        for (int t = 0; t < cnt; t++)
+            base[R->toff[idx[t]]] |= w[t];
+        return;
+    }
+    uint64_t dense[(2 * MAX_REACH + 1) * (2 * MAX_REACH + 1) * (2 * MAX_REACH + 1)];
+    memset(dense, 0, R->entry * sizeof *dense);
+    for (int t = 0; t < cnt; t++)
+        dense[idx[t]] = w[t];
+    w = dense;
+    int64_t c[3][2 * MAX_REACH + 1];
+    int ok[3][2 * MAX_REACH + 1];
+    for (int k = 0; k < 3; k++)
+        for (int d = -D; d <= D; d++) {
+            int64_t j = i[k] + d;
+            ok[k][d + D] = k < dim ? 1 : d == 0;
+            if (k < dim && (j < 0 || j >= R->n[k])) {
+                if (R->periodic[k])
+                    j = j < 0 ? j + R->n[k] : j - R->n[k]; /* n >= 2D + 1 (init) */
+                else
+                    ok[k][d + D] = 0; /* beyond a wall: no cell */
+            }
+            c[k][d + D] = j;
+        }
+    const int zr = dim == 3;
+    for (int dz = zr ? 0 : D; dz <= (zr ? 2 * D : D); dz++) {
+        if (!ok[2][dz])
+            continue;
+        for (int dy = 0; dy < W; dy++) {
+            if (!ok[1][dy])
+                continue;
+            uint64_t *row =
+                &R->covered[(uint64_t)(c[2][dz] * R->n[1] + c[1][dy]) * (uint64_t)R->n[0]];
+            const uint64_t *src = &w[((zr ? dz : 0) * W + dy) * W];
+            for (int dx = 0; dx < W; dx++)
+                if (ok[0][dx])
+                    row[c[0][dx]] |= src[dx];
+        }
+    }
+}
