@@ -5,9 +5,10 @@
  * momentum-conserving rule of spec §3.4 (Meier Eq. 3.9 generalised to
  * unequal masses), walls reflect in the co-moving sense.  Engine: delayed
  * states (each particle stores its position at its own last update time),
- * one pending event per particle in a binary heap with validity counters,
- * Donev-style per-particle neighbour lists (bounding spheres built with the
- * shared core/grid.h), periodic re-basing of the clock.
+ * one pending event per particle in a 4-ary heap with validity counters,
+ * Donev-style per-particle neighbour lists (bounding spheres filed in the
+ * dense cell levels of core/grid_uniform.h; skins shrink with the pressure
+ * near jamming), periodic re-basing of the clock.
  *
  * The true radius output is R_i(t) = ρ_i(t) − h(t), h the shell; every
  * surface gap of the result is therefore ≥ Δd (2h) and every wall clearance

@@ -15,20 +15,22 @@ double edmd_collide_pair(edmd_state *s, size_t i, size_t j)
 {
     edmd_sync(s, i);
     edmd_sync(s, j);
-    double n[3] = {0, 0, 0};
+    double xi[3], xj[3], n[3] = {0, 0, 0};
+    edmd_pos(s, i, xi);
+    edmd_pos(s, j, xj);
     for (int k = 0; k < s->dim; k++)
-        n[k] = s->x0[3 * j + k] - s->x0[3 * i + k];
+        n[k] = xj[k] - xi[k];
     edmd_min_image_near(s, n);
     double dist = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (!(dist > 0))
         return 0;
-    double *vi = &s->v[3 * i], *vj = &s->v[3 * j];
+    double *vi = s->k[i].v, *vj = s->k[j].v;
     double w = 0;
     for (int k = 0; k < s->dim; k++) {
         n[k] /= dist;
         w += (vj[k] - vi[k]) * n[k];
     }
-    double G = s->g[i] + s->g[j];
+    double G = s->k[i].g + s->k[j].g;
     double target = G + s->eps_v;
     if (w >= target)
         return 0; /* already separating fast enough (round-off prediction) */
@@ -43,20 +45,24 @@ double edmd_collide_pair(edmd_state *s, size_t i, size_t j)
         vj[k] += P / mj * n[k];
         k_after += mi * vi[k] * vi[k] + mj * vj[k] * vj[k];
     }
+    edmd_pin(s, i, xi);
+    edmd_pin(s, j, xj);
     s->K += 0.5 * (k_after - k_before);
     return dist * P;
 }
 
 void edmd_collide_wall(edmd_state *s, size_t i, int code)
 {
-    edmd_sync(s, i);
+    double x[3];
+    edmd_pos(s, i, x);
     int k = code / 2;
-    double *vk = &s->v[3 * i + k];
-    double min_out = s->g[i] + s->eps_v; /* admissible: outward speed > growth (spec §3.4) */
+    double *vk = &s->k[i].v[k];
+    double min_out = s->k[i].g + s->eps_v; /* admissible: outward speed > growth (spec §3.4) */
     double before = *vk;
     if (code % 2 == 0)
         *vk = fmax(-*vk, min_out);
     else
         *vk = fmin(-*vk, -min_out);
+    edmd_pin(s, i, x);
     s->K += 0.5 * s->m[i] * (*vk * *vk - before * before);
 }

@@ -6,9 +6,10 @@
  * lists stay exact while every grain stays inside its sphere; the exit time
  * (motion AND growth) is a per-particle event, after which only that grain's
  * sphere and list are rebuilt (symmetrically).  σ_i uses at least the
- * grain's target radius, so early (small, fast) grains rebuild rarely.  The bounding spheres live in
- * the shared multi-level grid (core/grid.h), so wide size ratios cost O(1)
- * cells per query. */
+ * grain's target radius, so early (small, fast) grains rebuild rarely.  The
+ * bounding spheres live in levels of dense cell lists (core/grid_uniform.h:
+ * pk_grid's levels without its hash probes — the rebuild queries were a
+ * third of the run time), so wide size ratios cost O(1) cells per query. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -73,15 +74,17 @@ static int visit(size_t j, const double dx[PK_MAXDIM], double dist2, void *ctx)
  * the list stays exact (the exit event is computed from the offset centre). */
 static void set_sphere(edmd_state *s, size_t i, double ahead)
 {
-    const double rho = s->a[i] + s->g[i] * s->t;
+    const double rho = edmd_rho(s, i, s->t);
     /* never smaller than the grain at its reference (target) size: while
      * grains are small and far apart the lists then last much longer */
-    const double sig = fmax(rho, s->rref[i]) + 0.5 * s->skin[i];
-    const double *v = &s->v[3 * i];
+    const double sig = fmax(rho, s->rref[i]) + 0.5 * s->skin_scale * s->skin[i];
+    const double *v = s->k[i].v;
+    double x[3];
+    edmd_pos(s, i, x);
     double speed = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
     double shift = speed > 0 ? ahead * (sig - rho) / speed : 0;
     for (int k = 0; k < 3; k++)
-        s->bs.x[3 * i + k] = s->x0[3 * i + k] + shift * v[k];
+        s->bs.x[3 * i + k] = x[k] + shift * v[k];
     pk_box_wrap(&s->box, &s->bs.x[3 * i]);
     s->bs.r[i] = sig;
     s->ncoll_nl[i] = s->ncoll[i];
@@ -89,25 +92,22 @@ static void set_sphere(edmd_state *s, size_t i, double ahead)
 
 int edmd_nlist_build_all(edmd_state *s)
 {
-    double lo = INFINITY, hi = 0;
     for (size_t i = 0; i < s->n; i++) {
         edmd_sync(s, i);
         set_sphere(s, i, 0);
         s->nl[i].n = 0;
-        lo = fmin(lo, s->bs.r[i]);
-        hi = fmax(hi, s->bs.r[i]);
     }
     s->bs.n = s->n;
-    pk_grid_free(&s->grid);
-    hi = fmax(hi, s->sig_hi);
-    if (pk_grid_init(&s->grid, &s->box, fmin(lo, hi), hi, 0.0, s->n) != 0)
+    pk_ugrid_free(&s->ugrid);
+    if (pk_ugrid_init(&s->ugrid, &s->box, s->bs.r, s->n, s->n) != 0)
         return -1;
+    /* file everyone first, then query (the lists are built one-sided) */
     for (size_t i = 0; i < s->n; i++)
-        if (pk_grid_insert(&s->grid, &s->bs, i) != 0)
+        if (pk_ugrid_insert(&s->ugrid, &s->bs, i) != 0)
             return -1;
     for (size_t i = 0; i < s->n; i++) {
         visit_ctx c = {s, (int32_t)i, 0, 0};
-        pk_grid_query(&s->grid, &s->bs, &s->bs.x[3 * i], s->bs.r[i], 0.0, visit, &c);
+        pk_ugrid_query(&s->ugrid, &s->bs, &s->bs.x[3 * i], s->bs.r[i], visit, &c);
         if (c.failed)
             return -1;
     }
@@ -122,14 +122,10 @@ int edmd_nlist_rebuild(edmd_state *s, size_t i)
     L->n = 0;
     edmd_sync(s, i);
     set_sphere(s, i, s->ncoll[i] == s->ncoll_nl[i] ? EDMD_AHEAD : 0);
-    /* remove + insert, not pk_grid_update: a sphere that outgrew the grid's
-     * top level but stayed in its cell would keep the level's old radius
-     * bound, and queries would miss it */
-    pk_grid_remove(&s->grid, i);
-    if (pk_grid_insert(&s->grid, &s->bs, i) != 0)
+    if (pk_ugrid_insert(&s->ugrid, &s->bs, i) != 0) /* re-files i (new level/cell) */
         return -1;
     visit_ctx c = {s, (int32_t)i, 1, 0};
-    pk_grid_query(&s->grid, &s->bs, &s->bs.x[3 * i], s->bs.r[i], 0.0, visit, &c);
+    pk_ugrid_query(&s->ugrid, &s->bs, &s->bs.x[3 * i], s->bs.r[i], visit, &c);
     return c.failed ? -1 : 0;
 }
 
@@ -140,6 +136,6 @@ void edmd_nlist_free(edmd_state *s)
             free(s->nl[i].nb);
     free(s->nl);
     s->nl = NULL;
-    pk_grid_free(&s->grid);
+    pk_ugrid_free(&s->ugrid);
     pk_particles_free(&s->bs);
 }

@@ -1,12 +1,16 @@
 /* edmd_state.h — the EDMD engine's internal state, shared by core/edmd*.c.
- * Structure of arrays; particle i's position at time t is
- * x0[3i..] + v[3i..]·(t − t0[i]) (delayed state), its simulated radius
- * a[i] + g[i]·t and its true radius that minus the shell h0 + h1·t. */
+ * Each grain's flight is one 64-byte record (one cache line: a prediction
+ * reads one line per neighbour): position at time t is p + v·t — p is the
+ * position extrapolated back to the re-based origin t = 0, so no per-grain
+ * sync time is stored (delayed states; the clock is re-based every window so
+ * |v·t| stays small against L) — simulated radius a + g·t, true radius that
+ * minus the shell h0 + h1·t. */
 #ifndef PK_EDMD_STATE_H
 #define PK_EDMD_STATE_H
 
 #include "edmd.h"
 #include "grid.h"
+#include "grid_uniform.h"
 
 enum { EV_NONE = 0, EV_PAIR, EV_WALL, EV_NLIST };
 
@@ -15,19 +19,29 @@ typedef struct edmd_nlist {
     uint32_t n, cap;
 } edmd_nlist;
 
+typedef struct edmd_kin {
+    double p[3];              /* position at t = 0 of the current flight */
+    double a;                 /* simulated radius at t = 0 */
+    double v[3];              /* velocity (0 beyond dim) */
+    double g;                 /* radius growth rate */
+} edmd_kin;
+_Static_assert(sizeof(edmd_kin) == 64, "one cache line per grain (aligned_alloc needs a multiple of 64)");
+
 typedef struct edmd_hnode {
     double t;                 /* event time (copy of ev_t[i]) */
     int32_t i;                /* particle */
 } edmd_hnode;
+_Static_assert(sizeof(edmd_hnode) == 16, "four heap nodes per cache line");
 
 typedef struct edmd_state {
     pk_box box;
-    double half_L[3];         /* L/2 on periodic axes, +inf otherwise */
+    double Lp[3], inv_Lp[3];  /* L and 1/L on periodic axes, 0 otherwise (pk_min_image3) */
     int dim;
+    int walled;               /* some axis < dim has walls */
     size_t n;
     /* kinematics */
-    double *x0, *v, *t0;      /* [3n], [3n], [n] */
-    double *a, *g, *m;        /* radius offset, radius rate, mass */
+    edmd_kin *k;              /* [n], 64-byte aligned */
+    double *m;                /* mass */
     double h0, h1;            /* shell h(t) = h0 + h1 t */
     double t;                 /* current time (re-based) */
     double eps_v;             /* extra separation speed (spec §3.4) */
@@ -37,17 +51,18 @@ typedef struct edmd_state {
     uint32_t *ev_stamp;       /* partner's ncoll at prediction time */
     uint8_t *ev_kind;
     uint32_t *ncoll;          /* velocity changes of each particle (validity counter) */
-    edmd_hnode *heap;         /* 4-ary heap of (ev_t, particle) */
+    edmd_hnode *heap;         /* 4-ary heap of (ev_t, particle), in heap_mem */
+    edmd_hnode *heap_mem;
     int32_t *hpos;            /* node of each particle in the heap */
     size_t hn;
     /* neighbour lists */
     edmd_nlist *nl;
     pk_particles bs;          /* bounding spheres: centre c_i, radius σ_i */
-    pk_grid grid;             /* on the bounding spheres */
-    double *skin;             /* per-particle skin s_i */
+    pk_ugrid ugrid;           /* cells of the bounding spheres */
+    double *skin;             /* per-particle skin s_i (at low pressure) */
+    double skin_scale;        /* skins shrink with the cages as the pressure rises */
     double *rref;             /* radius at the reference time (target size) */
     uint32_t *ncoll_nl;       /* ncoll[i] at i's last list build (ballistic test) */
-    double sig_hi;            /* expected largest bounding sphere (grid cell size) */
     /* physics accumulators */
     double K;                 /* kinetic energy ½Σm v² */
     double virial;            /* Σ σ J over particle collisions in the window */
@@ -56,23 +71,37 @@ typedef struct edmd_state {
     double max_overlap_rel;
 } edmd_state;
 
-/* Minimum image of a displacement between two synced grains (periodic
- * coordinates kept in [0, L) by edmd_sync, bounding-sphere centres wrapped):
- * |d_k| < L, so one conditional shift replaces the general rounding.  Fixed
- * three axes, no periodicity test: half_L is +inf on walled axes and beyond
- * dim (edmd_minimage_init). */
+/* Minimum image of a displacement along the periodic axes (branch-free,
+ * core/grid_uniform.h). */
 static inline void edmd_min_image_near(const edmd_state *s, double d[3])
 {
-    for (int k = 0; k < 3; k++) {
-        if (d[k] > s->half_L[k])
-            d[k] -= s->box.L[k];
-        else if (d[k] < -s->half_L[k])
-            d[k] += s->box.L[k];
-    }
+    pk_min_image3(s->Lp, s->inv_Lp, d);
+}
+
+/* Position of i now. */
+static inline void edmd_pos(const edmd_state *s, size_t i, double x[3])
+{
+    const edmd_kin *k = &s->k[i];
+    for (int d = 0; d < 3; d++)
+        x[d] = k->p[d] + k->v[d] * s->t;
+}
+
+/* Simulated radius of i at time t. */
+static inline double edmd_rho(const edmd_state *s, size_t i, double t)
+{
+    return s->k[i].a + s->k[i].g * t;
+}
+
+/* After i's velocity changed now: keep its position x now. */
+static inline void edmd_pin(edmd_state *s, size_t i, const double x[3])
+{
+    edmd_kin *k = &s->k[i];
+    for (int d = 0; d < 3; d++)
+        k->p[d] = x[d] - k->v[d] * s->t;
 }
 
 /* edmd_predict.c */
-void edmd_sync(edmd_state *s, size_t i);               /* x0 ← x(t), t0 ← t */
+void edmd_sync(edmd_state *s, size_t i);               /* periodic axes: x(t) back into [0, L) */
 void edmd_predict(edmd_state *s, size_t i);            /* refresh i's event and heap slot */
 double edmd_wall_time(const edmd_state *s, size_t i, int *code);
 
