@@ -118,6 +118,9 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
     }
     prm->eps = opt_num(o, "epsilon", prm->eps);
     prm->z_min = (int)opt_num(o, "z_min", prm->z_min);
+    const char *rule_name = json_string_value(json_object_get(o, "contact_rule"));
+    if (rule_name && strcmp(rule_name, "touching") == 0)
+        prm->contact_rule = PK_TETFILL_CONTACT_TOUCHING; /* the schema admits tangent|touching */
     prm->vertex_weight = opt_num(o, "vertex_weight", prm->vertex_weight);
     prm->skip_tet_loci = json_is_true(json_object_get(o, "loose"));
     prm->densify = !json_is_false(json_object_get(o, "densify"));
@@ -176,6 +179,10 @@ static json_t *observables(const tetfill_setup *S, const pk_tetfill_stats *ts,
     json_object_set_new(o, "count_trimmed", json_integer((json_int_t)ts->n_trimmed));
     json_object_set_new(o, "count_geometric", json_integer((json_int_t)ts->n_geometric));
     json_object_set_new(o, "phi_geometric", json_real(ts->phi_geometric));
+    json_object_set_new(o, "coordination_geometric", json_real(ts->geometric.z));
+    json_object_set_new(o, "coordination_tangent_geometric", json_real(ts->geometric.z_tangent));
+    json_object_set_new(o, "coordination_touching_geometric",
+                        json_real(ts->geometric.z_touching));
     json_object_set_new(o, "densify_passes", json_integer(ts->passes));
     json_object_set_new(o, "loci", json_integer((json_int_t)ts->loci));
     json_object_set_new(o, "solves", json_integer((json_int_t)ts->solves));
@@ -189,6 +196,7 @@ static json_t *observables(const tetfill_setup *S, const pk_tetfill_stats *ts,
     json_object_set_new(o, "pairs_over_bound", json_integer((json_int_t)ms->pairs_over_bound));
     json_object_set_new(o, "contacts", json_integer((json_int_t)ms->contacts));
     json_object_set_new(o, "coordination_mean", json_real(ms->z_mean));
+    json_object_set_new(o, "coordination_tangent", json_real(ms->z_tangent));
     json_object_set_new(o, "coordination_touching", json_real(ms->z_touching));
     json_object_set_new(o, "coordination_histogram", ints_json(ms->z_hist, PK_TETFILL_ZHIST));
     json_object_set_new(o, "fabric", reals_json(ms->fabric, 9));

@@ -1,10 +1,12 @@
 /* bench/tetfill.c — Jerier's mesh filling: cost per sphere vs mesh size
  * (flat = linear, his Fig. 8a at φ₀ = 0.6), 10⁵ spheres (bar < 10 s), 10⁶
  * spheres with PACKD_BENCH_LARGE=1 (bar < 2 min, < 2 GiB), and the R sweep
- * on the Gmsh cube of 1127 tets (his Fig. 4a/7a: 1112 tets) to saturation. */
+ * on the Gmsh cube of 1127 tets (his Fig. 4a/7a: 1112 tets) to saturation,
+ * with the default contact rule and with Jerier's ("touching", gap <= 0). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <sys/resource.h>
 #include <time.h>
 
@@ -53,7 +55,9 @@ static int box_case(const char *name, double L, double phi0, size_t n0)
     return rc;
 }
 
-static int sweep_case(const char *path, double R)
+/* One R of the sweep with the contact rule of the z_min test (tetfill.h);
+ * seed from PACKD_BENCH_SEED (default 0) for the spread over seeds. */
+static int sweep_case(const char *path, double R, pk_tetfill_contact_rule rule)
 {
     pk_mesh m;
     char err[512];
@@ -66,6 +70,9 @@ static int sweep_case(const char *path, double R)
     pk_mesh_translate(&m, lo);
     pk_tetfill_params prm;
     pk_tetfill_defaults(&prm);
+    prm.contact_rule = rule;
+    const char *seed = getenv("PACKD_BENCH_SEED");
+    prm.seed = seed ? strtoull(seed, NULL, 10) : 0;
     double rbar = m.edge_mean / 8; /* ratio alone: Jerier's rule */
     prm.r_min = 2 * rbar / (R + 1);
     prm.r_max = 2 * rbar - prm.r_min;
@@ -78,11 +85,16 @@ static int sweep_case(const char *path, double R)
         if (pk_tetfill(&m, &prm, NULL, &p, &st) != 0 ||
             pk_tetfill_measure(&m, &p, prm.r_min, prm.eps, &o) != 0)
             return -1;
-        printf("bench=tetfill case=sweep_R%g stage=%s tets=%zu spheres=%zu n_per_tet=%.2f "
-               "phi=%.4f z=%.3f z_touching=%.3f F1=%.4f F2=%.4f F3=%.4f passes=%d seconds=%.3f\n",
-               R, dens ? "saturated" : "steps1-6", m.ntet, p.n, (double)p.n / (double)m.ntet,
-               o.phi, o.z_mean, o.z_touching, o.fabric_eig[0], o.fabric_eig[1], o.fabric_eig[2], st.passes,
-               st.seconds);
+        /* z by the three contact definitions of tetfill_stats.h: gap <= ε r_min,
+         * <= 1e-9 r_min (tangent), <= 0 (touching) */
+        printf("bench=tetfill case=sweep%s_R%g seed=%llu stage=%s tets=%zu spheres=%zu "
+               "n_per_tet=%.2f phi=%.4f z=%.3f z_tangent=%.3f z_touching=%.3f F1=%.4f F2=%.4f "
+               "F3=%.4f z_tangent_steps1_6=%.3f passes=%d seconds=%.3f\n",
+               rule == PK_TETFILL_CONTACT_TOUCHING ? "_touching" : "", R,
+               (unsigned long long)prm.seed, dens ? "saturated" : "steps1-6", m.ntet, p.n,
+               (double)p.n / (double)m.ntet,
+               o.phi, o.z_mean, o.z_tangent, o.z_touching, o.fabric_eig[0], o.fabric_eig[1],
+               o.fabric_eig[2], st.geometric.z_tangent, st.passes, st.seconds);
         fflush(stdout);
         pk_tetfill_measures_free(&o);
         pk_particles_free(&p);
@@ -91,23 +103,39 @@ static int sweep_case(const char *path, double R)
     return 0;
 }
 
-int main(void)
+/* `tetfill [CASE]`: all cases, or only CASE (e.g. under valgrind --tool=callgrind
+ * for instruction counts on a shared machine). */
+static const char *only;
+
+static int want(const char *name) { return !only || strcmp(only, name) == 0; }
+
+int main(int argc, char **argv)
 {
     int rc = 0;
+    only = argc > 1 ? argv[1] : NULL;
     /* cost per sphere vs mesh size at φ₀ = 0.6: 8×, 64× the tets */
-    rc |= box_case("linear_L5", 5, 0.6, 0);
-    rc |= box_case("linear_L10", 10, 0.6, 0);
-    rc |= box_case("linear_L20", 20, 0.6, 0);
-    /* 10⁵ and 10⁶ spheres at the same density (edge ∝ N^⅓): both end near
-     * φ ≈ 0.58, past the geometric steps, early in the densification */
-    rc |= box_case("spheres_1e5", 17, 0, 100000);
-    if (getenv("PACKD_BENCH_LARGE"))
+    if (want("linear_L5"))
+        rc |= box_case("linear_L5", 5, 0.6, 0);
+    if (want("linear_L10"))
+        rc |= box_case("linear_L10", 10, 0.6, 0);
+    if (want("linear_L20"))
+        rc |= box_case("linear_L20", 20, 0.6, 0);
+    /* 10⁵ and 10⁶ spheres, box edge ∝ N^⅓: they end at φ ≈ 0.58 and 0.60 (less
+     * boundary loss in the larger box), past the geometric steps, early in 7b */
+    if (want("spheres_1e5"))
+        rc |= box_case("spheres_1e5", 17, 0, 100000);
+    if (getenv("PACKD_BENCH_LARGE") || (only && want("spheres_1e6")))
         rc |= box_case("spheres_1e6", 17 * cbrt(10), 0, 1000000);
+    if (only && strncmp(only, "sweep", 5) != 0)
+        return rc ? 1 : 0;
     const char *src = getenv("PACKD_SRC");
     char path[4096];
     snprintf(path, sizeof path, "%s/tests/data/meshes/cube41.msh", src ? src : ".");
+    /* "sweep": the default contact rule; "sweep_touching": Jerier's (gap <= 0) */
     const double R[4] = {2, 3, 5, 7};
-    for (int i = 0; i < 4; i++)
-        rc |= sweep_case(path, R[i]);
+    for (int i = 0; i < 4 && want("sweep"); i++)
+        rc |= sweep_case(path, R[i], PK_TETFILL_CONTACT_TANGENT);
+    for (int i = 0; i < 4 && want("sweep_touching"); i++)
+        rc |= sweep_case(path, R[i], PK_TETFILL_CONTACT_TOUCHING);
     return rc ? 1 : 0;
 }

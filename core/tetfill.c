@@ -18,8 +18,9 @@
 
 void pk_tetfill_defaults(pk_tetfill_params *prm)
 {
-    *prm = (pk_tetfill_params){.eps = 1e-4, .z_min = 3, .vertex_weight = 0.5, .densify = 1,
-                               .neighbours = 8, .max_combos = 30, .max_passes = 1000};
+    *prm = (pk_tetfill_params){.eps = 1e-4, .z_min = 3, .contact_rule = PK_TETFILL_CONTACT_TANGENT,
+                               .vertex_weight = 0.5, .densify = 1, .neighbours = 8,
+                               .max_combos = 30, .max_passes = 1000};
 }
 
 typedef struct nb_sphere {
@@ -36,7 +37,8 @@ typedef struct filler {
     size_t first;        /* p's grains before this run (not ours) */
     pk_grid g;
     pk_rng rng;
-    double tau;          /* contact tolerance */
+    double tau;          /* contact tolerance (query reach) */
+    double zgap;         /* a gap <= zgap is a contact in the z_min test */
     double Rv;           /* virtual sphere radius */
     double V, solid;
     pk_monitor *mon;
@@ -268,9 +270,9 @@ static int try_candidate(filler *F, const double x[3], double r)
         rn = db + dmax;
     if (rn < prm->r_min)
         return 0;
-    int z = db - rn <= F->tau;
+    int z = db - rn <= F->zgap;
     for (size_t i = 0; i < F->nn; i++)
-        z += F->nd[i] - rn - F->nr[i] <= F->tau;
+        z += F->nd[i] - rn - F->nr[i] <= F->zgap;
     if (z < prm->z_min)
         return 0;
     return add_sphere(F, x, rn) == 0 ? 1 : -1;
@@ -377,7 +379,8 @@ static int try_locus(filler *F, const double q[3], int void_only)
                     }
                     int nroot;
                     F->st->solves++;
-                    if (pk_tangent_sphere(cc, rr, 1e-9 * prm->r_min, x, r, &nroot) ==
+                    if (pk_tangent_sphere(cc, rr, PK_TETFILL_TANGENT_TOL * prm->r_min, x, r,
+                                          &nroot) ==
                         PK_TANGENT_SINGULAR) {
                         F->st->singular++;
                         continue;
@@ -567,12 +570,16 @@ int pk_tetfill(const pk_mesh *m, const pk_tetfill_params *prm, pk_monitor *mon, 
     memset(st, 0, sizeof *st);
     st->reason = PK_STOP_ERROR;
     if (!(prm->r_min > 0) || !(prm->r_max >= prm->r_min) || !(prm->eps >= 0) ||
+        (prm->contact_rule != PK_TETFILL_CONTACT_TANGENT &&
+         prm->contact_rule != PK_TETFILL_CONTACT_TOUCHING) ||
         prm->neighbours < 4 || prm->neighbours > MAX_NB - MAX_PLANES || prm->max_combos < 1 ||
         !(m->volume > 0) || p->dim != 3)
         return -1;
     double t0 = pk_wall_seconds();
     filler F = {.m = m, .prm = prm, .p = p, .first = p->n, .mon = mon, .st = st, .V = m->volume};
     F.tau = fmax(prm->eps * prm->r_min, 1e-9 * prm->r_min);
+    /* touching (YADE SpherePadder place_fifth_sphere: distance <= 0) */
+    F.zgap = prm->contact_rule == PK_TETFILL_CONTACT_TOUCHING ? 0 : F.tau;
     F.Rv = 100 * m->edge_mean;
     F.prog.stage = "tetfill";
     F.prog.eta_s = -1;
@@ -600,6 +607,7 @@ int pk_tetfill(const pk_mesh *m, const pk_tetfill_params *prm, pk_monitor *mon, 
         goto out;
     st->n_geometric = p->n - F.first;
     st->phi_geometric = F.solid / F.V;
+    pk_tetfill_coordination(&F.g, p, F.first, prm->r_min, prm->eps, &st->geometric);
     st->seconds_geometric = pk_wall_seconds() - t0;
     if (!F.stop && prm->densify && densify(&F) != 0)
         goto out;

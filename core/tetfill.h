@@ -23,7 +23,8 @@
  *        (The paper locates the voids with a Delaunay triangulation of the
  *        centres; packd uses random loci per mesh tet instead — same solve,
  *        same acceptance — which keeps the cost linear and needs no
- *        triangulation.  The three-sphere fallback below is not tried in 7b.)
+ *        triangulation; docs/tetfill.md weighs the difference.  The
+ *        three-sphere fallback below is not tried in 7b.)
  *
  * Each locus: the `neighbours` spheres nearest by surface distance (a
  * core/grid.h query), plus the boundary planes in reach as virtual spheres
@@ -33,7 +34,8 @@
  * after reducing the radius so that no overlap with a sphere or a boundary
  * face exceeds ε·r_min ("in last resort", §2.1), still r >= r_min and it
  * touches at least z_min spheres or boundary faces (gap <= τ,
- * τ = max(ε r_min, 1e-9 r_min), spec §4.4).
+ * τ = max(ε r_min, 1e-9 r_min), spec §4.4; with the contact rule
+ * "touching", gap <= 0 as in Jerier's own code, see below).
  *
  * packd addition (not in the paper): when the four-sphere root exceeds r_max
  * (a hole bigger than the range allows — with ℓ ≈ 8 r̄ this is the rule, not
@@ -53,11 +55,26 @@
 #include "particles.h"
 #include "progress.h"
 #include "rsa.h"
+#include "tetfill_stats.h"
+
+/* What counts as a contact in the z_min test of a candidate.
+ *   TANGENT  gap <= τ: every tangency the solve constructs (default);
+ *   TOUCHING gap <= 0, no tolerance: Jerier's own code (YADE SpherePadder,
+ *            place_fifth_sphere: distance <= 0).  A solved tangency lands on
+ *            either side of 0 by round-off, so a candidate needs z_min of
+ *            its tangencies to round to the overlapping side: about 30 %
+ *            fewer spheres, and z (gap <= 0) ≈ 5 after steps 1–6 — the state
+ *            Jerier reports (docs/tetfill.md). */
+typedef enum pk_tetfill_contact_rule {
+    PK_TETFILL_CONTACT_TANGENT = 0,
+    PK_TETFILL_CONTACT_TOUCHING = 1
+} pk_tetfill_contact_rule;
 
 typedef struct pk_tetfill_params {
     double r_min, r_max;
     double eps;              /* maximum overlap rate ε: δ_max = ε r_min */
     int z_min;               /* minimum contacts of an inserted sphere (2, 3, 4) */
+    pk_tetfill_contact_rule contact_rule; /* the contact of the z_min test */
     double phi_target;       /* stop at this solid fraction (0 = none) */
     size_t n_target;         /* stop at this many spheres (0 = none) */
     uint64_t seed;           /* loci order and random radii: streams 0, 1 */
@@ -70,8 +87,9 @@ typedef struct pk_tetfill_params {
     size_t max_spheres;      /* hard limit (0 = none) */
 } pk_tetfill_params;
 
-/* Defaults: ε = 1e-4 (YADE), z_min = 3, w = 0.5, neighbours 8, 30 combos,
- * 1000 passes (7b ends at saturation well before), densify on. */
+/* Defaults: ε = 1e-4 (YADE), z_min = 3, contact rule tangent, w = 0.5,
+ * neighbours 8, 30 combos, 1000 passes (7b ends at saturation well before),
+ * densify on. */
 void pk_tetfill_defaults(pk_tetfill_params *prm);
 
 typedef struct pk_tetfill_stats {
@@ -80,6 +98,7 @@ typedef struct pk_tetfill_stats {
     size_t n_trimmed;        /* removed at the boundary (7a) */
     size_t n_geometric;      /* after steps 4–6 */
     double phi_geometric;    /* solid fraction after steps 4–6 */
+    pk_tetfill_coord geometric; /* coordination after steps 1–6 (before 7b) */
     size_t n_final;
     double phi;              /* final solid fraction (Σ V_i / V_mesh) */
     size_t loci, solves, singular, accepted, accepted_three;

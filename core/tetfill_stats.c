@@ -37,10 +37,54 @@ void pk_sym3_eigenvalues(const double a[9], double ev[3])
             }
 }
 
+int pk_tetfill_contact_kind(double gap, double r_min, double eps)
+{
+    return (gap <= fmax(eps, 1e-9) * r_min ? PK_CONTACT_TOL : 0) |
+           (gap <= PK_TETFILL_TANGENT_TOL * r_min ? PK_CONTACT_TANGENT : 0) |
+           (gap <= 0 ? PK_CONTACT_TOUCHING : 0);
+}
+
+typedef struct coord_ctx {
+    const pk_particles *p;
+    size_t i, first;
+    double r_min, eps;
+    pk_tetfill_coord *o;
+} coord_ctx;
+
+static int visit_coord(size_t j, const double dx[PK_MAXDIM], double d2, void *vctx)
+{
+    (void)dx;
+    coord_ctx *c = vctx;
+    if (j <= c->i || j < c->first || d2 <= 0)
+        return 0; /* each pair once */
+    int k = pk_tetfill_contact_kind(sqrt(d2) - c->p->r[c->i] - c->p->r[j], c->r_min, c->eps);
+    c->o->contacts += (k & PK_CONTACT_TOL) != 0;
+    c->o->tangent += (k & PK_CONTACT_TANGENT) != 0;
+    c->o->touching += (k & PK_CONTACT_TOUCHING) != 0;
+    return 0;
+}
+
+void pk_tetfill_coordination(const pk_grid *g, const pk_particles *p, size_t first, double r_min,
+                             double eps, pk_tetfill_coord *out)
+{
+    memset(out, 0, sizeof *out);
+    out->n = p->n - first;
+    coord_ctx c = {p, 0, first, r_min, eps, out};
+    double tau = fmax(eps, 1e-9) * r_min;
+    for (size_t i = first; i < p->n; i++) {
+        c.i = i;
+        pk_grid_query(g, p, &p->x[3 * i], p->r[i], tau, visit_coord, &c);
+    }
+    double n = out->n ? (double)out->n : 1;
+    out->z = 2.0 * (double)out->contacts / n;
+    out->z_tangent = 2.0 * (double)out->tangent / n;
+    out->z_touching = 2.0 * (double)out->touching / n;
+}
+
 typedef struct pair_ctx {
     const pk_particles *p;
     size_t i;
-    double r_min, bound, tau;
+    double r_min, eps, bound, tau;
     pk_tetfill_measures *o;
     int32_t *z;
     double osum;
@@ -60,9 +104,10 @@ static int visit_pair(size_t j, const double dx[PK_MAXDIM], double d2, void *vct
         if (-g > c->bound)
             o->pairs_over_bound++;
     }
-    if (g <= 0 && d > 0)
-        o->contacts_touching++;
-    if (g <= c->tau && d > 0) {
+    int kind = d > 0 ? pk_tetfill_contact_kind(g, c->r_min, c->eps) : 0;
+    o->contacts_touching += (kind & PK_CONTACT_TOUCHING) != 0;
+    o->contacts_tangent += (kind & PK_CONTACT_TANGENT) != 0;
+    if (kind & PK_CONTACT_TOL) {
         o->contacts++;
         c->z[c->i]++;
         c->z[j]++;
@@ -117,7 +162,7 @@ int pk_tetfill_measure(const pk_mesh *m, const pk_particles *p, double r_min, do
         rc = -1;
     for (size_t k = 0; k < nr && rc == 0; k++)
         o->region_id[k] = ids[k];
-    pair_ctx c = {p, 0, r_min, eps * r_min * (1 + 1e-9), fmax(eps * r_min, 1e-9 * r_min), o, z, 0};
+    pair_ctx c = {p, 0, r_min, eps, eps * r_min * (1 + 1e-9), fmax(eps, 1e-9) * r_min, o, z, 0};
     for (size_t i = 0; i < p->n && rc == 0; i++) {
         c.i = i;
         pk_grid_query(&g, p, &p->x[3 * i], p->r[i], c.tau, visit_pair, &c);
@@ -148,6 +193,7 @@ int pk_tetfill_measure(const pk_mesh *m, const pk_particles *p, double r_min, do
         o->overlap_mean = o->pairs_overlapping ? c.osum / (double)o->pairs_overlapping : 0;
         o->z_mean = p->n ? 2.0 * (double)o->contacts / (double)p->n : 0;
         o->z_touching = p->n ? 2.0 * (double)o->contacts_touching / (double)p->n : 0;
+        o->z_tangent = p->n ? 2.0 * (double)o->contacts_tangent / (double)p->n : 0;
         for (int k = 0; k < 9; k++)
             o->fabric[k] = o->contacts ? o->fabric[k] / (double)o->contacts : 0;
         pk_sym3_eigenvalues(o->fabric, o->fabric_eig);

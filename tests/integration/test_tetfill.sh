@@ -2,7 +2,8 @@
 # test_tetfill.sh — 'tetfill' jobs end to end: inline, Gmsh (MSH 2.2 / 4.1,
 # a cylinder freshly meshed by gmsh when it is installed, else the stored
 # one) and TetGen meshes filled through `packd run`; the result's audit and
-# observables; mesh errors refused by `packd validate` naming the element.
+# observables; mesh errors refused by `packd validate` naming the element;
+# the contact_rule option (default unchanged, "touching" = Jerier's state).
 set -u
 PACKD=${PACKD:-build/packd}
 SRC=${PACKD_SRC:-.}
@@ -68,6 +69,8 @@ h5dump -a /particles/grains/box/boundary "$T/cyl.h5" >"$T/bnd" 2>&1
 if grep -q 'DATASET "mesh_nodes"' "$T/cyl.dump" && grep -q 'DATASET "mesh_tets"' "$T/cyl.dump" &&
     grep -q 'DATASET "fabric_eigenvalues"' "$T/cyl.dump" && grep -q 'DATASET "coordination_histogram"' "$T/cyl.dump" &&
     grep -q 'DATASET "coordination_touching"' "$T/cyl.dump" &&
+    grep -q 'DATASET "coordination_tangent"' "$T/cyl.dump" &&
+    grep -q 'DATASET "coordination_tangent_geometric"' "$T/cyl.dump" &&
     grep -q '"none", "none", "none"' "$T/bnd"; then
     pass tetfill_result_layout
 else
@@ -133,3 +136,37 @@ JOB
 check_invalid tetfill_box_needs_radii "$T/nor.json" /inputs/tetfill radii "a box domain needs"
 job "$T/coarse.json" "{\"file\": \"$M/cube41.msh\"}" '{"r_min": 0.01, "r_max": 0.03}'
 check_invalid tetfill_mesh_scale "$T/coarse.json" /inputs/tetfill meshScale "mean radii"
+
+# 6. contact_rule (docs/job-format.md): the option absent and "tangent" give
+# the same packing bit for bit; "touching" (Jerier's gap <= 0) passes the same
+# audit, with z (gap <= 0) after steps 1–6 in [4.5, 5.5] (measured 4.66–5.05
+# over seeds and R = 2–7, docs/tetfill.md; this cube at R = 3, seed 5: 4.92),
+# φ after steps 1–6 < 0.55 (0.47) and fewer spheres than the default (0.68×)
+for r in none tangent touching; do
+    case $r in
+    none) o='{"ratio": 3, "densify": false}' ;;
+    *) o="{\"ratio\": 3, \"densify\": false, \"contact_rule\": \"$r\"}" ;;
+    esac
+    job "$T/rule_$r.json" "{\"file\": \"$M/cube41.msh\"}" "$o"
+    "$PACKD" run "$T/rule_$r.json" -o "$T/rule_$r.h5" >"$T/rule_$r.out" 2>"$T/rule_$r.err"
+    for d in position radius; do
+        h5dump -b LE -d /particles/grains/$d -o "$T/rule_$r.$d" "$T/rule_$r.h5" >/dev/null 2>&1
+    done
+done
+audit tetfill_touching_audit "$T/rule_touching.out"
+if cmp -s "$T/rule_none.position" "$T/rule_tangent.position" && test -s "$T/rule_none.position" &&
+    test -s "$T/rule_none.radius" && cmp -s "$T/rule_none.radius" "$T/rule_tangent.radius"; then
+    pass tetfill_default_rule_unchanged
+else
+    fail tetfill_default_rule_unchanged
+fi
+if python3 - "$T/rule_touching.out" "$T/rule_none.out" <<'PY'; then pass tetfill_touching_rule; else fail tetfill_touching_rule "$(head -c 400 "$T/rule_touching.out")"; fi
+import json, sys
+t = json.load(open(sys.argv[1])); d = json.load(open(sys.argv[2]))
+z = t["tetfill"]["coordination_touching_geometric"]
+assert 4.5 <= z <= 5.5, z
+assert t["tetfill"]["phi_geometric"] < 0.55, t["tetfill"]["phi_geometric"]
+assert t["count_placed"] < 0.8 * d["count_placed"], (t["count_placed"], d["count_placed"])
+PY
+job "$T/rule_bad.json" "{\"file\": \"$M/cube41.msh\"}" '{"ratio": 3, "contact_rule": "overlap"}'
+check_invalid tetfill_contact_rule_enum "$T/rule_bad.json" /inputs/tetfill/contact_rule enum "tangent"

@@ -162,11 +162,14 @@ static void test_cylinder_contract(void)
 /* Jerier §2.2 and §3.1 on his kind of mesh (a cube of ~1100 tets, ratio R,
  * r̄ = ℓ/8): after steps 1–6 φ < 0.55; fabric eigenvalues 1/3 ± 0.02 at
  * R = 2 and ± 0.01 at R >= 3; denser with larger R.  The coordination he
- * reports (≈ 5) lies between packd's two counts: z with contacts gap <= ε r_min
- * (each inserted sphere touches >= 3-4, so 6–7) and z_touching, gap <= 0 as
- * his SpherePadder counts (a tangency solved in floating point lands on either
- * side of 0, so about half: 3–3.6).  The bounds [4.5, 7.5] and z_touching in
- * (0.3, 0.7)·z catch a change of either contact rule. */
+ * reports (≈ 5, no tolerance given) lies between packd's counts (docs/tetfill.md):
+ * z_tangent (gap <= 1e-9 r_min, every solved tangency: each inserted sphere
+ * brings 3–4, so 5.8–6.8) and z_touching (gap <= 0 as his SpherePadder counts:
+ * a tangency solved in floating point lands on either side of 0, so about
+ * half: 3–3.6; the option contact_rule "touching" reaches ≈ 5, see
+ * test_touching_rule).  The bounds [4.5, 7.5] and z_touching in (0.3, 0.7)·z catch a
+ * change of either contact rule; the count the filler makes after steps 1–6
+ * must equal the independent measure exactly (same spheres, same rules). */
 static void test_jerier_states(void)
 {
     pk_mesh m;
@@ -191,6 +194,11 @@ static void test_jerier_states(void)
         CHECK_MSG(o.z_mean > 4.5 && o.z_mean < 7.5, "R = %g: z = %.3f", R[c], o.z_mean);
         CHECK_MSG(o.z_touching > 0.3 * o.z_mean && o.z_touching < 0.7 * o.z_mean,
                   "R = %g: z_touching = %.3f, z = %.3f", R[c], o.z_touching, o.z_mean);
+        CHECK_MSG(o.z_tangent > 4.5 && o.z_tangent <= o.z_mean && o.z_tangent >= o.z_touching,
+                  "R = %g: z_tangent = %.3f", R[c], o.z_tangent);
+        CHECK(st.geometric.n == p.n && st.geometric.contacts == o.contacts &&
+              st.geometric.tangent == o.contacts_tangent &&
+              st.geometric.touching == o.contacts_touching);
         pk_tetfill_measures_free(&o);
         /* densified (3 passes keep the test short; the fabric is settled) */
         prm.densify = 1;
@@ -310,11 +318,123 @@ static void test_cancel(void)
     pk_particles_free(&p);
 }
 
+/* Fraction of the spheres [first, n) with at least z_min contacts gap <= 0
+ * (spheres or boundary faces), by brute force: what the "touching" rule
+ * demands of every sphere it inserts (spheres are never moved or shrunk
+ * after their insertion, so later ones only add contacts). */
+static double touching_supported(const pk_mesh *m, const pk_particles *p, size_t first, int z_min)
+{
+    size_t ok = 0;
+    for (size_t i = first; i < p->n; i++) {
+        const double *x = &p->x[3 * i];
+        int z = 0;
+        for (size_t f = 0; f < m->nbface; f++) {
+            double q[3];
+            pk_closest_on_triangle(x, &m->x[3 * (size_t)m->bface[3 * f]],
+                                   &m->x[3 * (size_t)m->bface[3 * f + 1]],
+                                   &m->x[3 * (size_t)m->bface[3 * f + 2]], q);
+            double d = sqrt((x[0] - q[0]) * (x[0] - q[0]) + (x[1] - q[1]) * (x[1] - q[1]) +
+                            (x[2] - q[2]) * (x[2] - q[2]));
+            z += d - p->r[i] <= 0;
+        }
+        for (size_t j = 0; j < p->n; j++) {
+            const double *y = &p->x[3 * j];
+            double d = sqrt((x[0] - y[0]) * (x[0] - y[0]) + (x[1] - y[1]) * (x[1] - y[1]) +
+                            (x[2] - y[2]) * (x[2] - y[2]));
+            z += j != i && d - p->r[i] - p->r[j] <= 0;
+        }
+        ok += z >= z_min;
+    }
+    return p->n > first ? (double)ok / (double)(p->n - first) : 0;
+}
+
+/* contact_rule "touching" (tetfill.h; Jerier's YADE SpherePadder counts a
+ * contact when distance <= 0) on the cube at R = 2 and 7, steps 1–6, next to
+ * the default rule with the same seed:
+ *  - z counted with gap <= 0 is Jerier's "about 5": band [4.5, 5.5].  Measured
+ *    4.66–5.05 over seeds 0–2 and R = 2, 3, 5, 7 (spread over seeds <= 0.03
+ *    at each R; docs/tetfill.md), so the band holds with >= 0.16 to spare and
+ *    the default rule (3.0–3.6) falls outside it;
+ *  - φ < 0.55 (the paper's "generally lower than"; measured 0.42–0.48);
+ *  - fewer spheres than the default: N_touching < 0.8 N_tangent (measured
+ *    0.67–0.71: a candidate's tangencies round to either side of 0);
+ *  - the rule itself, by brute force: every sphere of steps 4–6 has >= z_min
+ *    contacts gap <= 0 (measured: all of them; the bound 0.99 leaves room for
+ *    a gap of ~1e-16 r_min whose sign the brute-force evaluation order flips);
+ *    with the default rule about 0.6 do (measured 0.61 at R = 2), so the
+ *    check tells the two rules apart (bound 0.9);
+ *  - the filler's own count after steps 1–6 equals the independent measure;
+ *  - the contract (containment, overlaps <= ε r_min) after 3 densification
+ *    passes at R = 3 (the spheres of steps 1–6 included). */
+static void test_touching_rule(void)
+{
+    pk_mesh m;
+    if (load("cube41.msh", &m) != 0) {
+        CHECK(0);
+        return;
+    }
+    const double R[2] = {2, 7};
+    for (int c = 0; c < 2; c++) {
+        size_t n[2];
+        for (int rule = 0; rule < 2; rule++) {
+            pk_tetfill_params prm;
+            pk_tetfill_defaults(&prm);
+            ratio_radii(&m, R[c], &prm);
+            prm.densify = 0;
+            prm.seed = 1;
+            prm.contact_rule = rule ? PK_TETFILL_CONTACT_TOUCHING : PK_TETFILL_CONTACT_TANGENT;
+            pk_particles p;
+            pk_particles_init(&p, 3, 16);
+            pk_tetfill_stats st;
+            CHECK(pk_tetfill(&m, &prm, NULL, &p, &st) == 0);
+            n[rule] = p.n;
+            if (rule == 0) { /* once is enough to tell the rules apart */
+                double f = c ? 0 : touching_supported(&m, &p, st.n_direct - st.n_trimmed, 3);
+                CHECK_MSG(f < 0.9, "R = %g, tangent: %.4f supported by gap <= 0", R[c], f);
+                pk_particles_free(&p);
+                continue;
+            }
+            double f = touching_supported(&m, &p, st.n_direct - st.n_trimmed, prm.z_min);
+            CHECK_MSG(f >= 0.99, "R = %g, touching: %.4f supported by gap <= 0", R[c], f);
+            double z = st.geometric.z_touching;
+            CHECK_MSG(z >= 4.5 && z <= 5.5, "R = %g: z (gap <= 0) after steps 1–6 = %.3f", R[c], z);
+            CHECK_MSG(st.phi_geometric < 0.55, "R = %g: φ after steps 1–6 = %.4f", R[c],
+                      st.phi_geometric);
+            pk_tetfill_measures o;
+            CHECK(pk_tetfill_measure(&m, &p, prm.r_min, prm.eps, &o) == 0);
+            CHECK(st.geometric.n == p.n && st.geometric.touching == o.contacts_touching &&
+                  st.geometric.tangent == o.contacts_tangent && o.pairs_over_bound == 0);
+            pk_tetfill_measures_free(&o);
+            pk_particles_free(&p);
+        }
+        CHECK_MSG((double)n[1] < 0.8 * (double)n[0], "R = %g: N touching %zu, tangent %zu", R[c],
+                  n[1], n[0]);
+    }
+    pk_tetfill_params prm;
+    pk_tetfill_defaults(&prm);
+    ratio_radii(&m, 3, &prm);
+    prm.contact_rule = PK_TETFILL_CONTACT_TOUCHING;
+    prm.max_passes = 3;
+    pk_particles p;
+    pk_particles_init(&p, 3, 16);
+    pk_tetfill_stats st;
+    CHECK(pk_tetfill(&m, &prm, NULL, &p, &st) == 0);
+    CHECK(st.n_final > st.n_geometric && p.n == st.n_final);
+    check_contract(&m, &p, &prm);
+    /* a rule the enum does not name is refused */
+    prm.contact_rule = (pk_tetfill_contact_rule)2;
+    p.n = 0;
+    CHECK(pk_tetfill(&m, &prm, NULL, &p, &st) == -1);
+    pk_particles_free(&p);
+    pk_mesh_free(&m);
+}
+
 int main(void)
 {
     RUN(test_box_contract);
     RUN(test_cylinder_contract);
     RUN(test_jerier_states);
+    RUN(test_touching_rule);
     RUN(test_densify_saturates);
     RUN(test_reproducible);
     RUN(test_targets);
