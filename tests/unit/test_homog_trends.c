@@ -101,25 +101,39 @@ static void test_periodic_shear_plateau(void)
     CHECK_MSG(taylor > 5 * level[0], "Taylor τ/p %g vs periodic plateau %g", taylor, level[0]);
 }
 
-/* Restricted Taylor, one shear cycle 0 → 0.3 → −0.3 → 0 at 1 % pre-compression:
- * the confined RVE dilates, so the mean normal stress ratchets up at each
- * return to F̄12 = 0 (§9.3), and σ12 shows a hysteresis (loading and
- * unloading through the same γ differ).  Margins: 5 % per crossing (measured:
- * +22 % and +8 % on this RVE), a hysteresis gap above 20 % of |σ12|. */
+/* Restricted Taylor, one shear cycle 0 → 0.3 → −0.3 → 0 at 1 % pre-compression,
+ * averaged over 5 RVEs of 150 grains (the thesis averages 15): the confined
+ * RVE dilates, so the mean normal stress p is higher when F̄12 first returns
+ * to 0 (§9.3 "ratchet"), and σ12 shows a hysteresis (loading and unloading
+ * through γ = 0.12 differ).  Single 150-grain RVEs disagree (measured p at
+ * the returns: +2 … +20 % at the first, −13 … +8 % at the second; which local
+ * minimum a step lands in depends on the solver's path), so the checks are
+ * on the means: +12 % at the first return (check: > 5 %), the loading σ12
+ * above the unloading one by 2.6× (check: > 1.5×).  The second return is
+ * flat on average (−0.2 %) and is printed, not checked.  The size of both
+ * effects depends on the relaxation path: a DR tuned with an accurate λ_min
+ * (measured, not landed) gives +3 % and 1.4× on the same RVEs — it lands
+ * more often back in the loading branch's minimum. */
 static void test_restricted_taylor_ratchet(void)
 {
-    enum { STEPS = 80 };
+    enum { STEPS = 80, RVES = 5 };
     static double sg[STEPS + 1][9], g[STEPS + 1];
-    shear_path(PK_BC_RESTRICTED_TAYLOR, 150, 3, 1, 0.3, STEPS, sg, g);
-    double p0 = -(sg[0][0] + sg[0][4]) / 2, p1 = -(sg[STEPS / 2][0] + sg[STEPS / 2][4]) / 2,
-           p2 = -(sg[STEPS][0] + sg[STEPS][4]) / 2;
-    printf("  restricted Taylor: p at F12 = 0: %.5f → %.5f → %.5f\n", p0, p1, p2);
-    CHECK_MSG(p1 > 1.05 * p0 && p2 > 1.05 * p1, "no ratchet: %g %g %g", p0, p1, p2);
-    /* γ = 0.12 on loading (k = 8) and on unloading (k = 32) */
-    CHECK_NEAR(g[8], g[32], 1e-12);
-    double up = sg[8][1], down = sg[32][1];
-    printf("  σ12 at γ = 0.12: loading %.5f, unloading %.5f\n", up, down);
-    CHECK_MSG(up - down > 0.2 * fabs(up), "no hysteresis: %g vs %g", up, down);
+    double p0 = 0, p1 = 0, p2 = 0, up = 0, down = 0;
+    for (int k = 0; k < RVES; k++) {
+        shear_path(PK_BC_RESTRICTED_TAYLOR, 150, 3 + (uint64_t)k, 1, 0.3, STEPS, sg, g);
+        p0 += -(sg[0][0] + sg[0][4]) / 2 / RVES;
+        p1 += -(sg[STEPS / 2][0] + sg[STEPS / 2][4]) / 2 / RVES;
+        p2 += -(sg[STEPS][0] + sg[STEPS][4]) / 2 / RVES;
+        /* γ = 0.12 on loading (k = 8) and on unloading (k = 32) */
+        CHECK_NEAR(g[8], g[32], 1e-12);
+        up += sg[8][1] / RVES;
+        down += sg[32][1] / RVES;
+    }
+    printf("  restricted Taylor, mean of %d RVEs: p at F12 = 0: %.5f → %.5f → %.5f\n", RVES, p0, p1,
+           p2);
+    printf("  mean σ12 at γ = 0.12: loading %.5f, unloading %.5f\n", up, down);
+    CHECK_MSG(p1 > 1.05 * p0, "no ratchet: %g → %g", p0, p1);
+    CHECK_MSG(up > 1.5 * down, "no hysteresis: %g vs %g", up, down);
 }
 
 int main(void)
