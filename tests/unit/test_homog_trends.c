@@ -78,7 +78,8 @@ static double mean_ratio(double (*sigma)[9], const double *gamma, int steps, dou
  * have a macroscopic friction τ/p of about 0.1 (Peyneau & Roux 2008 report
  * 0.10); on 10² grains the single-state noise is ±100 %, so the plateau is
  * the mean over γ ∈ [0.1, 0.3] (20 states) and the bands are wide: 0 < τ/p
- * < 0.2, the two RVE sizes within 0.05 of each other, Taylor ≥ 5× higher.
+ * < 0.2, the two RVE sizes within 0.05 of each other, Taylor ≥ 5× higher
+ * (measured over seeds 3–8: N = 100 0.038–0.062, N = 300 0.054–0.068).
  * A model without rearrangements (σ12 growing linearly) fails all three. */
 static void test_periodic_shear_plateau(void)
 {
