@@ -39,7 +39,7 @@ double pk_tridiag_min_eig(const double *a, const double *b, int m)
     return 0.5 * (lo + hi);
 }
 
-static double dot_mask(const double *u, const double *v, const uint8_t *mask, size_t np, int dim)
+double pk_homog_dot_mask(const double *u, const double *v, const uint8_t *mask, size_t np, int dim)
 {
     double s = 0;
     for (size_t i = 0; i < np; i++)
@@ -52,11 +52,11 @@ static double dot_mask(const double *u, const double *v, const uint8_t *mask, si
 double pk_homog_rayleigh(const pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *mask,
                          const double *v, double *work)
 {
-    double vv = dot_mask(v, v, mask, np, dim);
+    double vv = pk_homog_dot_mask(v, v, mask, np, dim);
     if (!(vv > 0))
         return NAN;
     pk_dem_kv(c, dim, np, E, mask, v, work);
-    return dot_mask(v, work, mask, np, dim) / vv;
+    return pk_homog_dot_mask(v, work, mask, np, dim) / vv;
 }
 
 double pk_homog_lanczos_min(const pk_dem_pairs *c, int dim, size_t np, double E,
@@ -84,18 +84,18 @@ double pk_homog_lanczos_min(const pk_dem_pairs *c, int dim, size_t np, double E,
                 h ^= h << 13, h ^= h >> 7, h ^= h << 17;
                 q[3 * i + a] = (double)(h >> 11) / 9007199254740992.0 - 0.5;
             }
-    double nq = sqrt(dot_mask(q, q, mask, np, dim));
+    double nq = sqrt(pk_homog_dot_mask(q, q, mask, np, dim));
     for (size_t k = 0; k < 3 * np; k++)
         q[k] /= nq;
     int m = 0;
     double beta = 0;
     for (int it = 0; it < steps; it++) {
         pk_dem_kv(c, dim, np, E, mask, q, w);
-        double alpha = dot_mask(q, w, mask, np, dim);
+        double alpha = pk_homog_dot_mask(q, w, mask, np, dim);
         for (size_t k = 0; k < 3 * np; k++)
             w[k] -= alpha * q[k] + beta * qp[k];
         al[m++] = alpha;
-        beta = sqrt(dot_mask(w, w, mask, np, dim));
+        beta = sqrt(pk_homog_dot_mask(w, w, mask, np, dim));
         if (!(beta > 1e-14 * fabs(alpha)) || it + 1 == steps)
             break;
         be[m - 1] = beta;

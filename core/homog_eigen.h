@@ -27,4 +27,7 @@ double pk_homog_rayleigh(const pk_dem_pairs *c, int dim, size_t np, double E, co
  * by Sturm bisection. */
 double pk_tridiag_min_eig(const double *a, const double *b, int m);
 
+/* u·v over the particles with mask[i] != 0 (stride-3 vectors, dim axes). */
+double pk_homog_dot_mask(const double *u, const double *v, const uint8_t *mask, size_t np, int dim);
+
 #endif

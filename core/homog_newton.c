@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "dem_rattler.h"
+#include "homog_eigen.h"
 #include "homog_stiffness.h"
 
 /* Stiffness added on rattler DOFs (× E): a rattler without contacts has no
@@ -48,16 +49,6 @@ static double dot(const double *a, const double *b, size_t n)
     for (size_t k = 0; k < n; k++)
         s += a[k] * b[k];
     return s;
-}
-
-static double norm_on(const double *f, const uint8_t *m, size_t np, int dim)
-{
-    double s = 0;
-    for (size_t i = 0; i < np; i++)
-        if (m[i])
-            for (int a = 0; a < dim; a++)
-                s += f[3 * i + a] * f[3 * i + a];
-    return sqrt(s);
 }
 
 /* Evaluate at x (rebuilding the candidate list when stale). */
@@ -221,7 +212,7 @@ int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doub
     memcpy(w.x0, x, 3 * np * sizeof *x);
     double phi;
     pk_dem_eval(c, g, x, r, np, E, w.f, &phi, NULL);
-    double f0 = norm_on(w.f, is_free, np, dim), fn = f0;
+    double f0 = sqrt(pk_homog_dot_mask(w.f, w.f, is_free, np, dim)), fn = f0;
     double target = fmax(prm->tol * f0, prm->abs_floor);
     double best = fn;
     size_t best_it = 0;
@@ -309,7 +300,7 @@ int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doub
                     solver->release(fac);
                     goto out;
                 }
-                ftn = norm_on(w.ft, is_free, np, dim);
+                ftn = sqrt(pk_homog_dot_mask(w.ft, w.ft, is_free, np, dim));
                 double lin = -s * gd; /* predicted decrease to first order */
                 if (lin <= ENERGY_ROUNDOFF * fabs(phi))
                     ok = ftn < fn; /* energy change lost in round-off */

@@ -25,16 +25,6 @@ int pk_dr_stop_ok(pk_dr_stop s)
     return s == PK_DR_CONVERGED || s == PK_DR_CONVERGED_ABS || s == PK_DR_NOT_NEEDED;
 }
 
-static double free_norm(const double *f, const uint8_t *is_free, size_t np, int dim)
-{
-    double s = 0;
-    for (size_t i = 0; i < np; i++)
-        if (is_free[i])
-            for (int a = 0; a < dim; a++)
-                s += f[3 * i + a] * f[3 * i + a];
-    return sqrt(s);
-}
-
 /* (4.47): Δt = 2/√(λmin+λmax), γ = 2√(λmin λmax/(λmin+λmax)) */
 static void optimal_params(pk_dr_stats *st)
 {
@@ -73,7 +63,7 @@ static int forces(const relax_sys *s, const double *x, const double *u, double *
 
 static double resid_norm(const relax_sys *s, const double *f, const double *gu)
 {
-    double a = free_norm(f, s->is_free, s->np, s->g->dim), b = 0;
+    double a = sqrt(pk_homog_dot_mask(f, f, s->is_free, s->np, s->g->dim)), b = 0;
     if (s->fc)
         for (size_t i = 0; i < s->np; i++)
             b += gu[i] * gu[i];
