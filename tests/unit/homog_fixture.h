@@ -30,6 +30,19 @@ static inline void diagF(double F[9], double a, double b, double c)
     F[0] = a, F[4] = b, F[8] = c;
 }
 
+/* One load step F from the RVE's reference state (a fresh committed state):
+ * *out (zeroed by the caller) gets the relaxed state.  pk_homog_eval's code. */
+static inline int step_from_reference(const pk_homog_rve *rve, const pk_homog_opts *o,
+                                      const double F[9], pk_homog_state *out, pk_homog_step *st)
+{
+    pk_homog_state s0;
+    if (pk_homog_state_init(rve, o, &s0) != 0)
+        return -1;
+    int rc = pk_homog_eval(rve, o, &s0, F, out, st, NULL);
+    pk_homog_state_free(&s0);
+    return rc;
+}
+
 /* Jammed periodic packing: n grains, radii in [0.8, 1.2], overlapping at
  * φ_nominal, relaxed to equilibrium (DR tol 1e-12). */
 static inline void make_jammed(int dim, size_t n, double phi, uint64_t seed, pk_box *b, pk_particles *p)
@@ -59,19 +72,17 @@ static inline void make_jammed(int dim, size_t n, double phi, uint64_t seed, pk_
     char err[128];
     CHECK(pk_homog_rve_build(b, p, PK_BC_PERIODIC, 1.0, &rve, err, sizeof err) == 0);
     pk_homog_opts o = opts(1.0);
-    pk_homog_state s0, tr = {0};
-    pk_homog_state_init(&rve, &o, &s0);
+    pk_homog_state tr = {0};
     double I[9];
     pk_m3_identity(I);
     pk_homog_step st;
-    CHECK(pk_homog_eval(&rve, &o, &s0, I, &tr, &st, NULL) == 0);
+    CHECK(step_from_reference(&rve, &o, I, &tr, &st) == 0);
     CHECK_MSG(pk_dr_stop_ok(st.dr.stop), "jamming relaxation: %s after %zu iterations",
               pk_dr_stop_name(st.dr.stop), st.dr.iterations);
     for (size_t i = 0; i < n; i++) {
         memcpy(&p->x[3 * i], &tr.x[3 * i], 3 * sizeof(double));
         pk_box_wrap(b, &p->x[3 * i]);
     }
-    pk_homog_state_free(&s0);
     pk_homog_state_free(&tr);
     pk_homog_rve_free(&rve);
 }
@@ -91,12 +102,9 @@ static inline void fixture_make_opts(fixture *fx, const pk_box *b, const pk_part
     char err[128];
     CHECK(pk_homog_rve_build(b, p, bc, 1.0, &fx->rve, err, sizeof err) == 0);
     fx->o = *o;
-    pk_homog_state s0;
     memset(&fx->s, 0, sizeof fx->s);
-    pk_homog_state_init(&fx->rve, &fx->o, &s0);
-    CHECK(pk_homog_eval(&fx->rve, &fx->o, &s0, F0, &fx->s, &fx->st, NULL) == 0);
+    CHECK(step_from_reference(&fx->rve, &fx->o, F0, &fx->s, &fx->st) == 0);
     CHECK(pk_dr_stop_ok(fx->st.dr.stop));
-    pk_homog_state_free(&s0);
 }
 
 static inline void fixture_make(fixture *fx, const pk_box *b, const pk_particles *p, pk_homog_bc bc,
