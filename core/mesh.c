@@ -144,6 +144,16 @@ static int check_tets(pk_mesh *m, pk_mesh_report *rep, char *err, size_t errlen)
     return 0;
 }
 
+/* Scratch records for the face and edge passes: at least one element so an
+ * empty mesh still gets a valid pointer; the error names what was counted. */
+static void *alloc_records(size_t n, size_t size, const char *what, char *err, size_t errlen)
+{
+    void *p = malloc((n ? n : 1) * size);
+    if (!p)
+        snprintf(err, errlen, "out of memory for %zu %s", n, what);
+    return p;
+}
+
 typedef struct face_rec {
     int32_t key[3];  /* sorted node indices */
     int32_t tet;
@@ -181,11 +191,9 @@ static int sort3(int32_t v[3])
 static int build_faces(pk_mesh *m, char *err, size_t errlen)
 {
     size_t nf = 4 * m->ntet;
-    face_rec *f = malloc((nf ? nf : 1) * sizeof *f);
-    if (!f) {
-        snprintf(err, errlen, "out of memory for %zu faces", nf);
+    face_rec *f = alloc_records(nf, sizeof *f, "faces", err, errlen);
+    if (!f)
         return -1;
-    }
     for (size_t e = 0; e < m->ntet; e++)
         for (int k = 0; k < 4; k++) {
             face_rec *r = &f[4 * e + (size_t)k];
@@ -295,11 +303,9 @@ static int cmp_edge(const void *a, const void *b)
 static int check_boundary(const pk_mesh *m, char *err, size_t errlen)
 {
     size_t ne = 3 * m->nbface;
-    edge_rec *r = malloc((ne ? ne : 1) * sizeof *r);
-    if (!r) {
-        snprintf(err, errlen, "out of memory for %zu boundary edges", ne);
+    edge_rec *r = alloc_records(ne, sizeof *r, "boundary edges", err, errlen);
+    if (!r)
         return -1;
-    }
     for (size_t f = 0; f < m->nbface; f++)
         for (int k = 0; k < 3; k++) {
             uint32_t a = (uint32_t)m->bface[3 * f + (size_t)k];

@@ -19,17 +19,22 @@ pk_config pk_service_config(pk_service *s)
     return c;
 }
 
+/* The next path segment at or after p: its start, and its length in *n
+ * (0 at the end of the path).  Runs of '/' count as one separator. */
+static const char *next_segment(const char *p, size_t *n)
+{
+    while (*p == '/')
+        p++;
+    *n = strcspn(p, "/");
+    return p;
+}
+
 /* Split the path into segments; -1 if too many/long or it contains "..". */
 static int split_path(pk_req *r, const char *url)
 {
     r->nseg = 0;
-    const char *p = url;
-    while (*p) {
-        while (*p == '/')
-            p++;
-        if (!*p)
-            break;
-        size_t n = strcspn(p, "/");
+    size_t n;
+    for (const char *p = next_segment(url, &n); n; p = next_segment(p + n, &n)) {
         if (r->nseg == PK_MAX_SEGMENTS || n >= sizeof r->seg[0])
             return -1;
         memcpy(r->seg[r->nseg], p, n);
@@ -37,7 +42,6 @@ static int split_path(pk_req *r, const char *url)
         if (!strcmp(r->seg[r->nseg], "..") || !strcmp(r->seg[r->nseg], "."))
             return -1;
         r->nseg++;
-        p += n;
     }
     return 0;
 }
@@ -45,19 +49,13 @@ static int split_path(pk_req *r, const char *url)
 static int match(const pk_req *r, const char *pattern)
 {
     int i = 0;
-    const char *p = pattern;
-    while (*p) {
-        while (*p == '/')
-            p++;
-        if (!*p)
-            break;
-        size_t n = strcspn(p, "/");
+    size_t n;
+    for (const char *p = next_segment(pattern, &n); n; p = next_segment(p + n, &n)) {
         if (i >= r->nseg)
             return 0;
         if (!(n == 1 && *p == '*') && (strlen(r->seg[i]) != n || strncmp(r->seg[i], p, n) != 0))
             return 0;
         i++;
-        p += n;
     }
     return i == r->nseg;
 }
