@@ -1,12 +1,14 @@
 /* pack_place_edmd.c — the 'edmd' placer: core/edmd (Lubachevsky–Stillinger
  * growth) with the job's "edmd" options; start from zero radii (Meier) or
- * from RSA at δ·d (Titscher/Kansal, core/rsa). */
+ * from RSA at δ·d (Titscher/Kansal, core/rsa); walls keep Δd/2 clearance or,
+ * with "wall_gap": "none", only the true grains inside (core/edmd_walls.h). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "edmd.h"
 #include "edmd_contacts.h"
+#include "edmd_walls.h"
 #include "pack_placer.h"
 
 static double num(json_t *o, const char *key, double def)
@@ -67,6 +69,9 @@ static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, pk_sche
     if (prm.growth == PK_EDMD_GROW_SHELL && prm.until == PK_EDMD_UNTIL_TARGET && !(job->delta_d > 0))
         pk_schema_errors_add(errs, "/delta_d", "consistent",
                              "shell growth to a target needs delta_d > 0 (or maximize: delta_d)");
+    if (strcmp(str(o, "wall_gap", "half"), "none") == 0 && !(job->delta_d > 0))
+        pk_schema_errors_add(errs, "/edmd/wall_gap", "consistent",
+                             "wall_gap none lets the shell reach delta_d/2 into the walls: needs delta_d > 0");
     /* the periodic edge > 2 (d_max + Δd) rule is the plan's (pack_job.c) */
 }
 
@@ -112,8 +117,12 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
             return -1;
         }
     }
+    /* "wall_gap": "none" (Titscher §6.3: Δd between grains only): the shell
+     * may reach Δd/2 of the job into the walls */
+    json_t *o = json_object_get(job->inputs, "edmd");
+    double w = strcmp(str(o, "wall_gap", "half"), "none") == 0 ? 0.5 * job->delta_d : 0;
     pk_edmd_stats es;
-    if (pk_edmd_run(&job->box, p, &prm, mon, &es) != 0) {
+    if (pk_edmd_run_shell_in_walls(&job->box, w, p, &prm, mon, &es) != 0) {
         snprintf(err, errlen, "EDMD failed (bad parameters, periodic box too small or out of memory)");
         return -1;
     }
@@ -135,7 +144,7 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
         return -1;
     }
     *st = (pk_place_stats){.reason = es.reason, .placed = p->n, .requested = sz->n,
-                           .seconds = es.seconds};
+                           .seconds = es.seconds, .walls_touch = w > 0};
     json_t *obs = json_object();
     json_object_set_new(obs, "phi_final", json_real(es.phi));
     json_object_set_new(obs, "phi_shell", json_real(es.phi_sim));
@@ -144,6 +153,7 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
         json_object_set_new(obs, "phi_jamming_estimate", json_real(es.phi_jam_estimate));
     json_object_set_new(obs, "termination_criterion", json_string(pk_edmd_criterion_name(es.criterion)));
     json_object_set_new(obs, "delta_d_reached", json_real(es.delta_d));
+    json_object_set_new(obs, "wall_gap_guaranteed", json_real(fmax(0.5 * es.delta_d - w, 0)));
     json_object_set_new(obs, "time_simulated", json_real(es.t_stop));
     if (isfinite(es.t_end))
         json_object_set_new(obs, "time_end", json_real(es.t_end));

@@ -30,6 +30,8 @@ typedef struct pk_place_stats {
     pk_box domain_box;
     double domain_measure;
     double overlap_tol;   /* overlaps the placer allows by design (0 = hard grains) */
+    int walls_touch;      /* 1: Δd between grains only, grains may touch the walls
+                           * (edmd "wall_gap": "none", Titscher §6.3); 0: walls ≥ Δd/2 */
     /* Bulk datasets too large for obs (e.g. the mesh): written under
      * /observables/<algorithm>/ by write_extra, released by free_extra. */
     void *extra;
