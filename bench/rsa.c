@@ -7,11 +7,15 @@
  * along (batch_plain_draws: the packing of plain draws, bit for bit); *_plain
  * runs the reference (one uniform draw at a time, pk_rsa_params.plain_draws)
  * and *_voxels the per-grain voxel-pruned path (no_batch) for the ratios;
- * 1e6 plain and voxels are left out (a minute / 20 s). */
+ * 1e6 plain and voxels are left out (a minute / 20 s).  maxrss_kb: the
+ * process's peak resident memory so far (the 1e6 cases come last).
+ * `rsa mono` runs only the default-path monodisperse cases (1e4, 1e5, 1e6)
+ * and the scaling line: a quick re-measurement. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 
 #include "pack_job.h"
 #include "process.h"
@@ -37,8 +41,12 @@ static double mono(const char *name, int dim, size_t n, double phi, enum path pa
     pk_rsa_stats st;
     pk_rsa_place(&b, d, sp, n, &prm, NULL, &p, &st);
     double rate = (double)st.placed / st.seconds;
-    printf("bench=rsa case=%s n=%zu placed=%zu seconds=%.3f rate=%.0f draws_per_grain=%.3f\n", name,
-           n, st.placed, st.seconds, rate, (double)st.draws / (double)(st.placed ? st.placed : 1));
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    printf("bench=rsa case=%s n=%zu placed=%zu seconds=%.3f rate=%.0f draws_per_grain=%.3f "
+           "maxrss_kb=%ld\n",
+           name, n, st.placed, st.seconds, rate,
+           (double)st.draws / (double)(st.placed ? st.placed : 1), (long)ru.ru_maxrss);
     fflush(stdout);
     free(d);
     free(sp);
@@ -78,6 +86,14 @@ static void job_case(const char *name, const char *path)
 
 int main(int argc, char **argv)
 {
+    if (argc > 1 && strcmp(argv[1], "mono") == 0) {
+        double r4 = mono("mono3d_phi030_1e4", 3, 10000, 0.30, BATCHED);
+        double r5 = mono("mono3d_phi030_1e5", 3, 100000, 0.30, BATCHED);
+        double r6 = mono("mono3d_phi030_1e6", 3, 1000000, 0.30, BATCHED);
+        printf("bench=rsa case=scaling rate_ratio_1e6_over_1e4=%.3f rate_ratio_1e5_over_1e4=%.3f\n",
+               r6 / r4, r5 / r4);
+        return 0;
+    }
     const char *src = getenv("PACKD_SRC");
     char path[1024];
     snprintf(path, sizeof path, "%s/examples/din-a16-3d-walled.json", src ? src : ".");

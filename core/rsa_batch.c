@@ -9,7 +9,10 @@
 
 /* Batch size: enough attempts that the cell-ordered tests share cache lines
  * (B_MIN), few enough survivors that step 3's hash stays in cache
- * (SURVIVORS), bounded memory (B_MAX attempts ≈ 60 MB of scratch). */
+ * (SURVIVORS), bounded memory (B_MAX draws: 9 bytes of scratch per region
+ * draw, ~130 per attempt — region draws rejected at once make no attempt).
+ * Four times larger caps on both cut the cache misses at 10^6 grains by 18 %
+ * for 14 % more instructions (cachegrind): kept as they are. */
 #define B_MIN 4096
 #define B_MAX ((size_t)1 << 20)
 #define SURVIVORS 32768.0
@@ -45,7 +48,8 @@ int pk_rsa_batch_usable(const pk_box *b, double r, double gap, const double *lo,
 }
 
 typedef struct scratch {
-    size_t cap;
+    size_t cap;         /* attempts */
+    size_t capd;        /* region draws (rpos, rbit, rsort) */
     double *pos;        /* [cap][3] attempts in attempt order */
     uint32_t *rpos;     /* region draws: list position, then cell, of each draw */
     uint8_t *rbit;      /* its fine voxel, RBIT_CHEAP when rejected at once */
@@ -61,6 +65,7 @@ typedef struct scratch {
     int32_t *slot;      /* survivor number of attempt a (set where sbit is) */
     double *surv;       /* [cap][3] survivors in sorted order */
     uint8_t *taken;     /* survivor accepted in step 3 */
+    uint32_t *pid;      /* its index in the particle array (set where taken is) */
     uint32_t *count;    /* [MAX_BUCKETS + 1] */
     /* step 3: hash of the batch's accepted survivors by cell */
     int32_t *head;      /* [power of two >= 2 cap] */
@@ -84,6 +89,7 @@ static void scratch_free(scratch *w)
     free(w->slot);
     free(w->surv);
     free(w->taken);
+    free(w->pid);
     free(w->count);
     free(w->head);
     free(w->hnext);
@@ -100,6 +106,21 @@ static void *grow(void *p, size_t bytes, int *fail)
     return q ? q : p;
 }
 
+/* Room for region batches of B draws (grows only; -1 when out of memory). */
+static int scratch_reserve_draws(scratch *w, size_t B)
+{
+    if (B <= w->capd)
+        return 0;
+    int fail = 0;
+    w->rpos = grow(w->rpos, B * sizeof *w->rpos, &fail);
+    w->rbit = grow(w->rbit, B, &fail);
+    w->rsort = grow(w->rsort, B * sizeof *w->rsort, &fail);
+    if (fail)
+        return -1;
+    w->capd = B;
+    return 0;
+}
+
 /* Room for batches of B attempts (grows only; -1 when out of memory). */
 static int scratch_reserve(scratch *w, size_t B)
 {
@@ -111,9 +132,6 @@ static int scratch_reserve(scratch *w, size_t B)
     int fail = 0;
     w->pos = grow(w->pos, 3 * B * sizeof *w->pos, &fail);
     w->ord = grow(w->ord, (B + 1) * sizeof *w->ord, &fail);
-    w->rpos = grow(w->rpos, B * sizeof *w->rpos, &fail);
-    w->rbit = grow(w->rbit, B, &fail);
-    w->rsort = grow(w->rsort, B * sizeof *w->rsort, &fail);
     w->key = grow(w->key, B * sizeof *w->key, &fail);
     w->spos = grow(w->spos, 3 * B * sizeof *w->spos, &fail);
     w->sidx = grow(w->sidx, B * sizeof *w->sidx, &fail);
@@ -123,6 +141,7 @@ static int scratch_reserve(scratch *w, size_t B)
     w->slot = grow(w->slot, B * sizeof *w->slot, &fail);
     w->surv = grow(w->surv, 3 * B * sizeof *w->surv, &fail);
     w->taken = grow(w->taken, B, &fail);
+    w->pid = grow(w->pid, B * sizeof *w->pid, &fail);
     w->count = grow(w->count, (MAX_BUCKETS + 1) * sizeof *w->count, &fail);
     w->head = grow(w->head, hb * sizeof *w->head, &fail);
     w->hnext = grow(w->hnext, B * sizeof *w->hnext, &fail);
@@ -138,25 +157,39 @@ static inline uint64_t hash_cell(uint64_t lin, uint64_t mask)
     return (lin * 0x9E3779B97F4A7C15ull) >> 20 & mask;
 }
 
+/* The batch's occupancy map: bit lin is set while a survivor accepted in
+ * this batch lies in (real) cell lin — most survivors have no such neighbour,
+ * and 9 (3D) reads of three adjacent bits say so without hashing. */
+static inline int occupied(const uint8_t *map, uint64_t lin)
+{
+    return map[lin >> 3] >> (lin & 7) & 1;
+}
+
 /* Step 3's test: is survivor x (key: pk_rsa_cells_key) within contact of a
  * survivor accepted earlier in this batch?  Off the seams the neighbours are
  * the fixed offsets of the filter; ghost cells never match a stored cell. */
-static int batch_hits(const pk_rsa_cells *C, const scratch *w, uint64_t hmask, const double *x,
-                      uint32_t key)
+static int batch_hits(const pk_rsa_cells *C, const scratch *w, const uint8_t *map, uint64_t hmask,
+                      const double *x, uint32_t key)
 {
     uint64_t nb[27];
     int m;
-    if (C->cell[pk_rsa_cells_index(key)].seam) {
+    if (pk_rsa_cells_seam(C, x)) {
         m = pk_rsa_cells_around(C, x, nb);
     } else {
+        const uint64_t lin = pk_rsa_cells_index(key);
+        unsigned any = 0;
+        for (int r = 0; r < C->nrow; r++)
+            any |= pk_rsa_cells_bits3(map, lin + (uint64_t)C->row[r]);
+        if (!any)
+            return 0;
         const int64_t *off = C->off[pk_rsa_cells_octant(key)];
-        nb[0] = pk_rsa_cells_index(key);
         for (int q = 0; q < C->noff; q++)
-            nb[q + 1] = (uint64_t)((int64_t)nb[0] + off[q]);
-        m = C->noff + 1;
+            nb[q] = (uint64_t)((int64_t)lin + off[q]);
+        m = C->noff;
     }
     for (int q = 0; q < m; q++)
-        for (int32_t j = w->head[hash_cell(nb[q], hmask)]; j >= 0; j = w->hnext[j])
+        for (int32_t j = occupied(map, nb[q]) ? w->head[hash_cell(nb[q], hmask)] : -1; j >= 0;
+             j = w->hnext[j])
             if (w->hcell[j] == nb[q] && pk_rsa_cells_close(C, &w->surv[3 * (size_t)j], x))
                 return 1;
     return 0;
@@ -168,9 +201,10 @@ static int batch_hits(const pk_rsa_cells *C, const scratch *w, uint64_t hmask, c
  * look their marks up in list order (a counting sort by list position: the
  * list and the marks are read as streams, not at random — that is what keeps
  * large runs fast), flagging the certain rejections.  w->rpos[d] becomes the
- * cell of draw d. */
-static void region_pick(const pk_rsa_region *reg, scratch *w, size_t B, pk_rng *g)
+ * cell of draw d.  Returns the number of draws not rejected. */
+static size_t region_pick(const pk_rsa_region *reg, scratch *w, size_t B, pk_rng *rng)
 {
+    pk_rng g0 = *rng, *g = &g0; /* a local copy: in registers, whatever the stores below */
     int sh = 0;
     while (((reg->nlist - 1) >> sh) >= MAX_BUCKETS)
         sh++;
@@ -184,26 +218,42 @@ static void region_pick(const pk_rsa_region *reg, scratch *w, size_t B, pk_rng *
         w->rbit[d] = (uint8_t)bit;
         count[(q >> sh) + 1]++;
     }
+    *rng = g0;
     for (uint32_t k = 0; k < nb; k++)
         count[k + 1] += count[k];
     for (size_t d = 0; d < B; d++)
         w->rsort[count[w->rpos[d] >> sh]++] = (uint32_t)d;
+    const uint32_t *list = reg->list;
+    const uint64_t *covered = reg->covered;
+    size_t open = 0;
     for (size_t t = 0; t < B; t++) {
-        uint32_t d = w->rsort[t], cell = reg->list[w->rpos[d]];
+        uint32_t d = w->rsort[t], cell = list[w->rpos[d]];
         w->rpos[d] = cell;
-        if (reg->covered[cell] >> w->rbit[d] & 1)
+        uint64_t hit = covered[cell] >> w->rbit[d] & 1;
+        open += !hit;
+        if (hit)
             w->rbit[d] = RBIT_CHEAP;
     }
+    return open;
 }
 
 /* Steps 1–2 for B draws: draw, sort by cell bucket, filter against the
  * store.  Plain draws make B attempts; region draws (reg != NULL) skip the
  * certain rejections: *A attempts, w->ord[a] the draw number of attempt a,
- * w->ord[*A] = B.  Returns the number of survivors. */
-static size_t draw_and_filter(const pk_rsa_cells *C, scratch *w, size_t B, int dim,
-                              const double *lo, const double *span, pk_rng *rng, int shift,
-                              uint32_t nbucket, const pk_rsa_region *reg, size_t *A)
+ * w->ord[*A] = B.  Returns the number of survivors, SIZE_MAX when out of
+ * memory. */
+static size_t draw_and_filter(const pk_rsa_cells *C, const double *px, scratch *w, size_t B,
+                              int dim, const double *lo, const double *span, pk_rng *rng,
+                              int shift, uint32_t nbucket, const pk_rsa_region *reg, size_t *A)
 {
+    if (reg) { /* the certain rejections need no room beyond the draw arrays */
+        if (scratch_reserve_draws(w, B) != 0)
+            return SIZE_MAX;
+        if (scratch_reserve(w, region_pick(reg, w, B, rng)) != 0)
+            return SIZE_MAX;
+    } else if (scratch_reserve(w, B) != 0) {
+        return SIZE_MAX;
+    }
     const double lo0 = lo[0], lo1 = lo[1], lo2 = lo[2], sp0 = span[0], sp1 = span[1];
     const double sp2 = dim == 3 ? span[2] : 0;
     /* local copies: the stores below cannot alias them, so the generator state
@@ -214,7 +264,6 @@ static size_t draw_and_filter(const pk_rsa_cells *C, scratch *w, size_t B, int d
     uint32_t *restrict keys = w->key, *restrict ord = w->ord;
     size_t a = 0;
     if (reg) {
-        region_pick(reg, w, B, &g);
         for (size_t d = 0; d < B; d++) {
             double x[3];
             if (w->rbit[d] == RBIT_CHEAP)
@@ -254,7 +303,7 @@ static size_t draw_and_filter(const pk_rsa_cells *C, scratch *w, size_t B, int d
         w->sidx[t] = (uint32_t)q;
         w->skey[t] = key;
     }
-    size_t S = pk_rsa_cells_filter(C, w->spos, w->skey, B, w->kept);
+    size_t S = pk_rsa_cells_filter(C, px, w->spos, w->skey, B, w->kept);
     memset(w->sbit, 0, (B / 64 + 1) * sizeof *w->sbit);
     for (size_t j = 0; j < S; j++) {
         uint32_t t = w->kept[j], q = w->sidx[t];
@@ -301,10 +350,18 @@ static int region_start(pk_rsa_region *reg, const pk_rsa_cells *C, const pk_box 
                 &C->cell[C->base + (uint64_t)z * C->stride[2] + (uint64_t)y * C->stride[1]];
             for (int64_t x = 0; x < C->n[0]; x++) {
                 const pk_rsa_cell2 *cl = &row[x];
-                for (int q = 0; q < cl->n && q < 2; q++)
-                    pk_rsa_region_mark(reg, cl->x[q]);
-                for (int32_t e = cl->more; e >= 0; e = C->extra[e].next)
-                    pk_rsa_region_mark(reg, C->extra[e].x);
+                uint32_t a = cl->id[0], b2 = cl->id[1];
+                if (a == PK_RSA_CELLS_NONE)
+                    continue;
+                pk_rsa_region_mark(reg, &out->x[3 * (size_t)a]);
+                if (b2 == PK_RSA_CELLS_NONE)
+                    continue;
+                if (!(b2 & PK_RSA_CELLS_MORE))
+                    pk_rsa_region_mark(reg, &out->x[3 * (size_t)b2]);
+                else
+                    for (int32_t e = (int32_t)(b2 & ~PK_RSA_CELLS_MORE); e >= 0;
+                         e = C->extra[e].next)
+                        pk_rsa_region_mark(reg, &out->x[3 * (size_t)C->extra[e].id]);
             }
         }
     pk_rsa_region_compact(reg);
@@ -328,6 +385,11 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
         return PK_STOP_ERROR;
     scratch w;
     memset(&w, 0, sizeof w);
+    uint8_t *map = calloc(C.ncell / 8 + 16, 1);
+    if (!map) {
+        pk_rsa_cells_free(&C);
+        return PK_STOP_ERROR;
+    }
     int shift = 0;
     while (((C.ncell - 1) >> shift) >= MAX_BUCKETS)
         shift++;
@@ -371,14 +433,14 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
             reason = cc == 2 ? PK_STOP_WALL_TIME : PK_STOP_CANCELLED;
             break;
         }
-        if (scratch_reserve(&w, B) != 0) {
+        pk_rng start = *rng;
+        size_t A;
+        size_t S = draw_and_filter(&C, out->x, &w, B, b->dim, lo, span, rng, shift, nbucket,
+                                   region ? &reg : NULL, &A);
+        if (S == SIZE_MAX) {
             reason = PK_STOP_ERROR;
             break;
         }
-        pk_rng start = *rng;
-        size_t A;
-        size_t S = draw_and_filter(&C, &w, B, b->dim, lo, span, rng, shift, nbucket,
-                                   region ? &reg : NULL, &A);
 
         /* step 3: attempt order */
         uint64_t hmask = 63;
@@ -413,7 +475,7 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
             int32_t j = w.slot[cur];
             const double *x = &w.surv[3 * (size_t)j];
             uint32_t key = pk_rsa_cells_key(&C, x);
-            int ok = !batch_hits(&C, &w, hmask, x, key) &&
+            int ok = !batch_hits(&C, &w, map, hmask, x, key) &&
                      (grid_empty || !pk_grid_overlaps(grid, out, x, r));
             if (!ok) {
                 if (++failed >= max_failed) {
@@ -423,11 +485,13 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
                 }
                 continue;
             }
-            if (pk_particles_push(out, x, r, species[placed]) == (size_t)-1) {
+            size_t idx = pk_particles_push(out, x, r, species[placed]);
+            if (idx == (size_t)-1 || idx >= PK_RSA_CELLS_MORE) {
                 used = next_d;
                 reason = PK_STOP_ERROR;
                 break;
             }
+            w.pid[j] = (uint32_t)idx;
             failed = 0;
             placed++;
             acc++;
@@ -435,6 +499,7 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
             w.taken[j] = 1;
             uint64_t lin = pk_rsa_cells_index(key), h = hash_cell(lin, hmask);
             w.hcell[j] = lin;
+            map[lin >> 3] |= (uint8_t)(1u << (lin & 7));
             w.hnext[j] = w.head[h];
             w.head[h] = j;
             if (placed == m) {
@@ -459,7 +524,8 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
          * the region marks the new grains' exclusion balls */
         for (size_t j = 0; j < S; j++)
             if (w.taken[j]) {
-                if (pk_rsa_cells_insert(&C, &w.surv[3 * j]) != 0) {
+                map[w.hcell[j] >> 3] = 0; /* the occupancy map is empty again */
+                if (pk_rsa_cells_insert(&C, &w.surv[3 * j], w.pid[j]) != 0) {
                     reason = PK_STOP_ERROR;
                     break;
                 }
@@ -475,6 +541,7 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
     }
     pk_rsa_region_free(&reg);
     scratch_free(&w);
+    free(map);
     pk_rsa_cells_free(&C);
     return reason;
 }

@@ -56,11 +56,14 @@ int pk_rsa_cells_init(pk_rsa_cells *C, const pk_box *b, double r, double gap, co
         C->lo[k] = lo[k];
         C->n[k] = axis_cells(span[k], 2 * r + gap);
         C->np[k] = C->n[k] + 2;
+        C->h[k] = span[k] / (double)C->n[k];
         C->inv_h[k] = span[k] > 0 ? (double)C->n[k] / span[k] : 0;
         C->inv_h2[k] = span[k] > 0 ? (double)(2 * C->n[k]) / span[k] : 0;
         C->jmax[k] = 2 * C->n[k] - 1;
     }
     C->ncell = nc;
+    C->s2_lo = C->s2 * (1 - PK_RSA_CELLS_BAND);
+    C->s2_hi = C->s2 * (1 + PK_RSA_CELLS_BAND);
     uint64_t stride = 1;
     for (int k = 0; k < PK_MAXDIM; k++) {
         C->stride[k] = stride;
@@ -68,25 +71,16 @@ int pk_rsa_cells_init(pk_rsa_cells *C, const pk_box *b, double r, double gap, co
         stride *= (uint64_t)C->np[k];
     }
     set_offsets(C);
-    /* one record = one cache line */
-    C->cell = aligned_alloc(64, nc * sizeof *C->cell);
+    /* two records to a cache line; all slots empty (0xff bytes: PK_RSA_CELLS_NONE) */
+    C->cell = aligned_alloc(64, (nc * sizeof *C->cell + 63) / 64 * 64);
     if (!C->cell)
         return -1;
-    for (uint64_t i = 0; i < nc; i++) {
-        C->cell[i].n = 0;
-        C->cell[i].more = -1;
+    memset(C->cell, 0xff, nc * sizeof *C->cell);
+    C->occ = calloc(nc / 8 + 16, 1);
+    if (!C->occ) {
+        pk_rsa_cells_free(C);
+        return -1;
     }
-    /* seam flags (rsa_cells.h) of the padded cells; ghosts are never a query's own cell */
-    uint64_t i = 0;
-    for (int64_t z = 0; z < C->np[2]; z++)
-        for (int64_t y = 0; y < C->np[1]; y++)
-            for (int64_t x = 0; x < C->np[0]; x++, i++) {
-                int64_t c[3] = {x - 1, y - 1, z - 1}; /* real coordinates */
-                int seam = 0;
-                for (int k = 0; k < C->dim; k++)
-                    seam |= C->periodic[k] && (C->n[k] < 4 || c[k] <= 0 || c[k] >= C->n[k] - 1);
-                C->cell[i].seam = seam;
-            }
     return 0;
 }
 
@@ -107,15 +101,27 @@ static int offset_rank(int dim, const int d[3], unsigned oct)
 static void set_offsets(pk_rsa_cells *C)
 {
     int zr = C->dim == 3 ? 1 : 0;
+    C->nrow = zr ? 9 : 3;
+    for (int r = 0; r < C->nrow; r++)
+        C->row[r] = (int64_t)(r / 3 - zr) * (int64_t)C->stride[2] +
+                    (int64_t)(r % 3 - 1) * (int64_t)C->stride[1] - 1;
     for (unsigned oct = 0; oct < 8; oct++) {
         int cnt = 0;
-        for (int rank = 1; rank < 16; rank++)
+        for (int rank = 0; rank < 16; rank++) /* rank 0: the cell itself */
             for (int dz = -zr; dz <= zr; dz++)
                 for (int dy = -1; dy <= 1; dy++)
                     for (int dx = -1; dx <= 1; dx++) {
                         int d[3] = {dx, dy, dz};
-                        if ((dx || dy || dz) && offset_rank(C->dim, d, oct) == rank)
+                        if (offset_rank(C->dim, d, oct) == rank) {
+                            int r = (dz + zr) * 3 + dy + 1;
+                            for (unsigned pat = 0; pat < 8; pat++)
+                                if (pat >> (dx + 1) & 1)
+                                    C->order[oct][r][pat] |= 1u << cnt;
+                            C->shift[oct][cnt][0] = dx * C->h[0];
+                            C->shift[oct][cnt][1] = dy * C->h[1];
+                            C->shift[oct][cnt][2] = dz * C->h[2];
                             C->off[oct][cnt++] = ((int64_t)dz * C->np[1] + dy) * C->np[0] + dx;
+                        }
                     }
         C->noff = cnt;
     }
@@ -124,6 +130,7 @@ static void set_offsets(pk_rsa_cells *C)
 void pk_rsa_cells_free(pk_rsa_cells *C)
 {
     free(C->cell);
+    free(C->occ);
     free(C->extra);
     memset(C, 0, sizeof *C);
 }
@@ -154,38 +161,74 @@ int pk_rsa_cells_around(const pk_rsa_cells *C, const double *x, uint64_t out[27]
     return cnt;
 }
 
-static int store(pk_rsa_cells *C, uint64_t lin, const double *p)
+int pk_rsa_cells_seam(const pk_rsa_cells *C, const double *x)
 {
-    pk_rsa_cell2 *c = &C->cell[lin];
-    if (c->n < 2) {
-        memcpy(c->x[c->n], p, 3 * sizeof *p);
-    } else {
-        if (C->nextra == C->capextra) {
-            size_t cap = C->capextra ? 2 * C->capextra : 1024;
-            pk_rsa_extra *e = realloc(C->extra, cap * sizeof *e);
-            if (!e)
-                return -1;
-            C->extra = e;
-            C->capextra = cap;
-        }
-        pk_rsa_extra *e = &C->extra[C->nextra];
-        memcpy(e->x, p, 3 * sizeof *p);
-        e->next = c->more;
-        c->more = (int32_t)C->nextra++;
+    /* Off the seams every neighbour is nearer than 2h <= L/2 on each periodic
+     * axis, where the hash's fixed offsets hold (no image needed). */
+    for (int k = 0; k < C->dim; k++) {
+        if (!C->periodic[k])
+            continue;
+        int64_t i = (int64_t)(pk_rsa_cells_half(C, k, x[k]) >> 1);
+        if (C->n[k] < 4 || i == 0 || i == C->n[k] - 1)
+            return 1;
     }
-    c->n++;
     return 0;
 }
 
-int pk_rsa_cells_insert(pk_rsa_cells *C, const double *x)
+static int store(pk_rsa_cells *C, uint64_t lin, const float *f, uint32_t id)
 {
-    double p[3] = {x[0], x[1], C->dim == 3 ? x[2] : 0};
+    pk_rsa_cell2 *c = &C->cell[lin];
+    C->occ[lin >> 3] |= (uint8_t)(1u << (lin & 7));
+    if (c->id[0] == PK_RSA_CELLS_NONE) {
+        memcpy(c->x[0], f, 3 * sizeof *f);
+        c->id[0] = id;
+        return 0;
+    }
+    if (c->id[1] == PK_RSA_CELLS_NONE) {
+        memcpy(c->x[1], f, 3 * sizeof *f);
+        c->id[1] = id;
+        return 0;
+    }
+    /* a third grain: the second slot's grain moves to the pool, the chain starts there */
+    int first = !(c->id[1] & PK_RSA_CELLS_MORE);
+    if (C->nextra + 2 > C->capextra) {
+        size_t cap = C->capextra ? 2 * C->capextra : 1024;
+        pk_rsa_extra *e = realloc(C->extra, cap * sizeof *e);
+        if (!e)
+            return -1;
+        C->extra = e;
+        C->capextra = cap;
+    }
+    if (C->nextra + 2 >= PK_RSA_CELLS_MORE)
+        return -1;
+    if (first) {
+        pk_rsa_extra *e = &C->extra[C->nextra];
+        memcpy(e->x, c->x[1], sizeof e->x);
+        e->id = c->id[1];
+        e->next = -1;
+        c->id[1] = PK_RSA_CELLS_MORE | (uint32_t)C->nextra++;
+    }
+    pk_rsa_extra *e = &C->extra[C->nextra];
+    memcpy(e->x, f, sizeof e->x);
+    e->id = id;
+    e->next = (int32_t)(c->id[1] & ~PK_RSA_CELLS_MORE);
+    c->id[1] = PK_RSA_CELLS_MORE | (uint32_t)C->nextra++;
+    return 0;
+}
+
+int pk_rsa_cells_insert(pk_rsa_cells *C, const double *x, uint32_t id)
+{
+    if (id & PK_RSA_CELLS_MORE)
+        return -1; /* indices below 2^31 only */
     /* padded coordinates: the real one, plus the ghost on the far side of a
-     * periodic axis when the cell touches the seam */
+     * periodic axis when the cell touches the seam; the offset from the real
+     * cell's corner serves the ghost too (rsa_cells.h) */
     int64_t a[3][2] = {{0}};
     int m[3] = {1, 1, 1};
+    float f[3] = {0, 0, 0};
     for (int k = 0; k < C->dim; k++) {
         int64_t i = pk_rsa_cells_coord(C, k, x[k]);
+        f[k] = (float)(x[k] - (C->lo[k] + (double)i * C->h[k]));
         a[k][0] = i + 1;
         if (C->periodic[k] && i == 0)
             a[k][m[k]++] = C->n[k] + 1;
@@ -197,49 +240,42 @@ int pk_rsa_cells_insert(pk_rsa_cells *C, const double *x)
             for (int xx = 0; xx < m[0]; xx++) {
                 uint64_t lin = ((uint64_t)a[2][z] * (uint64_t)C->np[1] + (uint64_t)a[1][y]) *
                                    (uint64_t)C->np[0] + (uint64_t)a[0][xx];
-                if (store(C, lin, p) != 0)
+                if (store(C, lin, f, id) != 0)
                     return -1;
             }
     return 0;
 }
 
-static inline int cell_hits(const pk_rsa_cells *C, const pk_rsa_cell2 *c, const double *x)
+/* One stored grain (offsets f, index id) against x, whose offsets from the
+ * grain's cell corner are q: the float answer outside the band, the exact
+ * predicate inside (rsa_cells.h). */
+static inline int near_one(const pk_rsa_cells *C, const float *f, uint32_t id, const double *q,
+                           const double *px, const double *x)
 {
-    int n = c->n;
-    if (n == 0)
-        return 0;
-    if (pk_rsa_cells_close(C, c->x[0], x))
+    double d0 = q[0] - f[0], d1 = q[1] - f[1], d2 = q[2] - f[2];
+    double s = d0 * d0 + d1 * d1 + d2 * d2;
+    if (s < C->s2_lo)
         return 1;
-    if (n == 1)
+    if (s >= C->s2_hi)
         return 0;
-    if (pk_rsa_cells_close(C, c->x[1], x))
-        return 1;
-    for (int32_t e = c->more; e >= 0; e = C->extra[e].next)
-        if (pk_rsa_cells_close(C, C->extra[e].x, x))
-            return 1;
-    return 0;
+    return pk_rsa_cells_close(C, &px[3 * (size_t)id], x);
 }
 
-/* Away from seams: d as is (pk_rsa_cells_key), the z term +0 in 2D. */
-static inline int near_direct(const double *a, const double *x, double s2)
+/* The grains of a nonempty cell c (corner: x's cell corner + sh) against x
+ * (offsets q0 from its own cell's corner). */
+static inline int cell_hits(const pk_rsa_cells *C, const pk_rsa_cell2 *c, const double *q0,
+                            const double *sh, const double *px, const double *x)
 {
-    double d0 = a[0] - x[0], d1 = a[1] - x[1], d2 = a[2] - x[2];
-    return d0 * d0 + d1 * d1 + d2 * d2 < s2;
-}
-
-static inline int cell_hits_direct(const pk_rsa_cells *C, const pk_rsa_cell2 *c, const double *x)
-{
-    int n = c->n;
-    if (n == 0)
-        return 0;
-    if (near_direct(c->x[0], x, C->s2))
+    const double q[3] = {q0[0] - sh[0], q0[1] - sh[1], q0[2] - sh[2]};
+    if (near_one(C, c->x[0], c->id[0], q, px, x))
         return 1;
-    if (n == 1)
+    uint32_t b = c->id[1];
+    if (b == PK_RSA_CELLS_NONE)
         return 0;
-    if (near_direct(c->x[1], x, C->s2))
-        return 1;
-    for (int32_t e = c->more; e >= 0; e = C->extra[e].next)
-        if (near_direct(C->extra[e].x, x, C->s2))
+    if (!(b & PK_RSA_CELLS_MORE))
+        return near_one(C, c->x[1], b, q, px, x);
+    for (int32_t e = (int32_t)(b & ~PK_RSA_CELLS_MORE); e >= 0; e = C->extra[e].next)
+        if (near_one(C, C->extra[e].x, C->extra[e].id, q, px, x))
             return 1;
     return 0;
 }
@@ -250,38 +286,59 @@ static inline int cell_hits_direct(const pk_rsa_cells *C, const pk_rsa_cell2 *c,
 #define PREFETCH_BYTES ((uint64_t)4 << 20)
 #define PREFETCH_AHEAD 8
 
-size_t pk_rsa_cells_filter(const pk_rsa_cells *C, const double *pos, const uint32_t *key, size_t n,
-                           uint32_t *kept)
+size_t pk_rsa_cells_filter(const pk_rsa_cells *C, const double *px, const double *pos,
+                           const uint32_t *key, size_t n, uint32_t *kept)
 {
     size_t cnt = 0;
-    const int noff = C->noff;
-    int64_t row[9]; /* first record of each row of 3 around a cell */
-    int nrow = 0;
-    for (int64_t dz = -(C->dim == 3); dz <= (C->dim == 3); dz++)
-        for (int64_t dy = -1; dy <= 1; dy++)
-            row[nrow++] = dz * (int64_t)C->stride[2] + dy * (int64_t)C->stride[1] - 1;
+    const int dim = C->dim, nrow = C->nrow;
+    const uint8_t *occ = C->occ;
     const size_t ahead = C->ncell * sizeof *C->cell > PREFETCH_BYTES ? PREFETCH_AHEAD : n;
     for (size_t i = 0; i < n; i++) {
-        if (i + ahead < n) {
+        if (i + ahead < n) { /* both cache lines of each row of records */
             const pk_rsa_cell2 *p = &C->cell[pk_rsa_cells_index(key[i + ahead])];
-            for (int r = 0; r < nrow; r++) {
-                __builtin_prefetch(p + row[r]);
-                __builtin_prefetch(p + row[r] + 1);
-                __builtin_prefetch(p + row[r] + 2);
+            const int64_t *row = C->row;
+#define PK_FETCH_ROW(r) (__builtin_prefetch(p + row[r]), __builtin_prefetch(p + row[r] + 2))
+            PK_FETCH_ROW(0), PK_FETCH_ROW(1), PK_FETCH_ROW(2);
+            if (nrow == 9) {
+                PK_FETCH_ROW(3), PK_FETCH_ROW(4), PK_FETCH_ROW(5);
+                PK_FETCH_ROW(6), PK_FETCH_ROW(7), PK_FETCH_ROW(8);
             }
+#undef PK_FETCH_ROW
         }
         const double *x = &pos[3 * i];
-        const pk_rsa_cell2 *c0 = &C->cell[pk_rsa_cells_index(key[i])];
-        const int64_t *off = C->off[pk_rsa_cells_octant(key[i])];
-        int hit;
-        if (c0->seam) {
-            hit = cell_hits(C, c0, x);
-            for (int q = 0; q < noff && !hit; q++)
-                hit = cell_hits(C, c0 + off[q], x);
-        } else {
-            hit = cell_hits_direct(C, c0, x);
-            for (int q = 0; q < noff && !hit; q++)
-                hit = cell_hits_direct(C, c0 + off[q], x);
+        const uint64_t lin = pk_rsa_cells_index(key[i]);
+        const unsigned oct = pk_rsa_cells_octant(key[i]);
+        const pk_rsa_cell2 *c0 = &C->cell[lin];
+        /* offsets of x from its cell's corner (the key's cell) */
+        double q[3] = {0, 0, 0};
+        for (int k = 0; k < dim; k++)
+            q[k] = x[k] - (C->lo[k] +
+                           (double)(int64_t)(pk_rsa_cells_half(C, k, x[k]) >> 1) * C->h[k]);
+        /* the cell itself first (offset 0, the likeliest overlap), then the
+         * nonempty cells around, as bits of the near-first order off[oct] */
+        const int64_t *off = C->off[oct];
+        const double(*sh)[3] = C->shift[oct];
+        uint32_t m = occ[lin >> 3] >> (lin & 7) & 1;
+        int hit = 0, around = 0;
+        for (;;) {
+            if (!m) {
+                if (around)
+                    break;
+                const uint32_t(*ord)[8] = C->order[oct];
+                const int64_t *row = C->row;
+#define PK_ROW(r) ord[r][pk_rsa_cells_bits3(occ, lin + (uint64_t)row[r])]
+                m = PK_ROW(0) | PK_ROW(1) | PK_ROW(2);
+                if (nrow == 9)
+                    m |= PK_ROW(3) | PK_ROW(4) | PK_ROW(5) | PK_ROW(6) | PK_ROW(7) | PK_ROW(8);
+#undef PK_ROW
+                m &= ~(uint32_t)1;
+                around = 1;
+                continue;
+            }
+            int t = __builtin_ctz(m);
+            m &= m - 1;
+            if ((hit = cell_hits(C, c0 + off[t], q, sh[t], px, x)))
+                break;
         }
         kept[cnt] = (uint32_t)i;
         cnt += !hit; /* branch-free: most points are rejected */

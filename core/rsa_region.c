@@ -21,6 +21,7 @@ int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, cons
         return -1;
     R->dim = b->dim;
     R->S = b->dim == 3 ? 4 : 8; /* S^dim = 64: one word per cell */
+    R->sbits = b->dim == 3 ? 2 : 3;
     uint64_t nc = 1;
     double lmax = 0;
     for (int k = 0; k < PK_MAXDIM; k++) {

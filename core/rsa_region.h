@@ -30,6 +30,7 @@ typedef struct pk_rsa_region {
     int dim, S;
     int periodic[PK_MAXDIM];
     int64_t n[PK_MAXDIM];       /* cells per axis (1 on unused axes) */
+    int sbits;                  /* log2 S */
     int64_t nf[PK_MAXDIM];      /* fine voxels per axis: S·n */
     double lo[PK_MAXDIM];       /* lower end of the draw range */
     double hf[PK_MAXDIM];       /* fine voxel edge span/(S·n) */
@@ -95,16 +96,17 @@ static inline uint32_t pk_rsa_region_pick(const pk_rsa_region *R, pk_rng *g, uns
 static inline void pk_rsa_region_point(const pk_rsa_region *R, uint32_t cell, unsigned bit,
                                        pk_rng *g, double x[3])
 {
-    const int S = R->S;
-    uint64_t c = cell;
+    const int sb = R->sbits;
+    uint32_t c = cell; /* 32-bit divisions: ncell <= UINT32_MAX */
     unsigned f = bit;
     x[2] = 0;
     for (int k = 0; k < R->dim; k++) {
-        uint64_t i = c % (uint64_t)R->n[k];
-        c /= (uint64_t)R->n[k];
-        unsigned l = f % (unsigned)S;
-        f /= (unsigned)S;
-        x[k] = R->lo[k] + R->hf[k] * ((double)(i * (uint64_t)S + l) + pk_rng_uniform(g));
+        const uint32_t n = (uint32_t)R->n[k];
+        uint64_t i = c % n;
+        c /= n;
+        unsigned l = f & ((1u << sb) - 1);
+        f >>= sb;
+        x[k] = R->lo[k] + R->hf[k] * ((double)(i << sb | l) + pk_rng_uniform(g));
     }
 }
 

@@ -199,7 +199,7 @@ static void test_cells_predicate_and_neighbours(void)
         for (int k = 0; k < 3; k++)
             pts[i][k] = lo[k] + span[k] * pk_rng_uniform(&g);
     for (int i = 0; i < 200; i++)
-        CHECK(pk_rsa_cells_insert(&C, pts[i]) == 0);
+        CHECK(pk_rsa_cells_insert(&C, pts[i], (uint32_t)i) == 0);
     int wrong = 0, near = 0;
     uint8_t keep[200] = {0};
     uint32_t key[200], kept[200];
@@ -212,7 +212,7 @@ static void test_cells_predicate_and_neighbours(void)
         }
     }
     CHECK(seam > 20); /* points next to seams and walls are among them */
-    size_t nkept = pk_rsa_cells_filter(&C, pts[200], key, 200, kept);
+    size_t nkept = pk_rsa_cells_filter(&C, &pts[0][0], pts[200], key, 200, kept);
     int ascending = 1;
     for (size_t j = 0; j < nkept; j++) {
         ascending &= j == 0 || kept[j] > kept[j - 1];
@@ -233,9 +233,97 @@ static void test_cells_predicate_and_neighbours(void)
     pk_rsa_cells_free(&C);
 }
 
+/* The store keeps float offsets and lets the double predicate decide within
+ * a band around contact (rsa_cells.h): queries at distance s·(1 + δ) from a
+ * stored centre, δ from -1e-4 to 1e-4 down to 0 and ±1 ulp-size, across
+ * periodic seams (ghost copies) and next to walls, in 3D and 2D, must get
+ * exactly the answers of the exact predicate over all stored centres (the
+ * store holds 3+ centres per cell here too: its pool). */
+static void test_cells_band_matches_exact_predicate(void)
+{
+    const pk_box boxes[2] = {
+        {.dim = 3, .L = {7.9, 6.3, 5.2}, .periodic = {true, false, true}},
+        {.dim = 2, .L = {9.7, 8.2, 0}, .periodic = {true, false}},
+    };
+    const double delta[] = {-1e-4, -3e-5, -1e-6, -1e-9, -1e-13, -2e-16, 0,
+                            2e-16, 1e-13, 1e-9, 1e-6, 3e-5, 1e-4};
+    const int nd = (int)(sizeof delta / sizeof *delta);
+    pk_rng g;
+    pk_rng_seed(&g, 11, 2);
+    for (int t = 0; t < 2; t++) {
+        const pk_box *b = &boxes[t];
+        double r = 0.61, gap = 0.03, s = r + r + gap, lo[3] = {0, 0, 0}, span[3] = {0, 0, 0};
+        for (int k = 0; k < b->dim; k++) {
+            lo[k] = b->periodic[k] ? 0 : r + 0.5 * gap;
+            span[k] = b->periodic[k] ? b->L[k] : b->L[k] - 2 * lo[k];
+        }
+        pk_rsa_cells C;
+        CHECK(pk_rsa_cells_init(&C, b, r, gap, lo, span) == 0);
+        /* few centres (queries at contact with one are mostly clear of the
+         * others), four of them in one cell (the pool), eight on seams and walls */
+        enum { NS = 16, NQ = 3000 };
+        static double pts[NS][3], q[NQ][3];
+        memset(pts, 0, sizeof pts); /* z = 0 in 2D, as in the particle array */
+        memset(q, 0, sizeof q);
+        for (int i = 0; i < NS; i++) {
+            for (int k = 0; k < b->dim; k++)
+                pts[i][k] = i < 4 ? lo[k] + 0.5 * C.h[k] + 0.3 * C.h[k] * pk_rng_uniform(&g)
+                                  : lo[k] + span[k] * pk_rng_uniform(&g);
+            if (i >= 4 && i < 12)
+                pts[i][i % b->dim] = i % 4 < 2 ? lo[i % b->dim] : lo[i % b->dim] + span[i % b->dim];
+            CHECK(pk_rsa_cells_insert(&C, pts[i], (uint32_t)i) == 0);
+        }
+        int nq = 0;
+        while (nq < NQ) {
+            const double *p = pts[pk_rng_next(&g) % NS];
+            double u[3] = {0, 0, 0}, n2 = 0;
+            for (int k = 0; k < b->dim; k++) {
+                u[k] = pk_rng_normal(&g);
+                n2 += u[k] * u[k];
+            }
+            double f = s * (1 + delta[nq % nd]) / sqrt(n2);
+            int inside = 1;
+            for (int k = 0; k < b->dim; k++) {
+                q[nq][k] = p[k] + f * u[k];
+                if (b->periodic[k])
+                    q[nq][k] -= b->L[k] * floor(q[nq][k] / b->L[k]);
+                inside &= q[nq][k] >= lo[k] && q[nq][k] <= lo[k] + span[k];
+            }
+            nq += inside;
+        }
+        static uint32_t key[NQ], kept[NQ];
+        static uint8_t keep[NQ];
+        for (int i = 0; i < NQ; i++)
+            key[i] = pk_rsa_cells_key(&C, q[i]);
+        size_t nk = pk_rsa_cells_filter(&C, &pts[0][0], &q[0][0], key, NQ, kept);
+        memset(keep, 0, sizeof keep);
+        for (size_t j = 0; j < nk; j++)
+            keep[kept[j]] = 1;
+        int wrong = 0, band = 0, open = 0;
+        for (int i = 0; i < NQ; i++) {
+            int hit = 0;
+            double m2 = INFINITY;
+            for (int j = 0; j < NS; j++) {
+                hit |= pk_rsa_cells_close(&C, pts[j], q[i]);
+                m2 = fmin(m2, pk_box_dist2(b, pts[j], q[i]));
+            }
+            wrong += keep[i] == hit;
+            band += fabs(m2 / (s * s) - 1) < 1e-6;
+            open += !hit;
+        }
+        printf("  dim %d: %d queries, %d within 1e-6 of contact, %d kept, %d wrong\n", b->dim,
+               NQ, band, open, wrong);
+        CHECK_MSG(wrong == 0, "dim %d: %d answers differ from the exact predicate", b->dim, wrong);
+        CHECK(band > NQ / 8 && open > NQ / 20); /* the band and both answers are exercised */
+        CHECK(C.nextra > 0);                    /* and the overflow pool */
+        pk_rsa_cells_free(&C);
+    }
+}
+
 int main(void)
 {
     RUN(test_cells_predicate_and_neighbours);
+    RUN(test_cells_band_matches_exact_predicate);
     RUN(test_mono_matches_plain);
     RUN(test_classes_and_present_grains);
     RUN(test_distinct_sizes);
