@@ -43,6 +43,15 @@ static const char *eval_error(int rc)
                       : "out of memory";
 }
 
+/* An object of the n named values (taking their references). */
+static json_t *object_of(const char *const *names, json_t *const *vals, size_t n)
+{
+    json_t *o = json_object();
+    for (size_t k = 0; k < n; k++)
+        json_object_set_new(o, names[k], vals[k]);
+    return o;
+}
+
 /* Final micro state and contact network (output options). */
 static int final_state_json(const pk_homog_rve *rve, const pk_homog_opts *o,
                             const pk_homog_state *s, int micro, int contacts, json_t *rec)
@@ -63,7 +72,7 @@ static int final_state_json(const pk_homog_rve *rve, const pk_homog_opts *o,
             rc = -1;
     }
     if (rc == 0 && micro) {
-        json_t *m = json_object(), *x = json_array(), *xi = json_array(), *ra = json_array(),
+        json_t *x = json_array(), *xi = json_array(), *ra = json_array(),
                *gr = json_array(), *fx = json_array(), *hu = json_array();
         for (size_t i = 0; i < rve->n; i++) {
             double X[3];
@@ -77,16 +86,13 @@ static int final_state_json(const pk_homog_rve *rve, const pk_homog_opts *o,
             json_array_append_new(fx, json_integer(rve->fixed[i]));
             json_array_append_new(hu, json_integer(rve->hull[i]));
         }
-        json_object_set_new(m, "position", x);
-        json_object_set_new(m, "fluctuation", xi);
-        json_object_set_new(m, "rattler", ra);
-        json_object_set_new(m, "grain", gr);
-        json_object_set_new(m, "prescribed", fx);
-        json_object_set_new(m, "hull", hu);
-        json_object_set_new(rec, "final_state", m);
+        json_object_set_new(rec, "final_state",
+                            object_of((const char *const[]){"position", "fluctuation", "rattler",
+                                                            "grain", "prescribed", "hull"},
+                                      (json_t *const[]){x, xi, ra, gr, fx, hu}, 6));
     }
     if (rc == 0 && contacts) {
-        json_t *k = json_object(), *ci = json_array(), *cj = json_array(), *ov = json_array(),
+        json_t *ci = json_array(), *cj = json_array(), *ov = json_array(),
                *fn = json_array(), *br = json_array();
         for (size_t p = 0; p < c.n; p++) {
             if (!(c.eps[p] >= 0) || !(c.len[p] > 0))
@@ -98,12 +104,10 @@ static int final_state_json(const pk_homog_rve *rve, const pk_homog_opts *o,
             for (int a = 0; a < dim; a++)
                 json_array_append_new(br, json_real(c.l[3 * p + a]));
         }
-        json_object_set_new(k, "i", ci);
-        json_object_set_new(k, "j", cj);
-        json_object_set_new(k, "overlap", ov);
-        json_object_set_new(k, "normal_force", fn);
-        json_object_set_new(k, "branch", br);
-        json_object_set_new(rec, "final_contacts", k);
+        json_object_set_new(rec, "final_contacts",
+                            object_of((const char *const[]){"i", "j", "overlap", "normal_force",
+                                                            "branch"},
+                                      (json_t *const[]){ci, cj, ov, fn, br}, 5));
     }
     pk_dem_pairs_free(&c);
     free(fr);

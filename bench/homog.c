@@ -5,8 +5,9 @@
  *   bench=homog case=periodic_step_{dr,newton}_2d rve=KIND n=N iterations=K seconds=S ...
  *   bench=homog case=tangent_periodic_2d rve=KIND n=N tangent_s=S free_dofs=D
  * The step is 0.1 % uniaxial compression at tolerance 1e-8 (the thesis's),
- * solved by Newton (trust region, CHOLMOD) and by DR from the same committed
- * state; the DR line carries the agreement of P̄ and the Newton line the
+ * solved by the Newton/DR hybrid (core/homog_newton.h, CHOLMOD) and by DR
+ * alone from the same committed state; the DR line carries the agreement of
+ * P̄ and of the energy (the same local minimum?) and the Newton line the
  * speed-up.  10⁴ grains with PACKD_BENCH_LARGE=1. */
 #include <math.h>
 #include <stdio.h>
@@ -41,7 +42,7 @@ static pk_homog_opts opts(double tol)
 }
 
 /* A jammed periodic 2D RVE of n grains (radii 0.8–1.2), of two kinds:
- *  dense:  random overlapping disks at φ = 0.86 relaxed at F̄ = 1 — well
+ *  dense:  random overlapping disks at φ = 0.90 relaxed at F̄ = 1 — well
  *          above jamming (φ_J ≈ 0.84), a stiff, stable contact network;
  *  near_jamming: as packd makes one — EDMD grows hard disks until nearly
  *          jammed (reduced pressure 1e5), the radii are inflated by 1.5 %
@@ -134,16 +135,19 @@ static double step_case(size_t n, int near_jamming)
             d = fmax(d, fabs(sd.P[c] - sn.P[c]));
         }
         printf("bench=homog case=periodic_step_dr_2d rve=%s n=%zu iterations=%zu seconds=%.3f "
-               "particle_iter_per_s=%.3g stop=%s contacts=%zu rattlers=%zu "
-               "P_rel_diff_newton_vs_dr=%.2g\n",
+               "particle_iter_per_s=%.3g stop=%s contacts=%zu rattlers=%zu energy=%.12g "
+               "P_rel_diff_newton_vs_dr=%.2g energy_rel_diff_newton_vs_dr=%.2g\n",
                kind, n, sd.dr.iterations, tdr, rate, pk_dr_stop_name(sd.dr.stop), sd.contacts,
-               sd.rattlers, d / Pn);
+               sd.rattlers, sd.energy, d / Pn, (sn.energy - sd.energy) / sd.energy);
     }
     printf("bench=homog case=periodic_step_newton_2d rve=%s n=%zu factorisations=%zu qn_steps=%zu "
-           "dr_iterations=%zu "
-           "seconds=%.3f exit=%s stop=%s contacts=%zu rattlers=%zu speedup_vs_dr=%.2f\n",
-           kind, n, sn.newton.iterations, sn.newton.steps, sn.dr.iterations, tnw, pk_newton_exit_name(sn.newton.exit),
-           pk_dr_stop_name(sn.dr.stop), sn.contacts, sn.rattlers, tdr > 0 ? tdr / tnw : -1);
+           "dr_iterations=%zu attempts=%zu shift_raises=%zu seconds=%.3f exit=%s stop=%s "
+           "residual_rel=%.2g "
+           "contacts=%zu rattlers=%zu energy=%.12g speedup_vs_dr=%.2f\n",
+           kind, n, sn.newton.iterations, sn.newton.steps, sn.dr.iterations, sn.newton.attempts,
+           sn.newton.shifts, tnw,
+           pk_newton_exit_name(sn.newton.exit), pk_dr_stop_name(sn.dr.stop), sn.dr.f / sn.dr.f0,
+           sn.contacts, sn.rattlers, sn.energy, tdr > 0 ? tdr / tnw : -1);
     double A[81];
     pk_tangent_info ti;
     int rc = pk_homog_tangent(&rve, &o, &tn, &pk_sparse_cholmod, A, &ti);

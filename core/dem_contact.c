@@ -232,6 +232,63 @@ void pk_dem_branch(const pk_dem_geom *g, const double *xi, const double *xj, dou
         l[2] = 0;
 }
 
+/* Round to nearest, ties to even (= nearbyint in the default rounding mode)
+ * without a libm call: exact for |v| < 2⁵¹. */
+static inline double round_even(double v)
+{
+    const double big = 0x1.8p52;
+    return fabs(v) < 0x1p51 ? (v + big) - big : nearbyint(v);
+}
+
+/* pk_dem_eval for 2D: the same operations as the generic loop with the
+ * vanishing third components dropped (x·0 terms), so the same numbers
+ * (tests/unit/test_homog_newton.c) at less than half the instructions — this
+ * loop is most of the cost of a DR iteration. */
+static size_t eval_2d(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
+                      double E, double *f, double *energy, double S[9])
+{
+    const double *F = g->F, *Fi = g->Finv;
+    const int per = g->periodic;
+    const double L0 = g->L[0], L1 = g->L[1];
+    double phi = 0;
+    size_t nc = 0;
+    for (size_t p = 0; p < c->n; p++) {
+        size_t i = (size_t)c->i[p], j = (size_t)c->j[p];
+        double *l = &c->l[3 * p];
+        double d0 = x[3 * j] - x[3 * i], d1 = x[3 * j + 1] - x[3 * i + 1];
+        if (per) { /* ref_diff + F·ds, as pk_dem_branch */
+            double s0 = Fi[0] * d0 + Fi[1] * d1, s1 = Fi[3] * d0 + Fi[4] * d1;
+            s0 -= L0 * round_even(s0 / L0);
+            s1 -= L1 * round_even(s1 / L1);
+            d0 = F[0] * s0 + F[1] * s1;
+            d1 = F[3] * s0 + F[4] * s1;
+        }
+        l[0] = d0, l[1] = d1, l[2] = 0;
+        double len = sqrt(d0 * d0 + d1 * d1);
+        double eps = r[i] + r[j] - len; /* (4.1) */
+        c->len[p] = len;
+        c->eps[p] = eps;
+        if (!(eps >= 0) || !(len > 0))
+            continue;
+        nc++;
+        double k = pk_dem_pair_E(c, p, E);
+        phi += 0.5 * k * eps * eps; /* (4.3) */
+        double fn = k * eps;        /* (4.8) */
+        double fa0 = -fn * d0 / len, fa1 = -fn * d1 / len;
+        if (f) {
+            f[3 * i] += fa0, f[3 * i + 1] += fa1;
+            f[3 * j] -= fa0, f[3 * j + 1] -= fa1;
+        }
+        if (S) {
+            S[0] += fa0 * d0, S[1] += fa0 * d1;
+            S[3] += fa1 * d0, S[4] += fa1 * d1;
+        }
+    }
+    if (energy)
+        *energy = phi;
+    return nc;
+}
+
 size_t pk_dem_eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
                    size_t np, double E, double *f, double *energy, double S[9])
 {
@@ -240,6 +297,8 @@ size_t pk_dem_eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const
         memset(f, 0, 3 * np * sizeof *f);
     if (S)
         memset(S, 0, 9 * sizeof *S);
+    if (dim == 2)
+        return eval_2d(c, g, x, r, E, f, energy, S);
     double phi = 0;
     size_t nc = 0;
     for (size_t p = 0; p < c->n; p++) {
@@ -284,10 +343,12 @@ static inline void kblock_apply(int dim, double E, double len, double eps, const
         out[a] = c * (eps * d[a] - R * nd * l[a] / len);
 }
 
-void pk_dem_kv(const pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *mask,
-               const double *v, double *out)
+/* The K·v loop; pk_dem_kv calls it with dim a constant (2 or 3), so the
+ * compiler unrolls the axis loops — the same operations in the same order,
+ * at fewer instructions (it runs 40 times per DR estimate refresh). */
+static inline void kv_loop(const pk_dem_pairs *c, const int dim, double E, const uint8_t *mask,
+                           const double *v, double *out)
 {
-    memset(out, 0, 3 * np * sizeof *out);
     for (size_t p = 0; p < c->n; p++) {
         if (!(c->eps[p] >= 0) || !(c->len[p] > 0))
             continue;
@@ -307,6 +368,16 @@ void pk_dem_kv(const pk_dem_pairs *c, int dim, size_t np, double E, const uint8_
                 out[3 * j + a] -= kd[a];
         }
     }
+}
+
+void pk_dem_kv(const pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *mask,
+               const double *v, double *out)
+{
+    memset(out, 0, 3 * np * sizeof *out);
+    if (dim == 2)
+        kv_loop(c, 2, E, mask, v, out);
+    else
+        kv_loop(c, dim, E, mask, v, out);
 }
 
 double pk_dem_gershgorin(const pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *mask)

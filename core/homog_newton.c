@@ -12,22 +12,42 @@
  * stiffness at all, and its force is zero, so any small shift gives the
  * right step (zero) without spoiling the conditioning of the jammed part. */
 #define RATTLER_SHIFT 1e-6
-/* Levenberg–Marquardt shifts (× E) tried on an indefinite block. */
-#define MIN_SHIFT 1e-6
-#define MAX_SHIFT 1e2
 /* Armijo: accept a step achieving this share of the linear decrease. */
 #define ARMIJO 1e-4
 /* Below this relative size the energy difference is round-off: judge the
  * step by the residual instead (near convergence f·Δx ~ |f|²/λ is ~1e-18 Φ). */
 #define ENERGY_ROUNDOFF 1e-11
-/* Factorisations without halving the residual before giving up to DR. */
-#define STALL_FACTORS 6
+/* Factorisations without halving the residual before Newton, from the step's
+ * start, hands the step to DR — and before an attempt from one of DR's
+ * points is given up.  An attempt gets more: near the end of a plastic
+ * event Newton may first slide on along a soft mode (the residual rises,
+ * Φ_n falls) before it converges (measured at 10⁴ grains: 5 factorisations,
+ * where DR needs ~3,000 more iterations to the next attempt). */
+#define STALL_FACTORS 3
+#define ATTEMPT_STALL 6
+/* Residuals (× |f⁰|) of DR's points from which Newton tries to finish a
+ * step it could not take from the start: HANDOVER, × HANDOVER_STEP, …
+ * (see pk_homog_newton). */
+#define HANDOVER 1e-3
+#define HANDOVER_STEP 0.3
 /* Quasi-Newton steps per factorisation: at most, and the window within which
  * the residual must halve before the preconditioner is refreshed. */
 #define MAX_INNER 60
 #define REFRESH_WINDOW 12
 /* Line-search halvings before the direction is given up. */
-#define MAX_CUTS 30
+#define MAX_CUTS 12
+/* Largest displacement of a grain per step, × the Verlet skin. */
+#define MAX_MOVE 0.5
+/* Levenberg–Marquardt shifts (× E) of an attempt from DR's point: the first,
+ * the largest, and the one below which the shift is dropped; at most
+ * SHIFT_RAISES raises per attempt (a converging attempt needed 2 at 10⁴
+ * grains; attempts that need more creep along a valley DR is faster down:
+ * measured 7 raises and 13–17 factorisations in the relaxation of random
+ * overlaps). */
+#define SHIFT_FIRST 1e-3
+#define SHIFT_MAX 1e-1
+#define SHIFT_MIN 1e-6
+#define SHIFT_RAISES 3
 /* L-BFGS memory (pairs). */
 #define MEMORY 8
 
@@ -64,14 +84,13 @@ static int eval_at(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const
     return 0;
 }
 
-/* K + μ1 over every free DOF: the exact Hessian (4.11)–(4.14) on contacts
+/* K over every free DOF: the exact Hessian (4.11)–(4.14) on contacts
  * between jammed grains — what makes Newton quadratic and what the tangent
  * uses — and the Gauss–Newton part E n⊗n (positive semi-definite) on contacts
  * that touch a rattler, plus a small shift on rattler DOFs, which may have no
  * stiffness at all.  A rattler is thus pushed out of its overlaps along n in
- * one step instead of being left to a separate relaxation.  μ > 0 is the
- * Levenberg–Marquardt shift used when the exact block is indefinite (a
- * buckling grain away from equilibrium). */
+ * one step instead of being left to a separate relaxation.  μ > 0: the
+ * Levenberg–Marquardt shift of an attempt from DR's point (newton_phase). */
 static int assemble(const pk_dem_pairs *c, int dim, double E, const int32_t *dof,
                     const uint8_t *rat, double mu, size_t np, pk_sparse_sym *K)
 {
@@ -96,7 +115,7 @@ static int assemble(const pk_dem_pairs *c, int dim, double E, const int32_t *dof
             return -1;
     }
     for (size_t i = 0; i < np; i++)
-        if (dof[i] >= 0 && (mu > 0 || rat[i]))
+        if (dof[i] >= 0 && (rat[i] || mu > 0))
             for (int a = 0; a < dim; a++)
                 if (pk_sparse_sym_add(K, dof[i] + a, dof[i] + a,
                                       mu + (rat[i] ? RATTLER_SHIFT * E : 0)) != 0)
@@ -193,6 +212,274 @@ static void gather_gradient(const double *f, const int32_t *dof, size_t np, int 
                 gv[dof[i] + a] = -f[3 * i + a];
 }
 
+/* The problem one solve works on. */
+typedef struct newton_sys {
+    pk_dem_pairs *c;
+    const pk_dem_geom *g;
+    const double *r;
+    size_t np;
+    double E;
+    const uint8_t *is_free;
+    const pk_dr_params *prm;
+    const pk_sparse_solver *solver;
+    pk_monitor *mon;
+} newton_sys;
+
+/* Rattlers at the current contacts, K + μ1 assembled and factorised (one
+ * factorisation counted).  NULL with info->status FAILED on error. */
+static pk_sparse_factor *factor_block(const newton_sys *sy, newton_work *w, double mu,
+                                      size_t *budget, pk_newton_stats *ns, pk_sparse_info *info)
+{
+    const int dim = sy->g->dim;
+    info->status = PK_SPARSE_FAILED;
+    if (pk_dem_rattlers(sy->c, dim, sy->np, sy->is_free, w->rat) == (size_t)-1)
+        return NULL;
+    w->K.nnz = 0;
+    w->K.n = w->mem.nd;
+    if (assemble(sy->c, dim, sy->E, w->dof, w->rat, mu, sy->np, &w->K) != 0)
+        return NULL;
+    if (*budget > 0) /* the check of a shifted end point may come with the budget spent */
+        (*budget)--;
+    ns->iterations++;
+    return sy->solver->factor(&w->K, info);
+}
+
+/* One Newton phase from x (w->f, *phi, *fn describe x on entry and on exit):
+ * factorisations of the stiffness at the current point, each followed by
+ * L-BFGS steps it preconditions, until |f| <= target.  It hands back
+ * (ns->exit != CONVERGED, x at its last, lowest-energy point) as soon as
+ * the step leaves the region where Newton is fast: the exact block is not
+ * positive definite (an instability — the configuration must rearrange), a
+ * fresh Newton direction finds no decrease, or the residual does not halve
+ * over `stall` factorisations.
+ * With `shift` (an attempt from DR's point) and a positive definite block at
+ * the entry point (DR is past the instability; Newton's own path met one) an
+ * indefinite block gets a Levenberg–Marquardt shift μ instead: SHIFT_FIRST·E,
+ * ×10 while indefinite (at most SHIFT_RAISES times), ÷10 per positive
+ * definite factorisation, 0 below SHIFT_MIN·E.  A point reached with μ > 0
+ * counts as converged only if the unshifted block is positive definite there
+ * (a minimum, not a saddle).
+ * *budget factorisations at most (decremented).
+ * Returns 0, -1 (memory), -2 (box), 1 (cancelled: st->stop set). */
+static int newton_phase(const newton_sys *sy, newton_work *w, double *x, double *phi, double *fn,
+                        double target, size_t stall, int shift, size_t *budget,
+                        pk_newton_stats *ns, pk_dr_stats *st)
+{
+    pk_dem_pairs *c = sy->c;
+    const pk_dem_geom *g = sy->g;
+    const int dim = g->dim;
+    const size_t np = sy->np, nd = w->mem.nd;
+    const double E = sy->E;
+    double best = *fn, mu = 0, mu_used = 0;
+    size_t since_best = 0;
+    int stable_start = 0; /* the block was positive definite at the entry point */
+    int raises = 0;
+    ns->exit = PK_NEWTON_CAP;
+    while (*fn > target) {
+        if (*budget == 0)
+            return 0;
+        if (since_best >= stall) {
+            ns->exit = PK_NEWTON_STALLED;
+            return 0;
+        }
+        pk_sparse_info info;
+        pk_sparse_factor *fac = factor_block(sy, w, mu, budget, ns, &info);
+        if (info.status == PK_SPARSE_FAILED) {
+            sy->solver->release(fac);
+            return -1;
+        }
+        if (info.status != PK_SPARSE_OK) {
+            sy->solver->release(fac);
+            if (shift && stable_start && raises < SHIFT_RAISES && mu < SHIFT_MAX * E) {
+                mu = mu > 0 ? 10 * mu : SHIFT_FIRST * E;
+                ns->shifts++;
+                raises++;
+                continue;
+            }
+            ns->exit = PK_NEWTON_BLOCK_NOT_PD;
+            return 0;
+        }
+        mu_used = mu;
+        mu = mu > 10 * SHIFT_MIN * E ? 0.1 * mu : 0;
+        stable_start = 1;
+        /* Quasi-Newton steps preconditioned by this factor: exact Newton first,
+         * then L-BFGS corrections as contacts open and close, until the
+         * residual stops halving within the window (refresh the factor). */
+        w->mem.count = w->mem.head = 0;
+        gather_gradient(w->f, w->dof, np, dim, w->g);
+        double f_window = *fn;
+        size_t window_start = 0;
+        int failed_first = 0, rc = 0;
+        for (size_t inner = 0; inner < MAX_INNER && *fn > target; inner++) {
+            if (qn_direction(&w->mem, sy->solver, fac, w->g, w->qv, w->d) != 0) {
+                rc = -1;
+                break;
+            }
+            double gd = dot(w->g, w->d, nd);
+            if (!(gd < 0)) { /* memory spoilt the direction: plain preconditioned step */
+                w->mem.count = w->mem.head = 0;
+                if (qn_direction(&w->mem, sy->solver, fac, w->g, w->qv, w->d) != 0) {
+                    rc = -1;
+                    break;
+                }
+                gd = dot(w->g, w->d, nd);
+                if (!(gd < 0))
+                    break;
+            }
+            /* Trust region in the max norm: no grain moves more than half the
+             * Verlet skin per step — along a soft mode the step is cut to the
+             * region where contacts are known (trial points keep their
+             * candidate list, no rebuild per line-search cut). */
+            double dmax2 = 0;
+            for (size_t e = 0; e < nd; e += (size_t)dim) {
+                double q = 0;
+                for (int a = 0; a < dim; a++)
+                    q += w->d[e + a] * w->d[e + a];
+                dmax2 = fmax(dmax2, q);
+            }
+            double reach = MAX_MOVE * sy->prm->skin;
+            if (dmax2 > reach * reach) {
+                double shrink = reach / sqrt(dmax2);
+                for (size_t e = 0; e < nd; e++)
+                    w->d[e] *= shrink;
+                gd *= shrink;
+            }
+            double s = 1, phit = *phi, ftn = *fn;
+            int ok = 0;
+            for (int cut = 0; cut < MAX_CUTS; cut++, s *= 0.5) {
+                memcpy(w->xt, x, 3 * np * sizeof *x);
+                for (size_t i = 0; i < np; i++)
+                    if (w->dof[i] >= 0)
+                        for (int a = 0; a < dim; a++)
+                            w->xt[3 * i + a] += s * w->d[w->dof[i] + a];
+                rc = eval_at(c, g, w->xt, sy->r, np, E, sy->prm, w->ft, &phit);
+                if (rc != 0)
+                    break;
+                ftn = sqrt(pk_homog_dot_mask(w->ft, w->ft, sy->is_free, np, dim));
+                double lin = -s * gd; /* predicted decrease to first order */
+                if (lin <= ENERGY_ROUNDOFF * fabs(*phi))
+                    ok = ftn < *fn; /* energy change lost in round-off */
+                else
+                    ok = phit <= *phi - ARMIJO * lin;
+                if (ok)
+                    break;
+                ns->cuts++;
+            }
+            if (rc != 0)
+                break;
+            if (!ok) {
+                failed_first = inner == 0;
+                break;
+            }
+            gather_gradient(w->ft, w->dof, np, dim, w->gt);
+            for (size_t e = 0; e < nd; e++) {
+                w->sv[e] = s * w->d[e];
+                w->yv[e] = w->gt[e] - w->g[e];
+            }
+            qn_push(&w->mem, w->sv, w->yv);
+            memcpy(w->g, w->gt, nd * sizeof *w->g);
+            memcpy(x, w->xt, 3 * np * sizeof *x);
+            memcpy(w->f, w->ft, 3 * np * sizeof *w->f);
+            *phi = phit;
+            *fn = ftn;
+            ns->steps++;
+            if (*fn < 0.5 * f_window) {
+                f_window = *fn;
+                window_start = inner;
+            } else if (inner >= window_start + REFRESH_WINDOW) {
+                break;
+            }
+            if (sy->mon) {
+                pk_progress pr = {.stage = "newton", .fraction = -1, .phi = -1, .eta_s = -1,
+                                  .done = ns->steps};
+                int t = pk_monitor_tick(sy->mon, &pr, 0);
+                if (t) {
+                    st->stop = t == 1 ? PK_DR_CANCELLED : PK_DR_WALL_TIME;
+                    rc = 1;
+                    break;
+                }
+            }
+        }
+        sy->solver->release(fac);
+        if (rc != 0)
+            return rc;
+        rc = eval_at(c, g, x, sy->r, np, E, sy->prm, w->f, phi); /* contacts of the current point */
+        if (rc != 0)
+            return rc;
+        if (failed_first) {
+            ns->exit = PK_NEWTON_LINE_SEARCH;
+            return 0;
+        }
+        if (*fn < 0.5 * best) {
+            best = *fn;
+            since_best = 0;
+        } else {
+            since_best++;
+        }
+    }
+    if (mu_used > 0) { /* converged on a shifted model: a minimum only if K itself is PD */
+        pk_sparse_info info;
+        pk_sparse_factor *fac = factor_block(sy, w, 0, budget, ns, &info);
+        sy->solver->release(fac);
+        if (info.status == PK_SPARSE_FAILED)
+            return -1;
+        if (info.status != PK_SPARSE_OK) {
+            ns->exit = PK_NEWTON_BLOCK_NOT_PD;
+            return 0;
+        }
+    }
+    ns->exit = PK_NEWTON_CONVERGED;
+    return 0;
+}
+
+/* The Newton attempts DR makes along its way (pk_dr_hook): Newton runs on a
+ * copy of DR's point with a pair list of its own, so that a failed attempt
+ * leaves DR's iteration exactly as it was. */
+typedef struct attempt_ctx {
+    newton_sys sy;     /* sy.c = the attempts' own pair list */
+    newton_work *w;
+    double target;
+    size_t *budget;
+    pk_newton_stats *ns;
+    pk_dr_stats *st;
+} attempt_ctx;
+
+static int newton_attempt(void *vctx, double *x, double *fres, double *at)
+{
+    attempt_ctx *a = vctx;
+    newton_work *w = a->w;
+    const int dim = a->sy.g->dim;
+    const size_t np = a->sy.np;
+    *at *= HANDOVER_STEP;
+    if (*at <= a->target)
+        *at = 0; /* DR finishes alone */
+    if (*a->budget == 0)
+        return 0;
+    double *xn = w->x0;
+    memcpy(xn, x, 3 * np * sizeof *x);
+    int rc = pk_dem_pairs_build(a->sy.c, a->sy.g, xn, a->sy.r, np, a->sy.prm->skin);
+    if (rc != 0)
+        return rc;
+    double phi;
+    pk_dem_eval(a->sy.c, a->sy.g, xn, a->sy.r, np, a->sy.E, w->f, &phi, NULL);
+    double fn = sqrt(pk_homog_dot_mask(w->f, w->f, a->sy.is_free, np, dim));
+    a->ns->attempts++;
+    pk_dr_stop keep = a->st->stop;
+    rc = newton_phase(&a->sy, w, xn, &phi, &fn, a->target, ATTEMPT_STALL, 1, a->budget, a->ns,
+                      a->st);
+    if (rc < 0)
+        return rc;
+    if (rc == 1) { /* cancelled: DR's monitor sees it within 64 iterations */
+        a->st->stop = keep;
+        return 0;
+    }
+    if (a->ns->exit != PK_NEWTON_CONVERGED)
+        return 0;
+    memcpy(x, xn, 3 * np * sizeof *x);
+    *fres = fn;
+    return 1;
+}
+
 int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
                     double E, const uint8_t *is_free, const pk_dr_params *prm,
                     const pk_sparse_solver *solver, size_t max_newton, pk_monitor *mon,
@@ -205,169 +492,56 @@ int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doub
     if (rc != 0)
         return rc;
     newton_work w;
+    pk_dem_pairs c2 = {0};
+    pk_dem_pairs_stiffness(&c2, c->kclass, c->kmat, c->nclass, c->kref);
     if (work_alloc(&w, np, dim) != 0) {
         rc = -1;
         goto out;
     }
-    memcpy(w.x0, x, 3 * np * sizeof *x);
+    newton_sys sy = {c, g, r, np, E, is_free, prm, solver, mon};
     double phi;
     pk_dem_eval(c, g, x, r, np, E, w.f, &phi, NULL);
     double f0 = sqrt(pk_homog_dot_mask(w.f, w.f, is_free, np, dim)), fn = f0;
     double target = fmax(prm->tol * f0, prm->abs_floor);
-    double best = fn;
-    size_t best_it = 0;
-    double mu = 0; /* Levenberg–Marquardt shift, kept (decaying) across factorisations */
     size_t nd = 0;
     for (size_t i = 0; i < np; i++)
         w.dof[i] = is_free[i] ? (int32_t)(dim * nd++) : -1;
-    nd *= (size_t)dim;
-    w.mem.nd = nd;
-    ns->exit = PK_NEWTON_CAP;
-    while (fn > target) {
-        if (ns->iterations >= max_newton)
-            break;
-        if (fn < 0.5 * best) {
-            best = fn;
-            best_it = ns->iterations;
-        } else if (ns->iterations >= best_it + STALL_FACTORS) {
-            ns->exit = PK_NEWTON_STALLED;
-            break;
-        }
-        if (pk_dem_rattlers(c, dim, np, is_free, w.rat) == (size_t)-1) {
-            rc = -1;
-            goto out;
-        }
-        w.K.nnz = 0;
-        w.K.n = nd;
-        if (assemble(c, dim, E, w.dof, w.rat, mu, np, &w.K) != 0) {
-            rc = -1;
-            goto out;
-        }
-        pk_sparse_info info;
-        pk_sparse_factor *fac = solver->factor(&w.K, &info);
-        if (info.status == PK_SPARSE_FAILED) {
-            solver->release(fac);
-            rc = -1;
-            goto out;
-        }
-        if (info.status != PK_SPARSE_OK) {
-            solver->release(fac);
-            if (mu < MAX_SHIFT * E) { /* indefinite: shift until positive definite */
-                mu = mu > 0 ? 10 * mu : MIN_SHIFT * E;
-                continue;
-            }
-            ns->exit = PK_NEWTON_BLOCK_NOT_PD;
-            break;
-        }
-        ns->iterations++;
-        mu = mu > 10 * MIN_SHIFT * E ? 0.1 * mu : 0;
-        /* Quasi-Newton steps preconditioned by this factor: exact Newton first,
-         * then L-BFGS corrections as contacts open and close, until the
-         * residual stops halving within the window (refresh the factor). */
-        w.mem.count = w.mem.head = 0;
-        gather_gradient(w.f, w.dof, np, dim, w.g);
-        double f_window = fn;
-        size_t window_start = 0;
-        int failed_first = 0;
-        for (size_t inner = 0; inner < MAX_INNER && fn > target; inner++) {
-            if (qn_direction(&w.mem, solver, fac, w.g, w.qv, w.d) != 0) {
-                solver->release(fac);
-                rc = -1;
-                goto out;
-            }
-            double gd = dot(w.g, w.d, nd);
-            if (!(gd < 0)) { /* memory spoilt the direction: plain preconditioned step */
-                w.mem.count = w.mem.head = 0;
-                if (qn_direction(&w.mem, solver, fac, w.g, w.qv, w.d) != 0) {
-                    solver->release(fac);
-                    rc = -1;
-                    goto out;
-                }
-                gd = dot(w.g, w.d, nd);
-                if (!(gd < 0))
-                    break;
-            }
-            double s = 1, phit = phi, ftn = fn;
-            int ok = 0;
-            for (int cut = 0; cut < MAX_CUTS; cut++, s *= 0.5) {
-                memcpy(w.xt, x, 3 * np * sizeof *x);
-                for (size_t i = 0; i < np; i++)
-                    if (w.dof[i] >= 0)
-                        for (int a = 0; a < dim; a++)
-                            w.xt[3 * i + a] += s * w.d[w.dof[i] + a];
-                rc = eval_at(c, g, w.xt, r, np, E, prm, w.ft, &phit);
-                if (rc != 0) {
-                    solver->release(fac);
-                    goto out;
-                }
-                ftn = sqrt(pk_homog_dot_mask(w.ft, w.ft, is_free, np, dim));
-                double lin = -s * gd; /* predicted decrease to first order */
-                if (lin <= ENERGY_ROUNDOFF * fabs(phi))
-                    ok = ftn < fn; /* energy change lost in round-off */
-                else
-                    ok = phit <= phi - ARMIJO * lin;
-                if (ok)
-                    break;
-                ns->cuts++;
-            }
-            if (!ok) {
-                failed_first = inner == 0;
-                break;
-            }
-            gather_gradient(w.ft, w.dof, np, dim, w.gt);
-            for (size_t e = 0; e < nd; e++) {
-                w.sv[e] = s * w.d[e];
-                w.yv[e] = w.gt[e] - w.g[e];
-            }
-            qn_push(&w.mem, w.sv, w.yv);
-            memcpy(w.g, w.gt, nd * sizeof *w.g);
-            memcpy(x, w.xt, 3 * np * sizeof *x);
-            memcpy(w.f, w.ft, 3 * np * sizeof *w.f);
-            phi = phit;
-            fn = ftn;
-            ns->steps++;
-            if (fn < 0.5 * f_window) {
-                f_window = fn;
-                window_start = inner;
-            } else if (inner >= window_start + REFRESH_WINDOW) {
-                break;
-            }
-            if (mon) {
-                pk_progress pr = {.stage = "newton", .fraction = -1, .phi = -1, .eta_s = -1,
-                                  .done = ns->steps};
-                int t = pk_monitor_tick(mon, &pr, 0);
-                if (t) {
-                    solver->release(fac);
-                    st->stop = t == 1 ? PK_DR_CANCELLED : PK_DR_WALL_TIME;
-                    st->f0 = f0;
-                    st->f = fn;
-                    goto out;
-                }
-            }
-        }
-        solver->release(fac);
-        rc = eval_at(c, g, x, r, np, E, prm, w.f, &phi); /* contacts of the current point */
-        if (rc != 0)
-            goto out;
-        if (failed_first) {
-            ns->exit = PK_NEWTON_LINE_SEARCH;
-            break;
-        }
-    }
-    if (fn <= target) {
-        ns->exit = PK_NEWTON_CONVERGED;
-        st->stop = fn <= prm->tol * f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
+    w.mem.nd = nd * (size_t)dim;
+    memcpy(w.x0, x, 3 * np * sizeof *x);
+    size_t budget = max_newton;
+    rc = newton_phase(&sy, &w, x, &phi, &fn, target, STALL_FACTORS, 0, &budget, ns, st);
+    if (rc == 1) { /* cancelled */
         st->f0 = f0;
         st->f = fn;
+        rc = 0;
         goto out;
     }
-    /* DR from the start point, as if Newton had not been asked: where Newton
-     * stalls the configuration is near an instability (negative curvature,
-     * contacts chattering), and DR's eigenvalue estimates taken there cost
-     * it several times the iterations it needs from the start. */
+    if (rc != 0)
+        goto out;
+    if (ns->exit == PK_NEWTON_CONVERGED) {
+        st->f0 = f0;
+        st->f = fn;
+        st->stop = fn <= prm->tol * f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
+        goto out;
+    }
+    /* Newton left its region: the step crosses instabilities (contacts
+     * open and close, grains rearrange — a plastic event).  DR takes the
+     * step from its start point, as if Newton had not been asked, through
+     * the rearrangement (fast: the path is set by the fast modes); at
+     * residuals HANDOVER·|f⁰|, HANDOVER_STEP× that, … Newton tries to finish
+     * the slow tail near the new minimum — where DR spends most of its
+     * iterations — from a copy of DR's point.  A failed attempt leaves DR's
+     * iteration untouched, so without a successful one the result is DR's. */
     memcpy(x, w.x0, 3 * np * sizeof *x);
-    rc = pk_homog_relax(c, g, x, r, np, E, is_free, prm, mon, st);
+    attempt_ctx a = {sy, &w, target, &budget, ns, st};
+    a.sy.c = &c2;
+    pk_dr_hook hook = {newton_attempt, &a, HANDOVER * f0 > target ? HANDOVER * f0 : 0};
+    rc = pk_homog_relax_hooked(c, g, x, r, np, E, is_free, prm, &hook, mon, st);
+    /* an attempt's point may be beyond DR's candidate list: the caller evaluates c at x */
+    if (rc == 0 && pk_dem_pairs_stale(c, x, dim))
+        rc = pk_dem_pairs_build(c, g, x, r, np, prm->skin);
 out:
+    pk_dem_pairs_free(&c2);
     work_free(&w);
     return rc;
 }

@@ -152,7 +152,8 @@ static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t
 
 static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
                  double E, const uint8_t *is_free, const pk_dr_params *prm, pk_fric_ctx *fc,
-                 double *u, pk_monitor *mon, pk_dr_stats *st, pk_fric_totals *tot)
+                 double *u, pk_dr_hook *hook, pk_monitor *mon, pk_dr_stats *st,
+                 pk_fric_totals *tot)
 {
     const int dim = g->dim;
     memset(st, 0, sizeof *st);
@@ -222,6 +223,19 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
             st->stop = st->f <= prm->tol * st->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
             break;
         }
+        if (hook && st->f <= hook->at) {
+            double fh = st->f;
+            int h = hook->fn(hook->ctx, x, &fh, &hook->at);
+            if (h < 0) {
+                rc = h;
+                goto out;
+            }
+            if (h == 1) { /* the hook solved the step from here */
+                st->f = fh;
+                st->stop = fh <= prm->tol * st->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
+                break;
+            }
+        }
         if (st->iterations >= prm->max_iter) {
             st->stop = PK_DR_MAX_ITER;
             break;
@@ -271,7 +285,14 @@ int pk_homog_relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doubl
                    double E, const uint8_t *is_free, const pk_dr_params *prm, pk_monitor *mon,
                    pk_dr_stats *st)
 {
-    return relax(c, g, x, r, np, E, is_free, prm, NULL, NULL, mon, st, NULL);
+    return relax(c, g, x, r, np, E, is_free, prm, NULL, NULL, NULL, mon, st, NULL);
+}
+
+int pk_homog_relax_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
+                          size_t np, double E, const uint8_t *is_free, const pk_dr_params *prm,
+                          pk_dr_hook *hook, pk_monitor *mon, pk_dr_stats *st)
+{
+    return relax(c, g, x, r, np, E, is_free, prm, NULL, NULL, hook, mon, st, NULL);
 }
 
 int pk_homog_relax_fric(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
@@ -279,5 +300,5 @@ int pk_homog_relax_fric(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const 
                         pk_fric_ctx *fc, double *u, pk_monitor *mon, pk_dr_stats *st,
                         pk_fric_totals *tot)
 {
-    return relax(c, g, x, r, np, E, is_free, prm, fc, u, mon, st, tot);
+    return relax(c, g, x, r, np, E, is_free, prm, fc, u, NULL, mon, st, tot);
 }

@@ -55,6 +55,23 @@ int pk_homog_relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doubl
                    double E, const uint8_t *is_free, const pk_dr_params *prm, pk_monitor *mon,
                    pk_dr_stats *st);
 
+/* A hook into a frictionless relaxation (the Newton/DR hybrid,
+ * homog_newton.h): called after an iteration whose residual |f| is <= at,
+ * with the current x and *fres = |f|.  It returns 0 to let DR go on (x
+ * untouched, it sets the next threshold *at), 1 when it has solved the step
+ * from x (x and *fres replaced: DR stops as converged), < 0 on an error (DR
+ * returns it).  It must not touch the pair list DR works on. */
+typedef struct pk_dr_hook {
+    int (*fn)(void *ctx, double *x, double *fres, double *at);
+    void *ctx;
+    double at;
+} pk_dr_hook;
+
+/* pk_homog_relax with a hook (hook->at: the first threshold). */
+int pk_homog_relax_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
+                          size_t np, double E, const uint8_t *is_free, const pk_dr_params *prm,
+                          pk_dr_hook *hook, pk_monitor *mon, pk_dr_stats *st);
+
 /* The same with inter-particle friction (2D, dem_friction.h): relaxes the
  * free centres and EVERY rotation u_i = r_i θ_i (Remark 7.3: all grains
  * rotate freely, Taylor included), starting from and reading only the
