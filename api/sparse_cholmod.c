@@ -13,19 +13,76 @@ struct pk_sparse_factor {
 /* |d| below this share of the largest pivot counts as zero (singular). */
 #define ZERO_PIVOT_SHARE 1e-12
 
+/* Classify pivots d_j (LDLᵀ's D, or L_jj² of an LLᵀ factor) into the inertia
+ * of info; |d| ≤ ZERO_PIVOT_SHARE·max|d| counts as zero. */
+static void classify_pivots(const double *d, size_t ncol, size_t n, pk_sparse_info *info)
+{
+    double dmax = 0, dmin = INFINITY;
+    for (size_t j = 0; j < ncol; j++)
+        dmax = fmax(dmax, fabs(d[j]));
+    for (size_t j = 0; j < ncol; j++) {
+        dmin = fmin(dmin, fabs(d[j]));
+        if (fabs(d[j]) <= ZERO_PIVOT_SHARE * dmax)
+            info->nzero++;
+        else if (d[j] < 0)
+            info->nneg++;
+        else
+            info->npos++;
+    }
+    info->nzero += n - ncol; /* factorization stopped at a zero pivot */
+    info->min_abs_pivot = ncol ? dmin : 0;
+    info->max_abs_pivot = dmax;
+    info->status = info->nzero ? PK_SPARSE_SINGULAR
+                               : info->nneg ? PK_SPARSE_INDEFINITE : PK_SPARSE_OK;
+}
+
+/* The pivots of a supernodal LLᵀ factor: L_jj² from each supernode's dense
+ * column block (column-major, nsrow rows). */
+static int supernodal_pivots(const cholmod_factor *L, double *d)
+{
+    const int *super = L->super, *pi = L->pi, *px = L->px;
+    const double *x = L->x;
+    for (size_t s = 0; s < L->nsuper; s++) {
+        int k1 = super[s], k2 = super[s + 1];
+        int nsrow = pi[s + 1] - pi[s];
+        for (int jj = 0; jj < k2 - k1; jj++) {
+            double l = x[px[s] + jj + (size_t)jj * nsrow];
+            d[k1 + jj] = l * l;
+        }
+    }
+    return 0;
+}
+
+/* Analyse and factorise S in the given mode; 0 when CHOLMOD ran (the factor
+ * may still stop early: L->minor < n). */
+static int factorize_mode(pk_sparse_factor *f, cholmod_sparse *S, int mode)
+{
+    f->c.supernodal = mode;
+    f->c.final_ll = 0; /* simplicial: keep LDLᵀ, D carries the inertia */
+    f->L = cholmod_analyze(S, &f->c);
+    if (!f->L)
+        return -1;
+    cholmod_factorize(S, f->L, &f->c);
+    return f->c.status < 0 ? -1 : 0;
+}
+
+/* Supernodal LLᵀ first: BLAS-3 on dense column blocks, 2.5× faster than the
+ * simplicial LDLᵀ on the 2·10⁴-DOF 2D blocks of issue 6 (bench/homog, with
+ * OpenBLAS).  It stops at the first non-positive pivot, so a block that is
+ * not positive definite is factorised again as simplicial LDLᵀ, whose D
+ * gives the full inertia that the tangent and Newton report. */
 static pk_sparse_factor *chol_factor(const pk_sparse_sym *A, pk_sparse_info *info)
 {
     info->status = PK_SPARSE_FAILED;
     info->npos = info->nneg = info->nzero = 0;
     info->min_abs_pivot = info->max_abs_pivot = 0;
     pk_sparse_factor *f = calloc(1, sizeof *f);
+    double *d = NULL;
     if (!f)
         return NULL;
     cholmod_start(&f->c);
     f->c.print = 0;
     f->c.error_handler = NULL;
-    f->c.supernodal = CHOLMOD_SIMPLICIAL;
-    f->c.final_ll = 0; /* keep LDLᵀ: D carries the inertia */
     f->n = A->n;
     cholmod_triplet *T = cholmod_allocate_triplet(A->n, A->n, A->nnz ? A->nnz : 1, 1, CHOLMOD_REAL, &f->c);
     cholmod_sparse *S = NULL;
@@ -41,36 +98,30 @@ static pk_sparse_factor *chol_factor(const pk_sparse_sym *A, pk_sparse_info *inf
     T->nnz = A->nnz;
     S = cholmod_triplet_to_sparse(T, A->nnz, &f->c);
     cholmod_free_triplet(&T, &f->c);
-    if (!S)
+    d = malloc((A->n ? A->n : 1) * sizeof *d);
+    if (!S || !d)
         goto fail;
-    f->L = cholmod_analyze(S, &f->c);
-    if (!f->L)
+    if (factorize_mode(f, S, CHOLMOD_SUPERNODAL) != 0)
         goto fail;
-    cholmod_factorize(S, f->L, &f->c);
-    cholmod_free_sparse(&S, &f->c);
-    if (f->c.status < 0)
-        goto fail;
-    const int *Lp = f->L->p;
-    const double *Lx = f->L->x;
-    double dmax = 0, dmin = INFINITY;
-    size_t ncol = f->L->minor < A->n ? f->L->minor : A->n;
-    for (size_t j = 0; j < ncol; j++)
-        dmax = fmax(dmax, fabs(Lx[Lp[j]]));
-    for (size_t j = 0; j < ncol; j++) {
-        double d = Lx[Lp[j]];
-        dmin = fmin(dmin, fabs(d));
-        if (fabs(d) <= ZERO_PIVOT_SHARE * dmax)
-            info->nzero++;
-        else if (d < 0)
-            info->nneg++;
-        else
-            info->npos++;
+    if (f->L->minor >= A->n && f->L->is_super) {
+        supernodal_pivots(f->L, d);
+        classify_pivots(d, A->n, A->n, info);
     }
-    info->nzero += A->n - ncol; /* factorization stopped at a zero pivot */
-    info->min_abs_pivot = ncol ? dmin : 0;
-    info->max_abs_pivot = dmax;
-    info->status = info->nzero ? PK_SPARSE_SINGULAR
-                               : info->nneg ? PK_SPARSE_INDEFINITE : PK_SPARSE_OK;
+    if (info->status != PK_SPARSE_OK) { /* not positive definite: the inertia from LDLᵀ */
+        cholmod_free_factor(&f->L, &f->c);
+        info->npos = info->nneg = info->nzero = 0;
+        if (factorize_mode(f, S, CHOLMOD_SIMPLICIAL) != 0)
+            goto fail;
+        const int *Lp = f->L->p;
+        const double *Lx = f->L->x;
+        size_t ncol = f->L->minor < A->n ? f->L->minor : A->n;
+        for (size_t j = 0; j < ncol; j++)
+            d[j] = Lx[Lp[j]];
+        classify_pivots(d, ncol, A->n, info);
+    }
+    cholmod_free_sparse(&S, &f->c); /* sets S = NULL */
+    free(d);
+    d = NULL;
     if (info->status == PK_SPARSE_SINGULAR)
         goto fail_keep_status;
     return f;
@@ -79,6 +130,7 @@ fail:
 fail_keep_status:
     if (S)
         cholmod_free_sparse(&S, &f->c);
+    free(d);
     if (f->L)
         cholmod_free_factor(&f->L, &f->c);
     cholmod_finish(&f->c);
@@ -115,7 +167,7 @@ static void chol_release(pk_sparse_factor *f)
 }
 
 const pk_sparse_solver pk_sparse_cholmod = {
-    .name = "cholmod-ldlt",
+    .name = "cholmod",
     .factor = chol_factor,
     .solve = chol_solve,
     .release = chol_release,

@@ -40,6 +40,71 @@ static void test_sparse_solver_status(void)
     pk_sparse_sym_free(&D);
 }
 
+/* 5-point Laplacian of an m×m periodic grid plus shift·1: big enough for
+ * CHOLMOD to form real supernodes (the factor path of 10⁴-grain RVEs). */
+static void grid_laplacian(int m, double shift, pk_sparse_sym *A)
+{
+    *A = (pk_sparse_sym){.n = (size_t)(m * m)};
+    for (int i = 0; i < m; i++)
+        for (int j = 0; j < m; j++) {
+            int32_t k = (int32_t)(i * m + j);
+            int32_t e = (int32_t)(i * m + (j + 1) % m), n = (int32_t)(((i + 1) % m) * m + j);
+            pk_sparse_sym_add(A, k, k, 4 + shift);
+            pk_sparse_sym_add(A, k < e ? k : e, k < e ? e : k, -1);
+            pk_sparse_sym_add(A, k < n ? k : n, k < n ? n : k, -1);
+        }
+}
+
+/* The supernodal LLᵀ path and its fallback: an SPD block solves to round-off
+ * (residual 1e-12 of |b|: condition ≈ 8/shift = 800) with pivots read from
+ * the supernodes (max/min ≤ the condition bound 8/shift); the unshifted
+ * periodic Laplacian has exactly one zero eigenvalue (constants) and must be
+ * reported singular (its last LLᵀ pivot is round-off: ~1e-15 of the largest,
+ * below the 1e-12 share); shifted by minus half the smallest nonzero
+ * eigenvalue 2(1−cos 2π/m) the block is indefinite with exactly one
+ * negative pivot (inertia from the LDLᵀ refactorisation). */
+static void test_sparse_solver_supernodal(void)
+{
+    const int m = 40;
+    pk_sparse_sym A;
+    pk_sparse_info info;
+    grid_laplacian(m, 0.01, &A);
+    pk_sparse_factor *f = pk_sparse_cholmod.factor(&A, &info);
+    CHECK(f && info.status == PK_SPARSE_OK && info.npos == A.n && info.nneg == 0 && info.nzero == 0);
+    CHECK_MSG(info.min_abs_pivot > 0 && info.max_abs_pivot / info.min_abs_pivot < 8 / 0.01,
+              "pivots %g .. %g", info.min_abs_pivot, info.max_abs_pivot);
+    double *b = malloc(A.n * sizeof *b), *x = malloc(A.n * sizeof *x), *Ax = calloc(A.n, sizeof *Ax);
+    for (size_t k = 0; k < A.n; k++)
+        b[k] = sin(0.37 * (double)k) + 0.1;
+    CHECK(f && pk_sparse_cholmod.solve(f, 1, b, x) == 0);
+    for (size_t k = 0; k < A.nnz; k++) {
+        Ax[A.row[k]] += A.val[k] * x[A.col[k]];
+        if (A.row[k] != A.col[k])
+            Ax[A.col[k]] += A.val[k] * x[A.row[k]];
+    }
+    double res = 0, nb = 0;
+    for (size_t k = 0; k < A.n; k++)
+        res += (Ax[k] - b[k]) * (Ax[k] - b[k]), nb += b[k] * b[k];
+    CHECK_MSG(sqrt(res / nb) < 1e-12, "relative residual %g", sqrt(res / nb));
+    pk_sparse_cholmod.release(f);
+    pk_sparse_sym_free(&A);
+
+    grid_laplacian(m, 0, &A);
+    f = pk_sparse_cholmod.factor(&A, &info);
+    CHECK_MSG(!f && info.status == PK_SPARSE_SINGULAR && info.nzero >= 1, "status %d nzero %zu",
+              (int)info.status, info.nzero);
+    pk_sparse_sym_free(&A);
+
+    double lam1 = 2 * (1 - cos(2 * M_PI / m)); /* smallest nonzero eigenvalue (4-fold) */
+    grid_laplacian(m, -0.5 * lam1, &A);
+    f = pk_sparse_cholmod.factor(&A, &info);
+    CHECK_MSG(info.status == PK_SPARSE_INDEFINITE && info.nneg == 1 && info.npos == A.n - 1,
+              "status %d inertia %zu/%zu/%zu", (int)info.status, info.npos, info.nneg, info.nzero);
+    pk_sparse_cholmod.release(f);
+    pk_sparse_sym_free(&A);
+    free(b), free(x), free(Ax);
+}
+
 /* Remark 6.1 analytically: A_1111 = A_2222 = E√N/(√N−1), all else 0
  * (basis erratum of (6.10)).  Exact formula: tolerance 1e-12 relative. */
 static void test_square_lattice_tangent(void)
@@ -200,6 +265,7 @@ static void test_newton_matches_dr(void)
 int main(void)
 {
     RUN(test_sparse_solver_status);
+    RUN(test_sparse_solver_supernodal);
     RUN(test_square_lattice_tangent);
     RUN(test_tangent_vs_finite_differences);
     RUN(test_constraint_ranking);
