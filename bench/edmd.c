@@ -4,11 +4,12 @@
  * (job cases: rates per wall second of the placement, cpu_s of the whole job)
  * Cases: monodisperse 3D periodic N = 10^4 to φ = 0.60 and to jamming,
  * N = 2000 slow/fast (the MRJ band and the rate dependence), Fuller-like
- * 3D diameters 1–16 (counts ∝ d^-2.5) N = 10^4 to jamming, Titscher's
- * walled A16 with Δd = 1 mm at φ_M = 53.5 %, Meier's 2D quartz and A32
- * (nop = 1000) to jamming over 3 seeds.  The N = 10^6 case (to φ = 0.55)
+ * 3D diameters 1–16 (counts ∝ d^-2.5) N = 10^4 to jamming, Meier's 2D
+ * quartz and A32 (nop = 1000) to jamming over 3 seeds.  The N = 10^6 case (to φ = 0.55)
  * takes minutes: opt in with PACKD_BENCH_LARGE=1.  peak_rss_mb is the
- * process peak so far (getrusage), so it is monotone over the cases. */
+ * process peak so far (getrusage), so it is monotone over the cases.
+ * Titscher's walled A16 (Δd = 1 mm at φ_M = 53.5 %, both wall rules, through
+ * packd's job path) is bench/edmd_titscher. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -176,11 +177,6 @@ int main(void)
     printf("bench=edmd case=mono3d_2000_check band_0.634_0.652=%s faster_is_looser=%s\n",
            slow >= 0.634 && slow <= 0.652 ? "yes" : "no", fast < slow ? "yes" : "no");
     fuller("fuller3d_d1to16_1e4_jam", 10000, 0.01);
-    job_case("titscher_a16_walled_phiM0.535_dd1",
-             "{\"process\":\"pack\",\"inputs\":{\"dim\":3,\"domain\":{\"box\":{\"size\":[80,80,80],"
-             "\"periodic\":false}},\"grading\":{\"type\":\"preset\",\"name\":\"A16\"},\"d_min\":2,"
-             "\"phi\":{\"value\":0.535,\"refers_to\":\"mix\"},\"delta_d\":1,\"algorithm\":\"edmd\","
-             "\"edmd\":{\"growth\":\"shell\",\"growth_rate\":0.01},\"seed\":1}}");
     for (int s = 1; s <= 3; s++)
         meier("meier_quartz_2d_jam", QUARTZ, 3.0, s);
     for (int s = 1; s <= 3; s++)

@@ -78,6 +78,7 @@ typedef struct pk_edmd_stats {
     double t_stop, t_end;       /* simulated times (unit d̄/u) */
     double seconds;
     uint64_t events, pair, wall, nlist, invalid, rescales, rebases, overlaps;
+    uint64_t resorts;           /* renumberings along the Z-order (large N) */
     double max_overlap_rel;     /* largest overlap seen by the predictor, relative to R */
     size_t nhist;               /* φ(t) history: events, time, φ, p */
     double hist_events[PK_EDMD_HIST_MAX], hist_t[PK_EDMD_HIST_MAX];

@@ -77,7 +77,7 @@ static void set_sphere(edmd_state *s, size_t i, double ahead)
     const double rho = edmd_rho(s, i, s->t);
     /* never smaller than the grain at its reference (target) size: while
      * grains are small and far apart the lists then last much longer */
-    const double sig = fmax(rho, s->rref[i]) + 0.5 * s->skin_scale * s->skin[i];
+    const double sig = (rho > s->rref[i] ? rho : s->rref[i]) + 0.5 * s->skin_scale * s->skin[i];
     const double *v = s->k[i].v;
     double x[3];
     edmd_pos(s, i, x);
@@ -85,7 +85,7 @@ static void set_sphere(edmd_state *s, size_t i, double ahead)
     double shift = speed > 0 ? ahead * (sig - rho) / speed : 0;
     for (int k = 0; k < 3; k++)
         s->bs.x[3 * i + k] = x[k] + shift * v[k];
-    pk_box_wrap(&s->box, &s->bs.x[3 * i]);
+    edmd_wrap_near(s, &s->bs.x[3 * i]);
     s->bs.r[i] = sig;
     s->ncoll_nl[i] = s->ncoll[i];
 }

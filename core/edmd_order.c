@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "edmd_state.h"
 
@@ -51,4 +52,40 @@ int edmd_spatial_order(const pk_box *b, const double *x, size_t n, double h, siz
         perm[i] = k[i].i;
     free(k);
     return 0;
+}
+
+/* a[k] = a[ord[k]] for n elements of size bytes (tmp holds n of them). */
+static void permute(void *a, size_t size, size_t n, const size_t *ord, void *tmp)
+{
+    char *src = a, *dst = tmp;
+    for (size_t k = 0; k < n; k++)
+        memcpy(dst + k * size, src + ord[k] * size, size);
+    memcpy(a, tmp, n * size);
+}
+
+int edmd_reorder(edmd_state *s, size_t *perm, double h)
+{
+    const size_t n = s->n;
+    size_t *ord = malloc(n * sizeof *ord);
+    double *x = calloc(3 * n, sizeof *x);
+    void *tmp = malloc(n * sizeof(edmd_kin)); /* the largest element */
+    int rc = -1;
+    if (!ord || !x || !tmp)
+        goto out;
+    for (size_t i = 0; i < n; i++)
+        edmd_pos(s, i, &x[3 * i]);
+    if (edmd_spatial_order(&s->box, x, n, h, ord) != 0)
+        goto out;
+    permute(s->k, sizeof *s->k, n, ord, tmp);
+    permute(s->m, sizeof *s->m, n, ord, tmp);
+    permute(s->skin, sizeof *s->skin, n, ord, tmp);
+    permute(s->rref, sizeof *s->rref, n, ord, tmp);
+    permute(s->ncoll, sizeof *s->ncoll, n, ord, tmp);
+    permute(perm, sizeof *perm, n, ord, tmp);
+    rc = 0;
+out:
+    free(ord);
+    free(x);
+    free(tmp);
+    return rc;
 }

@@ -3,6 +3,7 @@
  * sift compares neighbouring memory instead of chasing ev_t[] of random
  * particles; 4 children per node halve the depth (fewer cache lines per
  * re-key).  hpos[i] is the node of particle i, for O(log N) re-keying. */
+#include <math.h>
 #include <stdlib.h>
 
 #include "edmd_state.h"
@@ -28,22 +29,24 @@ static void sift_up(edmd_state *s, size_t k)
     place(s, k, e);
 }
 
+/* The heap is followed by ARITY − 1 nodes at +inf (edmd_queue_init), so the
+ * last parent's child group is always full: no bound per child. */
 static void sift_down(edmd_state *s, size_t k)
 {
-    edmd_hnode e = s->heap[k];
+    edmd_hnode *h = s->heap;
+    const edmd_hnode e = h[k];
     const size_t n = s->hn;
     for (;;) {
-        size_t c = ARITY * k + 1;
+        const size_t c = ARITY * k + 1;
         if (c >= n)
             break;
-        size_t end = c + ARITY < n ? c + ARITY : n, m = c;
-        for (size_t q = c + 1; q < end; q++)
-            if (s->heap[q].t < s->heap[m].t)
-                m = q;
-        if (!(s->heap[m].t < e.t))
+        const edmd_hnode *ch = &h[c];
+        size_t a = ch[1].t < ch[0].t ? 1 : 0, b = ch[3].t < ch[2].t ? 3 : 2;
+        size_t m = ch[b].t < ch[a].t ? b : a;
+        if (!(ch[m].t < e.t))
             break;
-        place(s, k, s->heap[m]);
-        k = m;
+        place(s, k, ch[m]);
+        k = c + m;
     }
     place(s, k, e);
 }
@@ -53,6 +56,8 @@ int edmd_queue_init(edmd_state *s)
     s->hn = s->n;
     for (size_t i = 0; i < s->n; i++)
         place(s, i, (edmd_hnode){s->ev_t[i], (int32_t)i});
+    for (size_t q = 0; q + 1 < ARITY; q++) /* sentinels, never moved */
+        s->heap[s->n + q] = (edmd_hnode){INFINITY, -1};
     for (size_t k = s->hn / ARITY + 1; k-- > 0;)
         if (k < s->hn)
             sift_down(s, k);

@@ -78,6 +78,26 @@ static inline void edmd_min_image_near(const edmd_state *s, double d[3])
     pk_min_image3(s->Lp, s->inv_Lp, d);
 }
 
+/* x back into [0, L) on the periodic axes when it is less than a period
+ * outside (bounding-sphere centres: a grain plus a fraction of its room);
+ * pk_box_wrap (floor, division) otherwise. */
+static inline void edmd_wrap_near(const edmd_state *s, double x[3])
+{
+    for (int d = 0; d < 3; d++) {
+        const double L = s->Lp[d];
+        if (L > 0) {
+            if (x[d] < 0)
+                x[d] += L;
+            if (x[d] >= L)
+                x[d] -= L;
+            if (!(x[d] >= 0 && x[d] < L)) {
+                pk_box_wrap(&s->box, x);
+                return;
+            }
+        }
+    }
+}
+
 /* Position of i now. */
 static inline void edmd_pos(const edmd_state *s, size_t i, double x[3])
 {
@@ -100,8 +120,24 @@ static inline void edmd_pin(edmd_state *s, size_t i, const double x[3])
         k->p[d] = x[d] - k->v[d] * s->t;
 }
 
+/* Moves p by whole periods so that x(t) is in [0, L) on periodic axes (a
+ * grain flies less than L between two syncs: its list sphere is smaller). */
+static inline void edmd_sync(edmd_state *s, size_t i)
+{
+    edmd_kin *k = &s->k[i];
+    for (int d = 0; d < 3; d++) {
+        const double L = s->Lp[d];
+        if (L > 0) {
+            const double x = k->p[d] + k->v[d] * s->t;
+            if (x < 0)
+                k->p[d] += L;
+            else if (x >= L)
+                k->p[d] -= L;
+        }
+    }
+}
+
 /* edmd_predict.c */
-void edmd_sync(edmd_state *s, size_t i);               /* periodic axes: x(t) back into [0, L) */
 void edmd_predict(edmd_state *s, size_t i);            /* refresh i's event and heap slot */
 double edmd_wall_time(const edmd_state *s, size_t i, int *code);
 
@@ -117,6 +153,11 @@ void edmd_queue_shift(edmd_state *s, double dt);       /* all times −= dt */
 /* edmd_order.c: perm[k] = index of the k-th grain along a Z-order curve of
  * cells of edge h.  0 or -1 (out of memory). */
 int edmd_spatial_order(const pk_box *b, const double *x, size_t n, double h, size_t *perm);
+/* Renumber the grains along the Z-order of their positions now (cells of
+ * edge h), perm (engine index → caller's grain) with them.  Neighbour lists,
+ * bounding spheres and events are not carried over: the caller rebuilds
+ * them.  0 or -1 (out of memory). */
+int edmd_reorder(edmd_state *s, size_t *perm, double h);
 
 /* edmd_nlist.c */
 int edmd_nlist_build_all(edmd_state *s);

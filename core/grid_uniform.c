@@ -5,12 +5,23 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* floor(v) for |v| < 2^62 without the libm call (SSE2 has no roundsd). */
+static inline double fast_floor(double v)
+{
+    double t = (double)(int64_t)v;
+    return t > v ? t - 1 : t;
+}
+
+/* floor(log2(r_top / r)) clamped to the levels, by halving (exact in binary
+ * floating point, no libm call: an insert per list rebuild). */
 static int level_of(const pk_ugrid *g, double r)
 {
     if (!(r > 0))
         return g->nlevel - 1;
-    double l = floor(log2(g->r_top / r));
-    return l < 0 ? 0 : l >= g->nlevel ? g->nlevel - 1 : (int)l;
+    int l = 0;
+    for (double bound = 0.5 * g->r_top; l + 1 < g->nlevel && r <= bound; bound *= 0.5)
+        l++;
+    return l;
 }
 
 /* Cells of edge >= 2 r_hi per axis, at most max_cells in all. */
@@ -94,7 +105,7 @@ void pk_ugrid_free(pk_ugrid *g)
 /* Cell coordinate along k, clamped (round-off at L, grains off a wall). */
 static inline int32_t coord(const pk_ugrid_level *lv, int k, double xk)
 {
-    double c = floor(xk * lv->inv_h[k]);
+    double c = fast_floor(xk * lv->inv_h[k]);
     return c < 0 ? 0 : c >= lv->n[k] ? lv->n[k] - 1 : (int32_t)c;
 }
 
@@ -142,58 +153,90 @@ static inline int32_t wrap_index(int64_t c, int32_t n)
     return (int32_t)(m < 0 ? m + n : m);
 }
 
+/* Query context of one level: the point, the radius and the box. */
+typedef struct qctx {
+    const int32_t *next;
+    const double *X, *R;
+    double x0, x1, x2, r;
+    double L0, L1, L2, iL0, iL1, iL2;
+    pk_grid_visit fn;
+    void *ctx;
+} qctx;
+
+/* Cells [a, b) of one row.  images = 0 when the query box lies inside the
+ * periodic cell range without wrapping: then every grain within reach is
+ * within reach by its stored position (an image x_j ± L is outside [0, L),
+ * hence outside the box), and the minimum image of those differences is the
+ * difference itself (round(d/L) = 0), so it is skipped. */
+static inline int scan_cells(const qctx *q, const int32_t *row, int32_t a, int32_t b,
+                             const int images)
+{
+    const double M = 6755399441055744.0; /* round-to-nearest trick of pk_min_image3 */
+    for (int32_t c = a; c < b; c++)
+        for (int32_t j = row[c]; j >= 0; j = q->next[j]) {
+            const double *xj = &q->X[3 * (size_t)j];
+            double d0 = xj[0] - q->x0, d1 = xj[1] - q->x1, d2 = xj[2] - q->x2;
+            if (images) {
+                d0 -= q->L0 * ((d0 * q->iL0 + M) - M);
+                d1 -= q->L1 * ((d1 * q->iL1 + M) - M);
+                d2 -= q->L2 * ((d2 * q->iL2 + M) - M);
+            }
+            const double dd = d0 * d0 + d1 * d1 + d2 * d2;
+            const double sr = q->r + q->R[j];
+            if (dd < sr * sr) {
+                const double d[PK_MAXDIM] = {d0, d1, d2};
+                int stop = q->fn((size_t)j, d, dd, q->ctx);
+                if (stop)
+                    return stop;
+            }
+        }
+    return 0;
+}
+
 static int query_level(const pk_ugrid *g, const pk_ugrid_level *lv, const pk_particles *p,
                        const double x[PK_MAXDIM], double r, pk_grid_visit fn, void *ctx)
 {
     /* margin: a grain within round-off of a cell face may be filed in the
      * neighbouring cell of its periodic image */
     const double reach = (r + lv->r_max) * (1 + 1e-9);
-    int64_t lo[PK_MAXDIM] = {0, 0, 0}, hi[PK_MAXDIM] = {0, 0, 0};
+    int32_t lo[PK_MAXDIM] = {0, 0, 0}, cnt[PK_MAXDIM] = {1, 1, 1};
+    int images = 0; /* some periodic axis wraps or is covered whole */
     for (int k = 0; k < g->box.dim; k++) {
         const int32_t n = lv->n[k];
         const double m = 1e-9 * n; /* cells of round-off margin, see above */
-        double flo = floor((x[k] - reach) * lv->inv_h[k] - m);
-        double fhi = floor((x[k] + reach) * lv->inv_h[k] + m);
+        double flo = fast_floor((x[k] - reach) * lv->inv_h[k] - m);
+        double fhi = fast_floor((x[k] + reach) * lv->inv_h[k] + m);
         if (g->box.periodic[k]) {
             if (fhi - flo + 1 >= n) { /* the whole axis, each cell once */
                 flo = 0;
                 fhi = n - 1;
+                images = 1;
+            } else if (flo < 0 || fhi > n - 1) {
+                images = 1;
             }
         } else {
-            flo = fmax(flo, 0);
-            fhi = fmin(fhi, n - 1);
+            flo = flo > 0 ? flo : 0;
+            fhi = fhi < n - 1 ? fhi : n - 1;
         }
-        lo[k] = (int64_t)flo;
-        hi[k] = (int64_t)fhi;
+        /* first cell (wrapped once: the modulo stays out of the loops) and count */
+        lo[k] = wrap_index((int64_t)flo, n);
+        cnt[k] = (int32_t)(fhi - flo) + 1;
     }
-    const double *X = p->x, *R = p->r;
-    const double M = 6755399441055744.0; /* round-to-nearest trick of pk_min_image3 */
-    const double L0 = g->L[0], L1 = g->L[1], L2 = g->L[2];
-    const double iL0 = g->inv_L[0], iL1 = g->inv_L[1], iL2 = g->inv_L[2];
-    const double x0 = x[0], x1 = x[1], x2 = x[2];
-    const int32_t nx = lv->n[0], ix0 = wrap_index(lo[0], nx);
-    for (int64_t cz = lo[2]; cz <= hi[2]; cz++) {
-        const int32_t iz = wrap_index(cz, lv->n[2]);
-        for (int64_t cy = lo[1]; cy <= hi[1]; cy++) {
-            const int32_t *row = &lv->head[(iz * lv->n[1] + wrap_index(cy, lv->n[1])) * nx];
-            int32_t ix = ix0;
-            for (int64_t cx = lo[0]; cx <= hi[0]; cx++, ix = ix + 1 == nx ? 0 : ix + 1) {
-                for (int32_t j = row[ix]; j >= 0; j = g->next[j]) {
-                    const double *xj = &X[3 * (size_t)j];
-                    double d0 = xj[0] - x0, d1 = xj[1] - x1, d2 = xj[2] - x2;
-                    d0 -= L0 * ((d0 * iL0 + M) - M);
-                    d1 -= L1 * ((d1 * iL1 + M) - M);
-                    d2 -= L2 * ((d2 * iL2 + M) - M);
-                    const double dd = d0 * d0 + d1 * d1 + d2 * d2;
-                    const double sr = r + R[j];
-                    if (dd < sr * sr) {
-                        const double d[PK_MAXDIM] = {d0, d1, d2};
-                        int stop = fn((size_t)j, d, dd, ctx);
-                        if (stop)
-                            return stop;
-                    }
-                }
-            }
+    const qctx q = {g->next, p->x, p->r, x[0], x[1], x[2], r,
+                    g->L[0], g->L[1], g->L[2], g->inv_L[0], g->inv_L[1], g->inv_L[2], fn, ctx};
+    const int32_t nx = lv->n[0], ny = lv->n[1], nz = lv->n[2];
+    /* x cells: [lo, e1) then, past the periodic seam, [0, e2) */
+    const int32_t e1 = lo[0] + cnt[0] <= nx ? lo[0] + cnt[0] : nx, e2 = lo[0] + cnt[0] - e1;
+    int32_t iz = lo[2];
+    for (int32_t cz = 0; cz < cnt[2]; cz++, iz = iz + 1 == nz ? 0 : iz + 1) {
+        int32_t iy = lo[1];
+        for (int32_t cy = 0; cy < cnt[1]; cy++, iy = iy + 1 == ny ? 0 : iy + 1) {
+            const int32_t *row = &lv->head[((size_t)iz * (size_t)ny + (size_t)iy) * (size_t)nx];
+            int stop = images ? scan_cells(&q, row, lo[0], e1, 1) : scan_cells(&q, row, lo[0], e1, 0);
+            if (!stop && e2 > 0)
+                stop = scan_cells(&q, row, 0, e2, 1);
+            if (stop)
+                return stop;
         }
     }
     return 0;

@@ -37,6 +37,26 @@ static void box_cube(pk_box *b, int dim, double L, int periodic)
     }
 }
 
+/* Edge of the 3D cube that n spheres of radius r fill to phi. */
+static double cube_edge(int n, double r, double phi)
+{
+    return cbrt(n * pk_ball_measure(3, r) / phi);
+}
+
+/* The common set-up: n grains (radius r, every 4th r4 — r4 = r for equal
+ * grains) at the origin (the zero start places them) in a cube of edge L,
+ * and the default parameters. */
+static void setup(pk_box *b, pk_particles *p, pk_edmd_params *prm, int dim, double L,
+                  int periodic, int n, double r, double r4)
+{
+    box_cube(b, dim, L, periodic);
+    pk_particles_init(p, dim, (size_t)n);
+    double x[3] = {0, 0, 0};
+    for (int i = 0; i < n; i++)
+        pk_particles_push(p, x, i % 4 == 0 ? r4 : r, 0);
+    pk_edmd_params_default(prm);
+}
+
 /* Spec §3.3a check case: the (B + √Δ)/(−A) form stays exact where the
  * conjugate form loses 1e-4.  Exact answer: t = 9/(1 − Δv) (Δv exactly
  * representable difference, Sterbenz). */
@@ -168,14 +188,9 @@ static void run_walled_cube(int per_axis)
 {
     int n = per_axis * per_axis * per_axis;
     pk_box b;
-    box_cube(&b, 3, 1.0, 0);
     pk_particles p;
-    pk_particles_init(&p, 3, (size_t)n);
-    double x[3] = {0, 0, 0};
-    for (int i = 0; i < n; i++)
-        pk_particles_push(&p, x, 0.1, 0);
     pk_edmd_params prm;
-    pk_edmd_params_default(&prm);
+    setup(&b, &p, &prm, 3, 1.0, 0, n, 0.1, 0.1);
     prm.until = PK_EDMD_UNTIL_JAMMED;
     prm.growth_rate = 0.02;
     prm.seed = 3;
@@ -204,14 +219,9 @@ static void test_target_phi_exact(void)
 {
     int n = 300;
     pk_box b;
-    box_cube(&b, 3, pow(n * M_PI / 6 / 0.55, 1.0 / 3), 1); /* unit diameters fill 0.55 */
     pk_particles p;
-    pk_particles_init(&p, 3, (size_t)n);
-    double x[3] = {0, 0, 0};
-    for (int i = 0; i < n; i++)
-        pk_particles_push(&p, x, 0.5, 0);
     pk_edmd_params prm;
-    pk_edmd_params_default(&prm);
+    setup(&b, &p, &prm, 3, cube_edge(n, 0.5, 0.55), 1, n, 0.5, 0.5);
     prm.phi_target = 0.5;
     prm.growth_rate = 0.05;
     pk_edmd_stats st;
@@ -228,15 +238,10 @@ static void test_walled_2d_delta_d(void)
 {
     int n = 400;
     pk_box b;
-    box_cube(&b, 2, 45, 0); /* φ = 0.51 at the target sizes */
-    b.periodic[1] = 1;      /* mixed: walls on x, periodic on y */
     pk_particles p;
-    pk_particles_init(&p, 2, (size_t)n);
-    double x[3] = {0, 0, 0};
-    for (int i = 0; i < n; i++)
-        pk_particles_push(&p, x, i % 4 == 0 ? 1.6 : 0.5, 0);
     pk_edmd_params prm;
-    pk_edmd_params_default(&prm);
+    setup(&b, &p, &prm, 2, 45, 0, n, 0.5, 1.6); /* φ = 0.51 at the target sizes */
+    b.periodic[1] = 1;                          /* mixed: walls on x, periodic on y */
     prm.delta_d = 0.1;
     prm.growth_rate = 0.05;
     pk_edmd_stats st;
@@ -256,14 +261,9 @@ static void test_rescale_switch(void)
     for (int on = 0; on <= 1; on++) {
         int n = 300;
         pk_box b;
-        box_cube(&b, 3, pow(n * M_PI / 6 / 0.5, 1.0 / 3), 1);
         pk_particles p;
-        pk_particles_init(&p, 3, (size_t)n);
-        double x[3] = {0, 0, 0};
-        for (int i = 0; i < n; i++)
-            pk_particles_push(&p, x, 0.5, 0);
         pk_edmd_params prm;
-        pk_edmd_params_default(&prm);
+        setup(&b, &p, &prm, 3, cube_edge(n, 0.5, 0.5), 1, n, 0.5, 0.5);
         prm.until = PK_EDMD_UNTIL_JAMMED;
         prm.growth_rate = 0.1;
         prm.rescale = on;
@@ -319,6 +319,42 @@ static void test_rsa_start_relative_and_shell(void)
     free(sp);
 }
 
+/* From RESORT_MIN_N = 32768 grains on the engine renumbers the grains along
+ * a Z-order curve every 10·N events and rebuilds lists and events there:
+ * the result must stay overlap-free, give every grain its own size in the
+ * caller's order (relative growth: r_i / target_i the same for all, to
+ * round-off), and repeat bit for bit with the same seed.  N = 40000 from
+ * zero radii to φ = 0.3 at a fast rate: 5.7·10⁵ events, one renumbering. */
+static void test_renumbering_large_n(void)
+{
+    const int n = 40000;
+    pk_box b;
+    pk_particles p, q;
+    pk_edmd_params prm;
+    setup(&b, &p, &prm, 3, cube_edge(n, 0.5, 0.5), 1, n, 0.5, 0.7);
+    pk_particles_init(&q, 3, (size_t)n);
+    for (int i = 0; i < n; i++)
+        pk_particles_push(&q, &p.x[3 * i], p.r[i], 0);
+    prm.phi_target = 0.3;
+    prm.growth_rate = 0.5;
+    pk_edmd_stats st, st2;
+    CHECK(pk_edmd_run(&b, &p, &prm, NULL, &st) == 0);
+    CHECK(pk_edmd_run(&b, &q, &prm, NULL, &st2) == 0);
+    CHECK(st.reason == PK_STOP_COMPLETE);
+    CHECK_MSG(st.resorts >= 1, "%llu renumberings", (unsigned long long)st.resorts);
+    CHECK(st2.events == st.events);
+    CHECK(memcmp(p.x, q.x, 3 * (size_t)n * sizeof *p.x) == 0);
+    CHECK(memcmp(p.r, q.r, (size_t)n * sizeof *p.r) == 0);
+    const double scale = p.r[1] / 0.5;
+    for (int i = 0; i < n; i++)
+        CHECK_NEAR(p.r[i] / (i % 4 == 0 ? 0.7 : 0.5), scale, 1e-12 * scale);
+    check_no_overlap(&b, &p, 0);
+    printf("  N=%d: events=%llu renumberings=%llu phi=%.6f\n", n,
+           (unsigned long long)st.events, (unsigned long long)st.resorts, st.phi);
+    pk_particles_free(&p);
+    pk_particles_free(&q);
+}
+
 static int cancel_after(const pk_progress *pr, void *ctx)
 {
     (void)ctx;
@@ -330,14 +366,9 @@ static void test_cancel(void)
 {
     int n = 2000;
     pk_box b;
-    box_cube(&b, 3, pow(n * M_PI / 6 / 0.6, 1.0 / 3), 1);
     pk_particles p;
-    pk_particles_init(&p, 3, (size_t)n);
-    double x[3] = {0, 0, 0};
-    for (int i = 0; i < n; i++)
-        pk_particles_push(&p, x, 0.5, 0);
     pk_edmd_params prm;
-    pk_edmd_params_default(&prm);
+    setup(&b, &p, &prm, 3, cube_edge(n, 0.5, 0.6), 1, n, 0.5, 0.5);
     prm.until = PK_EDMD_UNTIL_JAMMED;
     prm.growth_rate = 1e-4; /* would run for minutes */
     pk_monitor mon = {.fn = cancel_after, .interval_s = 0.05};
@@ -361,6 +392,7 @@ int main(void)
     RUN(test_walled_2d_delta_d);
     RUN(test_rescale_switch);
     RUN(test_rsa_start_relative_and_shell);
+    RUN(test_renumbering_large_n);
     RUN(test_cancel);
     return check_summary();
 }
