@@ -33,12 +33,6 @@ static void optimal_params(pk_dr_stats *st)
     st->gamma = 2 * sqrt(lmin * lmax / (lmin + lmax));
 }
 
-/* Fresh estimates on the jammed free grains (rattlers re-detected):
- * λ_max by Gershgorin, λ_min by Lanczos, lowered further by the Rayleigh
- * quotient of the current residual f (dominated by the slow modes late in a
- * relaxation).  A non-positive λ_min (indefinite block under large overlaps,
- * or no jammed grain) falls back to the residual's Rayleigh quotient on the
- * free grains, and only then to a tiny share of λ_max (flagged). */
 /* Forces at (x, u): normal (4.10) plus, with friction, tangential (7.19) and
  * couples gu (7.23).  -1 on allocation failure. */
 typedef struct relax_sys {
@@ -112,6 +106,12 @@ static double fric_rayleigh(const relax_sys *s, double *x, double *u, const doub
     return num / (eta * vv);
 }
 
+/* Fresh estimates on the jammed free grains (rattlers re-detected):
+ * λ_max by Gershgorin, λ_min by Lanczos, lowered further by the Rayleigh
+ * quotient of the current residual f (dominated by the slow modes late in a
+ * relaxation).  A non-positive λ_min (indefinite block under large overlaps,
+ * or no jammed grain) falls back to the residual's Rayleigh quotient on the
+ * free grains, and only then to a tiny share of λ_max (flagged). */
 static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *is_free,
                     const double *f, uint8_t *rat, uint8_t *mask, double *work, int lanczos,
                     pk_dr_stats *st, const relax_sys *sys, double *x, double *u, const double *gu)

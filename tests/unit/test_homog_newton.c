@@ -81,6 +81,22 @@ static double P_rel_diff(const pk_homog_step *a, const pk_homog_step *b)
     return d / Pn;
 }
 
+/* One uniaxial compression step from the reference state by DR and by the
+ * hybrid (Newton with DR fallback), both to 1e-10: od and F as used. */
+static void dr_and_hybrid(const pk_homog_rve *rve, double strain, pk_homog_opts *od, double F[9],
+                          pk_homog_state *td, pk_homog_state *tn, pk_homog_step *sd,
+                          pk_homog_step *sn)
+{
+    *od = opts(1.0);
+    od->dr.tol = 1e-10;
+    pk_homog_opts on = *od;
+    on.newton = &pk_sparse_cholmod;
+    on.newton_max_iter = 50;
+    diagF(F, 1 - strain, 1.0, 1.0);
+    CHECK(step_from_reference(rve, od, F, td, sd) == 0);
+    CHECK(step_from_reference(rve, &on, F, tn, sn) == 0);
+}
+
 /* Compressions of packings just above jamming cross instabilities: contacts
  * open and close, grains rearrange.  Newton leaves at once, DR takes the step
  * through the rearrangement, Newton finishes from one of DR's points (≥ 1
@@ -110,22 +126,16 @@ static void test_plastic_step_ends_at_a_minimum(void)
         pk_homog_rve rve;
         char err[128];
         CHECK(pk_homog_rve_build(&b, &p, PK_BC_PERIODIC, 1.0, &rve, err, sizeof err) == 0);
-        pk_homog_opts od = opts(1.0), on;
-        od.dr.tol = 1e-10;
-        on = od;
-        on.newton = &pk_sparse_cholmod;
-        on.newton_max_iter = 50;
+        pk_homog_opts od;
         double F[9];
-        diagF(F, 1 - cases[s].strain, 1.0, 1.0);
+        pk_homog_state td = {0}, tn = {0};
+        pk_homog_step sd, sn;
+        dr_and_hybrid(&rve, cases[s].strain, &od, F, &td, &tn, &sd, &sn);
         double *x0 = malloc(3 * rve.n * sizeof *x0);
         affine_start(&rve, F, x0);
         double phi0, f0;
         int pd0;
         inspect_state(&rve, &od, F, x0, &phi0, &f0, &pd0);
-        pk_homog_state td = {0}, tn = {0};
-        pk_homog_step sd, sn;
-        CHECK(step_from_reference(&rve, &od, F, &td, &sd) == 0);
-        CHECK(step_from_reference(&rve, &on, F, &tn, &sn) == 0);
         CHECK(pk_dr_stop_ok(sd.dr.stop) && pk_dr_stop_ok(sn.dr.stop));
         CHECK_MSG(sn.newton.attempts >= 1, "case %zu: no plastic event (%zu attempts)", s,
                   sn.newton.attempts);
@@ -172,17 +182,11 @@ static void test_elastic_step_is_pure_newton(void)
     pk_homog_rve rve;
     char err[128];
     CHECK(pk_homog_rve_build(&b, &p, PK_BC_PERIODIC, 1.0, &rve, err, sizeof err) == 0);
-    pk_homog_opts od = opts(1.0), on;
-    od.dr.tol = 1e-10;
-    on = od;
-    on.newton = &pk_sparse_cholmod;
-    on.newton_max_iter = 50;
+    pk_homog_opts od;
     double F[9];
-    diagF(F, 0.999, 1.0, 1.0);
     pk_homog_state td = {0}, tn = {0};
     pk_homog_step sd, sn;
-    CHECK(step_from_reference(&rve, &od, F, &td, &sd) == 0);
-    CHECK(step_from_reference(&rve, &on, F, &tn, &sn) == 0);
+    dr_and_hybrid(&rve, 0.001, &od, F, &td, &tn, &sd, &sn);
     CHECK(pk_dr_stop_ok(sd.dr.stop) && pk_dr_stop_ok(sn.dr.stop));
     CHECK_MSG(sn.newton.attempts == 0 && sn.dr.iterations == 0 &&
                   sn.newton.exit == PK_NEWTON_CONVERGED,
