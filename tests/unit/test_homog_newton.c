@@ -81,6 +81,15 @@ static double P_rel_diff(const pk_homog_step *a, const pk_homog_step *b)
     return d / Pn;
 }
 
+/* A jammed 2D periodic packing (make_jammed) and its RVE. */
+static void jammed_rve(size_t n, double phi, uint64_t seed, pk_particles *p, pk_homog_rve *rve)
+{
+    pk_box b;
+    make_jammed(2, n, phi, seed, &b, p);
+    char err[128];
+    CHECK(pk_homog_rve_build(&b, p, PK_BC_PERIODIC, 1.0, rve, err, sizeof err) == 0);
+}
+
 /* One uniaxial compression step from the reference state by DR and by the
  * hybrid (Newton with DR fallback), both to 1e-10: od and F as used. */
 static void dr_and_hybrid(const pk_homog_rve *rve, double strain, pk_homog_opts *od, double F[9],
@@ -120,12 +129,9 @@ static void test_plastic_step_ends_at_a_minimum(void)
         int shifted;
     } cases[] = {{200, 0.86, 0.01, 2, 0}, {200, 0.86, 0.01, 3, 0}, {400, 0.88, 0.005, 7, 1}};
     for (size_t s = 0; s < sizeof cases / sizeof *cases; s++) {
-        pk_box b;
         pk_particles p;
-        make_jammed(2, cases[s].n, cases[s].phi, cases[s].seed, &b, &p);
         pk_homog_rve rve;
-        char err[128];
-        CHECK(pk_homog_rve_build(&b, &p, PK_BC_PERIODIC, 1.0, &rve, err, sizeof err) == 0);
+        jammed_rve(cases[s].n, cases[s].phi, cases[s].seed, &p, &rve);
         pk_homog_opts od;
         double F[9];
         pk_homog_state td = {0}, tn = {0};
@@ -176,12 +182,9 @@ static void test_plastic_step_ends_at_a_minimum(void)
  * ~1e-10), Φ (quadratic in the error) to 1e-12. */
 static void test_elastic_step_is_pure_newton(void)
 {
-    pk_box b;
     pk_particles p;
-    make_jammed(2, 200, 0.90, 7, &b, &p);
     pk_homog_rve rve;
-    char err[128];
-    CHECK(pk_homog_rve_build(&b, &p, PK_BC_PERIODIC, 1.0, &rve, err, sizeof err) == 0);
+    jammed_rve(200, 0.90, 7, &p, &rve);
     pk_homog_opts od;
     double F[9];
     pk_homog_state td = {0}, tn = {0};

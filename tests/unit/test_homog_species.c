@@ -49,6 +49,14 @@ static void test_series_springs(void)
     }
 }
 
+/* A jammed 2D packing of 90 grains, species alternating 0, 1. */
+static void two_species_packing(pk_box *b, pk_particles *p)
+{
+    make_jammed(2, 90, 0.88, 21, b, p);
+    for (size_t i = 0; i < p->n; i++)
+        p->species[i] = (int32_t)(i % 2);
+}
+
 /* A matrix of E_n everywhere is the uniform model, bit for bit; a matrix of
  * 2·E_n doubles P̄ (equilibrium positions do not depend on a common factor),
  * to the relaxation tolerance. */
@@ -56,9 +64,7 @@ static void test_uniform_matrix_and_scaling(void)
 {
     pk_box b;
     pk_particles p;
-    make_jammed(2, 90, 0.88, 21, &b, &p);
-    for (size_t i = 0; i < p.n; i++)
-        p.species[i] = (int32_t)(i % 2);
+    two_species_packing(&b, &p);
     double same[4] = {1, 1, 1, 1}, twice[4] = {2, 2, 2, 2};
     double F0[9];
     diagF(F0, 0.995, 1.0, 1.0);
@@ -88,9 +94,7 @@ static void test_tangent_mixed_stiffness(void)
 {
     pk_box b;
     pk_particles p;
-    make_jammed(2, 90, 0.88, 21, &b, &p);
-    for (size_t i = 0; i < p.n; i++)
-        p.species[i] = (int32_t)(i % 2);
+    two_species_packing(&b, &p);
     double mixed[4] = {1, 2, 2, 5};
     double F0[9];
     diagF(F0, 0.994, 1.0, 1.0);
