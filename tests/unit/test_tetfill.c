@@ -66,6 +66,16 @@ static int in_tet(const pk_mesh *m, size_t e, const double *p)
     return s <= pk_mesh_tet_volume(m, e) * (1 + 1e-9);
 }
 
+/* Distance from x to boundary face f of m. */
+static double face_distance(const pk_mesh *m, size_t f, const double x[3])
+{
+    double q[3];
+    pk_closest_on_triangle(x, &m->x[3 * (size_t)m->bface[3 * f]], &m->x[3 * (size_t)m->bface[3 * f + 1]],
+                           &m->x[3 * (size_t)m->bface[3 * f + 2]], q);
+    return sqrt((x[0] - q[0]) * (x[0] - q[0]) + (x[1] - q[1]) * (x[1] - q[1]) +
+                (x[2] - q[2]) * (x[2] - q[2]));
+}
+
 /* The contract, by brute force: radii in range, centres in the mesh, every
  * sphere inside up to ε r_min (distance to every boundary face >= r − ε r_min),
  * every overlap <= ε r_min.  Slack 1e-9 r_min: round-off of the distance
@@ -82,12 +92,7 @@ static void check_contract(const pk_mesh *m, const pk_particles *p, const pk_tet
             found = in_tet(m, e, x);
         outside += !found;
         for (size_t f = 0; f < m->nbface; f++) {
-            double q[3];
-            pk_closest_on_triangle(x, &m->x[3 * (size_t)m->bface[3 * f]],
-                                   &m->x[3 * (size_t)m->bface[3 * f + 1]],
-                                   &m->x[3 * (size_t)m->bface[3 * f + 2]], q);
-            double d = sqrt((x[0] - q[0]) * (x[0] - q[0]) + (x[1] - q[1]) * (x[1] - q[1]) +
-                            (x[2] - q[2]) * (x[2] - q[2]));
+            double d = face_distance(m, f, x);
             if (d < p->r[i] - bound - slack) {
                 wall++;
                 break;
@@ -329,12 +334,7 @@ static double touching_supported(const pk_mesh *m, const pk_particles *p, size_t
         const double *x = &p->x[3 * i];
         int z = 0;
         for (size_t f = 0; f < m->nbface; f++) {
-            double q[3];
-            pk_closest_on_triangle(x, &m->x[3 * (size_t)m->bface[3 * f]],
-                                   &m->x[3 * (size_t)m->bface[3 * f + 1]],
-                                   &m->x[3 * (size_t)m->bface[3 * f + 2]], q);
-            double d = sqrt((x[0] - q[0]) * (x[0] - q[0]) + (x[1] - q[1]) * (x[1] - q[1]) +
-                            (x[2] - q[2]) * (x[2] - q[2]));
+            double d = face_distance(m, f, x);
             z += d - p->r[i] <= 0;
         }
         for (size_t j = 0; j < p->n; j++) {
