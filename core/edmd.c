@@ -154,6 +154,17 @@ static void predict_all(edmd_state *s)
     edmd_queue_init(s);
 }
 
+/* All lists and events anew (after a skin change or a renumbering): 0, -1
+ * out of memory, 1 when the monitor stopped the run during the list build
+ * (s->stop): the run must end, its positions are still exact. */
+static int rebuild_all(edmd_state *s)
+{
+    int rc = edmd_nlist_build_all(s);
+    if (rc == 0)
+        predict_all(s);
+    return rc;
+}
+
 /* Synchronise everyone and move the time origin to now (spec §6: |t| stays
  * small against Δt).  Predictions are shifted, not recomputed. */
 static void rebase(edmd_state *s)
@@ -397,6 +408,8 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
     pk_progress pr = {.stage = "edmd", .fraction = -1, .phi = phi_true(s, 0), .eta_s = -1};
     char msg[160];
     pk_monitor_begin(mon);
+    s->mon = mon; /* ticked inside the full list builds from here on */
+    s->pr = &pr;
     hist_push(st, &hist_stride, 0, 0, pr.phi, 0);
     pk_edmd_criterion crit = PK_EDMD_CRIT_NONE;
 
@@ -516,9 +529,13 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
             s->skin_scale = pressure > SKIN_P0 ? fmax(SKIN_P0 / pressure, SKIN_MIN) : 1;
             if (s->skin_scale < 0.5 * skin_built) {
                 skin_built = s->skin_scale;
-                if (edmd_nlist_build_all(s) != 0)
+                int rb = rebuild_all(s);
+                if (rb < 0)
                     goto out;
-                predict_all(s);
+                if (rb > 0) {
+                    crit = s->stop == 2 ? PK_EDMD_CRIT_WALL_TIME : PK_EDMD_CRIT_CANCEL;
+                    break;
+                }
             }
             phi_prev = phis;
             t_base += s->t;
@@ -535,10 +552,16 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
         }
         if (resort_win && st->events >= next_resort) {
             next_resort = st->events + resort_win;
-            if (edmd_reorder(s, perm, hcell > 0 ? hcell : 1) != 0 || edmd_nlist_build_all(s) != 0)
+            if (edmd_reorder(s, perm, hcell > 0 ? hcell : 1) != 0)
                 goto out;
-            predict_all(s);
             st->resorts++;
+            int rb = rebuild_all(s);
+            if (rb < 0)
+                goto out;
+            if (rb > 0) {
+                crit = s->stop == 2 ? PK_EDMD_CRIT_WALL_TIME : PK_EDMD_CRIT_CANCEL;
+                break;
+            }
         }
     }
     /* final state */

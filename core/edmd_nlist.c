@@ -106,6 +106,8 @@ int edmd_nlist_build_all(edmd_state *s)
         if (pk_ugrid_insert(&s->ugrid, &s->bs, i) != 0)
             return -1;
     for (size_t i = 0; i < s->n; i++) {
+        if ((i & 0x3fff) == 0 && s->mon && (s->stop = pk_monitor_tick(s->mon, s->pr, 0)) != 0)
+            return 1; /* cancel within a second also at 10⁶ grains */
         visit_ctx c = {s, (int32_t)i, 0, 0};
         pk_ugrid_query(&s->ugrid, &s->bs, &s->bs.x[3 * i], s->bs.r[i], visit, &c);
         if (c.failed)

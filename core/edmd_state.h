@@ -68,6 +68,11 @@ typedef struct edmd_state {
     double virial;            /* Σ σ J over particle collisions in the window */
     double kint;              /* ∫K dt over the window */
     uint64_t n_overlap;
+    /* the run's monitor, ticked inside full list builds (~1 s at 10⁶ grains);
+     * NULL during the start-up build */
+    pk_monitor *mon;
+    pk_progress *pr;
+    int stop;                 /* what the monitor said: 1 cancelled, 2 wall limit */
     double max_overlap_rel;
 } edmd_state;
 
@@ -160,6 +165,8 @@ int edmd_spatial_order(const pk_box *b, const double *x, size_t n, double h, siz
 int edmd_reorder(edmd_state *s, size_t *perm, double h);
 
 /* edmd_nlist.c */
+/* Every list from scratch: 0, -1 out of memory, or 1 when the monitor (if
+ * set) stopped the run part-way (s->stop; the lists are then unusable). */
 int edmd_nlist_build_all(edmd_state *s);
 int edmd_nlist_rebuild(edmd_state *s, size_t i);
 void edmd_nlist_free(edmd_state *s);
