@@ -154,14 +154,22 @@ static void predict_all(edmd_state *s)
     edmd_queue_init(s);
 }
 
+/* The criterion of a monitor stop (pk_monitor_tick: 1 cancelled, 2 wall limit). */
+static pk_edmd_criterion monitor_criterion(int m)
+{
+    return m == 2 ? PK_EDMD_CRIT_WALL_TIME : PK_EDMD_CRIT_CANCEL;
+}
+
 /* All lists and events anew (after a skin change or a renumbering): 0, -1
  * out of memory, 1 when the monitor stopped the run during the list build
- * (s->stop): the run must end, its positions are still exact. */
-static int rebuild_all(edmd_state *s)
+ * (*crit set): the run must end, its positions are still exact. */
+static int rebuild_all(edmd_state *s, pk_edmd_criterion *crit)
 {
     int rc = edmd_nlist_build_all(s);
     if (rc == 0)
         predict_all(s);
+    else if (rc > 0)
+        *crit = monitor_criterion(s->stop);
     return rc;
 }
 
@@ -497,7 +505,7 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
             pr.message = msg;
             int m = pk_monitor_tick(mon, &pr, 0);
             if (m) {
-                crit = m == 2 ? PK_EDMD_CRIT_WALL_TIME : PK_EDMD_CRIT_CANCEL;
+                crit = monitor_criterion(m);
                 break;
             }
         }
@@ -529,13 +537,11 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
             s->skin_scale = pressure > SKIN_P0 ? fmax(SKIN_P0 / pressure, SKIN_MIN) : 1;
             if (s->skin_scale < 0.5 * skin_built) {
                 skin_built = s->skin_scale;
-                int rb = rebuild_all(s);
+                int rb = rebuild_all(s, &crit);
                 if (rb < 0)
                     goto out;
-                if (rb > 0) {
-                    crit = s->stop == 2 ? PK_EDMD_CRIT_WALL_TIME : PK_EDMD_CRIT_CANCEL;
+                if (rb > 0)
                     break;
-                }
             }
             phi_prev = phis;
             t_base += s->t;
@@ -555,13 +561,11 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
             if (edmd_reorder(s, perm, hcell > 0 ? hcell : 1) != 0)
                 goto out;
             st->resorts++;
-            int rb = rebuild_all(s);
+            int rb = rebuild_all(s, &crit);
             if (rb < 0)
                 goto out;
-            if (rb > 0) {
-                crit = s->stop == 2 ? PK_EDMD_CRIT_WALL_TIME : PK_EDMD_CRIT_CANCEL;
+            if (rb > 0)
                 break;
-            }
         }
     }
     /* final state */
