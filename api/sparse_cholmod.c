@@ -70,8 +70,9 @@ static int factorize_mode(pk_sparse_factor *f, cholmod_sparse *S, int mode)
  * simplicial LDLᵀ on the 2·10⁴-DOF 2D blocks of issue 6 (bench/homog, with
  * OpenBLAS).  It stops at the first non-positive pivot, so a block that is
  * not positive definite is factorised again as simplicial LDLᵀ, whose D
- * gives the full inertia that the tangent and Newton report. */
-static pk_sparse_factor *chol_factor(const pk_sparse_sym *A, pk_sparse_info *info)
+ * gives the full inertia that the tangent reports — unless `pd_only`
+ * (factor_pd): then the answer is NOT_PD and no second factorisation. */
+static pk_sparse_factor *factor_any(const pk_sparse_sym *A, int pd_only, pk_sparse_info *info)
 {
     info->status = PK_SPARSE_FAILED;
     info->npos = info->nneg = info->nzero = 0;
@@ -107,6 +108,11 @@ static pk_sparse_factor *chol_factor(const pk_sparse_sym *A, pk_sparse_info *inf
         supernodal_pivots(f->L, d);
         classify_pivots(d, A->n, A->n, info);
     }
+    if (info->status != PK_SPARSE_OK && pd_only) {
+        info->status = PK_SPARSE_NOT_PD;
+        info->npos = info->nneg = info->nzero = 0;
+        goto fail_keep_status;
+    }
     if (info->status != PK_SPARSE_OK) { /* not positive definite: the inertia from LDLᵀ */
         cholmod_free_factor(&f->L, &f->c);
         info->npos = info->nneg = info->nzero = 0;
@@ -136,6 +142,16 @@ fail_keep_status:
     cholmod_finish(&f->c);
     free(f);
     return NULL;
+}
+
+static pk_sparse_factor *chol_factor(const pk_sparse_sym *A, pk_sparse_info *info)
+{
+    return factor_any(A, 0, info);
+}
+
+static pk_sparse_factor *chol_factor_pd(const pk_sparse_sym *A, pk_sparse_info *info)
+{
+    return factor_any(A, 1, info);
 }
 
 static int chol_solve(pk_sparse_factor *f, size_t nrhs, const double *B, double *X)
@@ -169,6 +185,7 @@ static void chol_release(pk_sparse_factor *f)
 const pk_sparse_solver pk_sparse_cholmod = {
     .name = "cholmod",
     .factor = chol_factor,
+    .factor_pd = chol_factor_pd,
     .solve = chol_solve,
     .release = chol_release,
 };

@@ -4,6 +4,8 @@
  *   bench=homog case=jam_2d rve=KIND n=N ... (making the RVE)
  *   bench=homog case=periodic_step_{dr,newton}_2d rve=KIND n=N iterations=K seconds=S ...
  *   bench=homog case=tangent_periodic_2d rve=KIND n=N tangent_s=S free_dofs=D
+ *   bench=homog case=contact_eval_2d rve=KIND n=N pairs=P ns_per_pair=T ... (the
+ *     forces-only pk_dem_eval a DR iteration runs, on the relaxed state)
  * The step is 0.1 % uniaxial compression at tolerance 1e-8 (the thesis's),
  * solved by the Newton/DR hybrid (core/homog_newton.h, CHOLMOD) and by DR
  * alone from the same committed state; the DR line carries the agreement of
@@ -106,6 +108,34 @@ static void make_rve(size_t n, int near_jamming, pk_homog_rve *rve, pk_homog_sta
     pk_particles_free(&p);
 }
 
+/* Time of the contact evaluation a DR iteration runs (forces only) per
+ * candidate pair, on the relaxed RVE under the step's F̄; the repetitions
+ * make ~10⁷ pair evaluations (≈ 0.1 s). */
+static void eval_case(const pk_homog_rve *rve, const pk_homog_state *s, const double F[9],
+                      double skin, const char *kind)
+{
+    pk_dem_geom g = {.dim = rve->dim, .periodic = rve->periodic};
+    memcpy(g.L, rve->L, sizeof g.L);
+    pk_dem_geom_set_F(&g, F);
+    pk_dem_pairs c = {0};
+    double *f = malloc(3 * rve->n * sizeof *f);
+    if (!f || pk_dem_pairs_build(&c, &g, s->x, rve->r, rve->n, skin) != 0 || c.n == 0) {
+        free(f);
+        pk_dem_pairs_free(&c);
+        return;
+    }
+    size_t reps = 1 + 10000000 / c.n, nc = 0;
+    double t0 = pk_wall_seconds();
+    for (size_t k = 0; k < reps; k++)
+        nc = pk_dem_eval(&c, &g, s->x, rve->r, rve->n, 1.0, f, NULL, NULL);
+    double t = pk_wall_seconds() - t0;
+    printf("bench=homog case=contact_eval_2d rve=%s n=%zu pairs=%zu contacts=%zu reps=%zu "
+           "ns_per_pair=%.2f\n",
+           kind, rve->n, c.n, nc, reps, 1e9 * t / ((double)reps * (double)c.n));
+    free(f);
+    pk_dem_pairs_free(&c);
+}
+
 static double step_case(size_t n, int near_jamming)
 {
     pk_homog_rve rve;
@@ -116,6 +146,7 @@ static double step_case(size_t n, int near_jamming)
     double F[9];
     pk_m3_identity(F);
     F[0] = 0.999;
+    eval_case(&rve, &s0, F, o.dr.skin, kind);
     pk_homog_step sd, sn;
     pk_homog_opts on = o;
     on.newton = &pk_sparse_cholmod;

@@ -78,6 +78,16 @@ int pk_dem_pairs_stale(const pk_dem_pairs *c, const double *x, int dim);
 size_t pk_dem_eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
                    size_t np, double E, double *f, double *energy, double S[9]);
 
+/* The coefficients of a contact's stiffness block (4.12)₁ in the form
+ * k_ij·d = a d − b (l·d) l (l = |l| n): a = Eε/|l|, b = ER/|l|³ with
+ * R = ε + |l| — two divisions per block. */
+static inline void pk_dem_kblock_coef(double E, double len, double eps, double *a, double *b)
+{
+    double c = E / len;
+    *a = c * eps;
+    *b = c * (eps + len) / (len * len);
+}
+
 /* out = K v on the particles with mask[i] != 0 (the others are held: v = 0
  * there, out = 0 there).  K = ∂²Φ_n/∂x∂x from the last pk_dem_eval. */
 void pk_dem_kv(const pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *mask,

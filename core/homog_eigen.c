@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dem_kblocks.h"
+
 /* number of eigenvalues of T below s (Sturm sequence) */
 static int sturm_count(const double *a, const double *b, int m, double s)
 {
@@ -39,7 +41,11 @@ double pk_tridiag_min_eig(const double *a, const double *b, int m)
     return 0.5 * (lo + hi);
 }
 
-double pk_homog_dot_mask(const double *u, const double *v, const uint8_t *mask, size_t np, int dim)
+/* The masked dot product with dim a constant (2 or 3): the axis loop
+ * unrolled, the same operations in the same order (it runs on every DR
+ * iteration for the residual and in every Lanczos step). */
+static inline double dot_mask_loop(const double *u, const double *v, const uint8_t *mask,
+                                   size_t np, const int dim)
 {
     double s = 0;
     for (size_t i = 0; i < np; i++)
@@ -47,6 +53,11 @@ double pk_homog_dot_mask(const double *u, const double *v, const uint8_t *mask, 
             for (int a = 0; a < dim; a++)
                 s += u[3 * i + a] * v[3 * i + a];
     return s;
+}
+
+double pk_homog_dot_mask(const double *u, const double *v, const uint8_t *mask, size_t np, int dim)
+{
+    return dim == 2 ? dot_mask_loop(u, v, mask, np, 2) : dot_mask_loop(u, v, mask, np, dim);
 }
 
 double pk_homog_rayleigh(const pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *mask,
@@ -72,7 +83,8 @@ double pk_homog_lanczos_min(const pk_dem_pairs *c, int dim, size_t np, double E,
     double *q = calloc(3 * np, sizeof *q), *qp = calloc(3 * np, sizeof *qp);
     double *w = calloc(3 * np, sizeof *w);
     double *al = calloc((size_t)steps + 1, sizeof *al), *be = calloc((size_t)steps + 1, sizeof *be);
-    if (!q || !qp || !w || !al || !be) {
+    pk_dem_kblocks kb = {0}; /* K once for the `steps` products */
+    if (!q || !qp || !w || !al || !be || pk_dem_kblocks_build(&kb, c, E, mask) != 0) {
         free(q), free(qp), free(w), free(al), free(be);
         return NAN;
     }
@@ -90,7 +102,7 @@ double pk_homog_lanczos_min(const pk_dem_pairs *c, int dim, size_t np, double E,
     int m = 0;
     double beta = 0;
     for (int it = 0; it < steps; it++) {
-        pk_dem_kv(c, dim, np, E, mask, q, w);
+        pk_dem_kblocks_kv(&kb, dim, np, q, w);
         double alpha = pk_homog_dot_mask(q, w, mask, np, dim);
         for (size_t k = 0; k < 3 * np; k++)
             w[k] -= alpha * q[k] + beta * qp[k];
@@ -105,6 +117,7 @@ double pk_homog_lanczos_min(const pk_dem_pairs *c, int dim, size_t np, double E,
         }
     }
     double lmin = pk_tridiag_min_eig(al, be, m);
+    pk_dem_kblocks_free(&kb);
     free(q), free(qp), free(w), free(al), free(be);
     return lmin;
 }

@@ -150,6 +150,36 @@ static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t
     return 0;
 }
 
+/* One step of (4.39)–(4.41): v ← cv·v + cf·f, x ← x + Δt·v on the free
+ * grains, with cv = (2 − γΔt)/(2 + γΔt), cf = 2Δt/(2 + γΔt) — or cv = 0,
+ * cf = Δt/2 on the first step (4.41).  Returns pk_dem_pairs_stale(c, x) in
+ * the same pass (held grains do not move within a relaxation).  dim a
+ * constant (2 or 3) at the call: the axis loops unrolled. */
+typedef struct dr_coef {
+    double dt, cv, cf;
+} dr_coef;
+
+static inline int dr_update(double *x, double *v, const double *f, const uint8_t *is_free,
+                            size_t np, const int dim, dr_coef cf, const pk_dem_pairs *c)
+{
+    const double lim2 = 0.25 * c->skin * c->skin;
+    int stale = 0;
+    for (size_t i = 0; i < np; i++) {
+        if (!is_free[i])
+            continue;
+        double s = 0;
+        for (int a = 0; a < dim; a++) {
+            double *vi = &v[3 * i + a];
+            *vi = cf.cv * *vi + cf.cf * f[3 * i + a];
+            x[3 * i + a] += cf.dt * *vi;
+            double d = x[3 * i + a] - c->xb[3 * i + a];
+            s += d * d;
+        }
+        stale |= s > lim2;
+    }
+    return stale;
+}
+
 static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
                  double E, const uint8_t *is_free, const pk_dr_params *prm, pk_fric_ctx *fc,
                  double *u, pk_dr_hook *hook, pk_monitor *mon, pk_dr_stats *st,
@@ -190,25 +220,17 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
     double fbest = st->f0;
     for (size_t k = 0;; k++) {
         double dt = st->dt, gm = st->gamma;
-        for (size_t i = 0; i < np; i++) {
-            if (!is_free[i])
-                continue;
-            for (int a = 0; a < dim; a++) {
-                double *vi = &v[3 * i + a], fi = f[3 * i + a];
-                if (k == 0)
-                    *vi = 0.5 * dt * fi; /* (4.41) */
-                else
-                    *vi = ((2 - gm * dt) * *vi + 2 * dt * fi) / (2 + gm * dt); /* (4.39) */
-                x[3 * i + a] += dt * *vi;                                      /* (4.40) */
-            }
-        }
+        dr_coef cf = {dt, k == 0 ? 0 : (2 - gm * dt) / (2 + gm * dt),
+                      k == 0 ? 0.5 * dt : 2 * dt / (2 + gm * dt)};
+        int stale = dim == 2 ? dr_update(x, v, f, is_free, np, 2, cf, c)
+                             : dr_update(x, v, f, is_free, np, dim, cf, c);
         if (sys.fric_active) /* the rotations, same scheme (unit pseudo-mass of u = rθ) */
             for (size_t i = 0; i < np; i++) {
-                vu[i] = k == 0 ? 0.5 * dt * gu[i] : ((2 - gm * dt) * vu[i] + 2 * dt * gu[i]) / (2 + gm * dt);
+                vu[i] = cf.cv * vu[i] + cf.cf * gu[i];
                 u[i] += dt * vu[i];
             }
         st->iterations = k + 1;
-        if (pk_dem_pairs_stale(c, x, dim)) {
+        if (stale) {
             rc = pk_dem_pairs_build(c, g, x, r, np, prm->skin);
             if (rc != 0)
                 goto out;

@@ -58,6 +58,7 @@ const char *pk_sparse_status_name(pk_sparse_status s)
     case PK_SPARSE_INDEFINITE: return "indefinite";
     case PK_SPARSE_SINGULAR: return "singular";
     case PK_SPARSE_FAILED: return "failed";
+    case PK_SPARSE_NOT_PD: return "not_positive_definite";
     }
     return "unknown";
 }

@@ -105,6 +105,42 @@ static void test_sparse_solver_supernodal(void)
     free(b), free(x), free(Ax);
 }
 
+/* factor_pd (Newton's question) agrees with factor on "positive definite?"
+ * for the SPD, singular and indefinite blocks above, returns a factor that
+ * solves like factor's for the SPD one (the same supernodal LLᵀ: equal to
+ * round-off, 1e-14 relative), and nothing with status NOT_PD otherwise. */
+static void test_sparse_solver_pd_only(void)
+{
+    const int m = 40;
+    const double lam1 = 2 * (1 - cos(2 * M_PI / m));
+    const double shifts[3] = {0.01, 0, -0.5 * lam1};
+    for (int t = 0; t < 3; t++) {
+        pk_sparse_sym A;
+        pk_sparse_info full, pd;
+        grid_laplacian(m, shifts[t], &A);
+        pk_sparse_factor *f = pk_sparse_cholmod.factor(&A, &full);
+        pk_sparse_factor *g = pk_sparse_cholmod.factor_pd(&A, &pd);
+        CHECK_MSG((full.status == PK_SPARSE_OK) == (pd.status == PK_SPARSE_OK), "shift %g: %s vs %s",
+                  shifts[t], pk_sparse_status_name(full.status), pk_sparse_status_name(pd.status));
+        if (t == 0) {
+            double *b = malloc(A.n * sizeof *b), *x = malloc(A.n * sizeof *x), *y = malloc(A.n * sizeof *y);
+            for (size_t k = 0; k < A.n; k++)
+                b[k] = cos(0.21 * (double)k);
+            CHECK(f && g && pk_sparse_cholmod.solve(f, 1, b, x) == 0 && pk_sparse_cholmod.solve(g, 1, b, y) == 0);
+            double d = 0, nx = 0;
+            for (size_t k = 0; k < A.n; k++)
+                d += (x[k] - y[k]) * (x[k] - y[k]), nx += x[k] * x[k];
+            CHECK_MSG(sqrt(d / nx) < 1e-14, "factor vs factor_pd solution %g", sqrt(d / nx));
+            free(b), free(x), free(y);
+        } else {
+            CHECK(!g && pd.status == PK_SPARSE_NOT_PD);
+        }
+        pk_sparse_cholmod.release(f);
+        pk_sparse_cholmod.release(g);
+        pk_sparse_sym_free(&A);
+    }
+}
+
 /* Remark 6.1 analytically: A_1111 = A_2222 = E√N/(√N−1), all else 0
  * (basis erratum of (6.10)).  Exact formula: tolerance 1e-12 relative. */
 static void test_square_lattice_tangent(void)
@@ -266,6 +302,7 @@ int main(void)
 {
     RUN(test_sparse_solver_status);
     RUN(test_sparse_solver_supernodal);
+    RUN(test_sparse_solver_pd_only);
     RUN(test_square_lattice_tangent);
     RUN(test_tangent_vs_finite_differences);
     RUN(test_constraint_ranking);
