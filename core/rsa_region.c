@@ -4,20 +4,17 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Quantisation steps per axis and cell of the mark table (rsa_region.h).
- * With cells of half the store's edge (h ≈ c/2): delta = √3·h/(2·8) ≈ 0.054 c,
- * under half a fine voxel (c/8); 512 entries of (2·2 + 1)³ words, 0.5 MB. */
-#define TABLE_STEPS 8
 /* Cells a mark reaches on each side (the ball radius c over the cell edge,
  * rounded up, at most this; farther marks are left out, which is safe). */
 #define MAX_REACH 2
 #define NOT_MADE 0xff
 
 int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, const double *lo,
-                       const double *span, double c)
+                       const double *span, double c, int steps)
 {
     memset(R, 0, sizeof *R);
-    if (!b || b->dim < 2 || b->dim > 3 || !(c > 0))
+    if (!b || b->dim < 2 || b->dim > 3 || !(c > 0) || steps < 1 ||
+        steps > PK_RSA_REGION_MAX_STEPS)
         return -1;
     R->dim = b->dim;
     R->S = b->dim == 3 ? 4 : 8; /* S^dim = 64: one word per cell */
@@ -49,7 +46,7 @@ int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, cons
     R->margin = 1e-9 * c + 1e-12 * lmax;
     R->ncell = nc;
     R->c = c;
-    R->Q = TABLE_STEPS;
+    R->Q = steps;
     double diag2 = 0;
     for (int k = 0; k < b->dim; k++)
         diag2 += R->h[k] * R->h[k];
@@ -260,13 +257,13 @@ static void make_entry(pk_rsa_region *R, size_t e, const double *p)
     R->tcnt[e] = (uint8_t)cnt;
 }
 
-void pk_rsa_region_mark(pk_rsa_region *R, const double *x)
+/* The cell of x (i[]) and its table entry (the centre's step per axis;
+ * p[]: the step's centre as an offset in the cell). */
+static inline size_t locate(const pk_rsa_region *R, const double *x, int64_t i[3], double p[3])
 {
-    const int dim = R->dim, Q = R->Q, D = R->D, W = 2 * D + 1;
-    int64_t i[3] = {0, 0, 0};
+    const int Q = R->Q;
     size_t e = 0;
-    double p[3] = {0, 0, 0};
-    for (int k = dim - 1; k >= 0; k--) {
+    for (int k = R->dim - 1; k >= 0; k--) {
         double f = (x[k] - R->lo[k]) * R->inv_h[k];
         int64_t ik = f < 0 ? 0 : (int64_t)f;
         if (ik > R->n[k] - 1)
@@ -279,15 +276,47 @@ void pk_rsa_region_mark(pk_rsa_region *R, const double *x)
         e = e * (size_t)Q + (size_t)q;
         p[k] = ((double)q + 0.5) / Q * R->h[k];
     }
+    return e;
+}
+
+static inline int inner_cell(const pk_rsa_region *R, const int64_t *i)
+{
+    int inner = 1;
+    for (int k = 0; k < R->dim; k++)
+        inner &= i[k] >= R->D && i[k] < R->n[k] - R->D;
+    return inner;
+}
+
+void pk_rsa_region_prefetch(const pk_rsa_region *R, const double *x)
+{
+    const int D = R->D, zr = R->dim == 3;
+    int64_t i[3] = {0, 0, 0};
+    double p[3];
+    locate(R, x, i, p); /* (its table entry: fetching it ahead too gained nothing) */
+    if (!inner_cell(R, i))
+        return; /* rare: the mark wraps or clips; it only costs the misses */
+    const uint64_t *c = &R->covered[(uint64_t)(i[2] * R->n[1] + i[1]) * (uint64_t)R->n[0] +
+                                    (uint64_t)i[0]];
+    for (int dz = -D * zr; dz <= D * zr; dz++)
+        for (int dy = -D; dy <= D; dy++) { /* both ends of each row of 2D + 1 words */
+            const uint64_t *row = c + (dz * R->n[1] + dy) * R->n[0];
+            __builtin_prefetch(row - D, 1);
+            __builtin_prefetch(row + D, 1);
+        }
+}
+
+void pk_rsa_region_mark(pk_rsa_region *R, const double *x)
+{
+    const int dim = R->dim, D = R->D, W = 2 * D + 1;
+    int64_t i[3] = {0, 0, 0};
+    double p[3] = {0, 0, 0};
+    const size_t e = locate(R, x, i, p);
     if (R->tcnt[e] == NOT_MADE)
         make_entry(R, e, p);
     const uint64_t *w = &R->tab[e * R->entry];
     const uint8_t *idx = &R->tidx[e * R->entry];
     const int cnt = R->tcnt[e];
-    int inner = 1;
-    for (int k = 0; k < dim; k++)
-        inner &= i[k] >= D && i[k] < R->n[k] - D;
-    if (inner) { /* the common case: no wrap, no wall — fixed offsets */
+    if (inner_cell(R, i)) { /* the common case: no wrap, no wall — fixed offsets */
         uint64_t *base = &R->covered[(uint64_t)(i[2] * R->n[1] + i[1]) * (uint64_t)R->n[0] +
                                      (uint64_t)i[0]];
         for (int t = 0; t < cnt; t++)

@@ -55,10 +55,16 @@ typedef struct pk_rsa_region {
     uint64_t nlist;
 } pk_rsa_region;
 
+/* Steps of the mark table per axis and cell: with cells of half the store's
+ * edge (h ≈ c/2), delta = √3·h/(2·steps) ≈ 0.054 c at 8 steps (512 entries of
+ * (2·2 + 1)³ words, 0.5 MB), 0.027 c at 16 (4096 entries, 4.6 MB). */
+#define PK_RSA_REGION_MAX_STEPS 16
+
 /* For the draw range lo[], span[] cut into n[k] cells per axis (the store's
- * cells), contact distance c.  All bits clear, every cell listed.  0 or -1. */
+ * cells), contact distance c, a mark table of `steps` steps per axis (1 to
+ * PK_RSA_REGION_MAX_STEPS).  All bits clear, every cell listed.  0 or -1. */
 int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, const double *lo,
-                       const double *span, double c);
+                       const double *span, double c, int steps);
 void pk_rsa_region_free(pk_rsa_region *R);
 
 /* Mark the fine voxels lying entirely inside the ball of radius rad around x
@@ -69,6 +75,11 @@ void pk_rsa_region_cover(pk_rsa_region *R, const double *x, double rad);
  * range) through the table: a subset of pk_rsa_region_cover(R, x, c)'s marks
  * at a fraction of its cost. */
 void pk_rsa_region_mark(pk_rsa_region *R, const double *x);
+
+/* Ask the memory system for the words pk_rsa_region_mark(R, x) will write
+ * (a hint: at 10^6 grains each mark's rows are misses; rsa_batch.c asks a few
+ * marks ahead). */
+void pk_rsa_region_prefetch(const pk_rsa_region *R, const double *x);
 
 /* Drop fully covered cells from the list (cost: the list's length). */
 void pk_rsa_region_compact(pk_rsa_region *R);

@@ -101,8 +101,10 @@ static void test_marks_are_exact(void)
         int64_t n[3];
         region_cells(b, c, span, n);
         pk_rsa_region table, direct;
-        CHECK(pk_rsa_region_init(&table, b, n, lo, span, c) == 0);
-        CHECK(pk_rsa_region_init(&direct, b, n, lo, span, c) == 0);
+        /* table steps: the fewest and the most the runs use, and an odd count */
+        const int steps = t == 1 ? PK_RSA_REGION_MAX_STEPS : (t == 0 ? 6 : 7);
+        CHECK(pk_rsa_region_init(&table, b, n, lo, span, c, steps) == 0);
+        CHECK(pk_rsa_region_init(&direct, b, n, lo, span, c, steps) == 0);
         enum { NB = 12 };
         double x[NB][3] = {{0}}, rad[NB];
         for (int i = 0; i < NB; i++) {
@@ -178,7 +180,7 @@ static void freeze(frozen *F, int dim, size_t n, double phi, double gap)
         pk_grid_insert(&F->grid, &F->p, j);
     int64_t nc[3];
     region_cells(&F->box, F->c, F->span, nc);
-    CHECK(pk_rsa_region_init(&F->R, &F->box, nc, F->lo, F->span, F->c) == 0);
+    CHECK(pk_rsa_region_init(&F->R, &F->box, nc, F->lo, F->span, F->c, 8) == 0);
     for (size_t j = 0; j < F->p.n; j++)
         pk_rsa_region_mark(&F->R, &F->p.x[3 * j]);
     pk_rsa_region_compact(&F->R);
@@ -353,17 +355,36 @@ static long open_points(const pk_box *b, const pk_particles *p, int probes, uint
 /* Default (region) runs against plain runs, 6 seeds each, 3D φ = 0.30:
  * pair distances near contact by two-sample χ² (pairs of one packing are not
  * independent: test_rsa_voxels.c measured plain-vs-plain χ² up to 10 for 7
- * bins; threshold 30 as there) and the insertion probability left, pooled
- * probe counts by a two-proportion z-test, |z| < 4 (binomial noise only;
- * packing-to-packing spread adds little at 6 × 2000 grains: plain vs plain
- * with other seeds gave |z| < 1.5). */
+ * bins; threshold 30 as there) and the insertion probability left, per
+ * packing from 200 000 probes, compared by Welch's t over the 6 + 6 packings,
+ * |t| < 5 (t with ~10 degrees of freedom: p ~ 5e-4).  The packing-to-packing
+ * spread dominates (measured: 0.0018 to 0.0029 per packing at 2000 grains,
+ * against a binomial error of 0.0001), so a test on the pooled probe counts
+ * alone is far too strict: it gave |z| = 4.5 for region runs whose marks and
+ * draws the tests above show exact, where Welch's t gives 2. */
+static double mean_of(const double *v, int n)
+{
+    double s = 0;
+    for (int i = 0; i < n; i++)
+        s += v[i];
+    return s / n;
+}
+
+static double var_of(const double *v, int n)
+{
+    double m = mean_of(v, n), s = 0;
+    for (int i = 0; i < n; i++)
+        s += (v[i] - m) * (v[i] - m);
+    return s / (n - 1);
+}
+
 static void test_runs_match_plain(void)
 {
-    double hr[NBIN] = {0}, hp[NBIN] = {0};
-    long or_ = 0, op = 0;
+    enum { NSEED = 6 };
+    double hr[NBIN] = {0}, hp[NBIN] = {0}, fr[NSEED], fp[NSEED];
     const int probes = 200000;
     uint64_t dr = 0, dp = 0;
-    for (uint64_t seed = 1; seed <= 6; seed++) {
+    for (uint64_t seed = 1; seed <= NSEED; seed++) {
         pk_box b;
         pk_particles p;
         pk_rsa_stats st;
@@ -371,25 +392,25 @@ static void test_runs_match_plain(void)
         CHECK(st.reason == PK_STOP_COMPLETE && st.placed == 2000);
         dr += st.draws;
         pair_histogram(&b, &p, hr);
-        or_ += open_points(&b, &p, probes, seed);
+        fr[seed - 1] = (double)open_points(&b, &p, probes, seed) / probes;
         pk_particles_free(&p);
         mono_run(3, 2000, 0.30, 100 + seed, 1, &b, &p, &st);
         CHECK(st.reason == PK_STOP_COMPLETE && st.placed == 2000);
         dp += st.draws;
         pair_histogram(&b, &p, hp);
-        op += open_points(&b, &p, probes, seed);
+        fp[seed - 1] = (double)open_points(&b, &p, probes, seed) / probes;
         pk_particles_free(&p);
     }
     int dof;
     double chi2 = chi2_two(hr, hp, NBIN, &dof);
-    double pr = (double)or_ / (6.0 * probes), pp = (double)op / (6.0 * probes);
-    double pool = 0.5 * (pr + pp), z = (pr - pp) / sqrt(pool * (1 - pool) * 2 / (6.0 * probes));
-    printf("  contact bin %.0f / %.0f pairs, chi2 = %.2f; open fraction %.5f / %.5f, z = %.2f; "
-           "draws per grain %.1f / %.1f\n", hr[0], hp[0], chi2, pr, pp, z, dr / 12000.0,
+    double pr = mean_of(fr, NSEED), pp = mean_of(fp, NSEED);
+    double t = (pr - pp) / sqrt(var_of(fr, NSEED) / NSEED + var_of(fp, NSEED) / NSEED);
+    printf("  contact bin %.0f / %.0f pairs, chi2 = %.2f; open fraction %.5f / %.5f, t = %.2f; "
+           "draws per grain %.1f / %.1f\n", hr[0], hp[0], chi2, pr, pp, t, dr / 12000.0,
            dp / 12000.0);
     CHECK_MSG(chi2 < 30, "pair distributions differ, chi2 = %.1f", chi2);
-    CHECK_MSG(fabs(z) < 4, "insertion probability differs, z = %.2f", z);
-    /* the point of it: measured ≈ 20 vs 33 draws per grain */
+    CHECK_MSG(fabs(t) < 5, "insertion probability differs, t = %.2f", t);
+    /* the point of it: measured ≈ 22 vs 35 draws per grain */
     CHECK(1.3 * (double)dr < (double)dp);
 }
 
