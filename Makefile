@@ -79,7 +79,7 @@ $(BUILD)/obj/gen/schemas_embedded.o: $(BUILD)/gen/schemas_embedded.c
 $(BUILD)/packd: $(BUILD)/obj/daemon/main.o $(LIB_OBJ)
 	$(CC) $(SAN) -o $@ $^ $(EXT_LIBS)
 
-$(BUILD)/tests/%: tests/unit/%.c tests/check.h $(LIB_OBJ)
+$(BUILD)/tests/%: tests/unit/%.c tests/check.h $(wildcard tests/unit/*.h) $(LIB_OBJ)
 	@mkdir -p $(@D)
 	$(CC) $(EXT_CFLAGS) -Idaemon -Itests -o $@ $< $(LIB_OBJ) $(EXT_LIBS)
 
