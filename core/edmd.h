@@ -5,7 +5,10 @@
  * momentum-conserving rule of spec §3.4 (Meier Eq. 3.9 generalised to
  * unequal masses), walls reflect in the co-moving sense.  Engine: delayed
  * states (each particle stores its position at its own last update time),
- * one pending event per particle in a 4-ary heap with validity counters,
+ * one pending event per particle (and its runner-up, taken without a new
+ * prediction when the first is invalidated; Donev) in a 4-ary heap with
+ * validity counters, pair times of four neighbours at once (AVX2 when the
+ * CPU has it, bit-identical to the scalar loop),
  * Donev-style per-particle neighbour lists (bounding spheres filed in the
  * dense cell levels of core/grid_uniform.h; skins shrink with the pressure
  * near jamming), periodic re-basing of the clock.
@@ -79,6 +82,7 @@ typedef struct pk_edmd_stats {
     double seconds;
     uint64_t events, pair, wall, nlist, invalid, rescales, rebases, overlaps;
     uint64_t resorts;           /* renumberings along the Z-order (large N) */
+    uint64_t second;            /* invalid events replaced by their runner-up (no prediction) */
     double max_overlap_rel;     /* largest overlap seen by the predictor, relative to R */
     size_t nhist;               /* φ(t) history: events, time, φ, p */
     double hist_events[PK_EDMD_HIST_MAX], hist_t[PK_EDMD_HIST_MAX];

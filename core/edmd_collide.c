@@ -13,41 +13,36 @@
 
 double edmd_collide_pair(edmd_state *s, size_t i, size_t j)
 {
-    edmd_sync(s, i);
-    edmd_sync(s, j);
-    double xi[3], xj[3], n[3] = {0, 0, 0};
-    edmd_pos(s, i, xi);
-    edmd_pos(s, j, xj);
-    for (int k = 0; k < s->dim; k++)
+    /* p/v carry 0 beyond dim (2D): three components throughout */
+    double xi[3], xj[3], n[3];
+    edmd_sync_pos(s, i, xi);
+    edmd_sync_pos(s, j, xj);
+    for (int k = 0; k < 3; k++)
         n[k] = xj[k] - xi[k];
     edmd_min_image_near(s, n);
-    double dist = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const double dist = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (!(dist > 0))
         return 0;
     double *vi = s->k[i].v, *vj = s->k[j].v;
-    double w = 0;
-    for (int k = 0; k < s->dim; k++) {
-        n[k] /= dist;
-        w += (vj[k] - vi[k]) * n[k];
-    }
-    double G = s->k[i].g + s->k[j].g;
-    double target = G + s->eps_v;
+    const double inv = 1 / dist;
+    for (int k = 0; k < 3; k++)
+        n[k] *= inv;
+    const double w = (vj[0] - vi[0]) * n[0] + (vj[1] - vi[1]) * n[1] + (vj[2] - vi[2]) * n[2];
+    const double target = s->k[i].g + s->k[j].g + s->eps_v;
     if (w >= target)
         return 0; /* already separating fast enough (round-off prediction) */
-    double w_new = fmax(-w, target);
-    double mi = s->m[i], mj = s->m[j];
-    double P = mi * mj / (mi + mj) * (w_new - w); /* normal impulse on j */
-    double k_before = 0, k_after = 0;
-    for (int k = 0; k < s->dim; k++)
-        k_before += mi * vi[k] * vi[k] + mj * vj[k] * vj[k];
-    for (int k = 0; k < s->dim; k++) {
-        vi[k] -= P / mi * n[k];
-        vj[k] += P / mj * n[k];
-        k_after += mi * vi[k] * vi[k] + mj * vj[k] * vj[k];
+    const double w_new = -w > target ? -w : target;
+    const double mi = s->m[i], mj = s->m[j], mu = mi * mj / (mi + mj);
+    const double P = mu * (w_new - w); /* normal impulse on j */
+    const double di = P / mi, dj = P / mj;
+    for (int k = 0; k < 3; k++) {
+        vi[k] -= di * n[k];
+        vj[k] += dj * n[k];
     }
     edmd_pin(s, i, xi);
     edmd_pin(s, j, xj);
-    s->K += 0.5 * (k_after - k_before);
+    /* ΔK = P·w + P²/(2μ): the normal relative speed goes from w to w_new */
+    s->K += P * (w + 0.5 * (w_new - w));
     return dist * P;
 }
 

@@ -94,19 +94,28 @@ double edmd_wall_time(const edmd_state *s, size_t i, int *code)
  * (mono 3D N = 4000 to jamming: about −10 % run time at 3, none at 1). */
 #define PREFETCH_AHEAD 4
 
-/* Two lanes of doubles (GCC/Clang vector extension, SSE2 on x86-64): the
- * neighbour loop evaluates the quadratics of two neighbours at once.  Every
- * lane does the scalar code's operations in the scalar code's order (no FMA
- * contraction under -std=c17), so the results are bit-identical. */
-typedef double v2d __attribute__((vector_size(16)));
-typedef long long v2m __attribute__((vector_size(16)));
-
+/* The earliest two candidates (first, runner-up) of a prediction. */
 typedef struct pred {
-    double best;
-    uint8_t kind;
-    int32_t partner;
-    uint32_t stamp;
+    double best, second;
+    int32_t with, with2;
+    uint32_t stamp, stamp2;
 } pred;
+
+static inline void offer(pred *pr, double tau, int32_t with, uint32_t stamp)
+{
+    if (tau < pr->best) {
+        pr->second = pr->best;
+        pr->with2 = pr->with;
+        pr->stamp2 = pr->stamp;
+        pr->best = tau;
+        pr->with = with;
+        pr->stamp = stamp;
+    } else if (tau < pr->second) {
+        pr->second = tau;
+        pr->with2 = with;
+        pr->stamp2 = stamp;
+    }
+}
 
 /* One neighbour j: quadratic A τ² + 2B τ + C (dd = |Δx|², R = ρ_i + ρ_j). */
 static inline void pair_take(edmd_state *s, pred *pr, size_t j, double A, double B, double C,
@@ -118,105 +127,188 @@ static inline void pair_take(edmd_state *s, pred *pr, size_t j, double A, double
         if (rel > s->max_overlap_rel)
             s->max_overlap_rel = rel;
     }
-    double tau = pair_root(A, B, C, pr->best);
-    if (tau < pr->best) {
-        pr->best = tau;
-        pr->kind = EV_PAIR;
-        pr->partner = (int32_t)j;
-        pr->stamp = s->ncoll[j];
+    double tau = pair_root(A, B, C, pr->second);
+    if (tau < pr->second)
+        offer(pr, tau, (int32_t)j, s->ncoll[j]);
+}
+
+/* What every neighbour of i is compared with (p/v carry 0 beyond dim in 2D,
+ * so all three components are computed; minimum image as pk_min_image3). */
+typedef struct self {
+    double t, r, g;
+    double x[3], v[3], L[3], iL[3];
+} self;
+
+#define MIN_IMAGE_M 6755399441055744.0
+
+/* Neighbour j, scalar. */
+static inline void pair_one(edmd_state *s, pred *pr, const self *c, size_t j)
+{
+    const edmd_kin *kj = &s->k[j];
+    const double t = c->t, M = MIN_IMAGE_M;
+    double d0 = c->x[0] - (kj->p[0] + kj->v[0] * t), d1 = c->x[1] - (kj->p[1] + kj->v[1] * t),
+           d2 = c->x[2] - (kj->p[2] + kj->v[2] * t);
+    d0 -= c->L[0] * ((d0 * c->iL[0] + M) - M);
+    d1 -= c->L[1] * ((d1 * c->iL[1] + M) - M);
+    d2 -= c->L[2] * ((d2 * c->iL[2] + M) - M);
+    const double dv0 = c->v[0] - kj->v[0], dv1 = c->v[1] - kj->v[1], dv2 = c->v[2] - kj->v[2];
+    const double R = c->r + kj->a + kj->g * t, G = c->g + kj->g;
+    const double B = d0 * dv0 + d1 * dv1 + d2 * dv2 - R * G;
+    const double dd = d0 * d0 + d1 * d1 + d2 * d2;
+    const double A = dv0 * dv0 + dv1 * dv1 + dv2 * dv2 - G * G;
+    pair_take(s, pr, j, A, B, dd - R * R, R, dd);
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define HAVE_LANES4 1
+
+/* Four neighbours at once (AVX2, chosen at run time): each grain's record
+ * is one 64-byte line (p, a | v, g), so two aligned loads per neighbour and
+ * a 4×4 transpose give the lanes.  Every lane does pair_one's operations in
+ * its order (no FMA: -std=c17 contracts nothing, and the target has none),
+ * so the results are bit-identical to the scalar code.  The common root (gap
+ * open, approaching, A >= 0: C/(−B + √D), as pair_root) is taken in the
+ * lanes; touching, overlapping or A < 0 lanes go to pair_take.  A short last
+ * group repeats its first neighbour in the empty lanes and masks them. */
+__attribute__((target("avx2"))) static void pair_lanes4(edmd_state *s, pred *pr, const self *c,
+                                                        const int32_t *nb, uint32_t nq)
+{
+    typedef double v4d __attribute__((vector_size(32)));
+    typedef long long v4m __attribute__((vector_size(32)));
+    const edmd_kin *K = s->k;
+    const v4d T = _mm256_set1_pd(c->t), VM = _mm256_set1_pd(MIN_IMAGE_M);
+    const v4d RI = _mm256_set1_pd(c->r), GI = _mm256_set1_pd(c->g);
+    const v4d X0 = _mm256_set1_pd(c->x[0]), X1 = _mm256_set1_pd(c->x[1]),
+              X2 = _mm256_set1_pd(c->x[2]);
+    const v4d V0 = _mm256_set1_pd(c->v[0]), V1 = _mm256_set1_pd(c->v[1]),
+              V2 = _mm256_set1_pd(c->v[2]);
+    const v4d L0 = _mm256_set1_pd(c->L[0]), L1 = _mm256_set1_pd(c->L[1]),
+              L2 = _mm256_set1_pd(c->L[2]);
+    const v4d I0 = _mm256_set1_pd(c->iL[0]), I1 = _mm256_set1_pd(c->iL[1]),
+              I2 = _mm256_set1_pd(c->iL[2]);
+    const v4d ZERO = _mm256_setzero_pd(), TWO = _mm256_set1_pd(2);
+    const v4d NEG_TOL = _mm256_set1_pd(-1e-9);
+    for (uint32_t q = 0; q < nq; q += 4) {
+        const int32_t *ix = nb + q;
+        int32_t tail[4];
+        int lanes = 0xf;
+        if (q + 4 > nq) {
+            lanes = (1 << (nq - q)) - 1;
+            for (int l = 0; l < 4; l++)
+                tail[l] = nb[q + l < nq ? q + l : q];
+            ix = tail;
+        } else if (q + PREFETCH_AHEAD + 3 < nq) {
+            for (int l = 0; l < 4; l++)
+                __builtin_prefetch(&K[nb[q + PREFETCH_AHEAD + l]]);
+        }
+        const edmd_kin *ka = &K[ix[0]], *kb = &K[ix[1]], *kc = &K[ix[2]], *kd = &K[ix[3]];
+        /* rows (p0 p1 p2 a) and (v0 v1 v2 g) of the four grains → columns */
+        const v4d Pa = _mm256_load_pd(ka->p), Pb = _mm256_load_pd(kb->p),
+                  Pc = _mm256_load_pd(kc->p), Pd = _mm256_load_pd(kd->p);
+        const v4d Wa = _mm256_load_pd(ka->v), Wb = _mm256_load_pd(kb->v),
+                  Wc = _mm256_load_pd(kc->v), Wd = _mm256_load_pd(kd->v);
+        v4d lo = _mm256_unpacklo_pd(Pa, Pb), hi = _mm256_unpackhi_pd(Pa, Pb);
+        v4d lo2 = _mm256_unpacklo_pd(Pc, Pd), hi2 = _mm256_unpackhi_pd(Pc, Pd);
+        const v4d p0 = _mm256_permute2f128_pd(lo, lo2, 0x20), p2 = _mm256_permute2f128_pd(lo, lo2, 0x31);
+        const v4d p1 = _mm256_permute2f128_pd(hi, hi2, 0x20), ra = _mm256_permute2f128_pd(hi, hi2, 0x31);
+        lo = _mm256_unpacklo_pd(Wa, Wb), hi = _mm256_unpackhi_pd(Wa, Wb);
+        lo2 = _mm256_unpacklo_pd(Wc, Wd), hi2 = _mm256_unpackhi_pd(Wc, Wd);
+        const v4d v0 = _mm256_permute2f128_pd(lo, lo2, 0x20), v2 = _mm256_permute2f128_pd(lo, lo2, 0x31);
+        const v4d v1 = _mm256_permute2f128_pd(hi, hi2, 0x20), rg = _mm256_permute2f128_pd(hi, hi2, 0x31);
+        v4d d0 = X0 - (p0 + v0 * T), d1 = X1 - (p1 + v1 * T), d2 = X2 - (p2 + v2 * T);
+        d0 -= L0 * ((d0 * I0 + VM) - VM);
+        d1 -= L1 * ((d1 * I1 + VM) - VM);
+        d2 -= L2 * ((d2 * I2 + VM) - VM);
+        const v4d dv0 = V0 - v0, dv1 = V1 - v1, dv2 = V2 - v2;
+        const v4d R = RI + ra + rg * T, G = GI + rg;
+        const v4d B = d0 * dv0 + d1 * dv1 + d2 * dv2 - R * G;
+        const v4d dd = d0 * d0 + d1 * d1 + d2 * d2;
+        const v4d C = dd - R * R;
+        const v4d A = dv0 * dv0 + dv1 * dv1 + dv2 * dv2 - G * G;
+        const v4d D = B * B - A * C;
+        const v4d BOUND = _mm256_set1_pd(pr->second);
+        /* common lanes: gap open, A >= 0, approaching; pair_root dismisses
+         * them when the root lies beyond the runner-up (C >= −2B·bound) or
+         * there is none (D < 0), and touching lanes (C <= 0, no overlap
+         * beyond round-off) that separate with A >= 0 */
+        const v4m grow_slower = A >= ZERO;
+        const v4m common = (C > ZERO) & grow_slower;
+        const v4m hit = common & (B < ZERO) & (C < -TWO * B * BOUND) & (D >= ZERO);
+        const v4m parting = (C <= ZERO) & (B >= ZERO) & grow_slower & (C >= NEG_TOL * R * R);
+        const int m_hit = _mm256_movemask_pd((__m256d)hit) & lanes;
+        const int m_other = ~_mm256_movemask_pd((__m256d)(common | parting)) & lanes;
+        if (!(m_hit | m_other))
+            continue;
+        v4d tau = ZERO;
+        if (m_hit)
+            tau = C / (-B + _mm256_sqrt_pd(_mm256_max_pd(D, ZERO)));
+        for (int m = m_hit | m_other; m; m &= m - 1) {
+            const int l = __builtin_ctz((unsigned)m);
+            if (m_hit >> l & 1) {
+                if (tau[l] < pr->second)
+                    offer(pr, tau[l], ix[l], s->ncoll[ix[l]]);
+            } else {
+                pair_take(s, pr, (size_t)ix[l], A[l], B[l], C[l], R[l], dd[l]);
+            }
+        }
     }
+}
+
+/* (no cached flag: workers may predict in several threads; the builtin
+ * reads the CPU model libgcc filled in at start-up) */
+static int lanes4_ok(void)
+{
+    return __builtin_cpu_supports("avx2") && !edmd_scalar_only;
+}
+#endif
+
+int edmd_scalar_only = 0;
+
+int edmd_lanes_available(void)
+{
+#ifdef HAVE_LANES4
+    return lanes4_ok();
+#else
+    return 0;
+#endif
 }
 
 void edmd_predict(edmd_state *s, size_t i)
 {
-    edmd_sync(s, i);
-    const double t = s->t;
-    double xi[3];
-    edmd_pos(s, i, xi);
-    const double *vi = s->k[i].v;
-    const double ri = edmd_rho(s, i, t), gi = s->k[i].g;
-    pred pr = {INFINITY, EV_NONE, -1, 0};
-    int code = -1;
+    const edmd_kin *ki = &s->k[i];
+    self c = {.t = s->t, .r = edmd_rho(s, i, s->t), .g = ki->g};
+    edmd_sync_pos(s, i, c.x);
+    for (int k = 0; k < 3; k++) {
+        c.v[k] = ki->v[k];
+        c.L[k] = s->Lp[k];
+        c.iL[k] = s->inv_Lp[k];
+    }
+    pred pr = {INFINITY, INFINITY, EDMD_EV_NONE, EDMD_EV_NONE, 0, 0};
 
     /* leaving the bounding sphere */
     {
-        double q[3] = {0, 0, 0};
-        for (int k = 0; k < s->dim; k++)
-            q[k] = xi[k] - s->bs.x[3 * i + k];
+        double q[3];
+        for (int k = 0; k < 3; k++)
+            q[k] = c.x[k] - s->bs.x[3 * i + k]; /* 0 beyond dim */
         edmd_min_image_near(s, q);
-        pr.best = pk_edmd_exit_time(q, vi, ri, gi, s->bs.r[i]);
-        if (pr.best < INFINITY)
-            pr.kind = EV_NLIST;
+        offer(&pr, pk_edmd_exit_time(q, c.v, c.r, c.g, s->bs.r[i]), EDMD_EV_NLIST, 0);
     }
-    double tw = s->walled ? edmd_wall_time(s, i, &code) : INFINITY;
-    if (tw < pr.best) {
-        pr.best = tw;
-        pr.kind = EV_WALL;
-        pr.partner = code;
+    if (s->walled) {
+        int code = -1;
+        double tw = edmd_wall_time(s, i, &code);
+        offer(&pr, tw, EDMD_EV_WALL0 - code, 0);
     }
-    /* p/v carry 0 beyond dim (2D), so all three components are computed;
-     * minimum image as pk_min_image3, inlined with the box in registers */
-    const double M = 6755399441055744.0;
-    const edmd_kin *K = s->k;
-    const edmd_nlist *L = &s->nl[i];
-    const int32_t *nb = L->nb;
-    const uint32_t nq = L->n;
-    uint32_t q = 0;
+    const int32_t *nb = s->nl[i].nb;
+    const uint32_t nq = s->nl[i].n;
+#ifdef HAVE_LANES4
+    if (lanes4_ok()) {
+        pair_lanes4(s, &pr, &c, nb, nq);
+    } else
+#endif
     {
-        const v2d T = {t, t}, VM = {M, M}, RI = {ri, ri}, GI = {gi, gi};
-        const v2d X0 = {xi[0], xi[0]}, X1 = {xi[1], xi[1]}, X2 = {xi[2], xi[2]};
-        const v2d V0 = {vi[0], vi[0]}, V1 = {vi[1], vi[1]}, V2 = {vi[2], vi[2]};
-        const v2d L0 = {s->Lp[0], s->Lp[0]}, L1 = {s->Lp[1], s->Lp[1]}, L2 = {s->Lp[2], s->Lp[2]};
-        const v2d I0 = {s->inv_Lp[0], s->inv_Lp[0]}, I1 = {s->inv_Lp[1], s->inv_Lp[1]},
-                  I2 = {s->inv_Lp[2], s->inv_Lp[2]};
-        const v2d ZERO = {0, 0}, TWO = {2, 2};
-        for (; q + 2 <= nq; q += 2) {
-            if (q + PREFETCH_AHEAD + 1 < nq) {
-                __builtin_prefetch(&K[nb[q + PREFETCH_AHEAD]]);
-                __builtin_prefetch(&K[nb[q + PREFETCH_AHEAD + 1]]);
-            }
-            const edmd_kin *a = &K[nb[q]], *b = &K[nb[q + 1]];
-            const v2d p0 = {a->p[0], b->p[0]}, p1 = {a->p[1], b->p[1]}, p2 = {a->p[2], b->p[2]};
-            const v2d v0 = {a->v[0], b->v[0]}, v1 = {a->v[1], b->v[1]}, v2 = {a->v[2], b->v[2]};
-            const v2d ra = {a->a, b->a}, rg = {a->g, b->g};
-            v2d d0 = X0 - (p0 + v0 * T), d1 = X1 - (p1 + v1 * T), d2 = X2 - (p2 + v2 * T);
-            d0 -= L0 * ((d0 * I0 + VM) - VM);
-            d1 -= L1 * ((d1 * I1 + VM) - VM);
-            d2 -= L2 * ((d2 * I2 + VM) - VM);
-            const v2d dv0 = V0 - v0, dv1 = V1 - v1, dv2 = V2 - v2;
-            const v2d R = RI + ra + rg * T, G = GI + rg;
-            const v2d B = d0 * dv0 + d1 * dv1 + d2 * dv2 - R * G;
-            const v2d dd = d0 * d0 + d1 * d1 + d2 * d2;
-            const v2d C = dd - R * R;
-            const v2d A = dv0 * dv0 + dv1 * dv1 + dv2 * dv2 - G * G;
-            const v2d BEST = {pr.best, pr.best};
-            /* lanes pair_root certainly dismisses (INFINITY, no overlap) */
-            const v2m skip = (C > ZERO) & (A >= ZERO) & ((B >= ZERO) | (C >= -TWO * B * BEST));
-            if (skip[0] & skip[1])
-                continue;
-            if (!skip[0])
-                pair_take(s, &pr, (size_t)nb[q], A[0], B[0], C[0], R[0], dd[0]);
-            if (!skip[1])
-                pair_take(s, &pr, (size_t)nb[q + 1], A[1], B[1], C[1], R[1], dd[1]);
-        }
+        for (uint32_t q = 0; q < nq; q++)
+            pair_one(s, &pr, &c, (size_t)nb[q]);
     }
-    if (q < nq) { /* odd list: the last neighbour */
-        const size_t j = (size_t)nb[q];
-        const edmd_kin *kj = &K[j];
-        double d0 = xi[0] - (kj->p[0] + kj->v[0] * t), d1 = xi[1] - (kj->p[1] + kj->v[1] * t),
-               d2 = xi[2] - (kj->p[2] + kj->v[2] * t);
-        d0 -= s->Lp[0] * ((d0 * s->inv_Lp[0] + M) - M);
-        d1 -= s->Lp[1] * ((d1 * s->inv_Lp[1] + M) - M);
-        d2 -= s->Lp[2] * ((d2 * s->inv_Lp[2] + M) - M);
-        const double dv0 = vi[0] - kj->v[0], dv1 = vi[1] - kj->v[1], dv2 = vi[2] - kj->v[2];
-        const double R = ri + kj->a + kj->g * t, G = gi + kj->g;
-        const double B = d0 * dv0 + d1 * dv1 + d2 * dv2 - R * G;
-        const double dd = d0 * d0 + d1 * d1 + d2 * d2;
-        const double A = dv0 * dv0 + dv1 * dv1 + dv2 * dv2 - G * G;
-        pair_take(s, &pr, j, A, B, dd - R * R, R, dd);
-    }
-    s->ev_t[i] = t + pr.best;
-    s->ev_kind[i] = pr.kind;
-    s->ev_partner[i] = pr.partner;
-    s->ev_stamp[i] = pr.stamp;
+    s->ev[i] = (edmd_event){c.t + pr.best, c.t + pr.second, pr.with, pr.with2, pr.stamp, pr.stamp2};
 }

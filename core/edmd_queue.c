@@ -1,6 +1,6 @@
 /* edmd_queue.c — the event queue: a 4-ary heap holding each particle's one
  * pending event.  Each node carries its key (the event time) inline, so a
- * sift compares neighbouring memory instead of chasing ev_t[] of random
+ * sift compares neighbouring memory instead of chasing ev[].t of random
  * particles; 4 children per node halve the depth (fewer cache lines per
  * re-key).  hpos[i] is the node of particle i, for O(log N) re-keying. */
 #include <math.h>
@@ -55,7 +55,7 @@ int edmd_queue_init(edmd_state *s)
 {
     s->hn = s->n;
     for (size_t i = 0; i < s->n; i++)
-        place(s, i, (edmd_hnode){s->ev_t[i], (int32_t)i});
+        place(s, i, (edmd_hnode){s->ev[i].t, (int32_t)i});
     for (size_t q = 0; q + 1 < ARITY; q++) /* sentinels, never moved */
         s->heap[s->n + q] = (edmd_hnode){INFINITY, -1};
     for (size_t k = s->hn / ARITY + 1; k-- > 0;)
@@ -67,7 +67,7 @@ int edmd_queue_init(edmd_state *s)
 void edmd_queue_update(edmd_state *s, size_t i)
 {
     size_t k = (size_t)s->hpos[i];
-    double t = s->ev_t[i], old = s->heap[k].t;
+    double t = s->ev[i].t, old = s->heap[k].t;
     s->heap[k].t = t;
     if (t < old)
         sift_up(s, k);
@@ -79,7 +79,8 @@ void edmd_queue_shift(edmd_state *s, double dt)
 {
     /* a uniform shift keeps the heap order */
     for (size_t i = 0; i < s->n; i++) {
-        s->ev_t[i] -= dt;
+        s->ev[i].t -= dt;
+        s->ev[i].t2 -= dt;
         s->heap[i].t -= dt;
     }
 }

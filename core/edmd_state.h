@@ -12,7 +12,20 @@
 #include "grid.h"
 #include "grid_uniform.h"
 
-enum { EV_NONE = 0, EV_PAIR, EV_WALL, EV_NLIST };
+/* Who an event is with: a grain j >= 0, nobody, the grain's bounding
+ * sphere (neighbour list), or a wall EDMD_EV_WALL0 − code (code = 2k + side). */
+enum { EDMD_EV_NONE = -1, EDMD_EV_NLIST = -2, EDMD_EV_WALL0 = -3 };
+
+/* A grain's pending event and its runner-up (Donev): when the partner of
+ * the first changes course before it, the second is still a lower bound of
+ * every collision with the unchanged neighbours (a changed one re-predicted
+ * with this grain in its list), so it is taken without a new prediction. */
+typedef struct edmd_event {
+    double t, t2;             /* event times; t2 = +inf when there is no second */
+    int32_t with, with2;      /* EDMD_EV_* or the partner grain */
+    uint32_t stamp, stamp2;   /* partner's ncoll at prediction time */
+} edmd_event;
+_Static_assert(sizeof(edmd_event) == 32, "two events per cache line");
 
 typedef struct edmd_nlist {
     int32_t *nb;      /* neighbour indices */
@@ -45,18 +58,18 @@ typedef struct edmd_state {
     double h0, h1;            /* shell h(t) = h0 + h1 t */
     double t;                 /* current time (re-based) */
     double eps_v;             /* extra separation speed (spec §3.4) */
-    /* events: one per particle */
-    double *ev_t;
-    int32_t *ev_partner;      /* partner (EV_PAIR) or wall code 2k+side (EV_WALL) */
-    uint32_t *ev_stamp;       /* partner's ncoll at prediction time */
-    uint8_t *ev_kind;
+    /* events: one (and a runner-up) per particle, 32-byte aligned */
+    edmd_event *ev;
     uint32_t *ncoll;          /* velocity changes of each particle (validity counter) */
-    edmd_hnode *heap;         /* 4-ary heap of (ev_t, particle), in heap_mem */
+    edmd_hnode *heap;         /* 4-ary heap of (ev[i].t, particle), in heap_mem */
     edmd_hnode *heap_mem;
     int32_t *hpos;            /* node of each particle in the heap */
     size_t hn;
     /* neighbour lists */
     edmd_nlist *nl;
+    edmd_nlist nl_spare;      /* block the next rebuilt list is written into */
+    uint32_t *nl_mark;        /* [n] rebuild marks (edmd_nlist_rebuild) */
+    uint32_t nl_tag;
     pk_particles bs;          /* bounding spheres: centre c_i, radius σ_i */
     pk_ugrid ugrid;           /* cells of the bounding spheres */
     double *skin;             /* per-particle skin s_i (at low pressure) */
@@ -126,24 +139,33 @@ static inline void edmd_pin(edmd_state *s, size_t i, const double x[3])
 }
 
 /* Moves p by whole periods so that x(t) is in [0, L) on periodic axes (a
- * grain flies less than L between two syncs: its list sphere is smaller). */
-static inline void edmd_sync(edmd_state *s, size_t i)
+ * grain flies less than L between two syncs: its list sphere is smaller),
+ * and returns that position x(t) = p + v·t. */
+static inline void edmd_sync_pos(edmd_state *s, size_t i, double x[3])
 {
     edmd_kin *k = &s->k[i];
     for (int d = 0; d < 3; d++) {
         const double L = s->Lp[d];
-        if (L > 0) {
-            const double x = k->p[d] + k->v[d] * s->t;
-            if (x < 0)
-                k->p[d] += L;
-            else if (x >= L)
-                k->p[d] -= L;
+        x[d] = k->p[d] + k->v[d] * s->t;
+        if (L > 0 && !(x[d] >= 0 && x[d] < L)) {
+            k->p[d] += x[d] < 0 ? L : -L;
+            x[d] = k->p[d] + k->v[d] * s->t;
         }
     }
 }
 
+static inline void edmd_sync(edmd_state *s, size_t i)
+{
+    double x[3];
+    edmd_sync_pos(s, i, x);
+}
+
 /* edmd_predict.c */
 void edmd_predict(edmd_state *s, size_t i);            /* refresh i's event and heap slot */
+/* Test hook: 1 = the neighbour loop runs scalar even where AVX2 lanes are
+ * available (the lanes must give bit-identical events). */
+extern int edmd_scalar_only;
+int edmd_lanes_available(void);                        /* AVX2 lanes in use now */
 double edmd_wall_time(const edmd_state *s, size_t i, int *code);
 
 /* edmd_collide.c */
@@ -152,7 +174,7 @@ void edmd_collide_wall(edmd_state *s, size_t i, int code);
 
 /* edmd_queue.c */
 int edmd_queue_init(edmd_state *s);
-void edmd_queue_update(edmd_state *s, size_t i);       /* after ev_t[i] changed */
+void edmd_queue_update(edmd_state *s, size_t i);       /* after ev[i].t changed */
 void edmd_queue_shift(edmd_state *s, double dt);       /* all times −= dt */
 
 /* edmd_order.c: perm[k] = index of the k-th grain along a Z-order curve of
