@@ -48,7 +48,8 @@ static const char *const scalar_series[] = {
     "coordination", "rattlers", "max_overlap_ratio", "sum_force", "reaction_defect",
     "energy_tangential", "dissipation", "contacts_sliding", NULL};
 static const char *const dr_series[] = {"newton_iterations", "newton_steps", "newton_exit_code",
-                                        "newton_attempts", "newton_shifts", "iterations",
+                                        "newton_attempts", "newton_shifts", "fire_iterations",
+                                        "iterations",
                                         "residual", "residual_initial", "stop_code",
                                         "dt", "gamma", "lambda_min", "lambda_max",
                                         "lambda_min_clamped", NULL};
@@ -139,6 +140,7 @@ int pk_homog_record_step(json_t *rec, int dim, const pk_homog_step *st)
     rc |= put(dr, "newton_exit_code", json_integer(st->used_newton ? (json_int_t)st->newton.exit : -1));
     rc |= put(dr, "newton_attempts", json_integer((json_int_t)st->newton.attempts));
     rc |= put(dr, "newton_shifts", json_integer((json_int_t)st->newton.shifts));
+    rc |= put(dr, "fire_iterations", json_integer((json_int_t)st->newton.fire_iterations));
     rc |= put(dr, "iterations", json_integer((json_int_t)st->dr.iterations));
     rc |= put(dr, "residual", json_real(st->dr.f));
     rc |= put(dr, "residual_initial", json_real(st->dr.f0));

@@ -7,7 +7,7 @@
  *   bench=homog case=contact_eval_2d rve=KIND n=N pairs=P ns_per_pair=T ... (the
  *     forces-only pk_dem_eval a DR iteration runs, on the relaxed state)
  * The step is 0.1 % uniaxial compression at tolerance 1e-8 (the thesis's),
- * solved by the Newton/DR hybrid (core/homog_newton.h, CHOLMOD) and by DR
+ * solved by the Newton/DR/FIRE hybrid (core/homog_newton.h, CHOLMOD) and by DR
  * alone from the same committed state; the DR line carries the agreement of
  * P̄ and of the energy (the same local minimum?) and the Newton line the
  * speed-up.  10⁴ grains with PACKD_BENCH_LARGE=1. */
@@ -172,10 +172,11 @@ static double step_case(size_t n, int near_jamming)
                sd.rattlers, sd.energy, d / Pn, (sn.energy - sd.energy) / sd.energy);
     }
     printf("bench=homog case=periodic_step_newton_2d rve=%s n=%zu factorisations=%zu qn_steps=%zu "
-           "dr_iterations=%zu attempts=%zu shift_raises=%zu seconds=%.3f exit=%s stop=%s "
-           "residual_rel=%.2g "
+           "dr_iterations=%zu fire_iterations=%zu attempts=%zu shift_raises=%zu seconds=%.3f "
+           "exit=%s stop=%s residual_rel=%.2g "
            "contacts=%zu rattlers=%zu energy=%.12g speedup_vs_dr=%.2f\n",
-           kind, n, sn.newton.iterations, sn.newton.steps, sn.dr.iterations, sn.newton.attempts,
+           kind, n, sn.newton.iterations, sn.newton.steps,
+           sn.dr.iterations - sn.newton.fire_iterations, sn.newton.fire_iterations, sn.newton.attempts,
            sn.newton.shifts, tnw,
            pk_newton_exit_name(sn.newton.exit), pk_dr_stop_name(sn.dr.stop), sn.dr.f / sn.dr.f0,
            sn.contacts, sn.rattlers, sn.energy, tdr > 0 ? tdr / tnw : -1);

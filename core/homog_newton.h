@@ -14,10 +14,12 @@
  * attempt from DR's point, below).
  * Hybrid: after such an exit DR takes the step from its start point, as if
  * Newton had not been asked, and at residuals 1e-3·|f⁰|, 3e-4·|f⁰|, …
- * Newton tries to finish the slow tail near the new minimum (the part where
- * DR spends most of its iterations) from a copy of DR's point.  A failed
- * attempt leaves DR untouched: without a successful one the result is DR's,
- * bit for bit.  Newton only accepts steps that lower Φ_n and converges only
+ * Newton tries to finish the slow tail near the new minimum from a copy of
+ * DR's point (a failed attempt leaves DR untouched).  After two failed
+ * attempts FIRE (homog_fire.h) relaxes on from DR's point — the slow tail,
+ * where DR spends most of its iterations — with the further attempts from
+ * FIRE's points (without a successful one the result is FIRE's, at the same
+ * tolerance).  Newton only accepts steps that lower Φ_n and converges only
  * where the block it factorised last was positive definite: the end point is
  * a local minimum.  Which one, when the step crosses a plastic event, is
  * path dependent (docs/homogenization.md). */
@@ -42,6 +44,7 @@ typedef struct pk_newton_stats {
     size_t steps, cuts;          /* quasi-Newton steps, line-search halvings */
     size_t attempts;             /* Newton attempts from DR's points */
     size_t shifts;               /* Levenberg–Marquardt shift raises in those attempts */
+    size_t fire_iterations;      /* of the relaxation's iterations, those FIRE made */
     pk_newton_exit exit;         /* of the last Newton phase */
 } pk_newton_stats;
 

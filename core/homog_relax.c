@@ -16,6 +16,7 @@ const char *pk_dr_stop_name(pk_dr_stop s)
     case PK_DR_MAX_ITER: return "max_iter";
     case PK_DR_CANCELLED: return "cancelled";
     case PK_DR_WALL_TIME: return "wall_time";
+    case PK_DR_HANDED_OVER: return "handed_over";
     }
     return "unknown";
 }
@@ -255,6 +256,10 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
             if (h == 1) { /* the hook solved the step from here */
                 st->f = fh;
                 st->stop = fh <= prm->tol * st->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
+                break;
+            }
+            if (h == 2) {
+                st->stop = PK_DR_HANDED_OVER;
                 break;
             }
         }

@@ -22,7 +22,8 @@ typedef enum pk_dr_stop {
     PK_DR_NOT_NEEDED,        /* no free particle (Taylor) */
     PK_DR_MAX_ITER,
     PK_DR_CANCELLED,
-    PK_DR_WALL_TIME
+    PK_DR_WALL_TIME,
+    PK_DR_HANDED_OVER        /* a hook stopped the relaxation to go on otherwise (internal) */
 } pk_dr_stop;
 
 const char *pk_dr_stop_name(pk_dr_stop s);
@@ -59,8 +60,9 @@ int pk_homog_relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doubl
  * homog_newton.h): called after an iteration whose residual |f| is <= at,
  * with the current x and *fres = |f|.  It returns 0 to let DR go on (x
  * untouched, it sets the next threshold *at), 1 when it has solved the step
- * from x (x and *fres replaced: DR stops as converged), < 0 on an error (DR
- * returns it).  It must not touch the pair list DR works on. */
+ * from x (x and *fres replaced: DR stops as converged), 2 to stop DR at x
+ * (stop PK_DR_HANDED_OVER: the caller goes on from there), < 0 on an error
+ * (DR returns it).  It must not touch the pair list DR works on. */
 typedef struct pk_dr_hook {
     int (*fn)(void *ctx, double *x, double *fres, double *at);
     void *ctx;

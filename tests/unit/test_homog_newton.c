@@ -112,22 +112,29 @@ static void dr_and_hybrid(const pk_homog_rve *rve, double strain, pk_homog_opts 
  * attempt: the case the hybrid exists for — if it no longer happens the RVE
  * no longer tests it); in the third case Newton's own path from DR's point
  * meets an instability and needs the Levenberg–Marquardt shift (≥ 1 raise,
- * then the unshifted block is checked).  Both solvers must end at an
+ * then the unshifted block is checked); in the fourth two attempts fail and
+ * FIRE (core/homog_fire.h) relaxes on from DR's point.  Both solvers must end at an
  * equilibrium (residual ≤ tol·|f⁰|, recomputed here), below the start
  * energy, where the jammed stiffness is positive definite (a local minimum,
  * not a saddle).  Which minimum is path dependent (physics,
  * docs/homogenization.md); the hybrid follows DR's path until Newton
- * converges from one of DR's points, and all three end in DR's minimum (Φ
- * equal to 1e-12) — printed, not asserted: Newton may converge from a point
- * DR still leaves. */
+ * converges from one of DR's (or FIRE's) points, and all four end in DR's
+ * minimum (Φ equal to 1e-12) — printed, not asserted: Newton may converge
+ * from a point DR still leaves.  Asserted: the hybrid's minimum is not above
+ * DR's (beyond 1e-12 Φ, the round-off of the energy sum; at residuals 1e-10
+ * the energy error is quadratic, ~1e-20). */
 static void test_plastic_step_ends_at_a_minimum(void)
 {
     const struct {
         size_t n;
         double phi, strain;
         uint64_t seed;
-        int shifted;
-    } cases[] = {{200, 0.86, 0.01, 2, 0}, {200, 0.86, 0.01, 3, 0}, {400, 0.88, 0.01, 3, 1}};
+        int shifted; /* Newton's path from DR's point needs the shift */
+        int fire;    /* two attempts fail: FIRE takes over from DR */
+    } cases[] = {{200, 0.86, 0.01, 2, 0, 0},
+                 {200, 0.86, 0.01, 3, 0, 0},
+                 {400, 0.88, 0.01, 3, 1, 0},
+                 {800, 0.86, 0.01, 1, 0, 1}};
     for (size_t s = 0; s < sizeof cases / sizeof *cases; s++) {
         pk_particles p;
         pk_homog_rve rve;
@@ -146,6 +153,8 @@ static void test_plastic_step_ends_at_a_minimum(void)
         CHECK_MSG(sn.newton.attempts >= 1, "case %zu: no plastic event (%zu attempts)", s,
                   sn.newton.attempts);
         CHECK_MSG(!cases[s].shifted || sn.newton.shifts >= 1, "case %zu: no shifted attempt", s);
+        CHECK_MSG(!cases[s].fire == !sn.newton.fire_iterations, "case %zu: %zu FIRE iterations", s,
+                  sn.newton.fire_iterations);
         CHECK(sn.newton.exit == PK_NEWTON_CONVERGED);
         const pk_homog_state *end[2] = {&td, &tn};
         double phi[2];
@@ -160,12 +169,15 @@ static void test_plastic_step_ends_at_a_minimum(void)
                       phi[k], phi0);
             CHECK_MSG(pd, "%s ends at a saddle", k ? "hybrid" : "DR");
         }
+        CHECK_MSG(phi[1] <= phi[0] + 1e-12 * phi[0], "hybrid Φ %.15g above DR's %.15g", phi[1],
+                  phi[0]);
         printf("  %zu grains φ %.2f %.1f %% seed %lu: start Φ %.10g; DR %zu it → Φ %.12g; hybrid %zu "
-               "factorisations (%zu shift raises) + %zu DR it, %zu attempts → Φ %.12g; |ΔP|/|P| "
+               "factorisations (%zu shift raises) + %zu DR/FIRE it (%zu FIRE), %zu attempts → Φ %.12g; "
+               "|ΔP|/|P| "
                "%.1e (%s minimum)\n",
                cases[s].n, cases[s].phi, 100 * cases[s].strain, (unsigned long)cases[s].seed, phi0,
                sd.dr.iterations, phi[0], sn.newton.iterations, sn.newton.shifts, sn.dr.iterations,
-               sn.newton.attempts, phi[1], P_rel_diff(&sd, &sn),
+               sn.newton.fire_iterations, sn.newton.attempts, phi[1], P_rel_diff(&sd, &sn),
                fabs(phi[1] - phi[0]) <= 1e-12 * phi[0] ? "same" : "another");
         free(x0);
         pk_homog_state_free(&td);

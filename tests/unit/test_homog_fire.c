@@ -1,0 +1,192 @@
+/* test_homog_fire.c — FIRE (core/homog_fire.h), the relaxation the Newton
+ * hybrid switches to after failed attempts: the same minimum as DR on an
+ * elastic step in fewer iterations, and the hook / cap contract it shares
+ * with DR (core/homog_relax.h), incl. DR's hand-over result. */
+#include "check.h"
+#include "homog_eigen.h"
+#include "homog_fire.h"
+#include "homog_fixture.h"
+
+/* A relaxation problem: a dense 200-grain packing (φ 0.90, well above
+ * jamming: one minimum near the start, no plastic event) under 0.1 %
+ * compression, from the affine start. */
+typedef struct problem {
+    pk_particles p;
+    pk_homog_rve rve;
+    pk_homog_opts o;
+    pk_dem_geom g;
+    pk_dem_pairs c;
+    uint8_t *is_free;
+    double *x0;
+} problem;
+
+static void problem_make(problem *pb)
+{
+    pk_box b;
+    make_jammed(2, 200, 0.90, 7, &b, &pb->p);
+    char err[128];
+    CHECK(pk_homog_rve_build(&b, &pb->p, PK_BC_PERIODIC, 1.0, &pb->rve, err, sizeof err) == 0);
+    pb->o = opts(1.0);
+    pb->o.dr.tol = 1e-10;
+    double F[9];
+    diagF(F, 0.999, 1.0, 1.0);
+    memset(&pb->g, 0, sizeof pb->g);
+    pb->g.dim = 2;
+    pb->g.periodic = 1;
+    memcpy(pb->g.L, pb->rve.L, sizeof pb->g.L);
+    pk_dem_geom_set_F(&pb->g, F);
+    memset(&pb->c, 0, sizeof pb->c);
+    pk_homog_pairs_setup(&pb->c, &pb->rve, &pb->o);
+    size_t n = pb->rve.n;
+    pb->is_free = malloc(n);
+    pb->x0 = malloc(3 * n * sizeof *pb->x0);
+    for (size_t i = 0; i < n; i++) {
+        pb->is_free[i] = !pb->rve.fixed[i];
+        pk_m3_vec(F, &pb->rve.X[3 * i], &pb->x0[3 * i]);
+        pb->x0[3 * i + 2] = 0;
+    }
+}
+
+static void problem_free(problem *pb)
+{
+    pk_dem_pairs_free(&pb->c);
+    pk_homog_rve_free(&pb->rve);
+    pk_particles_free(&pb->p);
+    free(pb->is_free);
+    free(pb->x0);
+}
+
+/* Energy, stress sum and free residual at x. */
+static void measure(problem *pb, const double *x, double *phi, double S[9], double *fres)
+{
+    size_t n = pb->rve.n;
+    double *f = malloc(3 * n * sizeof *f);
+    CHECK(pk_dem_pairs_build(&pb->c, &pb->g, x, pb->rve.r, n, pb->o.dr.skin) == 0);
+    pk_dem_eval(&pb->c, &pb->g, x, pb->rve.r, n, pb->o.E_n, f, phi, S);
+    *fres = sqrt(pk_homog_dot_mask(f, f, pb->is_free, n, 2));
+    free(f);
+}
+
+static double *copy_x(const problem *pb)
+{
+    double *x = malloc(3 * pb->rve.n * sizeof *x);
+    memcpy(x, pb->x0, 3 * pb->rve.n * sizeof *x);
+    return x;
+}
+
+/* Both to 1e-10·|f⁰|: the same minimum, so Φ agrees to 1e-12 relative (its
+ * error is quadratic in the residual) and the stress sum to 1e-8 relative
+ * (linear in it; measured ~1e-10, as Newton against DR in
+ * test_homog_newton).  FIRE needs fewer iterations than DR (measured ratio
+ * printed; the reason it is there). */
+static void test_fire_reaches_dr_minimum(void)
+{
+    problem pb;
+    problem_make(&pb);
+    size_t n = pb.rve.n;
+    double *xd = copy_x(&pb), *xf = copy_x(&pb);
+    pk_dr_stats sd, sf;
+    pk_fire_params fp = pk_fire_params_default();
+    CHECK(pk_homog_relax(&pb.c, &pb.g, xd, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, NULL, &sd) ==
+          0);
+    CHECK(pk_homog_fire_hooked(&pb.c, &pb.g, xf, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, &fp,
+                               NULL, NULL, &sf) == 0);
+    CHECK_MSG(sf.stop == PK_DR_CONVERGED, "FIRE: %s", pk_dr_stop_name(sf.stop));
+    CHECK(pk_dr_stop_ok(sd.stop));
+    double phid, phif, Sd[9], Sf[9], fd, ff;
+    measure(&pb, xd, &phid, Sd, &fd);
+    measure(&pb, xf, &phif, Sf, &ff);
+    CHECK_MSG(ff <= pb.o.dr.tol * sf.f0, "FIRE |f| %g > tol·|f0| %g", ff, pb.o.dr.tol * sf.f0);
+    CHECK_NEAR(phif, phid, 1e-12 * phid);
+    double Sn = 0, dS = 0;
+    for (int k = 0; k < 9; k++) {
+        Sn = fmax(Sn, fabs(Sd[k]));
+        dS = fmax(dS, fabs(Sf[k] - Sd[k]));
+    }
+    CHECK_MSG(dS <= 1e-8 * Sn, "|ΔS|/|S| = %g", dS / Sn);
+    CHECK_MSG(sf.iterations < sd.iterations, "FIRE %zu it, DR %zu", sf.iterations, sd.iterations);
+    printf("  DR %zu it, FIRE %zu it (%zu restarts): %.1fx fewer; |ΔS|/|S| %.1e\n", sd.iterations,
+           sf.iterations, sf.refreshes, (double)sd.iterations / (double)sf.iterations, dS / Sn);
+    free(xd);
+    free(xf);
+    problem_free(&pb);
+}
+
+/* A hook that records its calls; `answer` is what it returns. */
+typedef struct spy {
+    int answer;
+    size_t calls, late; /* late: called with |f| above the threshold */
+} spy;
+
+static int spy_fn(void *ctx, double *x, double *fres, double *at)
+{
+    (void)x;
+    spy *s = ctx;
+    s->calls++;
+    s->late += *fres > *at;
+    *at *= 0.1;
+    return s->answer;
+}
+
+/* The hook contract: called when |f| <= at; 0 leaves the iteration exactly
+ * as without a hook (x bit for bit); 1 ends it at the hook's residual (here
+ * |f| itself, above tol·|f⁰|: stop converged_absolute); DR stops on 2 with
+ * handed_over at the point reached (its residual recomputed on a fresh pair
+ * list: equal to 1e-9, the summation order may differ).  The cap ends FIRE
+ * with max_iter. */
+static void test_hook_and_cap(void)
+{
+    problem pb;
+    problem_make(&pb);
+    size_t n = pb.rve.n;
+    pk_fire_params fp = pk_fire_params_default();
+    double *xa = copy_x(&pb), *xb = copy_x(&pb);
+    pk_dr_stats sa, sb;
+    CHECK(pk_homog_fire_hooked(&pb.c, &pb.g, xa, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, &fp,
+                               NULL, NULL, &sa) == 0);
+    spy s0 = {0, 0, 0};
+    pk_dr_hook h0 = {spy_fn, &s0, 1e-2 * sa.f0};
+    CHECK(pk_homog_fire_hooked(&pb.c, &pb.g, xb, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, &fp,
+                               &h0, NULL, &sb) == 0);
+    CHECK(s0.calls >= 3 && s0.late == 0); /* thresholds 1e-2, 1e-3, 1e-4 … all passed */
+    CHECK(sb.iterations == sa.iterations && memcmp(xa, xb, 3 * n * sizeof *xa) == 0);
+
+    /* 1: solved by the hook at the first threshold */
+    memcpy(xb, pb.x0, 3 * n * sizeof *xb);
+    spy s1 = {1, 0, 0};
+    pk_dr_hook h1 = {spy_fn, &s1, 1e-2 * sa.f0};
+    CHECK(pk_homog_fire_hooked(&pb.c, &pb.g, xb, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, &fp,
+                               &h1, NULL, &sb) == 0);
+    CHECK(s1.calls == 1 && sb.f <= 1e-2 * sa.f0 && sb.iterations < sa.iterations);
+    CHECK(sb.stop == PK_DR_CONVERGED_ABS); /* |f| > tol·|f⁰|: only the "floor" branch is left */
+
+    /* 2: DR hands over at the first threshold */
+    memcpy(xb, pb.x0, 3 * n * sizeof *xb);
+    spy s2 = {2, 0, 0};
+    pk_dr_hook h2 = {spy_fn, &s2, 1e-2 * sa.f0};
+    CHECK(pk_homog_relax_hooked(&pb.c, &pb.g, xb, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, &h2,
+                                NULL, &sb) == 0);
+    CHECK_MSG(sb.stop == PK_DR_HANDED_OVER, "%s", pk_dr_stop_name(sb.stop));
+    double phi, S[9], fr;
+    measure(&pb, xb, &phi, S, &fr);
+    CHECK(s2.calls == 1 && fr <= 1e-2 * sa.f0 * (1 + 1e-9));
+    CHECK_NEAR(fr, sb.f, 1e-9 * sb.f);
+
+    /* the cap */
+    memcpy(xb, pb.x0, 3 * n * sizeof *xb);
+    pk_dr_params capped = pb.o.dr;
+    capped.max_iter = 5;
+    CHECK(pk_homog_fire_hooked(&pb.c, &pb.g, xb, pb.rve.r, n, pb.o.E_n, pb.is_free, &capped, &fp,
+                               NULL, NULL, &sb) == 0);
+    CHECK(sb.stop == PK_DR_MAX_ITER && sb.iterations == 5);
+    free(xa);
+    free(xb);
+    problem_free(&pb);
+}
+
+int main(void)
+{
+    RUN(test_fire_reaches_dr_minimum);
+    RUN(test_hook_and_cap);
+    return check_summary();
+}
