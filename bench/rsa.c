@@ -1,5 +1,5 @@
 /* bench/rsa — RSA placement rate.  Prints one machine-readable line per case:
- *   bench=rsa case=NAME n=N placed=N seconds=S rate=PLACEMENTS_PER_S draws_per_grain=X
+ *   bench=rsa case=NAME n=N placed=N seconds=S cpu_s=S rate=PLACEMENTS_PER_S draws_per_grain=X
  * and a final line with the rate ratio 1e6/1e4 (flat = the placer scales).
  * The monodisperse cases without suffix take the default path (batched runs of
  * equal grains, rsa_batch.h, drawing from the open region once most draws
@@ -8,7 +8,9 @@
  * runs the reference (one uniform draw at a time, pk_rsa_params.plain_draws)
  * and *_voxels the per-grain voxel-pruned path (no_batch) for the ratios;
  * 1e6 plain and voxels are left out (a minute / 20 s).  maxrss_kb: the
- * process's peak resident memory so far (the 1e6 cases come last).
+ * process's peak resident memory so far (the 1e6 cases come last); cpu_s:
+ * the placement's CPU time (user + system; on a loaded machine the wall
+ * seconds wander 2-3x, compare cpu_s old vs new back to back).
  * `rsa mono` runs only the default-path monodisperse cases (1e4, 1e5, 1e6)
  * and the scaling line: a quick re-measurement. */
 #include <math.h>
@@ -22,6 +24,14 @@
 #include "rsa.h"
 
 enum path { PLAIN, VOXELS, BATCH_PLAIN, BATCHED };
+
+static double cpu_seconds(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (double)(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+           1e-6 * (double)(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
 
 static double mono(const char *name, int dim, size_t n, double phi, enum path path)
 {
@@ -39,13 +49,15 @@ static double mono(const char *name, int dim, size_t n, double phi, enum path pa
                          .plain_draws = path == PLAIN, .no_batch = path == VOXELS,
                          .batch_plain_draws = path == BATCH_PLAIN};
     pk_rsa_stats st;
+    double cpu0 = cpu_seconds();
     pk_rsa_place(&b, d, sp, n, &prm, NULL, &p, &st);
+    double cpu = cpu_seconds() - cpu0;
     double rate = (double)st.placed / st.seconds;
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
-    printf("bench=rsa case=%s n=%zu placed=%zu seconds=%.3f rate=%.0f draws_per_grain=%.3f "
-           "maxrss_kb=%ld\n",
-           name, n, st.placed, st.seconds, rate,
+    printf("bench=rsa case=%s n=%zu placed=%zu seconds=%.3f cpu_s=%.3f rate=%.0f "
+           "draws_per_grain=%.3f maxrss_kb=%ld\n",
+           name, n, st.placed, st.seconds, cpu, rate,
            (double)st.draws / (double)(st.placed ? st.placed : 1), (long)ru.ru_maxrss);
     fflush(stdout);
     free(d);

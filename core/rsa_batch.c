@@ -46,8 +46,8 @@
  * between 6 and 16.  Against 8 steps, 3D φ = 0.30: 10^4 grains (6 steps) -4 %
  * instructions, 10^5 (9) ±0, 10^6 (16) -7 % instructions and -5 % last-level
  * misses (callgrind, cachegrind); 16 steps at 10^5 +8 %, 4 steps at 10^5
- * +17 %.  Wall clock at 10^6: no difference beyond the noise (the 4.6 MB
- * table outgrows the L2 cache, marks take longer, draws less). */
+ * +17 %.  Wall clock at 10^6: no difference beyond the noise (the table, then
+ * 4.6 MB, outgrows the L2 cache, marks take longer, draws less). */
 #define REGION_STEPS_MIN 6
 #define REGION_GRAINS_PER_ENTRY 128.0
 
@@ -62,18 +62,23 @@ typedef struct scratch {
     size_t cap;         /* attempts */
     size_t capd;        /* region draws (rpos, rbit) */
     double *pos;        /* [cap][3] attempts in attempt order */
-    uint32_t *rpos;     /* region draws: list position, then cell, of each draw */
-    uint8_t *rbit;      /* its fine voxel, RBIT_CHEAP when rejected at once */
+    uint32_t *rpos;     /* region draws: list position of each draw, then the cell of
+                           each draw not rejected at once (in draw order) */
+    uint8_t *rbit;      /* its fine voxel (same order as rpos) */
+    uint32_t *rdraw;    /* draw number of each draw not rejected at once */
     uint32_t *ord;      /* [cap + 1] draw number of each attempt in its batch
                            (region draws: certain rejections make no attempt) */
     uint32_t *key;      /* bucket of each attempt */
-    double *spos;       /* [cap][3] attempts in bucket order */
+    double *spos;       /* [cap][3] attempts' offsets from their cells' corners
+                           (pk_rsa_cells_key_q) in bucket order */
     uint32_t *sidx;     /* attempt index of each sorted entry */
     uint32_t *skey;     /* its cell key */
     uint32_t *kept;     /* sorted positions of the survivors of step 2 */
     uint64_t *sbit;     /* bit a: attempt a survived step 2 */
     int32_t *slot;      /* survivor number of attempt a (set where sbit is) */
-    double *surv;       /* [cap][3] survivors in sorted order */
+    double *surv;       /* [cap][3] survivors in sorted order (before step 2: the
+                           attempts' offsets in attempt order) */
+    uint32_t *vkey;     /* survivors' keys */
     uint8_t *taken;     /* survivor accepted in step 3 */
     uint32_t *pid;      /* its index in the particle array (set where taken is) */
     uint32_t *count;    /* [MAX_BUCKETS + 1] */
@@ -89,6 +94,7 @@ static void scratch_free(scratch *w)
     free(w->ord);
     free(w->rpos);
     free(w->rbit);
+    free(w->rdraw);
     free(w->key);
     free(w->spos);
     free(w->sidx);
@@ -97,6 +103,7 @@ static void scratch_free(scratch *w)
     free(w->sbit);
     free(w->slot);
     free(w->surv);
+    free(w->vkey);
     free(w->taken);
     free(w->pid);
     free(w->count);
@@ -123,6 +130,7 @@ static int scratch_reserve_draws(scratch *w, size_t B)
     int fail = 0;
     w->rpos = grow(w->rpos, B * sizeof *w->rpos, &fail);
     w->rbit = grow(w->rbit, B, &fail);
+    w->rdraw = grow(w->rdraw, B * sizeof *w->rdraw, &fail);
     if (fail)
         return -1;
     w->capd = B;
@@ -148,6 +156,7 @@ static int scratch_reserve(scratch *w, size_t B)
     w->sbit = grow(w->sbit, (B / 64 + 1) * sizeof *w->sbit, &fail);
     w->slot = grow(w->slot, B * sizeof *w->slot, &fail);
     w->surv = grow(w->surv, 3 * B * sizeof *w->surv, &fail);
+    w->vkey = grow(w->vkey, B * sizeof *w->vkey, &fail);
     w->taken = grow(w->taken, B, &fail);
     w->pid = grow(w->pid, B * sizeof *w->pid, &fail);
     w->count = grow(w->count, (MAX_BUCKETS + 1) * sizeof *w->count, &fail);
@@ -173,7 +182,7 @@ static inline int occupied(const uint8_t *map, uint64_t lin)
     return map[lin >> 3] >> (lin & 7) & 1;
 }
 
-/* Step 3's test: is survivor x (key: pk_rsa_cells_key) within contact of a
+/* Step 3's test: is survivor x (key: pk_rsa_cells_key_q) within contact of a
  * survivor accepted earlier in this batch?  Off the seams the neighbours are
  * the fixed offsets of the filter; ghost cells never match a stored cell. */
 static int batch_hits(const pk_rsa_cells *C, const scratch *w, const uint8_t *map, uint64_t hmask,
@@ -203,7 +212,6 @@ static int batch_hits(const pk_rsa_cells *C, const scratch *w, const uint8_t *ma
     return 0;
 }
 
-#define RBIT_CHEAP 0xff
 /* Prefetch distance of the region draws' mark look-up (draws). */
 #define PICK_AHEAD 64
 /* Prefetch distance of step 4's marks (accepted grains; -6 % time at 10^6
@@ -211,11 +219,12 @@ static int batch_hits(const pk_rsa_cells *C, const scratch *w, const uint8_t *ma
 #define MARK_AHEAD 4
 
 /* Region draws, step 1a: pick B (cell, fine voxel) pairs, then look their
- * marks up, flagging the certain rejections.  w->rpos[d] becomes the cell of
- * draw d.  Returns the number of draws not rejected.  At 10^6 grains a
- * batch's draws are far sparser than the cache lines of the list and of the
- * marks, so in any order each look-up is two misses; fetched ahead (the mark's
- * address needs the list entry fetched earlier) they overlap.  (Before: a
+ * marks up, dropping the certain rejections: for a below the number returned,
+ * draw w->rdraw[a] was not rejected at once; cell w->rpos[a], fine voxel
+ * w->rbit[a].  At 10^6 grains a batch's draws are far sparser than the cache
+ * lines of the list and of the marks, so in any order each look-up is two
+ * misses; fetched ahead (the mark's address needs the list entry fetched
+ * earlier) they overlap.  (Before: a
  * counting sort by list position to read both as streams — no fewer misses,
  * since the draws are too sparse to share lines; dropping it and prefetching
  * took 18 % off the run's time at 10^6 grains and 10 % at 10^5, best of 8.) */
@@ -237,11 +246,12 @@ static size_t region_pick(const pk_rsa_region *reg, scratch *w, size_t B, pk_rng
         if (d + PICK_AHEAD / 2 < B)
             __builtin_prefetch(&covered[list[w->rpos[d + PICK_AHEAD / 2]]]);
         const uint32_t cell = list[w->rpos[d]];
-        w->rpos[d] = cell;
-        const uint64_t hit = covered[cell] >> w->rbit[d] & 1;
-        open += !hit;
-        if (hit)
-            w->rbit[d] = RBIT_CHEAP;
+        const unsigned bit = w->rbit[d];
+        /* (open <= d: the entries written here are read no more) */
+        w->rpos[open] = cell;
+        w->rbit[open] = (uint8_t)bit;
+        w->rdraw[open] = (uint32_t)d;
+        open += !(covered[cell] >> bit & 1);
     }
     return open;
 }
@@ -255,10 +265,12 @@ static size_t draw_and_filter(const pk_rsa_cells *C, const double *px, scratch *
                               int dim, const double *lo, const double *span, pk_rng *rng,
                               int shift, uint32_t nbucket, const pk_rsa_region *reg, size_t *A)
 {
+    size_t open = 0;
     if (reg) { /* the certain rejections need no room beyond the draw arrays */
         if (scratch_reserve_draws(w, B) != 0)
             return SIZE_MAX;
-        if (scratch_reserve(w, region_pick(reg, w, B, rng)) != 0)
+        open = region_pick(reg, w, B, rng);
+        if (scratch_reserve(w, open) != 0)
             return SIZE_MAX;
     } else if (scratch_reserve(w, B) != 0) {
         return SIZE_MAX;
@@ -269,19 +281,16 @@ static size_t draw_and_filter(const pk_rsa_cells *C, const double *px, scratch *
      * and the store's geometry stay in registers */
     pk_rng g = *rng;
     const pk_rsa_cells K = *C;
-    double *restrict pos = w->pos;
+    double *restrict pos = w->pos, *restrict qpos = w->surv;
     uint32_t *restrict keys = w->key, *restrict ord = w->ord;
     size_t a = 0;
     if (reg) {
-        for (size_t d = 0; d < B; d++) {
+        for (; a < open; a++) {
             double x[3];
-            if (w->rbit[d] == RBIT_CHEAP)
-                continue;
-            pk_rsa_region_point(reg, w->rpos[d], w->rbit[d], &g, x);
+            pk_rsa_region_point(reg, w->rpos[a], w->rbit[a], &g, x);
             memcpy(&pos[3 * a], x, sizeof x);
-            uint32_t key = pk_rsa_cells_key(&K, x);
-            keys[a] = key;
-            ord[a++] = (uint32_t)d;
+            keys[a] = pk_rsa_cells_key_q(&K, x, &qpos[3 * a]);
+            ord[a] = w->rdraw[a];
         }
         ord[a] = (uint32_t)B;
     } else {
@@ -292,8 +301,7 @@ static size_t draw_and_filter(const pk_rsa_cells *C, const double *px, scratch *
             x[1] = lo1 + sp1 * pk_rng_uniform(&g);
             x[2] = dim == 3 ? lo2 + sp2 * pk_rng_uniform(&g) : 0;
             memcpy(&pos[3 * a], x, sizeof x);
-            uint32_t key = pk_rsa_cells_key(&K, x);
-            keys[a] = key;
+            keys[a] = pk_rsa_cells_key_q(&K, x, &qpos[3 * a]);
         }
     }
     *rng = g;
@@ -308,15 +316,16 @@ static size_t draw_and_filter(const pk_rsa_cells *C, const double *px, scratch *
     for (size_t q = 0; q < B; q++) {
         uint32_t key = w->key[q];
         uint32_t t = w->count[pk_rsa_cells_index(key) >> shift]++;
-        memcpy(&w->spos[3 * (size_t)t], &w->pos[3 * q], 3 * sizeof(double));
+        memcpy(&w->spos[3 * (size_t)t], &w->surv[3 * q], 3 * sizeof(double)); /* offsets */
         w->sidx[t] = (uint32_t)q;
         w->skey[t] = key;
     }
-    size_t S = pk_rsa_cells_filter(C, px, w->spos, w->skey, B, w->kept);
+    size_t S = pk_rsa_cells_filter(C, px, w->spos, w->pos, w->sidx, w->skey, B, w->kept);
     memset(w->sbit, 0, (B / 64 + 1) * sizeof *w->sbit);
     for (size_t j = 0; j < S; j++) {
         uint32_t t = w->kept[j], q = w->sidx[t];
-        memcpy(&w->surv[3 * j], &w->spos[3 * (size_t)t], 3 * sizeof(double));
+        memcpy(&w->surv[3 * j], &w->pos[3 * (size_t)q], 3 * sizeof(double));
+        w->vkey[j] = w->skey[t];
         w->slot[q] = (int32_t)j;
         w->sbit[q >> 6] |= (uint64_t)1 << (q & 63);
     }
@@ -488,7 +497,7 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
             next_d = d + 1;
             int32_t j = w.slot[cur];
             const double *x = &w.surv[3 * (size_t)j];
-            uint32_t key = pk_rsa_cells_key(&C, x);
+            const uint32_t key = w.vkey[j];
             int ok = !batch_hits(&C, &w, map, hmask, x, key) &&
                      (grid_empty || !pk_grid_overlaps(grid, out, x, r));
             if (!ok) {

@@ -61,6 +61,22 @@ int pk_rsa_cells_init(pk_rsa_cells *C, const pk_box *b, double r, double gap, co
         C->inv_h2[k] = span[k] > 0 ? (double)(2 * C->n[k]) / span[k] : 0;
         C->jmax[k] = 2 * C->n[k] - 1;
     }
+    /* Seams (pk_rsa_cells_seam): off them every neighbour is nearer than
+     * 2h <= L/2 on each periodic axis, where the hash's fixed offsets hold (no
+     * image needed).  The key's cell is 0 iff 2·(x - lo)·inv_h < 2 (round-off
+     * ~1e-16 relative); the margin 1e-9·h keeps the bounds on the safe side. */
+    for (int k = 0; k < PK_MAXDIM; k++) {
+        C->seam_lo[k] = -INFINITY;
+        C->seam_hi[k] = INFINITY;
+        if (k >= b->dim || !b->periodic[k])
+            continue;
+        if (C->n[k] < 4) {
+            C->seam_lo[k] = INFINITY; /* always */
+            continue;
+        }
+        C->seam_lo[k] = C->lo[k] + C->h[k] * (1 + 1e-9);
+        C->seam_hi[k] = C->lo[k] + (double)(C->n[k] - 1) * C->h[k] * (1 - 1e-9);
+    }
     C->ncell = nc;
     C->s2_lo = C->s2 * (1 - PK_RSA_CELLS_BAND);
     C->s2_hi = C->s2 * (1 + PK_RSA_CELLS_BAND);
@@ -161,20 +177,6 @@ int pk_rsa_cells_around(const pk_rsa_cells *C, const double *x, uint64_t out[27]
     return cnt;
 }
 
-int pk_rsa_cells_seam(const pk_rsa_cells *C, const double *x)
-{
-    /* Off the seams every neighbour is nearer than 2h <= L/2 on each periodic
-     * axis, where the hash's fixed offsets hold (no image needed). */
-    for (int k = 0; k < C->dim; k++) {
-        if (!C->periodic[k])
-            continue;
-        int64_t i = (int64_t)(pk_rsa_cells_half(C, k, x[k]) >> 1);
-        if (C->n[k] < 4 || i == 0 || i == C->n[k] - 1)
-            return 1;
-    }
-    return 0;
-}
-
 static int store(pk_rsa_cells *C, uint64_t lin, const float *f, uint32_t id)
 {
     pk_rsa_cell2 *c = &C->cell[lin];
@@ -235,6 +237,10 @@ int pk_rsa_cells_insert(pk_rsa_cells *C, const double *x, uint32_t id)
         else if (C->periodic[k] && i == C->n[k] - 1)
             a[k][m[k]++] = 0;
     }
+    if (m[0] * m[1] * m[2] == 1) /* off the seams: no ghost */
+        return store(C, ((uint64_t)a[2][0] * (uint64_t)C->np[1] + (uint64_t)a[1][0]) *
+                                (uint64_t)C->np[0] + (uint64_t)a[0][0],
+                     f, id);
     for (int z = 0; z < m[2]; z++)
         for (int y = 0; y < m[1]; y++)
             for (int xx = 0; xx < m[0]; xx++) {
@@ -286,11 +292,12 @@ static inline int cell_hits(const pk_rsa_cells *C, const pk_rsa_cell2 *c, const 
 #define PREFETCH_BYTES ((uint64_t)4 << 20)
 #define PREFETCH_AHEAD 8
 
-size_t pk_rsa_cells_filter(const pk_rsa_cells *C, const double *px, const double *pos,
-                           const uint32_t *key, size_t n, uint32_t *kept)
+size_t pk_rsa_cells_filter(const pk_rsa_cells *C, const double *px, const double *qs,
+                           const double *pos, const uint32_t *idx, const uint32_t *key,
+                           size_t n, uint32_t *kept)
 {
     size_t cnt = 0;
-    const int dim = C->dim, nrow = C->nrow;
+    const int nrow = C->nrow;
     const uint8_t *occ = C->occ;
     const size_t ahead = C->ncell * sizeof *C->cell > PREFETCH_BYTES ? PREFETCH_AHEAD : n;
     for (size_t i = 0; i < n; i++) {
@@ -305,15 +312,11 @@ size_t pk_rsa_cells_filter(const pk_rsa_cells *C, const double *px, const double
             }
 #undef PK_FETCH_ROW
         }
-        const double *x = &pos[3 * i];
+        const double *x = &pos[3 * (idx ? (size_t)idx[i] : i)];
         const uint64_t lin = pk_rsa_cells_index(key[i]);
         const unsigned oct = pk_rsa_cells_octant(key[i]);
         const pk_rsa_cell2 *c0 = &C->cell[lin];
-        /* offsets of x from its cell's corner (the key's cell) */
-        double q[3] = {0, 0, 0};
-        for (int k = 0; k < dim; k++)
-            q[k] = x[k] - (C->lo[k] +
-                           (double)(int64_t)(pk_rsa_cells_half(C, k, x[k]) >> 1) * C->h[k]);
+        const double *q = &qs[3 * i]; /* offsets of x from its cell's corner (the key's) */
         /* the cell itself first (offset 0, the likeliest overlap), then the
          * nonempty cells around, as bits of the near-first order off[oct] */
         const int64_t *off = C->off[oct];

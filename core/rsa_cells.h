@@ -64,6 +64,9 @@ typedef struct pk_rsa_cells {
     double inv_h2[PK_MAXDIM];   /* 2·inv_h: half cells (the key's octant) */
     uint64_t jmax[PK_MAXDIM];   /* 2n - 1: last half cell */
     int periodic[PK_MAXDIM];
+    double seam_lo[PK_MAXDIM];  /* x < seam_lo or x >= seam_hi: maybe in a seam cell */
+    double seam_hi[PK_MAXDIM];  /* (pk_rsa_cells_seam; -inf / +inf where never,
+                                   seam_lo = +inf where always) */
     int64_t n[PK_MAXDIM];       /* real cells per axis (1 on unused axes) */
     int64_t np[PK_MAXDIM];      /* with the ghost layer: n + 2 on used axes */
     uint64_t ncell;             /* padded cells */
@@ -132,14 +135,21 @@ static inline uint64_t pk_rsa_cells_half(const pk_rsa_cells *C, int k, double xk
     return j;
 }
 
-/* Padded index of the real cell holding x (bits 0..27) and the octant of x in
- * it (bits 28..30, bit k: upper half along axis k; which neighbours to test
- * first).  (ncell < 2^28: the fields never collide.) */
-static inline uint32_t pk_rsa_cells_key(const pk_rsa_cells *C, const double *x)
+/* Key of x: padded index of the real cell holding x (bits 0..27) and the
+ * octant of x in it (bits 28..30, bit k: upper half along axis k; which
+ * neighbours to test first).  (ncell < 2^28: the fields never collide.)
+ * pk_rsa_cells_key_q also writes the offsets q of x from the lower corner of
+ * that cell (z = 0 in 2D): what pk_rsa_cells_filter tests with. */
+static inline uint32_t pk_rsa_cells_key_q(const pk_rsa_cells *C, const double *x, double q[3])
 {
     uint64_t j0 = pk_rsa_cells_half(C, 0, x[0]), j1 = pk_rsa_cells_half(C, 1, x[1]), j2 = 0;
-    if (C->dim == 3)
+    q[0] = x[0] - (C->lo[0] + (double)(int64_t)(j0 >> 1) * C->h[0]);
+    q[1] = x[1] - (C->lo[1] + (double)(int64_t)(j1 >> 1) * C->h[1]);
+    q[2] = 0;
+    if (C->dim == 3) {
         j2 = pk_rsa_cells_half(C, 2, x[2]);
+        q[2] = x[2] - (C->lo[2] + (double)(int64_t)(j2 >> 1) * C->h[2]);
+    }
     uint64_t lin = C->base + (j0 >> 1) + (j1 >> 1) * C->stride[1] + (j2 >> 1) * C->stride[2];
     uint32_t oct = (uint32_t)((j0 & 1) | (j1 & 1) << 1 | (j2 & 1) << 2);
     return (uint32_t)lin | oct << PK_RSA_CELLS_OCT_SHIFT;
@@ -180,19 +190,31 @@ int pk_rsa_cells_insert(pk_rsa_cells *C, const double *x, uint32_t id);
 
 /* 1 if x lies in a real cell next to a periodic seam (or on an axis of fewer
  * than 4 cells): its neighbours may need a periodic image (rsa_batch.c's
- * hash of a batch's grains).  The cell is the key's (pk_rsa_cells_key). */
-int pk_rsa_cells_seam(const pk_rsa_cells *C, const double *x);
+ * hash of a batch's grains).  The cell is the key's (pk_rsa_cells_key_q); the
+ * test is conservative: within 1e-9·h of the first or last cell's inner face
+ * it says 1 (harmless: the seam path serves every cell). */
+static inline int pk_rsa_cells_seam(const pk_rsa_cells *C, const double *x)
+{
+    int s = x[0] < C->seam_lo[0] || x[0] >= C->seam_hi[0];
+    s |= x[1] < C->seam_lo[1] || x[1] >= C->seam_hi[1];
+    if (C->dim == 3)
+        s |= x[2] < C->seam_lo[2] || x[2] >= C->seam_hi[2];
+    return s;
+}
 
-/* For the n points pos[3i..] (z = 0 in 2D) with keys key[i] (pk_rsa_cells_key;
- * any order, sorted by key is fast): writes the indices i of the points no
- * stored centre is within contact of, ascending, to kept[] and returns their
- * number.  px: the particle array's centres (stride 3), for the band. */
+/* For n points with keys key[i] and offsets q[3i..] from their cells' corners
+ * (pk_rsa_cells_key_q; any order, sorted by key is fast): writes the indices i
+ * of the points no stored centre is within contact of, ascending, to kept[]
+ * and returns their number.  Point i itself (z = 0 in 2D) is pos[3·idx[i]..]
+ * (idx NULL: pos[3i..]); it is read only in the band, with px: the particle
+ * array's centres (stride 3). */
 static inline uint64_t pk_rsa_cells_index(uint32_t key) { return key & PK_RSA_CELLS_INDEX_MASK; }
 static inline unsigned pk_rsa_cells_octant(uint32_t key)
 {
     return key >> PK_RSA_CELLS_OCT_SHIFT & 7u;
 }
-size_t pk_rsa_cells_filter(const pk_rsa_cells *C, const double *px, const double *pos,
-                           const uint32_t *key, size_t n, uint32_t *kept);
+size_t pk_rsa_cells_filter(const pk_rsa_cells *C, const double *px, const double *q,
+                           const double *pos, const uint32_t *idx, const uint32_t *key,
+                           size_t n, uint32_t *kept);
 
 #endif

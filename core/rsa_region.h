@@ -49,6 +49,7 @@ typedef struct pk_rsa_region {
     uint8_t *tidx;              /* [Q^dim][entry]: their cell numbers in the entry */
     uint8_t *tcnt;              /* [Q^dim]: how many; 0xff = not made yet */
     int64_t *toff;              /* [entry]: index offset of cell number q (off the seams) */
+    uint8_t *tdec;              /* [entry][3]: cell number q's steps dx, dy, dz + D */
     uint64_t ncell;
     uint64_t *covered;          /* [ncell] bit set: fine voxel inside an exclusion ball */
     uint32_t *list;             /* cells that had an open fine voxel at the last compaction */
@@ -57,7 +58,8 @@ typedef struct pk_rsa_region {
 
 /* Steps of the mark table per axis and cell: with cells of half the store's
  * edge (h ≈ c/2), delta = √3·h/(2·steps) ≈ 0.054 c at 8 steps (512 entries of
- * (2·2 + 1)³ words, 0.5 MB), 0.027 c at 16 (4096 entries, 4.6 MB). */
+ * (2·2 + 1)³ words, 0.5 MB), 0.027 c at 16 (4096 entries, 4.6 MB; a mark
+ * reads its entry's nonzero words and their cell numbers, ~80 in 3D). */
 #define PK_RSA_REGION_MAX_STEPS 16
 
 /* For the draw range lo[], span[] cut into n[k] cells per axis (the store's

@@ -203,16 +203,18 @@ static void test_cells_predicate_and_neighbours(void)
     int wrong = 0, near = 0;
     uint8_t keep[200] = {0};
     uint32_t key[200], kept[200];
+    double off[200][3];
     int seam = 0;
     for (int q = 0; q < 200; q++) {
-        key[q] = pk_rsa_cells_key(&C, pts[200 + q]);
+        key[q] = pk_rsa_cells_key_q(&C, pts[200 + q], off[q]);
         for (int k = 0; k < 3; k++) {
             int64_t i = pk_rsa_cells_coord(&C, k, pts[200 + q][k]);
             seam += i == 0 || i == C.n[k] - 1;
         }
     }
     CHECK(seam > 20); /* points next to seams and walls are among them */
-    size_t nkept = pk_rsa_cells_filter(&C, &pts[0][0], pts[200], key, 200, kept);
+    size_t nkept =
+        pk_rsa_cells_filter(&C, &pts[0][0], &off[0][0], pts[200], NULL, key, 200, kept);
     int ascending = 1;
     for (size_t j = 0; j < nkept; j++) {
         ascending &= j == 0 || kept[j] > kept[j - 1];
@@ -293,9 +295,11 @@ static void test_cells_band_matches_exact_predicate(void)
         }
         static uint32_t key[NQ], kept[NQ];
         static uint8_t keep[NQ];
+        static double off[NQ][3];
         for (int i = 0; i < NQ; i++)
-            key[i] = pk_rsa_cells_key(&C, q[i]);
-        size_t nk = pk_rsa_cells_filter(&C, &pts[0][0], &q[0][0], key, NQ, kept);
+            key[i] = pk_rsa_cells_key_q(&C, q[i], off[i]);
+        size_t nk =
+            pk_rsa_cells_filter(&C, &pts[0][0], &off[0][0], &q[0][0], NULL, key, NQ, kept);
         memset(keep, 0, sizeof keep);
         for (size_t j = 0; j < nk; j++)
             keep[kept[j]] = 1;
