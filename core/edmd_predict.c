@@ -299,7 +299,7 @@ void edmd_predict(edmd_state *s, size_t i)
         double tw = edmd_wall_time(s, i, &code);
         offer(&pr, tw, EDMD_EV_WALL0 - code, 0);
     }
-    const int32_t *nb = s->nl[i].nb;
+    const int32_t *nb = s->nl_pool + s->nl[i].off;
     const uint32_t nq = s->nl[i].n;
 #ifdef HAVE_LANES4
     if (lanes4_ok()) {
