@@ -115,40 +115,13 @@ int pk_homog_fire_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const
         }
         pk_dem_eval(c, g, x, r, np, E, f, NULL, NULL);
         st->f = sqrt(pk_homog_dot_mask(f, f, is_free, np, dim));
-        if (st->f <= target) {
-            st->stop = st->f <= prm->tol * st->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
+        int e = pk_relax_iteration_end(st, prm, target, k, x, hook, mon, &pr);
+        if (e < 0) {
+            rc = e;
+            goto out;
+        }
+        if (e)
             break;
-        }
-        if (hook && st->f <= hook->at) {
-            double fh = st->f;
-            int h = hook->fn(hook->ctx, x, &fh, &hook->at);
-            if (h < 0) {
-                rc = h;
-                goto out;
-            }
-            if (h == 1) { /* the hook solved the step from here */
-                st->f = fh;
-                st->stop = fh <= prm->tol * st->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
-                break;
-            }
-            if (h == 2) {
-                st->stop = PK_DR_HANDED_OVER;
-                break;
-            }
-        }
-        if (st->iterations >= prm->max_iter) {
-            st->stop = PK_DR_MAX_ITER;
-            break;
-        }
-        if ((k & 63) == 63 && mon) {
-            pr.done = st->iterations;
-            pr.fraction = log(st->f / st->f0) / log(target / st->f0);
-            int t = pk_monitor_tick(mon, &pr, 0);
-            if (t) {
-                st->stop = t == 1 ? PK_DR_CANCELLED : PK_DR_WALL_TIME;
-                break;
-            }
-        }
     }
 out:
     free(f);

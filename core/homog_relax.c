@@ -181,6 +181,44 @@ static inline int dr_update(double *x, double *v, const double *f, const uint8_t
     return stale;
 }
 
+int pk_relax_iteration_end(pk_dr_stats *st, const pk_dr_params *prm, double target, size_t k,
+                           double *x, pk_dr_hook *hook, pk_monitor *mon, pk_progress *pr)
+{
+    if (st->f <= target) {
+        st->stop = st->f <= prm->tol * st->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
+        return 1;
+    }
+    if (hook && st->f <= hook->at) {
+        double fh = st->f;
+        int h = hook->fn(hook->ctx, x, &fh, &hook->at);
+        if (h < 0)
+            return h;
+        if (h == 1) { /* the hook solved the step from here */
+            st->f = fh;
+            st->stop = fh <= prm->tol * st->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
+            return 1;
+        }
+        if (h == 2) {
+            st->stop = PK_DR_HANDED_OVER;
+            return 1;
+        }
+    }
+    if (st->iterations >= prm->max_iter) {
+        st->stop = PK_DR_MAX_ITER;
+        return 1;
+    }
+    if ((k & 63) == 63 && mon) {
+        pr->done = st->iterations;
+        pr->fraction = log(st->f / st->f0) / log(target / st->f0);
+        int t = pk_monitor_tick(mon, pr, 0);
+        if (t) {
+            st->stop = t == 1 ? PK_DR_CANCELLED : PK_DR_WALL_TIME;
+            return 1;
+        }
+    }
+    return 0;
+}
+
 static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
                  double E, const uint8_t *is_free, const pk_dr_params *prm, pk_fric_ctx *fc,
                  double *u, pk_dr_hook *hook, pk_monitor *mon, pk_dr_stats *st,
@@ -242,31 +280,13 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
             goto out;
         }
         st->f = resid_norm(&sys, f, gu);
-        if (st->f <= target) {
-            st->stop = st->f <= prm->tol * st->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
+        int e = pk_relax_iteration_end(st, prm, target, k, x, hook, mon, &pr);
+        if (e < 0) {
+            rc = e;
+            goto out;
+        }
+        if (e)
             break;
-        }
-        if (hook && st->f <= hook->at) {
-            double fh = st->f;
-            int h = hook->fn(hook->ctx, x, &fh, &hook->at);
-            if (h < 0) {
-                rc = h;
-                goto out;
-            }
-            if (h == 1) { /* the hook solved the step from here */
-                st->f = fh;
-                st->stop = fh <= prm->tol * st->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
-                break;
-            }
-            if (h == 2) {
-                st->stop = PK_DR_HANDED_OVER;
-                break;
-            }
-        }
-        if (st->iterations >= prm->max_iter) {
-            st->stop = PK_DR_MAX_ITER;
-            break;
-        }
         if (!isfinite(st->f) || st->f > 1e3 * fbest) {
             /* diverging: the spectrum moved (new contacts) — fresh estimates, restart at rest */
             if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu) != 0) {
@@ -286,15 +306,6 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
                 goto out;
             }
             st->refreshes++;
-        }
-        if ((k & 63) == 63 && mon) {
-            pr.done = st->iterations;
-            pr.fraction = log(st->f / st->f0) / log(target / st->f0);
-            int t = pk_monitor_tick(mon, &pr, 0);
-            if (t) {
-                st->stop = t == 1 ? PK_DR_CANCELLED : PK_DR_WALL_TIME;
-                break;
-            }
         }
     }
 out:

@@ -69,6 +69,14 @@ typedef struct pk_dr_hook {
     double at;
 } pk_dr_hook;
 
+/* The end of one relaxation iteration, shared by DR and FIRE (homog_fire.h),
+ * with st->f the residual after it: converged at target, the hook (if any),
+ * the iteration cap, and every 64th iteration (k & 63 == 63) the monitor.
+ * Returns 0 to go on, 1 to stop (st->stop set, x maybe replaced by the
+ * hook's), < 0 the hook's error. */
+int pk_relax_iteration_end(pk_dr_stats *st, const pk_dr_params *prm, double target, size_t k,
+                           double *x, pk_dr_hook *hook, pk_monitor *mon, pk_progress *pr);
+
 /* pk_homog_relax with a hook (hook->at: the first threshold). */
 int pk_homog_relax_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
                           size_t np, double E, const uint8_t *is_free, const pk_dr_params *prm,

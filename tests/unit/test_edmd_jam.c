@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "edmd_fixture.h"
 #include "edmd.h"
 #include "gap_audit.h"
 
@@ -27,21 +28,12 @@ static void check_no_overlap(const pk_box *b, const pk_particles *p)
  * for the start sizes; grown by relative growth from zero until jammed. */
 static double jam(int dim, int n, double ratio, double rate, uint64_t seed)
 {
-    pk_box b;
-    memset(&b, 0, sizeof b);
-    b.dim = dim;
     pk_particles p;
     pk_particles_init(&p, dim, (size_t)n);
-    double x[3] = {0, 0, 0}, vol = 0;
-    for (int i = 0; i < n; i++) {
-        double r = i % 2 ? 0.5 * ratio : 0.5;
-        pk_particles_push(&p, x, r, 0);
-        vol += pk_ball_measure(dim, r);
-    }
-    for (int k = 0; k < dim; k++) {
-        b.L[k] = pow(vol / 0.5, 1.0 / dim);
-        b.periodic[k] = 1;
-    }
+    double x[3] = {0, 0, 0};
+    for (int i = 0; i < n; i++)
+        pk_particles_push(&p, x, i % 2 ? 0.5 * ratio : 0.5, 0);
+    pk_box b = edmd_fixture_periodic_box(&p, 0.5);
     pk_edmd_params prm;
     pk_edmd_params_default(&prm);
     prm.until = PK_EDMD_UNTIL_JAMMED;

@@ -12,6 +12,7 @@
 #include "check.h"
 #include "edmd.h"
 #include "edmd_state.h"
+#include "edmd_fixture.h"
 
 typedef struct outcome {
     pk_edmd_stats st;
@@ -22,20 +23,11 @@ typedef struct outcome {
  * φ = 0.5 for the target sizes, grown from zero until jammed. */
 static void run(int dim, int n, double ratio, int scalar, outcome *o)
 {
-    pk_box b;
-    memset(&b, 0, sizeof b);
-    b.dim = dim;
     pk_particles_init(&o->p, dim, (size_t)n);
-    double x[3] = {0, 0, 0}, vol = 0;
-    for (int i = 0; i < n; i++) {
-        double r = 0.5 * (i % 5 == 0 ? ratio : 1 + (ratio - 1) * 0.1 * (i % 3));
-        pk_particles_push(&o->p, x, r, 0);
-        vol += pk_ball_measure(dim, r);
-    }
-    for (int k = 0; k < dim; k++) {
-        b.L[k] = pow(vol / 0.5, 1.0 / dim);
-        b.periodic[k] = 1;
-    }
+    double x[3] = {0, 0, 0};
+    for (int i = 0; i < n; i++)
+        pk_particles_push(&o->p, x, 0.5 * (i % 5 == 0 ? ratio : 1 + (ratio - 1) * 0.1 * (i % 3)), 0);
+    pk_box b = edmd_fixture_periodic_box(&o->p, 0.5);
     pk_edmd_params prm;
     pk_edmd_params_default(&prm);
     prm.until = PK_EDMD_UNTIL_JAMMED;

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "edmd_fixture.h"
 #include "edmd.h"
 #include "gap_audit.h"
 
@@ -17,23 +18,16 @@
  * grain i has radius r0[i] before and k·r0[i] after (relative growth). */
 static void test_pooled_lists_keep_grains_and_gaps(void)
 {
-    pk_box b;
-    memset(&b, 0, sizeof b);
-    b.dim = 2;
     pk_particles p;
     CHECK(pk_particles_init(&p, 2, N) == 0);
-    double x[3] = {0, 0, 0}, vol = 0, r0[N];
+    double x[3] = {0, 0, 0}, r0[N];
     for (int i = 0; i < N; i++) {
         /* radii in an order that is no spatial order: a mix-up of the
          * engine's numbering (perm) would give grains the wrong size */
         r0[i] = (i * 7919) % 3 ? 0.5 : 0.7;
         pk_particles_push(&p, x, r0[i], 0);
-        vol += pk_ball_measure(2, r0[i]);
     }
-    for (int k = 0; k < 2; k++) {
-        b.L[k] = sqrt(vol / 0.5);
-        b.periodic[k] = 1;
-    }
+    pk_box b = edmd_fixture_periodic_box(&p, 0.5);
     pk_edmd_params prm;
     pk_edmd_params_default(&prm);
     prm.until = PK_EDMD_UNTIL_JAMMED;
