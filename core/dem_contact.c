@@ -256,33 +256,27 @@ static inline double round_even(double v)
                 f[3 * icur + a_] += fi[a_];                                                    \
     } while (0)
 
-/* pk_dem_eval for 2D: the same operations as the generic loop with the
- * vanishing third components dropped (x·0 terms), so the same numbers
- * (tests/unit/test_homog_newton.c) at a fraction of the cost — this loop is
- * most of the cost of a DR iteration.  The flags are constants at each call
- * (eval_2d below), so the compiler drops the branches of what is not asked;
- * F and F⁻¹ are read into locals once (the stores to the pair arrays could
- * alias them otherwise). */
-static inline size_t eval_2d_loop(pk_dem_pairs *c, const pk_dem_geom *g, const double *x,
-                                  const double *r, double E, double *f, double *phi_out,
-                                  double S[9], const int per, const int want_phi, const int want_S)
+/* The geometry of candidates [p0, pe) in 2D (ref_diff + F·ds as
+ * pk_dem_branch, then |l| and the overlap (4.1)) into l, len, eps; the
+ * contacts (4.2; coincident centres carry no direction) are listed in idx
+ * (when not NULL), in pair order.  Returns their number.  per is a constant
+ * at each call, so the compiler drops the branch; F, F⁻¹ are read into
+ * locals once (the stores to the pair arrays could alias them otherwise). */
+static inline size_t geom_2d_scalar(pk_dem_pairs *c, const pk_dem_geom *g, const double *x,
+                                    const double *r, size_t p0, size_t pe, int32_t *idx,
+                                    const int per)
 {
     const double F0 = g->F[0], F1 = g->F[1], F3 = g->F[3], F4 = g->F[4];
     const double G0 = g->Finv[0], G1 = g->Finv[1], G3 = g->Finv[3], G4 = g->Finv[4];
     const double L0 = g->L[0], L1 = g->L[1];
     const double iL0 = per ? 1 / L0 : 0, iL1 = per ? 1 / L1 : 0;
-    const double *kf = c->kf;
     const int32_t *pi = c->i, *pj = c->j;
     double *pl = c->l, *plen = c->len, *peps = c->eps;
-    double phi = 0, fi0 = 0, fi1 = 0, S0 = 0, S1 = 0, S3 = 0, S4 = 0;
-    size_t nc = 0, icur = SIZE_MAX;
-    /* Two passes: the geometry of every candidate (a long dependent chain
-     * per pair: min image, √, overlap), then the forces of the contacts —
-     * short loop bodies keep more pairs in flight (measured 15 % faster). */
-    for (size_t p = 0; p < c->n; p++) {
+    size_t nc = 0;
+    for (size_t p = p0; p < pe; p++) {
         size_t i = (size_t)pi[p], j = (size_t)pj[p];
         double d0 = x[3 * j] - x[3 * i], d1 = x[3 * j + 1] - x[3 * i + 1];
-        if (per) { /* ref_diff + F·ds, as pk_dem_branch */
+        if (per) {
             double s0 = G0 * d0 + G1 * d1, s1 = G3 * d0 + G4 * d1;
             s0 -= L0 * round_even(s0 * iL0);
             s1 -= L1 * round_even(s1 * iL1);
@@ -291,33 +285,195 @@ static inline size_t eval_2d_loop(pk_dem_pairs *c, const pk_dem_geom *g, const d
         }
         pl[3 * p] = d0, pl[3 * p + 1] = d1, pl[3 * p + 2] = 0;
         double len = sqrt(d0 * d0 + d1 * d1);
+        double eps = r[i] + r[j] - len; /* (4.1) */
         plen[p] = len;
-        peps[p] = r[i] + r[j] - len; /* (4.1) */
+        peps[p] = eps;
+        if (idx && eps >= 0 && len > 0)
+            idx[nc++] = (int32_t)p;
     }
-    for (size_t p = 0; p < c->n; p++) {
-        double eps = peps[p], len = plen[p];
-        if (!(eps >= 0) || !(len > 0))
-            continue;
-        size_t i = (size_t)pi[p], j = (size_t)pj[p];
-        double d0 = pl[3 * p], d1 = pl[3 * p + 1];
-        nc++;
-        double k = kf ? E * kf[p] : E; /* pk_dem_pair_E */
-        if (want_phi)
-            phi += 0.5 * k * eps * eps; /* (4.3) */
-        double t = k * eps / len;       /* (4.8): f_ij = −t l on i, one division */
-        double fa0 = -t * d0, fa1 = -t * d1;
-        if (f) {
-            if (i != icur) {
-                if (icur != SIZE_MAX)
-                    f[3 * icur] += fi0, f[3 * icur + 1] += fi1;
-                icur = i, fi0 = fi1 = 0;
+    return nc;
+}
+
+int pk_dem_scalar_only = 0;
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define HAVE_GEOM_LANES4 1
+
+/* geom_2d_scalar with four candidates per step (AVX2, chosen at run time),
+ * which also gives the contacts' force factors t = E_n ε/|l| in tq (the one
+ * division of (4.8), four at a time).  The pairs' x_j − x_i and r are
+ * transposed to lanes (faster than vgatherdpd here), then every lane does
+ * the scalar operations in their order — no FMA (-std=c17 contracts nothing and the target has none), and
+ * round_even the same way ((v + 1.5·2⁵²) − 1.5·2⁵², vroundpd beyond 2⁵¹,
+ * which keeps even the sign of zero) — so l, len, eps and the contact list
+ * are bit-identical to the scalar loop (tests/unit/test_dem_lanes.c). */
+__attribute__((target("avx2"))) static size_t geom_2d_lanes4(pk_dem_pairs *c,
+                                                             const pk_dem_geom *g,
+                                                             const double *x, const double *r,
+                                                             double E, size_t p0, size_t pe,
+                                                             int32_t *idx, double *tq,
+                                                             const int per)
+{
+    const double *kf = c->kf;
+    const __m256d EV = _mm256_set1_pd(E);
+    const __m256d F0 = _mm256_set1_pd(g->F[0]), F1 = _mm256_set1_pd(g->F[1]),
+                  F3 = _mm256_set1_pd(g->F[3]), F4 = _mm256_set1_pd(g->F[4]);
+    const __m256d G0 = _mm256_set1_pd(g->Finv[0]), G1 = _mm256_set1_pd(g->Finv[1]),
+                  G3 = _mm256_set1_pd(g->Finv[3]), G4 = _mm256_set1_pd(g->Finv[4]);
+    const __m256d L0 = _mm256_set1_pd(g->L[0]), L1 = _mm256_set1_pd(g->L[1]);
+    const __m256d iL0 = _mm256_set1_pd(per ? 1 / g->L[0] : 0),
+                  iL1 = _mm256_set1_pd(per ? 1 / g->L[1] : 0);
+    const __m256d BIG = _mm256_set1_pd(0x1.8p52), LIM = _mm256_set1_pd(0x1p51);
+    const __m256d ABS = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffffLL));
+    const __m256d ZERO = _mm256_setzero_pd();
+    const int32_t *pi = c->i, *pj = c->j;
+    double *pl = c->l, *plen = c->len, *peps = c->eps;
+    size_t nc = 0, p = p0;
+    for (; p + 4 <= pe; p += 4) {
+        const size_t i0 = (size_t)pi[p], i1 = (size_t)pi[p + 1], i2 = (size_t)pi[p + 2],
+                     i3 = (size_t)pi[p + 3];
+        const size_t j0 = (size_t)pj[p], j1 = (size_t)pj[p + 1], j2 = (size_t)pj[p + 2],
+                     j3 = (size_t)pj[p + 3];
+        /* (x_j − x_i) of each pair in 128 bits, then transposed to lanes */
+        const __m128d e0 = _mm_sub_pd(_mm_loadu_pd(&x[3 * j0]), _mm_loadu_pd(&x[3 * i0]));
+        const __m128d e1 = _mm_sub_pd(_mm_loadu_pd(&x[3 * j1]), _mm_loadu_pd(&x[3 * i1]));
+        const __m128d e2 = _mm_sub_pd(_mm_loadu_pd(&x[3 * j2]), _mm_loadu_pd(&x[3 * i2]));
+        const __m128d e3 = _mm_sub_pd(_mm_loadu_pd(&x[3 * j3]), _mm_loadu_pd(&x[3 * i3]));
+        const __m256d e02 = _mm256_insertf128_pd(_mm256_castpd128_pd256(e0), e2, 1);
+        const __m256d e13 = _mm256_insertf128_pd(_mm256_castpd128_pd256(e1), e3, 1);
+        __m256d d0 = _mm256_unpacklo_pd(e02, e13), d1 = _mm256_unpackhi_pd(e02, e13);
+        if (per) {
+            __m256d s0 = _mm256_add_pd(_mm256_mul_pd(G0, d0), _mm256_mul_pd(G1, d1));
+            __m256d s1 = _mm256_add_pd(_mm256_mul_pd(G3, d0), _mm256_mul_pd(G4, d1));
+            __m256d v0 = _mm256_mul_pd(s0, iL0), v1 = _mm256_mul_pd(s1, iL1);
+            __m256d n0 = _mm256_sub_pd(_mm256_add_pd(v0, BIG), BIG);
+            __m256d n1 = _mm256_sub_pd(_mm256_add_pd(v1, BIG), BIG);
+            const __m256d far0 = _mm256_cmp_pd(_mm256_and_pd(v0, ABS), LIM, _CMP_NLT_UQ);
+            const __m256d far1 = _mm256_cmp_pd(_mm256_and_pd(v1, ABS), LIM, _CMP_NLT_UQ);
+            if (_mm256_movemask_pd(_mm256_or_pd(far0, far1))) {
+                const int mode = _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC;
+                n0 = _mm256_blendv_pd(n0, _mm256_round_pd(v0, mode), far0);
+                n1 = _mm256_blendv_pd(n1, _mm256_round_pd(v1, mode), far1);
             }
-            fi0 += fa0, fi1 += fa1;
-            f[3 * j] -= fa0, f[3 * j + 1] -= fa1;
+            s0 = _mm256_sub_pd(s0, _mm256_mul_pd(L0, n0));
+            s1 = _mm256_sub_pd(s1, _mm256_mul_pd(L1, n1));
+            d0 = _mm256_add_pd(_mm256_mul_pd(F0, s0), _mm256_mul_pd(F1, s1));
+            d1 = _mm256_add_pd(_mm256_mul_pd(F3, s0), _mm256_mul_pd(F4, s1));
         }
-        if (want_S) {
-            S0 += fa0 * d0, S1 += fa0 * d1;
-            S3 += fa1 * d0, S4 += fa1 * d1;
+        /* l rows (d0 d1 0) of the four pairs */
+        const __m256d lo = _mm256_unpacklo_pd(d0, d1), hi = _mm256_unpackhi_pd(d0, d1);
+        double *lp = &pl[3 * p];
+        _mm_storeu_pd(lp, _mm256_castpd256_pd128(lo));
+        _mm_storeu_pd(lp + 3, _mm256_castpd256_pd128(hi));
+        _mm_storeu_pd(lp + 6, _mm256_extractf128_pd(lo, 1));
+        _mm_storeu_pd(lp + 9, _mm256_extractf128_pd(hi, 1));
+        lp[2] = lp[5] = lp[8] = lp[11] = 0;
+        const __m256d len =
+            _mm256_sqrt_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)));
+        const __m256d eps = _mm256_sub_pd(
+            _mm256_add_pd(_mm256_setr_pd(r[i0], r[i1], r[i2], r[i3]),
+                          _mm256_setr_pd(r[j0], r[j1], r[j2], r[j3])),
+            len);
+        _mm256_storeu_pd(&plen[p], len);
+        _mm256_storeu_pd(&peps[p], eps);
+        int m = _mm256_movemask_pd(_mm256_and_pd(_mm256_cmp_pd(eps, ZERO, _CMP_GE_OQ),
+                                                 _mm256_cmp_pd(len, ZERO, _CMP_GT_OQ)));
+        const __m256d k = kf ? _mm256_mul_pd(EV, _mm256_loadu_pd(&kf[p])) : EV;
+        double t[4];
+        _mm256_storeu_pd(t, _mm256_div_pd(_mm256_mul_pd(k, eps), len));
+        for (; m; m &= m - 1) {
+            const int l = __builtin_ctz((unsigned)m);
+            idx[nc] = (int32_t)(p + (size_t)l);
+            tq[nc++] = t[l];
+        }
+    }
+    const size_t nl = nc;
+    nc += geom_2d_scalar(c, g, x, r, p, pe, idx + nc, per);
+    for (size_t q = nl; q < nc; q++)
+        tq[q] = (kf ? E * kf[idx[q]] : E) * peps[idx[q]] / plen[idx[q]];
+    return nc;
+}
+
+static int geom_lanes4_ok(void)
+{
+    return __builtin_cpu_supports("avx2") && !pk_dem_scalar_only;
+}
+#endif
+
+int pk_dem_lanes_available(void)
+{
+#ifdef HAVE_GEOM_LANES4
+    return geom_lanes4_ok();
+#else
+    return 0;
+#endif
+}
+
+/* Candidates are evaluated in blocks of this many: the geometry of the
+ * block, then the forces of its contacts while l, len, eps are in L1. */
+#define EVAL_BLOCK 512
+
+/* pk_dem_eval for 2D: the same operations as the generic loop with the
+ * vanishing third components dropped (x·0 terms), so the same numbers
+ * (tests/unit/test_homog_newton.c) at a fraction of the cost — this loop is
+ * most of the cost of a DR iteration.  The flags are constants at each call
+ * (eval_2d below, lanes = 1 when the AVX2 geometry is in use), so the
+ * compiler drops the branches of what is not asked.
+ * Two passes per block: the geometry of every candidate (a long dependent
+ * chain per pair: min image, √, overlap), then the forces of the contacts —
+ * short loop bodies keep more pairs in flight; with the lanes the force pass
+ * runs over their contact list (no unpredictable branch, t precomputed). */
+static inline size_t eval_2d_loop(pk_dem_pairs *c, const pk_dem_geom *g, const double *x,
+                                  const double *r, double E, double *f, double *phi_out,
+                                  double S[9], const int per, const int want_phi, const int want_S,
+                                  const int lanes)
+{
+    const double *kf = c->kf;
+    const int32_t *pi = c->i, *pj = c->j;
+    const double *pl = c->l, *plen = c->len, *peps = c->eps;
+    double phi = 0, fi0 = 0, fi1 = 0, S0 = 0, S1 = 0, S3 = 0, S4 = 0;
+    size_t nc = 0, icur = SIZE_MAX;
+    int32_t idx[EVAL_BLOCK];
+    double tq[EVAL_BLOCK];
+    for (size_t p0 = 0; p0 < c->n; p0 += EVAL_BLOCK) {
+        size_t pe = c->n - p0 < EVAL_BLOCK ? c->n : p0 + EVAL_BLOCK, m = pe - p0;
+#ifdef HAVE_GEOM_LANES4
+        if (lanes)
+            nc += m = geom_2d_lanes4(c, g, x, r, E, p0, pe, idx, tq, per);
+        else
+#endif
+            geom_2d_scalar(c, g, x, r, p0, pe, NULL, per);
+        /* the lanes list the contacts; the scalar loop tests every candidate
+         * (cheaper there than the indirection) */
+        for (size_t q = 0; q < m; q++) {
+            size_t p = lanes ? (size_t)idx[q] : p0 + q;
+            if (!lanes) {
+                if (!(peps[p] >= 0) || !(plen[p] > 0))
+                    continue;
+                nc++;
+            }
+            size_t i = (size_t)pi[p], j = (size_t)pj[p];
+            double d0 = pl[3 * p], d1 = pl[3 * p + 1];
+            double t = lanes ? tq[q] : (kf ? E * kf[p] : E) * peps[p] / plen[p]; /* (4.8) */
+            if (want_phi) {
+                double k = kf ? E * kf[p] : E, eps = peps[p]; /* pk_dem_pair_E */
+                phi += 0.5 * k * eps * eps;                   /* (4.3) */
+            }
+            double fa0 = -t * d0, fa1 = -t * d1;
+            if (f) {
+                if (i != icur) {
+                    if (icur != SIZE_MAX)
+                        f[3 * icur] += fi0, f[3 * icur + 1] += fi1;
+                    icur = i, fi0 = fi1 = 0;
+                }
+                fi0 += fa0, fi1 += fa1;
+                f[3 * j] -= fa0, f[3 * j + 1] -= fa1;
+            }
+            if (want_S) {
+                S0 += fa0 * d0, S1 += fa0 * d1;
+                S3 += fa1 * d0, S4 += fa1 * d1;
+            }
         }
     }
     if (f && icur != SIZE_MAX)
@@ -332,11 +488,20 @@ static inline size_t eval_2d_loop(pk_dem_pairs *c, const pk_dem_geom *g, const d
 static size_t eval_2d(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
                       double E, double *f, double *energy, double S[9])
 {
+#ifdef HAVE_GEOM_LANES4
+    if (geom_lanes4_ok()) {
+        if (!g->periodic)
+            return eval_2d_loop(c, g, x, r, E, f, energy, S, 0, 1, S != NULL, 1);
+        if (S || energy)
+            return eval_2d_loop(c, g, x, r, E, f, energy, S, 1, 1, S != NULL, 1);
+        return eval_2d_loop(c, g, x, r, E, f, NULL, NULL, 1, 0, 0, 1); /* the DR iteration */
+    }
+#endif
     if (!g->periodic)
-        return eval_2d_loop(c, g, x, r, E, f, energy, S, 0, 1, S != NULL);
+        return eval_2d_loop(c, g, x, r, E, f, energy, S, 0, 1, S != NULL, 0);
     if (S || energy)
-        return eval_2d_loop(c, g, x, r, E, f, energy, S, 1, 1, S != NULL);
-    return eval_2d_loop(c, g, x, r, E, f, NULL, NULL, 1, 0, 0); /* the DR iteration */
+        return eval_2d_loop(c, g, x, r, E, f, energy, S, 1, 1, S != NULL, 0);
+    return eval_2d_loop(c, g, x, r, E, f, NULL, NULL, 1, 0, 0, 0);
 }
 
 size_t pk_dem_eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,

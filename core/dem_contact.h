@@ -78,6 +78,13 @@ int pk_dem_pairs_stale(const pk_dem_pairs *c, const double *x, int dim);
 size_t pk_dem_eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
                    size_t np, double E, double *f, double *energy, double S[9]);
 
+/* The 2D evaluation takes the geometry of four candidates at once with AVX2
+ * when the CPU has it (bit-identical to the scalar loop); set
+ * pk_dem_scalar_only = 1 to force the scalar loop (tests).  1 when the
+ * lanes are in use. */
+extern int pk_dem_scalar_only;
+int pk_dem_lanes_available(void);
+
 /* The coefficients of a contact's stiffness block (4.12)₁ in the form
  * k_ij·d = a d − b (l·d) l (l = |l| n): a = Eε/|l|, b = ER/|l|³ with
  * R = ε + |l| — two divisions per block. */
