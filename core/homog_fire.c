@@ -55,11 +55,8 @@ int pk_homog_fire_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const
                          pk_dr_stats *st)
 {
     const int dim = g->dim;
-    memset(st, 0, sizeof *st);
-    size_t nfree = 0;
-    for (size_t i = 0; i < np; i++)
-        nfree += is_free[i] != 0;
-    int rc = pk_dem_pairs_build(c, g, x, r, np, prm->skin);
+    size_t nfree;
+    int rc = pk_relax_begin(c, g, x, r, np, is_free, prm, st, &nfree);
     if (rc != 0)
         return rc;
     double *f = malloc(3 * (np ? np : 1) * sizeof *f), *v = calloc(3 * (np ? np : 1), sizeof *v);

@@ -181,6 +181,17 @@ static inline int dr_update(double *x, double *v, const double *f, const uint8_t
     return stale;
 }
 
+int pk_relax_begin(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
+                   size_t np, const uint8_t *is_free, const pk_dr_params *prm, pk_dr_stats *st,
+                   size_t *nfree)
+{
+    memset(st, 0, sizeof *st);
+    *nfree = 0;
+    for (size_t i = 0; i < np; i++)
+        *nfree += is_free[i] != 0;
+    return pk_dem_pairs_build(c, g, x, r, np, prm->skin);
+}
+
 int pk_relax_iteration_end(pk_dr_stats *st, const pk_dr_params *prm, double target, size_t k,
                            double *x, pk_dr_hook *hook, pk_monitor *mon, pk_progress *pr)
 {
@@ -225,11 +236,8 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
                  pk_fric_totals *tot)
 {
     const int dim = g->dim;
-    memset(st, 0, sizeof *st);
-    size_t nfree = 0;
-    for (size_t i = 0; i < np; i++)
-        nfree += is_free[i] != 0;
-    int rc = pk_dem_pairs_build(c, g, x, r, np, prm->skin);
+    size_t nfree;
+    int rc = pk_relax_begin(c, g, x, r, np, is_free, prm, st, &nfree);
     if (rc != 0)
         return rc;
     double *f = malloc(3 * np * sizeof *f), *v = calloc(3 * np, sizeof *v);

@@ -69,6 +69,12 @@ typedef struct pk_dr_hook {
     double at;
 } pk_dr_hook;
 
+/* The start of a relaxation, shared by DR and FIRE: st cleared, the pair
+ * list built at x (returns its rc), *nfree the number of free grains. */
+int pk_relax_begin(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
+                   size_t np, const uint8_t *is_free, const pk_dr_params *prm, pk_dr_stats *st,
+                   size_t *nfree);
+
 /* The end of one relaxation iteration, shared by DR and FIRE (homog_fire.h),
  * with st->f the residual after it: converged at target, the hook (if any),
  * the iteration cap, and every 64th iteration (k & 63 == 63) the monitor.
