@@ -217,6 +217,36 @@ static int batch_hits(const pk_rsa_cells *C, const scratch *w, const uint8_t *ma
 /* Prefetch distance of step 4's marks (accepted grains; -6 % time at 10^6
  * grains, mean of 6 runs — the pick's prefetch above is the large part). */
 #define MARK_AHEAD 4
+/* Prefetch distance of the centres read by region_start's marks (grains):
+ * the centres come in cell order from the store, so each one is a miss in the
+ * particle array; with it and the mark's rows fetched ahead region_start took
+ * ~30 % less time at 10^6 grains, the run 9-11 % less CPU (same marks, same
+ * packing).
+ * Round 4 also measured, and dropped (10^6 grains, 3D φ = 0.30, CPU time,
+ * alternating runs against the kept version):
+ *  - marks in blocks of 2×2×2 cells (a 64-byte line each): a mark's lines
+ *    37 -> 27, its last-level misses -15 %, but +11 % instructions (block
+ *    index arithmetic in the pick, the point and the prefetch): no faster;
+ *  - draws from slots weighted by class (a cell with o open fine voxels gets
+ *    2^ceil(log2 o) slots, classes rebuilt at compaction, draw = the s-th open
+ *    fine voxel): draws per grain 19 -> 8-14, but the rebuilds (two passes,
+ *    new pages) cost more: +25 % CPU;
+ *  - the same draws from 64 slots with a bound of the cell's open count in
+ *    the list entry (the marks' word read only under the bound): -40 % of
+ *    those reads, but +6-15 % CPU (the select and an unpredictable branch);
+ *  - table marks without the outer cells (|d| = 2: 9 rows instead of 25):
+ *    +11 % draws, slower; without words of fewer than 4-12 marked bits:
+ *    +1-4 % draws, no faster;
+ *  - compacting the list 2-8 times as often, the region switch at a batch
+ *    acceptance of 0.12-0.4 instead of 0.2, mark-table steps 4 or 8 at 10^6:
+ *    within the noise or slower;
+ *  - transparent huge pages for the 290 MB (74 000 page faults, 0.14-0.18 s
+ *    of system time): faults -86 %, system time x3-4 on this machine. */
+#define START_AHEAD 16
+/* Prefetch distance of step 4's store records (grains: sorted by cell, but
+ * at 10^6 grains a batch's grains are far apart; -4..-6 % CPU at 10^6 grains,
+ * alternating runs; 16 the same). */
+#define INSERT_AHEAD 8
 
 /* Region draws, step 1a: pick B (cell, fine voxel) pairs, then look their
  * marks up, dropping the certain rejections: for a below the number returned,
@@ -364,29 +394,45 @@ static int region_start(pk_rsa_region *reg, const pk_rsa_cells *C, const pk_box 
         if ((j & 0xfff) == 0xfff && pk_monitor_tick(mon, pg, 0))
             break;
     }
-    /* the run's grains from the store, in cell order: neighbouring marks share
-     * cache lines (in placement order each mark would miss on large runs) */
+    /* the run's grains from the store, in cell order (neighbouring marks share
+     * cache lines; in placement order each mark would miss on large runs),
+     * listed first so that each grain's centre and its mark's rows can be
+     * fetched ahead (START_AHEAD, MARK_AHEAD grains) */
+    size_t k = 0;
+    uint32_t *ids = malloc((out->n - first + 1) * sizeof *ids); /* (+1: never malloc(0)) */
+    if (!ids) {
+        pk_rsa_region_free(reg);
+        return -1;
+    }
     for (int64_t z = 0; z < C->n[2]; z++)
-        for (int64_t y = 0; y < C->n[1] && !(mon && mon->cancelled); y++) {
-            pk_monitor_tick(mon, pg, 0);
+        for (int64_t y = 0; y < C->n[1]; y++) {
             const pk_rsa_cell2 *row =
                 &C->cell[C->base + (uint64_t)z * C->stride[2] + (uint64_t)y * C->stride[1]];
             for (int64_t x = 0; x < C->n[0]; x++) {
-                const pk_rsa_cell2 *cl = &row[x];
-                uint32_t a = cl->id[0], b2 = cl->id[1];
+                uint32_t a = row[x].id[0], b2 = row[x].id[1];
                 if (a == PK_RSA_CELLS_NONE)
                     continue;
-                pk_rsa_region_mark(reg, &out->x[3 * (size_t)a]);
+                ids[k++] = a;
                 if (b2 == PK_RSA_CELLS_NONE)
                     continue;
                 if (!(b2 & PK_RSA_CELLS_MORE))
-                    pk_rsa_region_mark(reg, &out->x[3 * (size_t)b2]);
+                    ids[k++] = b2;
                 else
                     for (int32_t e = (int32_t)(b2 & ~PK_RSA_CELLS_MORE); e >= 0;
                          e = C->extra[e].next)
-                        pk_rsa_region_mark(reg, &out->x[3 * (size_t)C->extra[e].id]);
+                        ids[k++] = C->extra[e].id;
             }
         }
+    for (size_t q = 0; q < k && !(mon && mon->cancelled); q++) {
+        if (q + START_AHEAD < k)
+            __builtin_prefetch(&out->x[3 * (size_t)ids[q + START_AHEAD]]);
+        if (q + MARK_AHEAD < k)
+            pk_rsa_region_prefetch(reg, &out->x[3 * (size_t)ids[q + MARK_AHEAD]]);
+        pk_rsa_region_mark(reg, &out->x[3 * (size_t)ids[q]]);
+        if ((q & 0xfff) == 0xfff)
+            pk_monitor_tick(mon, pg, 0);
+    }
+    free(ids);
     pk_rsa_region_compact(reg);
     return 0;
 }
@@ -551,6 +597,10 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
                 w.kept[ntaken++] = (uint32_t)j; /* (free again after step 2) */
         for (size_t q = 0; q < ntaken; q++) {
             const size_t j = w.kept[q];
+            if (q + INSERT_AHEAD < ntaken) {
+                const uint32_t key = w.vkey[w.kept[q + INSERT_AHEAD]];
+                __builtin_prefetch(&C.cell[pk_rsa_cells_index(key)], 1);
+            }
             map[w.hcell[j] >> 3] = 0; /* the occupancy map is empty again */
             if (pk_rsa_cells_insert(&C, &w.surv[3 * j], w.pid[j]) != 0) {
                 reason = PK_STOP_ERROR;

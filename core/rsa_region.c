@@ -4,9 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Cells a mark reaches on each side (the ball radius c over the cell edge,
- * rounded up, at most this; farther marks are left out, which is safe). */
-#define MAX_REACH 2
+#define MAX_REACH PK_RSA_REGION_MAX_REACH
 #define NOT_MADE 0xff
 
 int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, const double *lo,
@@ -71,8 +69,6 @@ int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, cons
         pk_rsa_region_free(R);
         return -1;
     }
-    for (uint64_t i = 0; i < nc; i++)
-        R->list[i] = (uint32_t)i;
     memset(R->tcnt, NOT_MADE, ne);
     const int D = R->D, W = 2 * D + 1, zr = b->dim == 3;
     for (int dz = 0; dz < (zr ? W : 1); dz++)
@@ -85,6 +81,10 @@ int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, cons
                 R->tdec[3 * q + 2] = (uint8_t)(zr ? dz : D);
             }
     R->nlist = nc;
+    R->nrow = 0; /* the rows of a mark's cells, for pk_rsa_region_prefetch */
+    for (int dz = 0; dz < (zr ? W : 1); dz++)
+        for (int dy = 0; dy < W; dy++)
+            R->roff[R->nrow++] = ((zr ? dz - D : 0) * R->n[1] + dy - D) * R->n[0];
     return 0;
 }
 
@@ -103,10 +103,18 @@ void pk_rsa_region_free(pk_rsa_region *R)
 void pk_rsa_region_compact(pk_rsa_region *R)
 {
     uint64_t k = 0;
-    for (uint64_t i = 0; i < R->nlist; i++) {
-        uint32_t c = R->list[i];
-        R->list[k] = c;
-        k += R->covered[c] != ~(uint64_t)0;
+    if (!R->listed) { /* the first: every cell is a candidate, in index order */
+        for (uint64_t c = 0; c < R->ncell; c++) {
+            R->list[k] = (uint32_t)c;
+            k += R->covered[c] != ~(uint64_t)0;
+        }
+        R->listed = 1;
+    } else {
+        for (uint64_t i = 0; i < R->nlist; i++) {
+            uint32_t c = R->list[i];
+            R->list[k] = c;
+            k += R->covered[c] != ~(uint64_t)0;
+        }
     }
     R->nlist = k;
 }
@@ -304,19 +312,17 @@ static inline int inner_cell(const pk_rsa_region *R, const int64_t *i)
 
 void pk_rsa_region_prefetch(const pk_rsa_region *R, const double *x)
 {
-    const int D = R->D, zr = R->dim == 3;
+    const int D = R->D;
     int64_t i[3] = {0, 0, 0};
     locate(R, x, i); /* (its table entry: fetching it ahead too gained nothing) */
     if (!inner_cell(R, i))
         return; /* rare: the mark wraps or clips; it only costs the misses */
     const uint64_t *c = &R->covered[(uint64_t)(i[2] * R->n[1] + i[1]) * (uint64_t)R->n[0] +
                                     (uint64_t)i[0]];
-    for (int dz = -D * zr; dz <= D * zr; dz++)
-        for (int dy = -D; dy <= D; dy++) { /* both ends of each row of 2D + 1 words */
-            const uint64_t *row = c + (dz * R->n[1] + dy) * R->n[0];
-            __builtin_prefetch(row - D, 1);
-            __builtin_prefetch(row + D, 1);
-        }
+    for (int q = 0; q < R->nrow; q++) { /* both ends of each row of 2D + 1 words */
+        __builtin_prefetch(c + R->roff[q] - D, 1);
+        __builtin_prefetch(c + R->roff[q] + D, 1);
+    }
 }
 
 void pk_rsa_region_mark(pk_rsa_region *R, const double *x)

@@ -26,6 +26,10 @@
 #include "box.h"
 #include "rng.h"
 
+/* Cells a mark reaches on each side at most (its ball radius c over the
+ * cell edge, rounded up; farther marks are left out, which is safe). */
+#define PK_RSA_REGION_MAX_REACH 2
+
 typedef struct pk_rsa_region {
     int dim, S;
     int periodic[PK_MAXDIM];
@@ -50,10 +54,15 @@ typedef struct pk_rsa_region {
     uint8_t *tcnt;              /* [Q^dim]: how many; 0xff = not made yet */
     int64_t *toff;              /* [entry]: index offset of cell number q (off the seams) */
     uint8_t *tdec;              /* [entry][3]: cell number q's steps dx, dy, dz + D */
+    int nrow;                   /* rows of 2D + 1 cells around a cell: (2D + 1)^(dim - 1) */
+    int64_t roff[(2 * PK_RSA_REGION_MAX_REACH + 1) * (2 * PK_RSA_REGION_MAX_REACH + 1)];
+                                /* index offset of each row's middle cell (off the seams) */
     uint64_t ncell;
     uint64_t *covered;          /* [ncell] bit set: fine voxel inside an exclusion ball */
     uint32_t *list;             /* cells that had an open fine voxel at the last compaction */
     uint64_t nlist;
+    int listed;                 /* 0 until the first compaction: then every cell counts as
+                                   listed (nlist = ncell) and list[] is not yet written */
 } pk_rsa_region;
 
 /* Steps of the mark table per axis and cell: with cells of half the store's
@@ -64,7 +73,11 @@ typedef struct pk_rsa_region {
 
 /* For the draw range lo[], span[] cut into n[k] cells per axis (the store's
  * cells), contact distance c, a mark table of `steps` steps per axis (1 to
- * PK_RSA_REGION_MAX_STEPS).  All bits clear, every cell listed.  0 or -1. */
+ * PK_RSA_REGION_MAX_STEPS).  All bits clear, every cell listed — the list is
+ * written by the first pk_rsa_region_compact, which must come before the
+ * first draw (the cells' first marks are usually made before: the list then
+ * never holds the cells they close, and the pages it would have needed are
+ * never touched).  0 or -1. */
 int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, const double *lo,
                        const double *span, double c, int steps);
 void pk_rsa_region_free(pk_rsa_region *R);
@@ -83,7 +96,8 @@ void pk_rsa_region_mark(pk_rsa_region *R, const double *x);
  * marks ahead). */
 void pk_rsa_region_prefetch(const pk_rsa_region *R, const double *x);
 
-/* Drop fully covered cells from the list (cost: the list's length). */
+/* Drop fully covered cells from the list (cost: the list's length); the
+ * first call lists the cells not fully covered. */
 void pk_rsa_region_compact(pk_rsa_region *R);
 
 /* A draw in two parts (needs nlist > 0).  Pick: the top 32 bits of one

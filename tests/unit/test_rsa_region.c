@@ -142,6 +142,71 @@ static void test_marks_are_exact(void)
     }
 }
 
+/* The list of open cells: written by the first compaction (every cell not
+ * fully marked, ascending), thinned by the later ones (the same order), with
+ * no cell lost that has an open fine voxel.  A region never marked lists all
+ * its cells. */
+static int list_is(const pk_rsa_region *R, const uint32_t *prev, uint64_t nprev)
+{
+    uint64_t k = 0;
+    for (uint64_t i = 0; i < nprev; i++) {
+        const uint32_t c = prev ? prev[i] : (uint32_t)i;
+        if (R->covered[c] == ~(uint64_t)0)
+            continue;
+        if (k >= R->nlist || R->list[k] != c)
+            return 0;
+        k++;
+    }
+    return k == R->nlist;
+}
+
+static void test_compaction_lists_open_cells(void)
+{
+    const pk_box boxes[2] = {
+        {.dim = 3, .L = {9.3, 8.1, 8.7}, .periodic = {true, true, true}},
+        {.dim = 2, .L = {12.1, 9.7, 0}, .periodic = {true, false}},
+    };
+    pk_rng g;
+    pk_rng_seed(&g, 11, 3);
+    for (int t = 0; t < 2; t++) {
+        const pk_box *b = &boxes[t];
+        double r = 0.5, gap = 0.03, c = 2 * r + gap, lo[3] = {0, 0, 0}, span[3] = {0, 0, 0};
+        for (int k = 0; k < b->dim; k++) {
+            lo[k] = b->periodic[k] ? 0 : r + 0.5 * gap;
+            span[k] = b->periodic[k] ? b->L[k] : b->L[k] - 2 * lo[k];
+        }
+        int64_t n[3];
+        region_cells(b, c, span, n);
+        pk_rsa_region R;
+        CHECK(pk_rsa_region_init(&R, b, n, lo, span, c, 8) == 0);
+        pk_rsa_region_compact(&R);
+        CHECK_MSG(R.nlist == R.ncell && list_is(&R, NULL, R.ncell), "dim %d: unmarked", b->dim);
+        pk_rsa_region_free(&R);
+
+        CHECK(pk_rsa_region_init(&R, b, n, lo, span, c, 8) == 0);
+        for (int round = 0; round < 3; round++) {
+            /* a few marks, and one wide cover that closes whole cells */
+            for (int i = 0; i < 12; i++) {
+                double x[3] = {0, 0, 0};
+                for (int k = 0; k < b->dim; k++)
+                    x[k] = lo[k] + span[k] * pk_rng_uniform(&g);
+                pk_rsa_region_mark(&R, x);
+                if (i == 0)
+                    pk_rsa_region_cover(&R, x, 2.5 * c);
+            }
+            uint64_t nprev = round ? R.nlist : R.ncell;
+            uint32_t *prev = round ? malloc(nprev * sizeof *prev) : NULL;
+            if (prev)
+                memcpy(prev, R.list, nprev * sizeof *prev);
+            pk_rsa_region_compact(&R);
+            CHECK_MSG(list_is(&R, prev, nprev), "dim %d, compaction %d", b->dim, round);
+            CHECK_MSG(R.nlist < nprev, "dim %d, compaction %d: nothing closed", b->dim, round);
+            free(prev);
+        }
+        pk_rsa_region_free(&R);
+    }
+}
+
 /* A frozen packing (plain RSA) and its region with every grain marked. */
 typedef struct frozen {
     pk_box box;
@@ -486,6 +551,7 @@ static void test_region_runs_exact_and_reproducible(void)
 int main(void)
 {
     RUN(test_marks_are_exact);
+    RUN(test_compaction_lists_open_cells);
     RUN(test_draws_uniform_over_open_space);
     RUN(test_runs_match_plain);
     RUN(test_region_runs_exact_and_reproducible);
