@@ -15,7 +15,9 @@
  * Hybrid: after such an exit DR takes the step from its start point, as if
  * Newton had not been asked, and at residuals 1e-3·|f⁰|, 3e-4·|f⁰|, …
  * Newton tries to finish the slow tail near the new minimum from a copy of
- * DR's point (a failed attempt leaves DR untouched).  After two failed
+ * DR's point (a failed attempt leaves DR untouched), and also when DR creeps
+ * (1,000 iterations after a failed attempt without reaching the next
+ * threshold nor rising: pk_dr_hook.crawl).  After two failed
  * attempts FIRE (homog_fire.h) relaxes on from DR's point — the slow tail,
  * where DR spends most of its iterations — with the further attempts from
  * FIRE's points (without a successful one the result is FIRE's, at the same

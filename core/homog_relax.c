@@ -199,7 +199,13 @@ int pk_relax_iteration_end(pk_dr_stats *st, const pk_dr_params *prm, double targ
         st->stop = st->f <= prm->tol * st->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
         return 1;
     }
-    if (hook && st->f <= hook->at) {
+    if (hook)
+        hook->f_peak = fmax(hook->f_peak, st->f);
+    if (hook && (st->f <= hook->at ||
+                 (hook->crawl && hook->last && st->iterations >= hook->last + hook->crawl &&
+                  hook->f_peak <= hook->f_last))) {
+        hook->last = st->iterations; /* >= 1 */
+        hook->f_last = hook->f_peak = st->f;
         double fh = st->f;
         int h = hook->fn(hook->ctx, x, &fh, &hook->at);
         if (h < 0)

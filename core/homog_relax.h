@@ -67,6 +67,15 @@ typedef struct pk_dr_hook {
     int (*fn)(void *ctx, double *x, double *fres, double *at);
     void *ctx;
     double at;
+    /* crawl > 0: after a first call the hook is also called when `crawl`
+     * iterations have passed since the last call with |f| neither reaching
+     * `at` nor rising above its value at that call — the relaxation creeps
+     * (no rearrangement under way, no progress either).  0: never. */
+    size_t crawl;
+    /* the relaxation's book-keeping (zero at the start) */
+    size_t last;   /* iteration of the last call (counted from 1; 0: not called yet) */
+    double f_last; /* |f| at the last call */
+    double f_peak; /* the largest |f| since */
 } pk_dr_hook;
 
 /* The start of a relaxation, shared by DR and FIRE: st cleared, the pair

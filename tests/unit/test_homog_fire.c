@@ -145,7 +145,7 @@ static void test_hook_and_cap(void)
     CHECK(pk_homog_fire_hooked(&pb.c, &pb.g, xa, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, &fp,
                                NULL, NULL, &sa) == 0);
     spy s0 = {0, 0, 0};
-    pk_dr_hook h0 = {spy_fn, &s0, 1e-2 * sa.f0};
+    pk_dr_hook h0 = {.fn = spy_fn, .ctx = &s0, .at = 1e-2 * sa.f0};
     CHECK(pk_homog_fire_hooked(&pb.c, &pb.g, xb, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, &fp,
                                &h0, NULL, &sb) == 0);
     CHECK(s0.calls >= 3 && s0.late == 0); /* thresholds 1e-2, 1e-3, 1e-4 … all passed */
@@ -154,7 +154,7 @@ static void test_hook_and_cap(void)
     /* 1: solved by the hook at the first threshold */
     memcpy(xb, pb.x0, 3 * n * sizeof *xb);
     spy s1 = {1, 0, 0};
-    pk_dr_hook h1 = {spy_fn, &s1, 1e-2 * sa.f0};
+    pk_dr_hook h1 = {.fn = spy_fn, .ctx = &s1, .at = 1e-2 * sa.f0};
     CHECK(pk_homog_fire_hooked(&pb.c, &pb.g, xb, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, &fp,
                                &h1, NULL, &sb) == 0);
     CHECK(s1.calls == 1 && sb.f <= 1e-2 * sa.f0 && sb.iterations < sa.iterations);
@@ -163,7 +163,7 @@ static void test_hook_and_cap(void)
     /* 2: DR hands over at the first threshold */
     memcpy(xb, pb.x0, 3 * n * sizeof *xb);
     spy s2 = {2, 0, 0};
-    pk_dr_hook h2 = {spy_fn, &s2, 1e-2 * sa.f0};
+    pk_dr_hook h2 = {.fn = spy_fn, .ctx = &s2, .at = 1e-2 * sa.f0};
     CHECK(pk_homog_relax_hooked(&pb.c, &pb.g, xb, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, &h2,
                                 NULL, &sb) == 0);
     CHECK_MSG(sb.stop == PK_DR_HANDED_OVER, "%s", pk_dr_stop_name(sb.stop));
