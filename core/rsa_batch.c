@@ -241,7 +241,23 @@ static int batch_hits(const pk_rsa_cells *C, const scratch *w, const uint8_t *ma
  *    acceptance of 0.12-0.4 instead of 0.2, mark-table steps 4 or 8 at 10^6:
  *    within the noise or slower;
  *  - transparent huge pages for the 290 MB (74 000 page faults, 0.14-0.18 s
- *    of system time): faults -86 %, system time x3-4 on this machine. */
+ *    of system time): faults -86 %, system time x3-4 on this machine.
+ * Round 5 (the memory a 10^6 run touches: 70 000 pages — marks 111 MB,
+ * store 58 MB, list 39 MB, particles 36 MB, scratch ~30 MB) measured, and
+ * dropped:
+ *  - region draws picked through a ring of 2 x 4096 entries a chunk ahead of
+ *    their look-ups, keeping only the draws not rejected at once (9.4 MB of
+ *    pick arrays -> 1.5 MB, -3 350 faults, same packings): wall and CPU time
+ *    unchanged within the noise (4 alternating pairs) — not worth its code;
+ *  - the list as a bitmap with ranks and samples (3.5 MB instead of 39 MB,
+ *    -8 000 faults, same packings): the select costs ~65 instructions a draw
+ *    and a chain of dependent misses: CPU x1.7-2;
+ *  - no list until the first compaction (draws from all cells; -17 MB,
+ *    -4 700 faults): draws per grain 19.0 -> 23.3, CPU within the noise;
+ *  - region cells of the store's edge (REGION_SPLIT 1: -100 MB, -20 000
+ *    faults, -0.06 s system): draws per grain 34.7, CPU +15-20 %;
+ *  - the marks' block pre-faulted (mmap MAP_POPULATE): the same faults and
+ *    system time — the kernel's cost is per page, not per trap. */
 #define START_AHEAD 16
 /* Prefetch distance of step 4's store records (grains: sorted by cell, but
  * at 10^6 grains a batch's grains are far apart; -4..-6 % CPU at 10^6 grains,
