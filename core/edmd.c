@@ -25,7 +25,8 @@
  * diffuse away from their start order and each prediction then misses the
  * cache once per neighbour (N = 10^6 from zero radii to φ = 0.55: 460 →
  * 339 s CPU, peak memory 395 → 522 MB; lists and events are rebuilt there,
- * as at the start). */
+ * as at the start; from 4096 grains instead: mono 3D N = 10^4 to jamming
+ * 1.17e6 → 1.11e6 collisions per CPU second with edmd_prefetch_list). */
 #define RESORT_MIN_N 32768
 #define RESORT_WINDOWS 10
 
@@ -454,6 +455,10 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
                 }
                 edmd_queue_update(s, i);
             } else {
+                /* both predictions below read the neighbours' records:
+                 * start all those loads now (edmd_prefetch_list) */
+                edmd_prefetch_list(s, i);
+                edmd_prefetch_list(s, j);
                 s->virial += edmd_collide_pair(s, i, j);
                 s->ncoll[i]++;
                 s->ncoll[j]++;

@@ -173,6 +173,9 @@ static inline void edmd_sync(edmd_state *s, size_t i)
 
 /* edmd_predict.c */
 void edmd_predict(edmd_state *s, size_t i);            /* refresh i's event and heap slot */
+/* Start loading the records of i's neighbours (before a collision: both
+ * grains' predictions then find them in cache). */
+void edmd_prefetch_list(const edmd_state *s, size_t i);
 /* Test hook: 1 = the neighbour loop runs scalar even where AVX2 lanes are
  * available (the lanes must give bit-identical events). */
 extern int edmd_scalar_only;
