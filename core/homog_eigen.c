@@ -121,19 +121,3 @@ double pk_homog_lanczos_min(const pk_dem_pairs *c, int dim, size_t np, double E,
     free(q), free(qp), free(w), free(al), free(be);
     return lmin;
 }
-
-void pk_increment_rq_add(pk_increment_rq *q, const double d[3], double dt)
-{
-    if (q->pend_dt > 0) {
-        q->num -= q->pend_dt * (d[0] - q->pend_vf);
-        q->den += q->pend_dt * q->pend_dt * q->pend_vv;
-    }
-    q->pend_vf = d[1], q->pend_vv = d[2], q->pend_dt = dt;
-}
-
-double pk_increment_rq_take(pk_increment_rq *q)
-{
-    double lam = q->den > 0 ? q->num / q->den : 0;
-    q->num = q->den = 0;
-    return lam;
-}

@@ -41,25 +41,16 @@
  * (ATTEMPT_RISES) denser attempts pay: near-jamming 10⁴ bench RVE, step 0.3 /
  * 0.4 / 0.5 / 0.6 / 0.7: 6,073 / 4,711 / 4,066 / 3,786 / 3,587 DR+FIRE
  * iterations, 11 / 13 / 7 / 7 / 9 factorisations; every value from 0.3 to
- * 0.7 ends in DR's minimum on it and on test_homog_newton's cases.  Since
- * DR's λ_min takes the Rayleigh quotient of its increments (homog_relax.c)
- * DR reaches 1e-3 sooner, still amid the rearrangement: the first attempt
- * from there needed 6 factorisations on the dense 10⁴ RVE (3 before); from
- * 3e-4 the dense RVE and near-jamming seeds 5, 6 take 3 / 4 / 17
- * factorisations instead of 6 / 10 / 24 (seed 7: 5 instead of 6 but 4,000
- * more DR iterations; 1e-4: no better); 24 plastic cases of 200/400 grains
- * all end in DR's minimum with either value. */
-#define HANDOVER 3e-4
+ * 0.7 ends in DR's minimum on it and on test_homog_newton's cases. */
+#define HANDOVER 1e-3
 #define HANDOVER_STEP 0.5
 /* DR iterations after a failed attempt in which the residual neither
  * reached the next threshold nor rose above the attempt's (pk_dr_hook.crawl)
  * after which the next attempt is made anyway: DR creeps along a mode far
- * softer than its λ_min estimate.  Measured while λ_min came from Lanczos
- * and the residual only (40 steps: 4e-3, where the block's λ_min is ~1e-5 at
- * 10⁴ grains near jamming): 8,750 iterations from 1.05e-4 to 5.3e-5 on one
- * RVE; the attempt fails there too, so FIRE (FIRE_AFTER) takes the creep
- * over.  The increments' quotient (homog_relax.c) now catches most such
- * modes; the rule stays as the guard.  Between DR's attempts the residual
+ * softer than its λ_min estimate (Lanczos, 40 steps: 4e-3, where the block's
+ * λ_min is ~1e-5 at 10⁴ grains near jamming) — measured 8,750 iterations
+ * from 1.05e-4 to 5.3e-5 on one RVE; the attempt fails there too, so FIRE
+ * (FIRE_AFTER) takes the creep over.  Between DR's attempts the residual
  * halves within 200–550 iterations on the other bench RVEs and never creeps
  * 1,000 iterations in test_homog_newton's cases (500 changes one 10⁴ path). */
 #define CRAWL 1000
@@ -70,7 +61,7 @@
  * point leaves DR's path while the rearrangement still goes on (even where
  * the block is positive definite there: the 400-grain case).  After 2, every
  * case measured ends in DR's minimum (FIRE then starts at HANDOVER ×
- * HANDOVER_STEP·|f⁰| at the earliest). */
+ * HANDOVER_STEP = 5e-4·|f⁰| at the earliest). */
 #define FIRE_AFTER 2
 /* Quasi-Newton steps per factorisation: at most, and the window within which
  * the residual must halve before the preconditioner is refreshed. */

@@ -110,18 +110,12 @@ static double fric_rayleigh(const relax_sys *s, double *x, double *u, const doub
 /* Fresh estimates on the jammed free grains (rattlers re-detected):
  * λ_max by Gershgorin, λ_min by Lanczos, lowered further by the Rayleigh
  * quotient of the current residual f (dominated by the slow modes late in a
- * relaxation) and by `moved`, the Rayleigh quotient of DR's own increments
- * since the last estimate (pk_increment_rq, homog_eigen.h: the slow mode DR
- * actually moves along).  All three are Rayleigh quotients — upper bounds of
- * λ_min on a positive block — so the smallest positive one is taken (of
- * `moved` its magnitude, see below).  A non-positive λ_min (indefinite block
- * under large overlaps, or no jammed grain) falls back to the residual's
- * Rayleigh quotient on the free grains and the increments', and only then
- * to a tiny share of λ_max (flagged). */
+ * relaxation).  A non-positive λ_min (indefinite block under large overlaps,
+ * or no jammed grain) falls back to the residual's Rayleigh quotient on the
+ * free grains, and only then to a tiny share of λ_max (flagged). */
 static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *is_free,
                     const double *f, uint8_t *rat, uint8_t *mask, double *work, int lanczos,
-                    pk_dr_stats *st, const relax_sys *sys, double *x, double *u, const double *gu,
-                    double moved)
+                    pk_dr_stats *st, const relax_sys *sys, double *x, double *u, const double *gu)
 {
     size_t nr = pk_dem_rattlers(c, dim, np, is_free, rat);
     if (nr == (size_t)-1)
@@ -142,14 +136,6 @@ static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t
     double rq = pk_homog_rayleigh(c, dim, np, E, m, f, work);
     if (rq > 0 && (rq < lmin || !(lmin > 0)))
         lmin = rq;
-    /* a negative `moved`: DR slides off a saddle along a mode of curvature
-     * −|moved|; damped for |moved| it leaves at that mode's own rate, where a
-     * λ_min from the stiff rest (e.g. the residual's 1e-3) overdamps it
-     * (10⁴ near-jamming RVE, DR alone: 127,000 → 43,000 iterations, same
-     * minimum) */
-    double mq = fabs(moved);
-    if (mq > 0 && (mq < lmin || !(lmin > 0)))
-        lmin = mq;
     if (sys->fric_active) {
         st->lambda_max += pk_dem_fric_gershgorin(c, sys->fc, np);
         double fq = fric_rayleigh(sys, x, u, f, gu, work);
@@ -169,37 +155,29 @@ static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t
  * grains, with cv = (2 − γΔt)/(2 + γΔt), cf = 2Δt/(2 + γΔt) — or cv = 0,
  * cf = Δt/2 on the first step (4.41).  Returns pk_dem_pairs_stale(c, x) in
  * the same pass (held grains do not move within a relaxation).  dim a
- * constant (2 or 3) at the call: the axis loops unrolled.  In the same pass
- * the dot products of pk_increment_rq_add: d[0] = v_old·f, d[1] = v_new·f,
- * d[2] = v_new·v_new (f the force before the move). */
+ * constant (2 or 3) at the call: the axis loops unrolled. */
 typedef struct dr_coef {
     double dt, cv, cf;
 } dr_coef;
 
 static inline int dr_update(double *x, double *v, const double *f, const uint8_t *is_free,
-                            size_t np, const int dim, dr_coef cf, const pk_dem_pairs *c,
-                            double d[3])
+                            size_t np, const int dim, dr_coef cf, const pk_dem_pairs *c)
 {
     const double lim2 = 0.25 * c->skin * c->skin;
     int stale = 0;
-    double vof = 0, vnf = 0, vnvn = 0;
     for (size_t i = 0; i < np; i++) {
         if (!is_free[i])
             continue;
         double s = 0;
         for (int a = 0; a < dim; a++) {
-            double *vi = &v[3 * i + a], fa = f[3 * i + a];
-            vof += *vi * fa;
-            *vi = cf.cv * *vi + cf.cf * fa;
-            vnf += *vi * fa;
-            vnvn += *vi * *vi;
+            double *vi = &v[3 * i + a];
+            *vi = cf.cv * *vi + cf.cf * f[3 * i + a];
             x[3 * i + a] += cf.dt * *vi;
-            double dx = x[3 * i + a] - c->xb[3 * i + a];
-            s += dx * dx;
+            double d = x[3 * i + a] - c->xb[3 * i + a];
+            s += d * d;
         }
         stale |= s > lim2;
     }
-    d[0] = vof, d[1] = vnf, d[2] = vnvn;
     return stale;
 }
 
@@ -287,22 +265,18 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
         st->stop = PK_DR_CONVERGED_ABS;
         goto out;
     }
-    if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu,
-                 0) != 0) {
+    if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu) != 0) {
         rc = -1;
         goto out;
     }
-    pk_increment_rq moved = {0};
     pk_progress pr = {.stage = "relax", .fraction = -1, .phi = -1, .eta_s = -1};
     double fbest = st->f0;
     for (size_t k = 0;; k++) {
         double dt = st->dt, gm = st->gamma;
         dr_coef cf = {dt, k == 0 ? 0 : (2 - gm * dt) / (2 + gm * dt),
                       k == 0 ? 0.5 * dt : 2 * dt / (2 + gm * dt)};
-        double d[3];
-        int stale = dim == 2 ? dr_update(x, v, f, is_free, np, 2, cf, c, d)
-                             : dr_update(x, v, f, is_free, np, dim, cf, c, d);
-        pk_increment_rq_add(&moved, d, dt);
+        int stale = dim == 2 ? dr_update(x, v, f, is_free, np, 2, cf, c)
+                             : dr_update(x, v, f, is_free, np, dim, cf, c);
         if (sys.fric_active) /* the rotations, same scheme (unit pseudo-mass of u = rθ) */
             for (size_t i = 0; i < np; i++) {
                 vu[i] = cf.cv * vu[i] + cf.cf * gu[i];
@@ -328,12 +302,8 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
         if (e)
             break;
         if (!isfinite(st->f) || st->f > 1e3 * fbest) {
-            /* diverging: the spectrum moved (new contacts) — fresh estimates, restart at rest
-             * (the increments' quotient of the diverging window discarded) */
-            pk_increment_rq_take(&moved);
-            moved.pend_dt = 0; /* the move before the restart has no force after it */
-            if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu,
-                         0) != 0) {
+            /* diverging: the spectrum moved (new contacts) — fresh estimates, restart at rest */
+            if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu) != 0) {
                 rc = -1;
                 goto out;
             }
@@ -345,10 +315,7 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
         }
         fbest = fmin(fbest, st->f);
         if (prm->refresh && st->iterations % prm->refresh == 0) {
-            /* the increments' quotient leaves out the rotations: frictionless only */
-            double lm = pk_increment_rq_take(&moved);
-            if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu,
-                         sys.fric_active ? 0 : lm) != 0) {
+            if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu) != 0) {
                 rc = -1;
                 goto out;
             }

@@ -4,9 +4,8 @@
  * (4.47).  Convergence: |f| <= max(tol·|f⁰|, abs_floor) (4.42 with an
  * absolute floor, spec H5), capped at max_iter.  The eigenvalue estimates are
  * taken at the start (Gershgorin + Lanczos, homog_eigen.h) and refreshed
- * every `refresh` iterations (Gershgorin again; for λ_min also the Rayleigh
- * quotients of the residual and of DR's increments since the last refresh —
- * adaptive DR, homog_eigen.h; rattlers re-detected) — spec H4. */
+ * every `refresh` iterations (Gershgorin again, Rayleigh quotient of the
+ * residual for λ_min; rattlers re-detected) — spec H4. */
 #ifndef PK_HOMOG_RELAX_H
 #define PK_HOMOG_RELAX_H
 
