@@ -112,7 +112,16 @@ static double fric_rayleigh(const relax_sys *s, double *x, double *u, const doub
  * quotient of the current residual f (dominated by the slow modes late in a
  * relaxation).  A non-positive λ_min (indefinite block under large overlaps,
  * or no jammed grain) falls back to the residual's Rayleigh quotient on the
- * free grains, and only then to a tiny share of λ_max (flagged). */
+ * free grains, and only then to a tiny share of λ_max (flagged).
+ * Measured and reverted (2026-11-22): λ_min also from the Rayleigh quotient
+ * of DR's own increments, Σ −Δx·Δf / Σ Δx·Δx over the 200 steps between
+ * estimates (adaptive DR, Underwood/Papadrakakis), its magnitude when
+ * negative.  DR alone on cached 10⁴ near-jamming RVEs: 5–17x fewer
+ * iterations, same minima.  But the Newton hybrid (with its hand-over at
+ * 3e-4 instead of 1e-3) on the whole bench pipeline — whose RVEs are relaxed
+ * at F̄ = 1 by the same DR — was slower on 4 of 5 seeds (near-jamming 10⁴,
+ * seeds 5–9: 1.5/5.4/2.6/2.9/0.9 s → 4.8/6.9/3.6/2.4/1.0 s CPU).  A lead for
+ * `solver: dr` jobs, where it is a clear gain. */
 static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *is_free,
                     const double *f, uint8_t *rat, uint8_t *mask, double *work, int lanczos,
                     pk_dr_stats *st, const relax_sys *sys, double *x, double *u, const double *gu)
