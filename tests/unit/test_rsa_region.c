@@ -29,6 +29,19 @@ static void region_cells(const pk_box *b, double c, const double *span, int64_t 
     }
 }
 
+/* The draw range of grains of radius r with gap `gap` (walls: centres at
+ * r + gap/2 from them, as the placer draws) and its region cells. */
+static void draw_range(const pk_box *b, double r, double gap, double *lo, double *span, int64_t *n)
+{
+    for (int k = 0; k < 3; k++)
+        lo[k] = span[k] = 0;
+    for (int k = 0; k < b->dim; k++) {
+        lo[k] = b->periodic[k] ? 0 : r + 0.5 * gap;
+        span[k] = b->periodic[k] ? b->L[k] : b->L[k] - 2 * lo[k];
+    }
+    region_cells(b, 2 * r + gap, span, n);
+}
+
 /* Is fine voxel j (per axis) inside the ball (x, rad), the voxel taken at
  * the image of x nearest to its centre?  All 2^dim corners within rad. */
 static int voxel_in_ball(const pk_box *b, const pk_rsa_region *R, const int64_t *j,
@@ -93,13 +106,9 @@ static void test_marks_are_exact(void)
     pk_rng_seed(&g, 5, 9);
     for (int t = 0; t < 3; t++) {
         const pk_box *b = &boxes[t];
-        double r = 0.5, gap = 0.07, c = 2 * r + gap, lo[3] = {0, 0, 0}, span[3] = {0, 0, 0};
-        for (int k = 0; k < b->dim; k++) {
-            lo[k] = b->periodic[k] ? 0 : r + 0.5 * gap;
-            span[k] = b->periodic[k] ? b->L[k] : b->L[k] - 2 * lo[k];
-        }
+        double r = 0.5, gap = 0.07, c = 2 * r + gap, lo[3], span[3];
         int64_t n[3];
-        region_cells(b, c, span, n);
+        draw_range(b, r, gap, lo, span, n);
         pk_rsa_region table, direct;
         /* table steps: the fewest and the most the runs use, and an odd count */
         const int steps = t == 1 ? PK_RSA_REGION_MAX_STEPS : (t == 0 ? 6 : 7);
@@ -170,13 +179,9 @@ static void test_compaction_lists_open_cells(void)
     pk_rng_seed(&g, 11, 3);
     for (int t = 0; t < 2; t++) {
         const pk_box *b = &boxes[t];
-        double r = 0.5, gap = 0.03, c = 2 * r + gap, lo[3] = {0, 0, 0}, span[3] = {0, 0, 0};
-        for (int k = 0; k < b->dim; k++) {
-            lo[k] = b->periodic[k] ? 0 : r + 0.5 * gap;
-            span[k] = b->periodic[k] ? b->L[k] : b->L[k] - 2 * lo[k];
-        }
+        double r = 0.5, gap = 0.03, c = 2 * r + gap, lo[3], span[3];
         int64_t n[3];
-        region_cells(b, c, span, n);
+        draw_range(b, r, gap, lo, span, n);
         pk_rsa_region R;
         CHECK(pk_rsa_region_init(&R, b, n, lo, span, c, 8) == 0);
         pk_rsa_region_compact(&R);
