@@ -30,23 +30,8 @@ static int fire_move(double *x, double *v, const double *f, double fn, const uin
                 v[3 * i + a] += dt * f[3 * i + a];
                 vv += v[3 * i + a] * v[3 * i + a];
             }
-    double cv = 1 - alpha, cf = fn > 0 ? alpha * sqrt(vv) / fn : 0;
-    const double lim2 = 0.25 * c->skin * c->skin;
-    int stale = 0;
-    for (size_t i = 0; i < np; i++) {
-        if (!is_free[i])
-            continue;
-        double s = 0;
-        for (int a = 0; a < dim; a++) {
-            double *vi = &v[3 * i + a];
-            *vi = cv * *vi + cf * f[3 * i + a];
-            x[3 * i + a] += dt * *vi;
-            double d = x[3 * i + a] - c->xb[3 * i + a];
-            s += d * d;
-        }
-        stale |= s > lim2;
-    }
-    return stale;
+    pk_relax_coef cf = {dt, 1 - alpha, fn > 0 ? alpha * sqrt(vv) / fn : 0};
+    return pk_relax_move(x, v, f, is_free, np, dim, cf, c);
 }
 
 int pk_homog_fire_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,

@@ -160,17 +160,12 @@ static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t
     return 0;
 }
 
-/* One step of (4.39)–(4.41): v ← cv·v + cf·f, x ← x + Δt·v on the free
- * grains, with cv = (2 − γΔt)/(2 + γΔt), cf = 2Δt/(2 + γΔt) — or cv = 0,
- * cf = Δt/2 on the first step (4.41).  Returns pk_dem_pairs_stale(c, x) in
- * the same pass (held grains do not move within a relaxation).  dim a
- * constant (2 or 3) at the call: the axis loops unrolled. */
-typedef struct dr_coef {
-    double dt, cv, cf;
-} dr_coef;
-
-static inline int dr_update(double *x, double *v, const double *f, const uint8_t *is_free,
-                            size_t np, const int dim, dr_coef cf, const pk_dem_pairs *c)
+/* v ← cv·v + cf·f, x ← x + Δt·v on the free grains; stale = some grain
+ * moved beyond half the skin since the pair list was built (held grains do
+ * not move within a relaxation).  dim a constant (2 or 3) at the call: the
+ * axis loops unrolled. */
+static inline int move(double *x, double *v, const double *f, const uint8_t *is_free, size_t np,
+                       const int dim, pk_relax_coef cf, const pk_dem_pairs *c)
 {
     const double lim2 = 0.25 * c->skin * c->skin;
     int stale = 0;
@@ -188,6 +183,12 @@ static inline int dr_update(double *x, double *v, const double *f, const uint8_t
         stale |= s > lim2;
     }
     return stale;
+}
+
+int pk_relax_move(double *x, double *v, const double *f, const uint8_t *is_free, size_t np,
+                  int dim, pk_relax_coef cf, const pk_dem_pairs *c)
+{
+    return dim == 2 ? move(x, v, f, is_free, np, 2, cf, c) : move(x, v, f, is_free, np, dim, cf, c);
 }
 
 int pk_relax_begin(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
@@ -282,10 +283,11 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
     double fbest = st->f0;
     for (size_t k = 0;; k++) {
         double dt = st->dt, gm = st->gamma;
-        dr_coef cf = {dt, k == 0 ? 0 : (2 - gm * dt) / (2 + gm * dt),
-                      k == 0 ? 0.5 * dt : 2 * dt / (2 + gm * dt)};
-        int stale = dim == 2 ? dr_update(x, v, f, is_free, np, 2, cf, c)
-                             : dr_update(x, v, f, is_free, np, dim, cf, c);
+        /* one step of (4.39)–(4.41): cv = (2 − γΔt)/(2 + γΔt), cf = 2Δt/(2 + γΔt),
+         * or cv = 0, cf = Δt/2 on the first step (4.41) */
+        pk_relax_coef cf = {dt, k == 0 ? 0 : (2 - gm * dt) / (2 + gm * dt),
+                            k == 0 ? 0.5 * dt : 2 * dt / (2 + gm * dt)};
+        int stale = pk_relax_move(x, v, f, is_free, np, dim, cf, c);
         if (sys.fric_active) /* the rotations, same scheme (unit pseudo-mass of u = rθ) */
             for (size_t i = 0; i < np; i++) {
                 vu[i] = cf.cv * vu[i] + cf.cf * gu[i];

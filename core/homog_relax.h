@@ -84,6 +84,16 @@ int pk_relax_begin(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const
                    size_t np, const uint8_t *is_free, const pk_dr_params *prm, pk_dr_stats *st,
                    size_t *nfree);
 
+/* The move of one relaxation iteration, shared by DR (4.39)–(4.41) and
+ * FIRE's mixing step: v ← cv·v + cf·f, x ← x + Δt·v on the free grains.
+ * Returns 1 when a grain moved beyond half the pair list's skin since it was
+ * built (the list must be rebuilt), else 0. */
+typedef struct pk_relax_coef {
+    double dt, cv, cf;
+} pk_relax_coef;
+int pk_relax_move(double *x, double *v, const double *f, const uint8_t *is_free, size_t np,
+                  int dim, pk_relax_coef cf, const pk_dem_pairs *c);
+
 /* The end of one relaxation iteration, shared by DR and FIRE (homog_fire.h),
  * with st->f the residual after it: converged at target, the hook (if any),
  * the iteration cap, and every 64th iteration (k & 63 == 63) the monitor.
