@@ -51,15 +51,9 @@ int pk_homog_fire_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const
     }
     pk_dem_eval(c, g, x, r, np, E, f, NULL, NULL);
     st->f0 = st->f = sqrt(pk_homog_dot_mask(f, f, is_free, np, dim));
-    if (nfree == 0) {
-        st->stop = PK_DR_NOT_NEEDED;
+    double target;
+    if (pk_relax_settled(st, prm, nfree == 0, &target))
         goto out;
-    }
-    double target = fmax(prm->tol * st->f0, prm->abs_floor);
-    if (st->f0 <= prm->abs_floor) {
-        st->stop = PK_DR_CONVERGED_ABS;
-        goto out;
-    }
     double lmax = pk_dem_gershgorin(c, dim, np, E, is_free);
     st->lambda_max = lmax > 0 ? lmax : E; /* no contact: any scale will do */
     const double dt_max = fp->dt_scale * 2 / sqrt(st->lambda_max);

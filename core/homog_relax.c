@@ -246,6 +246,18 @@ int pk_relax_iteration_end(pk_dr_stats *st, const pk_dr_params *prm, double targ
     return 0;
 }
 
+int pk_relax_settled(pk_dr_stats *st, const pk_dr_params *prm, int nothing_moves, double *target)
+{
+    *target = fmax(prm->tol * st->f0, prm->abs_floor);
+    if (nothing_moves)
+        st->stop = PK_DR_NOT_NEEDED;
+    else if (st->f0 <= prm->abs_floor)
+        st->stop = PK_DR_CONVERGED_ABS;
+    else
+        return 0;
+    return 1;
+}
+
 static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
                  double E, const uint8_t *is_free, const pk_dr_params *prm, pk_fric_ctx *fc,
                  double *u, pk_dr_hook *hook, pk_monitor *mon, pk_dr_stats *st,
@@ -266,15 +278,9 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
         goto out;
     }
     st->f0 = st->f = resid_norm(&sys, f, gu);
-    if (nfree == 0 && !sys.fric_active) {
-        st->stop = PK_DR_NOT_NEEDED;
+    double target;
+    if (pk_relax_settled(st, prm, nfree == 0 && !sys.fric_active, &target))
         goto out;
-    }
-    double target = fmax(prm->tol * st->f0, prm->abs_floor);
-    if (st->f0 <= prm->abs_floor) {
-        st->stop = PK_DR_CONVERGED_ABS;
-        goto out;
-    }
     if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu) != 0) {
         rc = -1;
         goto out;

@@ -84,6 +84,12 @@ int pk_relax_begin(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const
                    size_t np, const uint8_t *is_free, const pk_dr_params *prm, pk_dr_stats *st,
                    size_t *nfree);
 
+/* After the first residual st->f0, shared by DR and FIRE: *target = the
+ * residual to reach (tol·|f⁰|, at least abs_floor); returns 1 with st->stop
+ * set when there is nothing to do (nothing_moves: PK_DR_NOT_NEEDED; |f⁰| at
+ * most abs_floor: PK_DR_CONVERGED_ABS), else 0. */
+int pk_relax_settled(pk_dr_stats *st, const pk_dr_params *prm, int nothing_moves, double *target);
+
 /* The move of one relaxation iteration, shared by DR (4.39)–(4.41) and
  * FIRE's mixing step: v ← cv·v + cf·f, x ← x + Δt·v on the free grains.
  * Returns 1 when a grain moved beyond half the pair list's skin since it was
