@@ -14,6 +14,9 @@
  * Four times larger caps on both cut the cache misses at 10^6 grains by 18 %
  * for 14 % more instructions (cachegrind): kept as they are. */
 #define B_MIN 4096
+/* Prefetch distance of the region draws' mark look-up (draws; the draw
+ * arrays have this much slack: no bound tests in the look-up loop). */
+#define PICK_AHEAD 64
 #define B_MAX ((size_t)1 << 20)
 #define SURVIVORS 32768.0
 /* Counting sort of attempts by cell: at most this many buckets (contiguous
@@ -128,7 +131,7 @@ static int scratch_reserve_draws(scratch *w, size_t B)
     if (B <= w->capd)
         return 0;
     int fail = 0;
-    w->rpos = grow(w->rpos, B * sizeof *w->rpos, &fail);
+    w->rpos = grow(w->rpos, (B + PICK_AHEAD) * sizeof *w->rpos, &fail);
     w->rbit = grow(w->rbit, B, &fail);
     w->rdraw = grow(w->rdraw, B * sizeof *w->rdraw, &fail);
     if (fail)
@@ -212,11 +215,20 @@ static int batch_hits(const pk_rsa_cells *C, const scratch *w, const uint8_t *ma
     return 0;
 }
 
-/* Prefetch distance of the region draws' mark look-up (draws). */
-#define PICK_AHEAD 64
 /* Prefetch distance of step 4's marks (accepted grains; -6 % time at 10^6
  * grains, mean of 6 runs — the pick's prefetch above is the large part). */
 #define MARK_AHEAD 4
+/* Marks in flight: grain q + MARK_AHEAD is located (once: the prefetch and
+ * the mark share its spot) and its words fetched while grain q is marked. */
+#define MARK_RING 8 /* a power of two > MARK_AHEAD */
+
+static inline void mark_ahead(pk_rsa_region *reg, pk_rsa_region_spot *ring, size_t q,
+                              const double *x)
+{
+    pk_rsa_region_spot *s = &ring[q % MARK_RING];
+    *s = pk_rsa_region_locate(reg, x);
+    pk_rsa_region_prefetch(reg, *s);
+}
 /* Prefetch distance of the centres read by region_start's marks (grains):
  * the centres come in cell order from the store, so each one is a miss in the
  * particle array; with it and the mark's rows fetched ahead region_start took
@@ -257,7 +269,49 @@ static int batch_hits(const pk_rsa_cells *C, const scratch *w, const uint8_t *ma
  *  - region cells of the store's edge (REGION_SPLIT 1: -100 MB, -20 000
  *    faults, -0.06 s system): draws per grain 34.7, CPU +15-20 %;
  *  - the marks' block pre-faulted (mmap MAP_POPULATE): the same faults and
- *    system time — the kernel's cost is per page, not per trap. */
+ *    system time — the kernel's cost is per page, not per trap.
+ * Round 6: where a 10^6 run's time goes (3D φ = 0.30, rdtsc per phase, best
+ * of 3 on a quiet machine, 2.47 Gcycles): plain draws 16 %; region_start 20 %
+ * (its marks 16 %, a third of that the 27 000 first touches of the marks'
+ * array, the first compaction 3 %); region draws' pick 20 % (draws 3 %, list
+ * and mark look-ups 16 %); point, sort, filter 21 % (the filter 14 %); step 3
+ * 5 %; step 4's inserts and marks 18 %; later compactions < 1 % (there is one:
+ * the list shrinks 9.7 -> 4.6 M cells).  A page's first touch costs ~2 µs on
+ * this machine and unmapping ~0.1 ms per MB: ~0.18 s of the run for its
+ * 290 MB.  Kept: marks located once (pk_rsa_region_locate: the prefetch and
+ * the mark share the spot) and no bound tests in the pick's look-up loop:
+ * -3 % instructions, the same simulated misses (cachegrind), the same
+ * packings; wall and CPU time within the noise (5 alternating pairs at a
+ * load of 4-5).  Measured and dropped (same packings unless said):
+ *  - prefetching only the lines a mark writes (~19 of the ~37 its rows
+ *    span): no faster — the marks wait on latency, not on bandwidth;
+ *  - tables as runs of adjacent words per row (a switch on the run length):
+ *    -30 % of the marks' instructions but slower (the switch mispredicts);
+ *  - region cells' coordinates by products with 1/n instead of divisions:
+ *    more instructions, the point step no faster;
+ *  - the filter's prefetch limited to occupied cells (branches: the run
+ *    1.2x slower) or to the cells on the attempt's near sides (the filter
+ *    2-3x slower);
+ *  - region_start's marks without their rows fetched ahead: slower;
+ *  - no marks for the run's last 3-25 % of grains (marks are optional; other
+ *    packings): +0.2-18 % draws, no faster;
+ *  - step 4's marks limited to cells still listed (counted, not built): 34 %
+ *    of their words, but only 21 % of their lines, lie in cells already full
+ *    (41 % of the words gain no bit): <= 3 % to gain before a listed-cells
+ *    bitmap's cost;
+ *  - transparent huge pages for the marks' array: faults -37 %, user time
+ *    the same, system time erratic (x1-3);
+ *  - one-miss region draws (counted, not built): a copy of the cell's word in
+ *    its list entry, taken at compaction, would catch 74 % of the certain
+ *    rejections without reading the marks (a 32-bit fold 66 %, an 8-bit
+ *    summary of 2x2x2 blocks in spare bits of the entry 51 %, of 4x2x1 blocks
+ *    44 %) — but the copy doubles the list (+39 MB, ~+25 ms of first touches
+ *    and unmapping) and a summary costs 8-20 operations per listed cell at
+ *    each compaction: <= 2 % to gain, within the noise;
+ *  - draws weighted by open slots (a list entry per 16 or 32 open fine
+ *    voxels, the k-th open voxel drawn): draws x0.3-0.7, but other packings,
+ *    a select per draw and popcounts per compaction (round 4's classes:
+ *    +25 %): not built. */
 #define START_AHEAD 16
 /* Prefetch distance of step 4's store records (grains: sorted by cell, but
  * at 10^6 grains a batch's grains are far apart; -4..-6 % CPU at 10^6 grains,
@@ -283,14 +337,14 @@ static size_t region_pick(const pk_rsa_region *reg, scratch *w, size_t B, pk_rng
         w->rbit[d] = (uint8_t)bit;
     }
     *rng = g0;
+    memset(&w->rpos[B], 0, PICK_AHEAD * sizeof *w->rpos); /* the look-ahead past the end:
+                                                             list position 0, harmless */
     const uint32_t *list = reg->list;
     const uint64_t *covered = reg->covered;
     size_t open = 0;
     for (size_t d = 0; d < B; d++) {
-        if (d + PICK_AHEAD < B)
-            __builtin_prefetch(&list[w->rpos[d + PICK_AHEAD]]);
-        if (d + PICK_AHEAD / 2 < B)
-            __builtin_prefetch(&covered[list[w->rpos[d + PICK_AHEAD / 2]]]);
+        __builtin_prefetch(&list[w->rpos[d + PICK_AHEAD]]);
+        __builtin_prefetch(&covered[list[w->rpos[d + PICK_AHEAD / 2]]]);
         const uint32_t cell = list[w->rpos[d]];
         const unsigned bit = w->rbit[d];
         /* (open <= d: the entries written here are read no more) */
@@ -439,12 +493,15 @@ static int region_start(pk_rsa_region *reg, const pk_rsa_cells *C, const pk_box 
                         ids[k++] = C->extra[e].id;
             }
         }
+    pk_rsa_region_spot ring[MARK_RING];
+    for (size_t q = 0; q < k && q < MARK_AHEAD; q++)
+        mark_ahead(reg, ring, q, &out->x[3 * (size_t)ids[q]]);
     for (size_t q = 0; q < k && !(mon && mon->cancelled); q++) {
         if (q + START_AHEAD < k)
             __builtin_prefetch(&out->x[3 * (size_t)ids[q + START_AHEAD]]);
         if (q + MARK_AHEAD < k)
-            pk_rsa_region_prefetch(reg, &out->x[3 * (size_t)ids[q + MARK_AHEAD]]);
-        pk_rsa_region_mark(reg, &out->x[3 * (size_t)ids[q]]);
+            mark_ahead(reg, ring, q + MARK_AHEAD, &out->x[3 * (size_t)ids[q + MARK_AHEAD]]);
+        pk_rsa_region_mark_at(reg, ring[q % MARK_RING]);
         if ((q & 0xfff) == 0xfff)
             pk_monitor_tick(mon, pg, 0);
     }
@@ -611,6 +668,9 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
         for (size_t j = 0; j < S; j++)
             if (w.taken[j])
                 w.kept[ntaken++] = (uint32_t)j; /* (free again after step 2) */
+        pk_rsa_region_spot ring[MARK_RING];
+        for (size_t q = 0; region && q < ntaken && q < MARK_AHEAD; q++)
+            mark_ahead(&reg, ring, q, &w.surv[3 * (size_t)w.kept[q]]);
         for (size_t q = 0; q < ntaken; q++) {
             const size_t j = w.kept[q];
             if (q + INSERT_AHEAD < ntaken) {
@@ -622,10 +682,11 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
                 reason = PK_STOP_ERROR;
                 break;
             }
-            if (region && q + MARK_AHEAD < ntaken)
-                pk_rsa_region_prefetch(&reg, &w.surv[3 * (size_t)w.kept[q + MARK_AHEAD]]);
-            if (region)
-                pk_rsa_region_mark(&reg, &w.surv[3 * j]);
+            if (!region)
+                continue;
+            if (q + MARK_AHEAD < ntaken)
+                mark_ahead(&reg, ring, q + MARK_AHEAD, &w.surv[3 * (size_t)w.kept[q + MARK_AHEAD]]);
+            pk_rsa_region_mark_at(&reg, ring[q % MARK_RING]);
         }
         if (reason != PK_STOP_COMPLETE)
             break;

@@ -271,10 +271,11 @@ static void make_entry(pk_rsa_region *R, size_t e, const double *p)
     R->tcnt[e] = (uint8_t)cnt;
 }
 
-/* The cell of x (i[]) and its table entry (the centre's step per axis). */
-static inline size_t locate(const pk_rsa_region *R, const double *x, int64_t i[3])
+/* The cell of x and its table entry (the centre's step per axis). */
+pk_rsa_region_spot pk_rsa_region_locate(const pk_rsa_region *R, const double *x)
 {
     const int Q = R->Q;
+    pk_rsa_region_spot s = {{0, 0, 0}, 0, 0, 1};
     size_t e = 0;
     for (int k = R->dim - 1; k >= 0; k--) {
         double f = (x[k] - R->lo[k]) * R->inv_h[k];
@@ -285,10 +286,13 @@ static inline size_t locate(const pk_rsa_region *R, const double *x, int64_t i[3
         int q = t <= 0 ? 0 : (int)(t * Q);
         if (q > Q - 1)
             q = Q - 1;
-        i[k] = ik;
+        s.i[k] = ik;
+        s.inner &= ik >= R->D && ik < R->n[k] - R->D;
         e = e * (size_t)Q + (size_t)q;
     }
-    return e;
+    s.e = (uint32_t)e;
+    s.word = (uint64_t)(s.i[2] * R->n[1] + s.i[1]) * (uint64_t)R->n[0] + (uint64_t)s.i[0];
+    return s;
 }
 
 /* The centre of entry e's step per axis, as an offset in its cell (z = 0 in 2D). */
@@ -302,34 +306,22 @@ static void step_centre(const pk_rsa_region *R, size_t e, double p[3])
     }
 }
 
-static inline int inner_cell(const pk_rsa_region *R, const int64_t *i)
-{
-    int inner = 1;
-    for (int k = 0; k < R->dim; k++)
-        inner &= i[k] >= R->D && i[k] < R->n[k] - R->D;
-    return inner;
-}
-
-void pk_rsa_region_prefetch(const pk_rsa_region *R, const double *x)
+void pk_rsa_region_prefetch(const pk_rsa_region *R, pk_rsa_region_spot s)
 {
     const int D = R->D;
-    int64_t i[3] = {0, 0, 0};
-    locate(R, x, i); /* (its table entry: fetching it ahead too gained nothing) */
-    if (!inner_cell(R, i))
+    if (!s.inner)
         return; /* rare: the mark wraps or clips; it only costs the misses */
-    const uint64_t *c = &R->covered[(uint64_t)(i[2] * R->n[1] + i[1]) * (uint64_t)R->n[0] +
-                                    (uint64_t)i[0]];
+    const uint64_t *c = &R->covered[s.word]; /* (fetching the table entry too gained nothing) */
     for (int q = 0; q < R->nrow; q++) { /* both ends of each row of 2D + 1 words */
         __builtin_prefetch(c + R->roff[q] - D, 1);
         __builtin_prefetch(c + R->roff[q] + D, 1);
     }
 }
 
-void pk_rsa_region_mark(pk_rsa_region *R, const double *x)
+void pk_rsa_region_mark_at(pk_rsa_region *R, pk_rsa_region_spot s)
 {
     const int dim = R->dim, D = R->D;
-    int64_t i[3] = {0, 0, 0};
-    const size_t e = locate(R, x, i);
+    const size_t e = s.e;
     if (R->tcnt[e] == NOT_MADE) {
         double p[3];
         step_centre(R, e, p);
@@ -337,9 +329,8 @@ void pk_rsa_region_mark(pk_rsa_region *R, const double *x)
     }
     const uint64_t *w = &R->tab[e * R->entry];
     const int cnt = R->tcnt[e];
-    if (inner_cell(R, i)) { /* the common case: no wrap, no wall — fixed offsets */
-        uint64_t *base = &R->covered[(uint64_t)(i[2] * R->n[1] + i[1]) * (uint64_t)R->n[0] +
-                                     (uint64_t)i[0]];
+    if (s.inner) { /* the common case: no wrap, no wall — fixed offsets */
+        uint64_t *base = &R->covered[s.word];
         /* (the offsets by cell number: per-entry int32 offsets saved 1 % of
          * the instructions at 10^6 grains but made the 16-step table 45 %
          * larger, beyond the L2 cache: no faster) */
@@ -352,7 +343,7 @@ void pk_rsa_region_mark(pk_rsa_region *R, const double *x)
     int64_t c[3][2 * MAX_REACH + 1];
     for (int k = 0; k < 3; k++)
         for (int d = -D; d <= D; d++) {
-            int64_t j = k < dim ? i[k] + d : (d == 0 ? 0 : -1);
+            int64_t j = k < dim ? s.i[k] + d : (d == 0 ? 0 : -1);
             if (k < dim && (j < 0 || j >= R->n[k]))
                 j = !R->periodic[k] ? -1 /* beyond a wall: no cell */
                                     : (j < 0 ? j + R->n[k] : j - R->n[k]); /* n >= 2D + 1 */
@@ -366,4 +357,9 @@ void pk_rsa_region_mark(pk_rsa_region *R, const double *x)
             continue;
         R->covered[(uint64_t)(cz * R->n[1] + cy) * (uint64_t)R->n[0] + (uint64_t)cx] |= w[t];
     }
+}
+
+void pk_rsa_region_mark(pk_rsa_region *R, const double *x)
+{
+    pk_rsa_region_mark_at(R, pk_rsa_region_locate(R, x));
 }

@@ -91,10 +91,24 @@ void pk_rsa_region_cover(pk_rsa_region *R, const double *x, double rad);
  * at a fraction of its cost. */
 void pk_rsa_region_mark(pk_rsa_region *R, const double *x);
 
-/* Ask the memory system for the words pk_rsa_region_mark(R, x) will write
- * (a hint: at 10^6 grains each mark's rows are misses; rsa_batch.c asks a few
- * marks ahead). */
-void pk_rsa_region_prefetch(const pk_rsa_region *R, const double *x);
+/* Where the mark of a grain at x goes: its cell and its table entry.
+ * Located once, a mark can be fetched ahead and made later. */
+typedef struct pk_rsa_region_spot {
+    int64_t i[3];               /* the cell's coordinates */
+    uint64_t word;              /* its word in covered[] */
+    uint32_t e;                 /* the table entry */
+    int inner;                  /* the 2D + 1 cells around lie in the range on every axis */
+} pk_rsa_region_spot;
+
+pk_rsa_region_spot pk_rsa_region_locate(const pk_rsa_region *R, const double *x);
+
+/* pk_rsa_region_mark(R, x) for the spot s = pk_rsa_region_locate(R, x). */
+void pk_rsa_region_mark_at(pk_rsa_region *R, pk_rsa_region_spot s);
+
+/* Ask the memory system for the words the mark at spot s will write (a hint:
+ * at 10^6 grains each mark's rows are misses; rsa_batch.c asks a few marks
+ * ahead). */
+void pk_rsa_region_prefetch(const pk_rsa_region *R, pk_rsa_region_spot s);
 
 /* Drop fully covered cells from the list (cost: the list's length); the
  * first call lists the cells not fully covered. */
