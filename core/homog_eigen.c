@@ -99,6 +99,10 @@ double pk_homog_lanczos_min(const pk_dem_pairs *c, int dim, size_t np, double E,
     double nq = sqrt(pk_homog_dot_mask(q, q, mask, np, dim));
     for (size_t k = 0; k < 3 * np; k++)
         q[k] /= nq;
+    /* 40 steps at 10⁴ grains: 6.5 ms, of which 2.7 ms K·v and 0.5 ms the
+     * blocks; the rest is the vector passes (measured, round 7: fusing the
+     * update of w with |w|² and swapping q/qp instead of copying, bit for
+     * bit the same, saved 5 % of it — dropped). */
     int m = 0;
     double beta = 0;
     for (int it = 0; it < steps; it++) {

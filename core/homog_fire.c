@@ -6,6 +6,11 @@
 
 #include "homog_eigen.h"
 
+/* Measured (round 7, whole near-jamming 10⁴ bench pipeline, seeds 5/6/8,
+ * CPU s of the step; the RVEs move since they are relaxed by the same
+ * hybrid): these 1.3/2.7/2.2; FIRE 2.0's α_start 0.25: 1.5/2.8/2.0 (the
+ * same minima on 5 and 8, another on 6: ΔΦ/Φ −6.5e-8); with its N_delay 20
+ * as well: 3.2/271/2.7 (seed 6: 1.28·10⁶ FIRE iterations) — kept. */
 pk_fire_params pk_fire_params_default(void)
 {
     pk_fire_params p = {.n_min = 5, .f_inc = 1.1, .f_dec = 0.5, .alpha0 = 0.1, .f_alpha = 0.99,

@@ -24,8 +24,16 @@
  * event Newton may first slide on along a soft mode (the residual rises,
  * Φ_n falls) before it converges (measured at 10⁴ grains: 5 factorisations,
  * where DR needs ~3,000 more iterations to the next attempt; with 3 also
- * from FIRE's points, 10 attempts instead of 3 on the near-jamming bench RVE). */
-#define STALL_FACTORS 3
+ * from FIRE's points, 10 attempts instead of 3 on the near-jamming bench RVE).
+ * From the step's start one factorisation whose L-BFGS steps do not halve
+ * the residual is enough (was 3): DR starts from
+ * the step's start, not from where Newton stopped, so the result only
+ * changes where Newton would have converged after a factorisation that did
+ * not halve the residual — none measured (40 plastic and elastic steps of
+ * 200–400 grains; the 10⁴ bench steps and relaxations at F̄ = 1, where the
+ * 2nd or 3rd factorisation was indefinite: 1–2 factorisations and their
+ * L-BFGS window, ~0.1–0.25 s, saved per step, same DR path). */
+#define STALL_FACTORS 1
 #define ATTEMPT_STALL 6
 /* Rises of the residual from one factorisation's point to the next after
  * which an attempt is given up.  A converging attempt rises at most once
@@ -85,7 +93,16 @@
  * SHIFT_RAISES raises per attempt (a converging attempt needed 2 at 10⁴
  * grains; attempts that need more creep along a valley DR is faster down:
  * measured 7 raises and 13–17 factorisations in the relaxation of random
- * overlaps). */
+ * overlaps).  No shift once the attempt's residual has risen above its value
+ * at DR's point: Newton then slid along a soft mode into another instability.
+ * Measured (round 7): such shifted continuations converged in 0 of 10
+ * attempts on the 10⁴ bench steps (near jamming seeds 5–9, dense 5–6) — each
+ * cost 2–8 factorisations: step factorisations 9/24/7/21/5 → 7/14/7/12/5,
+ * dense 7 → 6, same DR/FIRE path, same minima — and in 2 of 8 on 40 steps of
+ * 200–400 grains (there the hybrid then needs 600–1,200 more relaxation
+ * iterations, same minima).  With the rule no shift was made at all in those
+ * 40 and 216 more 200–800-grain steps (φ 0.85–0.88, 0.5–2 %): the shift is
+ * kept for a block that turns indefinite while the residual falls. */
 #define SHIFT_FIRST 1e-3
 #define SHIFT_MAX 1e-1
 #define SHIFT_MIN 1e-6
@@ -302,7 +319,8 @@ static pk_sparse_factor *factor_block(const newton_sys *sy, newton_work *w, doub
  * definite factorisation except the first after a raise (held once: the
  * lower μ was just found indefinite; measured: one indefinite factorisation
  * less on both dense 10⁴ bench RVEs, one more on the 400-grain case of
- * test_homog_newton), 0 below SHIFT_MIN·E.  A point
+ * test_homog_newton), 0 below SHIFT_MIN·E — but only while the residual is
+ * at most its value at the entry point (above: the phase ends).  A point
  * reached with μ > 0 counts as converged only if the unshifted block is
  * positive definite there (a minimum, not a saddle).
  * *budget factorisations at most (decremented).
@@ -317,6 +335,7 @@ static int newton_phase(const newton_sys *sy, newton_work *w, double *x, double 
     const size_t np = sy->np, nd = w->mem.nd;
     const double E = sy->E;
     double best = *fn, mu = 0, mu_used = 0;
+    const double f_entry = *fn; /* no shift once the residual rose above it */
     size_t since_best = 0;
     int stable_start = 0; /* the block was positive definite at the entry point */
     int raises = 0, hold = 0; /* hold: keep μ at the next positive definite factorisation */
@@ -337,7 +356,8 @@ static int newton_phase(const newton_sys *sy, newton_work *w, double *x, double 
         }
         if (info.status != PK_SPARSE_OK) {
             sy->solver->release(fac);
-            if (shift && stable_start && raises < SHIFT_RAISES && mu < SHIFT_MAX * E) {
+            if (shift && stable_start && raises < SHIFT_RAISES && mu < SHIFT_MAX * E &&
+                *fn <= f_entry) {
                 mu = mu > 0 ? 10 * mu : SHIFT_FIRST * E;
                 ns->shifts++;
                 raises++;

@@ -10,8 +10,8 @@
  * contacts opening and closing), the factor being refreshed when the
  * residual stops halving.  The phase ends when the exact block is not
  * positive definite (an instability), a fresh Newton direction finds no
- * decrease, or the residual does not halve over 3 factorisations (6 in an
- * attempt from DR's point, below).
+ * decrease, or the residual does not halve over one factorisation's steps
+ * (over 6 factorisations in an attempt from DR's point, below).
  * Hybrid: after such an exit DR takes the step from its start point, as if
  * Newton had not been asked, and at residuals 1e-3·|f⁰|, 3e-4·|f⁰|, …
  * Newton tries to finish the slow tail near the new minimum from a copy of
