@@ -9,7 +9,8 @@
  * grain's target radius, so early (small, fast) grains rebuild rarely.  The
  * bounding spheres live in levels of dense cell lists (core/grid_uniform.h:
  * pk_grid's levels without its hash probes — the rebuild queries were a
- * third of the run time), so wide size ratios cost O(1) cells per query. */
+ * third of the run time), so wide size ratios cost O(1) cells per query;
+ * the small grains read the coarse levels from its cover (one cell). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

@@ -30,25 +30,31 @@ static void sift_up(edmd_state *s, size_t k)
 }
 
 /* The heap is followed by ARITY − 1 nodes at +inf (edmd_queue_init), so the
- * last parent's child group is always full: no bound per child. */
+ * last parent's child group is always full: no bound per child.  The child
+ * is picked by index arithmetic, without branches: gcc made one branch of
+ * the choice between the two pairs, taken at random.  Same choice, same
+ * heap, same events; mono 3D N = 10^4, first 3M events (callgrind
+ * --branch-sim): sift_down mispredictions 14.6M → 3.9M for +8.5 % of its
+ * instructions (+79M against −10.7M mispredictions of ~15 cycles). */
 static void sift_down(edmd_state *s, size_t k)
 {
     edmd_hnode *h = s->heap;
+    int32_t *hpos = s->hpos;
     const edmd_hnode e = h[k];
     const size_t n = s->hn;
-    for (;;) {
-        const size_t c = ARITY * k + 1;
-        if (c >= n)
-            break;
+    for (size_t c = ARITY * k + 1; c < n; c = ARITY * k + 1) {
         const edmd_hnode *ch = &h[c];
-        size_t a = ch[1].t < ch[0].t ? 1 : 0, b = ch[3].t < ch[2].t ? 3 : 2;
-        size_t m = ch[b].t < ch[a].t ? b : a;
+        const size_t a = ch[1].t < ch[0].t, b = 2 + (ch[3].t < ch[2].t);
+        const size_t m = a + ((b - a) & (0 - (size_t)(ch[b].t < ch[a].t)));
         if (!(ch[m].t < e.t))
             break;
-        place(s, k, ch[m]);
+        const edmd_hnode up = ch[m];
+        h[k] = up;
+        hpos[up.i] = (int32_t)k;
         k = c + m;
     }
-    place(s, k, e);
+    h[k] = e;
+    hpos[e.i] = (int32_t)k;
 }
 
 int edmd_queue_init(edmd_state *s)

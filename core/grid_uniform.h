@@ -8,7 +8,20 @@
  * not a hash probe, and a remove is O(1).  Each level gets at most
  * PK_UGRID_CELLS_PER_GRAIN cells per grain it holds at init (wider cells
  * beyond that), so memory stays O(N).  Same visitor contract as
- * pk_grid_query. */
+ * pk_grid_query (the order of the visits is not part of it).
+ *
+ * Cover (round 5): with many small grains and few big ones (Fuller-like
+ * gradings) the small grains' queries spent most of their time in the
+ * coarse levels — a box of big cells with few grains, ~50 tests for ~2
+ * found.  The levels coarser than the most populated one are therefore also
+ * listed in a cover: every grain there is listed in each cell (of the
+ * populated level's geometry) its ball r_j + cov_r touches, and a query of
+ * radius r <= cov_r tests the grains listed in its point's cell instead of
+ * scanning those levels.  Inserts and removes of coarse grains walk their
+ * ball's cells (rare: coarse grains are slow).  Memory: 16 bytes per cell
+ * of the populated level and the cells' lists, planned at init to at most
+ * 8 N + 65536 entries per covered level (levels whose balls span more than
+ * 512 cells are not covered).  Code: core/grid_cover.c. */
 #ifndef PK_GRID_UNIFORM_H
 #define PK_GRID_UNIFORM_H
 
@@ -29,6 +42,12 @@ typedef struct pk_ugrid_level {
     double r_max;               /* largest radius registered here (never lowered) */
 } pk_ugrid_level;
 
+/* A cover cell: the coarse grains whose balls r_j + cov_r touch it. */
+typedef struct pk_ugrid_cover {
+    int32_t *ids;
+    uint32_t n, cap;
+} pk_ugrid_cover;
+
 typedef struct pk_ugrid {
     pk_box box;
     double L[PK_MAXDIM];        /* box edges on periodic axes, 0 otherwise */
@@ -39,6 +58,21 @@ typedef struct pk_ugrid {
     int32_t *next, *prev, *cell; /* per grain; cell -1 = not registered */
     int8_t *level;
     size_t cap;
+    /* Cover of the levels coarser than the most populated one (few grains in
+     * big cells): each of their grains is also listed in every cell of that
+     * level's geometry its ball r_j + cov_r touches, so a query of radius
+     * <= cov_r reads one cell for all of them instead of a box of cells per
+     * coarse level.  cov_r = 0: no cover (one level, or the coarsest is the
+     * most populated). */
+    double cov_r;
+    int8_t covered[PK_UGRID_MAX_LEVELS];
+    int cov_level;              /* whose cell geometry the cover uses */
+    pk_ugrid_cover *cov;        /* cells */
+    pk_ugrid_cover cov_big;     /* grains grown past a bounded ball: tested by every cover query */
+    double *cov_ball;           /* per grain: centre and radius it is listed with (0: not; < 0: in cov_big) */
+    size_t cov_nmax;            /* most cells along an axis */
+    int64_t *cov_off;           /* scratch of the cover walks: 3 × cov_nmax cell offsets */
+    double *cov_e2;             /* and squared slab distances */
 } pk_ugrid;
 
 /* Minimum image of d along the axes with inv_L[k] = 1/L[k] (walled axes:

@@ -119,6 +119,93 @@ static void test_reach_beyond_box(void)
     compare(3, per, 60, 1.0, 4.0, 6);
 }
 
+/* Many fines and few coarse grains (counts ∝ d^-2.5 over 1:16, as the
+ * Fuller-like EDMD case): the coarse levels are covered (grid_uniform.h), and
+ * the fines' queries read the cover; periodic, walled and 2D; grains moved,
+ * resized, removed, and one grown to 0.4 L.  (Caught by mutation: cover
+ * balls r_j + cov_r/2, slab distances one cell too far, removes that leave
+ * the grain listed.) */
+static size_t cover_case(int dim, const bool periodic[3], uint64_t seed)
+{
+    size_t big = 0;
+    pk_box b;
+    memset(&b, 0, sizeof b);
+    b.dim = dim;
+    for (int k = 0; k < dim; k++) {
+        b.L[k] = (dim == 3 ? 24.0 : 14.0) + 2 * k;
+        b.periodic[k] = periodic[k];
+    }
+    const size_t n = dim == 3 ? 700 : 300;
+    pk_particles p;
+    pk_particles_init(&p, dim, n);
+    pk_rng rng;
+    pk_rng_seed(&rng, seed, 9);
+    for (size_t i = 0; i < n; i++) {
+        double x[3] = {0, 0, 0};
+        for (int k = 0; k < dim; k++)
+            x[k] = pk_rng_range(&rng, 0, b.L[k]);
+        /* inverse CDF of d^-2.5 on [1, 16], radii 0.25 .. 4 */
+        double u = pk_rng_range(&rng, 0, 1);
+        pk_particles_push(&p, x, 0.125 * pow(1 - u * (1 - pow(16, -1.5)), -1 / 1.5), 0);
+    }
+    pk_ugrid g;
+    CHECK(pk_ugrid_init(&g, &b, p.r, n, n) == 0);
+    CHECK(g.cov_r > 0 && g.covered[0]); /* the fines' level is the busiest: coarser ones covered */
+    for (size_t i = 0; i < n; i++)
+        CHECK(pk_ugrid_insert(&g, &p, i) == 0);
+    for (int round = 0; round < 3; round++) {
+        for (size_t i = (size_t)round; i < n; i += 4) { /* move, resize, re-file */
+            for (int k = 0; k < dim; k++)
+                p.x[3 * i + k] = pk_rng_range(&rng, 0, b.L[k]);
+            p.r[i] *= pk_rng_range(&rng, 0.6, 1.5);
+            CHECK(pk_ugrid_insert(&g, &p, i) == 0);
+        }
+        if (round == 1)
+            pk_ugrid_remove(&g, 1);
+        if (round == 2) { /* grown far past the cover's balls: tested by every cover query */
+            p.r[2] = 0.4 * b.L[0];
+            CHECK(pk_ugrid_insert(&g, &p, 2) == 0);
+            big = g.cov_big.n; /* 1 when its ball would span too many cells */
+            CHECK(big <= 1);
+        }
+        int *seen = calloc(n, sizeof *seen);
+        size_t wrong = 0, total = 0, covered_queries = 0;
+        for (size_t i = 0; i < n; i++) {
+            memset(seen, 0, n * sizeof *seen);
+            hits h = {seen};
+            pk_ugrid_query(&g, &p, &p.x[3 * i], p.r[i], count_hit, &h);
+            covered_queries += p.r[i] <= g.cov_r;
+            for (size_t j = 0; j < n; j++) {
+                double d2 = pk_box_dist2(&b, &p.x[3 * i], &p.x[3 * j]);
+                double s = p.r[i] + p.r[j];
+                if (fabs(sqrt(d2) - s) < 1e-12 * s) /* as compare() */
+                    continue;
+                int want = d2 < s * s && !(round >= 1 && j == 1);
+                total += want;
+                if (seen[j] != want)
+                    wrong++;
+            }
+        }
+        CHECK_MSG(wrong == 0, "dim %d round %d: %zu of %zu pairs wrong", dim, round, wrong, total);
+        CHECK_MSG(covered_queries > n / 3, "%zu of %zu queries read the cover", covered_queries, n);
+        CHECK(total > n);
+        free(seen);
+    }
+    pk_ugrid_free(&g);
+    pk_particles_free(&p);
+    return big;
+}
+
+static void test_cover_of_coarse_levels(void)
+{
+    bool per[3] = {true, true, true}, mixed[3] = {true, false, true}, walled[3] = {false, false, false};
+    size_t big = cover_case(3, per, 11);
+    big += cover_case(3, mixed, 12);
+    big += cover_case(2, per, 13);
+    big += cover_case(2, walled, 14);
+    CHECK(big >= 1); /* the grown grain went to cov_big at least once */
+}
+
 static void test_min_image3(void)
 {
     const double L[3] = {10, 0, 4}, inv_L[3] = {0.1, 0, 0.25};
@@ -140,6 +227,7 @@ int main(void)
     RUN(test_mixed_walls_3d);
     RUN(test_2d_walled_and_periodic);
     RUN(test_reach_beyond_box);
+    RUN(test_cover_of_coarse_levels);
     RUN(test_min_image3);
     return check_summary();
 }
