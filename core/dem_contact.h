@@ -8,7 +8,8 @@
  * periodic RVE the branch vector is the minimum image taken in the reference
  * frame, l = F̄·minimg(F̄⁻¹(x_j − x_i)), i.e. the lattice vectors are F̄L
  * (spec §2.5.4 "equivalent simpler form").  Candidate pairs (a Verlet list
- * with a skin) come from the shared pk_grid built on reference coordinates. */
+ * with a skin) come from the shared pk_grid built on reference coordinates;
+ * each keeps the lattice image it had at the build (pk_dem_pairs.sh). */
 #ifndef PK_DEM_CONTACT_H
 #define PK_DEM_CONTACT_H
 
@@ -48,6 +49,17 @@ typedef struct pk_dem_pairs {
     size_t nclass;
     double kref;
     double *kf;          /* [n] per-candidate factor, NULL when uniform */
+    /* The periodic image of each candidate, fixed at the build: while the
+     * grains stay within skin/2 of their build positions and F̄ is the same,
+     * a candidate's minimum image cannot change (pk_dem_pairs_build), so the
+     * evaluation takes l = x_j − x_i + sh[p] with the lattice shift
+     * sh = −F̄(L∘k) in the current frame ([n][3]) instead of F̄⁻¹, rounding
+     * and F̄ per pair.  sh_F, sh_L, sh_dim, sh_periodic: the geometry the
+     * shifts were formed under; pk_dem_eval forms them afresh at its x when
+     * it is given another (a new F̄ on the same list), never uses stale ones. */
+    double *sh;
+    double sh_F[9], sh_L[3];
+    int sh_dim, sh_periodic, sh_ok;
 } pk_dem_pairs;
 
 void pk_dem_pairs_free(pk_dem_pairs *c);
@@ -63,8 +75,10 @@ static inline double pk_dem_pair_E(const pk_dem_pairs *c, size_t p, double E)
 }
 
 /* Rebuild the candidate list: every pair whose spatial distance can be below
- * r_i + r_j + skin.  -1 on allocation failure, -2 when a periodic box is too
- * small for the deformed contact range (an image pair could be missed). */
+ * r_i + r_j + skin, with its periodic image (sh).  -1 on allocation failure,
+ * -2 when a periodic box is too small for the deformed contact range (an
+ * image pair could be missed).  The list (and its images) serve evaluations
+ * at positions within skin/2 of x (pk_dem_pairs_stale). */
 int pk_dem_pairs_build(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
                        size_t np, double skin);
 

