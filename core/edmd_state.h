@@ -191,6 +191,8 @@ void edmd_prefetch_list(const edmd_state *s, size_t i);
  * available (the lanes must give bit-identical events). */
 extern int edmd_scalar_only;
 int edmd_lanes_available(void);                        /* AVX2 lanes in use now */
+extern int edmd_lanes4_only;     /* 1: the AVX2 loop even where AVX-512 is there */
+int edmd_lanes8_available(void); /* AVX-512 lanes in use now */
 double edmd_wall_time(const edmd_state *s, size_t i, int *code);
 
 /* edmd_collide.c */

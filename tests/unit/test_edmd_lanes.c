@@ -1,9 +1,10 @@
-/* test_edmd_lanes.c — the AVX2 neighbour loop of core/edmd_predict.c gives
- * the scalar loop's events bit for bit: the same run with and without the
- * lanes ends with identical counts and positions.  Polydisperse 3D (lists of
- * every length, so full and short last groups of lanes) and 2D (zero third
- * components), from zero radii to jamming (touching lanes after every
- * collision).  A one-ulp change of one lane's root fails it (checked by
+/* test_edmd_lanes.c — the vector neighbour loops of core/edmd_predict.c (AVX2
+ * four lanes, AVX-512 eight lanes) give the scalar loop's events bit for
+ * bit: the same run through each path ends with identical counts and
+ * positions.  Polydisperse 3D (lists of every length, so full and short last
+ * groups of four and of eight lanes) and 2D (zero third components), from
+ * zero radii to jamming (touching lanes after every collision).  A one-ulp
+ * change of one lane's root fails it, in either vector loop (checked by
  * mutation). */
 #include <math.h>
 #include <stdio.h>
@@ -11,17 +12,20 @@
 
 #include "check.h"
 #include "edmd.h"
-#include "edmd_state.h"
 #include "edmd_fixture.h"
+#include "edmd_state.h"
 
 typedef struct outcome {
     pk_edmd_stats st;
     pk_particles p;
 } outcome;
 
+typedef enum path { PATH_SCALAR, PATH_LANES4, PATH_LANES8 } path;
+
 /* n grains, diameters 1..ratio (every 5th the coarse one), periodic box at
- * φ = 0.5 for the target sizes, grown from zero until jammed. */
-static void run(int dim, int n, double ratio, int scalar, outcome *o)
+ * φ = 0.5 for the target sizes, grown from zero until jammed, through the
+ * neighbour loop `via`. */
+static void run(int dim, int n, double ratio, path via, outcome *o)
 {
     pk_particles_init(&o->p, dim, (size_t)n);
     double x[3] = {0, 0, 0};
@@ -33,28 +37,46 @@ static void run(int dim, int n, double ratio, int scalar, outcome *o)
     prm.until = PK_EDMD_UNTIL_JAMMED;
     prm.growth_rate = 0.05;
     prm.seed = 7;
-    edmd_scalar_only = scalar;
+    edmd_scalar_only = via == PATH_SCALAR;
+    edmd_lanes4_only = via == PATH_LANES4;
     CHECK(pk_edmd_run(&b, &o->p, &prm, NULL, &o->st) == 0);
     edmd_scalar_only = 0;
+    edmd_lanes4_only = 0;
+}
+
+static void same(const outcome *v, const outcome *s)
+{
+    CHECK(v->st.events > 10000); /* long enough for the trajectories to diverge at any difference */
+    CHECK(v->st.events == s->st.events);
+    CHECK(v->st.pair == s->st.pair);
+    CHECK(v->st.nlist == s->st.nlist);
+    CHECK(v->st.invalid == s->st.invalid);
+    /* bit-identical: chaotic dynamics would amplify a one-ulp difference */
+    CHECK(memcmp(v->p.x, s->p.x, 3 * v->p.n * sizeof *v->p.x) == 0);
+    CHECK(memcmp(v->p.r, s->p.r, v->p.n * sizeof *v->p.r) == 0);
 }
 
 static void same_run(int dim, int n, double ratio)
 {
-    outcome v, s;
-    run(dim, n, ratio, 0, &v);
-    run(dim, n, ratio, 1, &s);
-    printf("  dim=%d n=%d ratio=%g: events=%llu collisions=%llu phi=%.6f (lanes %s)\n", dim, n,
-           ratio, (unsigned long long)v.st.events, (unsigned long long)v.st.pair, v.st.phi,
-           edmd_lanes_available() ? "AVX2" : "not available: both runs scalar");
-    CHECK(v.st.events > 10000); /* long enough for the trajectories to diverge at any difference */
-    CHECK(v.st.events == s.st.events);
-    CHECK(v.st.pair == s.st.pair);
-    CHECK(v.st.nlist == s.st.nlist);
-    CHECK(v.st.invalid == s.st.invalid);
-    /* bit-identical: chaotic dynamics would amplify a one-ulp difference */
-    CHECK(memcmp(v.p.x, s.p.x, 3 * v.p.n * sizeof *v.p.x) == 0);
-    CHECK(memcmp(v.p.r, s.p.r, v.p.n * sizeof *v.p.r) == 0);
-    pk_particles_free(&v.p);
+    outcome s, v4, v8;
+    run(dim, n, ratio, PATH_SCALAR, &s);
+    const int have4 = edmd_lanes_available(), have8 = edmd_lanes8_available();
+    printf("  dim=%d n=%d ratio=%g: events=%llu collisions=%llu phi=%.6f\n", dim, n, ratio,
+           (unsigned long long)s.st.events, (unsigned long long)s.st.pair, s.st.phi);
+    if (have4) {
+        run(dim, n, ratio, PATH_LANES4, &v4);
+        same(&v4, &s);
+        pk_particles_free(&v4.p);
+    } else {
+        printf("  AVX2 not available: 4-lane comparison skipped\n");
+    }
+    if (have8) {
+        run(dim, n, ratio, PATH_LANES8, &v8);
+        same(&v8, &s);
+        pk_particles_free(&v8.p);
+    } else {
+        printf("  AVX-512F not available: 8-lane comparison skipped\n");
+    }
     pk_particles_free(&s.p);
 }
 
