@@ -112,6 +112,88 @@ static void test_fire_reaches_dr_minimum(void)
     problem_free(&pb);
 }
 
+/* FIRE as first written (round 7): P = f·v, v ← v + Δt f, the mixed move
+ * and |f| as four separate passes — the oracle of the fused loop
+ * (homog_fire.c: one pass after each evaluation), which must follow it bit
+ * for bit: near jamming a difference in the last bit moves the plastic
+ * events.  Runs exactly `iters` iterations; returns the restarts. */
+static size_t fire_reference(problem *pb, double *x, const pk_fire_params *fp, size_t iters)
+{
+    const size_t n = pb->rve.n;
+    const double E = pb->o.E_n, dt_min_share = 0.02; /* DT_MIN_SHARE */
+    const uint8_t *fr = pb->is_free;
+    double *f = malloc(3 * n * sizeof *f), *v = calloc(3 * n, sizeof *v);
+    CHECK(pk_dem_pairs_build(&pb->c, &pb->g, x, pb->rve.r, n, pb->o.dr.skin) == 0);
+    pk_dem_eval(&pb->c, &pb->g, x, pb->rve.r, n, E, f, NULL, NULL);
+    double fn = sqrt(pk_homog_dot_mask(f, f, fr, n, 2));
+    const double dt_max = fp->dt_scale * 2 / sqrt(pk_dem_gershgorin(&pb->c, 2, n, E, fr));
+    double dt = 0.5 * dt_max, alpha = fp->alpha0;
+    size_t n_pos = 0, restarts = 0;
+    for (size_t k = 0; k < iters; k++) {
+        if (pk_homog_dot_mask(f, v, fr, n, 2) > 0) {
+            if (++n_pos > fp->n_min) {
+                dt = fmin(dt * fp->f_inc, dt_max);
+                alpha *= fp->f_alpha;
+            }
+        } else {
+            n_pos = 0;
+            dt = fmax(dt * fp->f_dec, dt_min_share * dt_max);
+            alpha = fp->alpha0;
+            for (size_t e = 0; e < 3 * n && k > 0; e++)
+                x[e] -= fr[e / 3] ? 0.5 * dt * v[e] : 0;
+            memset(v, 0, 3 * n * sizeof *v);
+            restarts++;
+        }
+        double vv = 0;
+        for (size_t e = 0; e < 3 * n; e++)
+            if (fr[e / 3] && e % 3 < 2) {
+                v[e] += dt * f[e];
+                vv += v[e] * v[e];
+            }
+        pk_relax_coef cf = {dt, 1 - alpha, fn > 0 ? alpha * sqrt(vv) / fn : 0};
+        if (pk_relax_move(x, v, f, fr, n, 2, cf, &pb->c))
+            CHECK(pk_dem_pairs_build(&pb->c, &pb->g, x, pb->rve.r, n, pb->o.dr.skin) == 0);
+        pk_dem_eval(&pb->c, &pb->g, x, pb->rve.r, n, E, f, NULL, NULL);
+        fn = sqrt(pk_homog_dot_mask(f, f, fr, n, 2));
+    }
+    free(f);
+    free(v);
+    return restarts;
+}
+
+/* The fused loop against the oracle over a fixed number of iterations with
+ * restarts among them (a 1 % compression: contacts close, uphill steps):
+ * the same positions to the last bit and the same restarts. */
+static void test_fused_loop_is_the_reference(void)
+{
+    problem pb;
+    problem_make(&pb);
+    size_t n = pb.rve.n;
+    double F[9];
+    diagF(F, 0.99, 1.0, 1.0);
+    pk_dem_geom_set_F(&pb.g, F);
+    for (size_t i = 0; i < n; i++)
+        pk_m3_vec(F, &pb.rve.X[3 * i], &pb.x0[3 * i]), pb.x0[3 * i + 2] = 0;
+    double *xr = copy_x(&pb), *xf = copy_x(&pb);
+    pk_fire_params fp = pk_fire_params_default();
+    const size_t iters = 600;
+    size_t restarts = fire_reference(&pb, xr, &fp, iters);
+    pk_dr_params prm = pb.o.dr;
+    prm.tol = 0, prm.abs_floor = 0, prm.max_iter = iters; /* stops at the cap */
+    pk_dr_stats st;
+    CHECK(pk_homog_fire_hooked(&pb.c, &pb.g, xf, pb.rve.r, n, pb.o.E_n, pb.is_free, &prm, &fp, NULL,
+                               NULL, &st) == 0);
+    CHECK(st.stop == PK_DR_MAX_ITER && st.iterations == iters);
+    CHECK_MSG(st.refreshes == restarts, "restarts %zu, reference %zu", st.refreshes, restarts);
+    CHECK_MSG(restarts >= 2, "only %zu restart(s): the uphill branch is not exercised", restarts);
+    CHECK(memcmp(xf, xr, 3 * n * sizeof *xf) == 0);
+    printf("  %zu iterations, %zu restarts, %zu rebuilds: bit-identical\n", iters, restarts,
+           st.rebuilds);
+    free(xr);
+    free(xf);
+    problem_free(&pb);
+}
+
 /* A hook that records its calls; `answer` is what it returns. */
 typedef struct spy {
     int answer;
@@ -188,5 +270,6 @@ int main(void)
 {
     RUN(test_fire_reaches_dr_minimum);
     RUN(test_hook_and_cap);
+    RUN(test_fused_loop_is_the_reference);
     return check_summary();
 }
