@@ -166,6 +166,44 @@ static inline void pair_one(edmd_state *s, pred *pr, const self *c, size_t j)
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
+
+/* pair_one's arithmetic on lanes of a GCC vector type VT, in pair_one's
+ * operation order (so every path gives bit-identical results), from the
+ * neighbours' columns p0..p2, v0..v2, ra, rg and the grain's broadcast terms
+ * (X, V, L, I, RI, GI, T, VM) to R, B, dd, C, A and the discriminant D.
+ * One text for the 4- and 8-lane loops. */
+#define LANE_TERMS(VT)                                                                         \
+    VT d0 = X0 - (p0 + v0 * T), d1 = X1 - (p1 + v1 * T), d2 = X2 - (p2 + v2 * T);            \
+    d0 -= L0 * ((d0 * I0 + VM) - VM);                                                          \
+    d1 -= L1 * ((d1 * I1 + VM) - VM);                                                          \
+    d2 -= L2 * ((d2 * I2 + VM) - VM);                                                          \
+    const VT dv0 = V0 - v0, dv1 = V1 - v1, dv2 = V2 - v2;                                      \
+    const VT R = RI + ra + rg * T, G = GI + rg;                                                \
+    const VT B = d0 * dv0 + d1 * dv1 + d2 * dv2 - R * G;                                       \
+    const VT dd = d0 * d0 + d1 * d1 + d2 * d2;                                                 \
+    const VT C = dd - R * R;                                                                   \
+    const VT A = dv0 * dv0 + dv1 * dv1 + dv2 * dv2 - G * G;                                    \
+    const VT D = B * B - A * C
+
+/* The lanes in `lanes` that the vector tests did not dismiss, in ascending
+ * lane (= list) order so that ties resolve as in the scalar loop: a common
+ * root (a lane in `hit`) is offered when it lies before the current
+ * runner-up, any other lane goes to pair_take.  The vectors are read as
+ * arrays of doubles. */
+static inline void lane_offers(edmd_state *s, pred *pr, const int32_t *ix, unsigned lanes,
+                               unsigned hit, const double *tau, const double *A, const double *B,
+                               const double *C, const double *R, const double *dd)
+{
+    for (unsigned m = lanes; m; m &= m - 1) {
+        const int l = __builtin_ctz(m);
+        if (hit >> l & 1) {
+            if (tau[l] < pr->second)
+                offer(pr, tau[l], ix[l], s->ncoll[ix[l]]);
+        } else {
+            pair_take(s, pr, (size_t)ix[l], A[l], B[l], C[l], R[l], dd[l]);
+        }
+    }
+}
 #define HAVE_LANES4 1
 
 /* Four neighbours at once (AVX2, chosen at run time): each grain's record
@@ -240,17 +278,7 @@ __attribute__((target("avx2"))) static void pair_lanes4(edmd_state *s, pred *pr,
         lo2 = _mm256_unpacklo_pd(Wc, Wd), hi2 = _mm256_unpackhi_pd(Wc, Wd);
         const v4d v0 = _mm256_permute2f128_pd(lo, lo2, 0x20), v2 = _mm256_permute2f128_pd(lo, lo2, 0x31);
         const v4d v1 = _mm256_permute2f128_pd(hi, hi2, 0x20), rg = _mm256_permute2f128_pd(hi, hi2, 0x31);
-        v4d d0 = X0 - (p0 + v0 * T), d1 = X1 - (p1 + v1 * T), d2 = X2 - (p2 + v2 * T);
-        d0 -= L0 * ((d0 * I0 + VM) - VM);
-        d1 -= L1 * ((d1 * I1 + VM) - VM);
-        d2 -= L2 * ((d2 * I2 + VM) - VM);
-        const v4d dv0 = V0 - v0, dv1 = V1 - v1, dv2 = V2 - v2;
-        const v4d R = RI + ra + rg * T, G = GI + rg;
-        const v4d B = d0 * dv0 + d1 * dv1 + d2 * dv2 - R * G;
-        const v4d dd = d0 * d0 + d1 * d1 + d2 * d2;
-        const v4d C = dd - R * R;
-        const v4d A = dv0 * dv0 + dv1 * dv1 + dv2 * dv2 - G * G;
-        const v4d D = B * B - A * C;
+        LANE_TERMS(v4d);
         const v4d BOUND = _mm256_set1_pd(pr->second);
         /* common lanes: gap open, A >= 0, approaching; pair_root dismisses
          * them when the root lies beyond the runner-up (C >= −2B·bound) or
@@ -267,15 +295,9 @@ __attribute__((target("avx2"))) static void pair_lanes4(edmd_state *s, pred *pr,
         v4d tau = ZERO;
         if (m_hit)
             tau = C / (-B + _mm256_sqrt_pd(_mm256_max_pd(D, ZERO)));
-        for (int m = m_hit | m_other; m; m &= m - 1) {
-            const int l = __builtin_ctz((unsigned)m);
-            if (m_hit >> l & 1) {
-                if (tau[l] < pr->second)
-                    offer(pr, tau[l], ix[l], s->ncoll[ix[l]]);
-            } else {
-                pair_take(s, pr, (size_t)ix[l], A[l], B[l], C[l], R[l], dd[l]);
-            }
-        }
+        lane_offers(s, pr, ix, (unsigned)(m_hit | m_other), (unsigned)m_hit, (const double *)&tau,
+                    (const double *)&A, (const double *)&B, (const double *)&C,
+                    (const double *)&R, (const double *)&dd);
     }
 }
 
@@ -355,17 +377,7 @@ __attribute__((target("avx512f"))) static uint32_t pair_lanes8(edmd_state *s, pr
         const v8d p2 = _mm512_shuffle_f64x2(u1, u5, 0x88), v2 = _mm512_shuffle_f64x2(u1, u5, 0xDD);
         const v8d p1 = _mm512_shuffle_f64x2(u2, u6, 0x88), v1 = _mm512_shuffle_f64x2(u2, u6, 0xDD);
         const v8d ra = _mm512_shuffle_f64x2(u3, u7, 0x88), rg = _mm512_shuffle_f64x2(u3, u7, 0xDD);
-        v8d d0 = X0 - (p0 + v0 * T), d1 = X1 - (p1 + v1 * T), d2 = X2 - (p2 + v2 * T);
-        d0 -= L0 * ((d0 * I0 + VM) - VM);
-        d1 -= L1 * ((d1 * I1 + VM) - VM);
-        d2 -= L2 * ((d2 * I2 + VM) - VM);
-        const v8d dv0 = V0 - v0, dv1 = V1 - v1, dv2 = V2 - v2;
-        const v8d R = RI + ra + rg * T, G = GI + rg;
-        const v8d B = d0 * dv0 + d1 * dv1 + d2 * dv2 - R * G;
-        const v8d dd = d0 * d0 + d1 * d1 + d2 * d2;
-        const v8d C = dd - R * R;
-        const v8d A = dv0 * dv0 + dv1 * dv1 + dv2 * dv2 - G * G;
-        const v8d D = B * B - A * C;
+        LANE_TERMS(v8d);
         const v8d BOUND = _mm512_set1_pd(pr->second);
         /* the lane classes of pair_lanes4 */
         const __mmask8 grow_slower = _mm512_cmp_pd_mask(A, ZERO, _CMP_GE_OQ);
@@ -382,15 +394,9 @@ __attribute__((target("avx512f"))) static uint32_t pair_lanes8(edmd_state *s, pr
         v8d tau = ZERO;
         if (m_hit)
             tau = C / (-B + _mm512_sqrt_pd(_mm512_max_pd(D, ZERO)));
-        for (unsigned m = m_hit | m_other; m; m &= m - 1) {
-            const int l = __builtin_ctz(m);
-            if (m_hit >> l & 1) {
-                if (tau[l] < pr->second)
-                    offer(pr, tau[l], ix[l], s->ncoll[ix[l]]);
-            } else {
-                pair_take(s, pr, (size_t)ix[l], A[l], B[l], C[l], R[l], dd[l]);
-            }
-        }
+        lane_offers(s, pr, ix, (unsigned)(m_hit | m_other), (unsigned)m_hit, (const double *)&tau,
+                    (const double *)&A, (const double *)&B, (const double *)&C,
+                    (const double *)&R, (const double *)&dd);
     }
     return q;
 }
