@@ -1,6 +1,9 @@
 # packd — build, test, sanitize, bench, run.
-#   make          build build/packd (installs missing Debian packages first)
-#   make test     build and run every unit and integration test
+#   make          build build/packd and the benchmarks' binaries (installs missing
+#                 Debian packages first; a bench binary is never left older than
+#                 the code it measures)
+#   make test     build and run every unit and integration test (the benchmarks
+#                 are built too, so they cannot rot, but not run)
 #   make sanitize the same tests under AddressSanitizer + UBSan (build-san/)
 #   make bench    build and run the benchmarks in bench/
 #   make run      build and start the daemon with its embedded defaults
@@ -43,7 +46,7 @@ BENCH_BIN  := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 .PHONY: all deps test sanitize bench run clean check-schemas
 .SECONDARY:
 
-all: $(DEPS_OK) $(BUILD)/packd
+all: $(DEPS_OK) $(BUILD)/packd $(BENCH_BIN)
 
 # Install missing Debian packages once per build directory
 # (deploy/install-deps.sh checks each package and installs only what is missing).
@@ -87,7 +90,7 @@ $(BUILD)/bench/%: bench/%.c $(LIB_OBJ)
 	@mkdir -p $(@D)
 	$(CC) $(EXT_CFLAGS) -Idaemon -o $@ $< $(LIB_OBJ) $(EXT_LIBS)
 
-test: $(DEPS_OK) $(BUILD)/packd $(UNIT_BIN)
+test: $(DEPS_OK) $(BUILD)/packd $(UNIT_BIN) $(BENCH_BIN)
 	@sh tests/run.sh $(BUILD)
 
 sanitize:
