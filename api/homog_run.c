@@ -147,6 +147,7 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
     int rc = -1;
     pk_homog_rve rve = {0};
     pk_homog_state com = {0}, tr = {0};
+    pk_sparse_ctx *nctx = NULL; /* Newton's solver context over the whole load path */
     json_t *rec = NULL;
     if (job.fdim && job.fdim != dim) {
         snprintf(err, errlen, "the load path is %dD but the RVE is %dD", job.fdim, dim);
@@ -162,6 +163,11 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
         }
     pk_homog_opts o;
     opts_of(&job, &rve, &o);
+    /* a contact pattern seen in an earlier factorisation of this job (elastic
+     * load steps) reuses its analysis; without a context (NULL on failure)
+     * every factorisation is analysed afresh — the same numbers either way */
+    if (o.newton && o.newton->ctx_new)
+        o.newton_ctx = nctx = o.newton->ctx_new();
     if (pk_homog_state_init(&rve, &o, &com) != 0) {
         snprintf(err, errlen, "out of memory");
         goto out;
@@ -299,6 +305,8 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
     *summary = sum;
     rc = 0;
 out:
+    if (nctx)
+        pk_sparse_cholmod.ctx_free(nctx);
     json_decref(rec);
     pk_homog_state_free(&com);
     pk_homog_state_free(&tr);

@@ -13,8 +13,12 @@
  * speed-up.  10⁴ grains with PACKD_BENCH_LARGE=1.
  * PACKD_BENCH_CASE=TEXT runs only the RVEs whose name KIND_N (dense_1000,
  * near_jamming_10000, …) contains TEXT; PACKD_BENCH_SEED=S makes the RVEs
- * from seed S (default 5) — more RVEs of the same kind. */
+ * from seed S (default 5) — more RVEs of the same kind.
+ * PACKD_BENCH_RVE_CACHE=DIR keeps the relaxed RVEs in DIR/KIND_N_seedS.bin:
+ * the RVE is relaxed at F̄ = 1 by the same hybrid the step measures, so
+ * without the cache two builds of the solver compare different RVEs. */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -71,7 +75,7 @@ static pk_homog_opts opts(double tol)
  * small packing is no substitute: stable in its own cell, it is a saddle
  * for the long-wavelength modes of the big one. */
 #define DENSE_PHI 0.90
-static void make_rve(size_t n, int near_jamming, pk_homog_rve *rve, pk_homog_state *relaxed)
+static void build_rve(size_t n, int near_jamming, pk_homog_rve *rve, pk_homog_state *relaxed)
 {
     pk_rng rng;
     pk_rng_seed(&rng, rve_seed(), 0);
@@ -124,6 +128,128 @@ static void make_rve(size_t n, int near_jamming, pk_homog_rve *rve, pk_homog_sta
            pk_dr_stop_name(st.dr.stop));
     pk_homog_state_free(&s0);
     pk_particles_free(&p);
+}
+
+/* The RVE cache (PACKD_BENCH_RVE_CACHE=DIR): the RVE and its relaxed state
+ * at F̄ = 1 (frictionless: no rotations, no slip history) in
+ * DIR/KIND_N_seedS.bin — a header, then the arrays.  A file whose header or
+ * size does not match is rebuilt. */
+#define CACHE_MAGIC "PKRVE01"
+typedef struct rve_cache_head {
+    char magic[8];
+    uint64_t n, ncontact, seed;
+    int32_t near_jamming, dim, bc, periodic;
+    double L[3], V, F[9];
+} rve_cache_head;
+
+static size_t cache_body_bytes(size_t n, size_t ncontact)
+{
+    return n * (7 * sizeof(double) + 2 * sizeof(int32_t) + 2) + ncontact * sizeof(uint64_t);
+}
+
+static int cache_path(size_t n, int near_jamming, char *path, size_t len)
+{
+    const char *dir = getenv("PACKD_BENCH_RVE_CACHE");
+    if (!dir || !*dir)
+        return 0;
+    snprintf(path, len, "%s/%s_%zu_seed%llu.bin", dir, near_jamming ? "near_jamming" : "dense", n,
+             (unsigned long long)rve_seed());
+    return 1;
+}
+
+/* fread/fwrite of count items, 0 when all went through */
+static int io(FILE *fp, void *p, size_t size, size_t count, int write)
+{
+    if (!count)
+        return 0;
+    return (write ? fwrite(p, size, count, fp) : fread(p, size, count, fp)) != count;
+}
+
+static int cache_arrays(FILE *fp, pk_homog_rve *rve, pk_homog_state *s, int write)
+{
+    size_t n = rve->n;
+    return io(fp, rve->X, sizeof *rve->X, 3 * n, write) | io(fp, rve->r, sizeof *rve->r, n, write) |
+           io(fp, rve->grain, sizeof *rve->grain, n, write) |
+           io(fp, rve->species, sizeof *rve->species, n, write) |
+           io(fp, rve->fixed, 1, n, write) | io(fp, rve->hull, 1, n, write) |
+           io(fp, s->x, sizeof *s->x, 3 * n, write) |
+           io(fp, s->keys, sizeof *s->keys, s->ncontact, write);
+}
+
+static void cache_save(const char *path, int near_jamming, pk_homog_rve *rve, pk_homog_state *s)
+{
+    rve_cache_head h = {.magic = CACHE_MAGIC, .n = rve->n, .ncontact = s->ncontact,
+                        .seed = rve_seed(), .near_jamming = near_jamming, .dim = rve->dim,
+                        .bc = (int32_t)rve->bc, .periodic = rve->periodic, .V = rve->V};
+    memcpy(h.L, rve->L, sizeof h.L);
+    memcpy(h.F, s->F, sizeof h.F);
+    FILE *fp = fopen(path, "wb");
+    if (!fp)
+        return;
+    int bad = io(fp, &h, sizeof h, 1, 1) | cache_arrays(fp, rve, s, 1);
+    if (fclose(fp) != 0 || bad)
+        remove(path);
+}
+
+/* 1 when rve and s were loaded from path, 0 (nothing allocated) otherwise. */
+static int cache_load(const char *path, size_t n, int near_jamming, pk_homog_rve *rve,
+                      pk_homog_state *s)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp)
+        return 0;
+    rve_cache_head h;
+    int ok = io(fp, &h, sizeof h, 1, 0) == 0 && memcmp(h.magic, CACHE_MAGIC, 8) == 0 &&
+             h.n == n && h.seed == rve_seed() && h.near_jamming == near_jamming &&
+             h.ncontact <= 8 * n && fseek(fp, 0, SEEK_END) == 0 &&
+             (size_t)ftell(fp) == sizeof h + cache_body_bytes(n, h.ncontact) &&
+             fseek(fp, (long)sizeof h, SEEK_SET) == 0;
+    if (ok) {
+        memset(rve, 0, sizeof *rve);
+        memset(s, 0, sizeof *s);
+        rve->dim = h.dim;
+        rve->bc = (pk_homog_bc)h.bc;
+        rve->n = n;
+        rve->periodic = h.periodic;
+        memcpy(rve->L, h.L, sizeof h.L);
+        rve->V = h.V;
+        rve->X = malloc(3 * n * sizeof *rve->X);
+        rve->r = malloc(n * sizeof *rve->r);
+        rve->grain = malloc(n * sizeof *rve->grain);
+        rve->species = malloc(n * sizeof *rve->species);
+        rve->fixed = malloc(n);
+        rve->hull = malloc(n);
+        s->n = n;
+        s->ncontact = h.ncontact;
+        memcpy(s->F, h.F, sizeof h.F);
+        s->x = malloc(3 * n * sizeof *s->x);
+        s->u = calloc(n, sizeof *s->u);
+        s->keys = malloc((h.ncontact ? h.ncontact : 1) * sizeof *s->keys);
+        ok = rve->X && rve->r && rve->grain && rve->species && rve->fixed && rve->hull && s->x &&
+             s->u && s->keys && cache_arrays(fp, rve, s, 0) == 0;
+        if (!ok) {
+            pk_homog_rve_free(rve);
+            pk_homog_state_free(s);
+        }
+    }
+    fclose(fp);
+    return ok;
+}
+
+/* The RVE of the case: from the cache when there is one, else built (and
+ * cached when a cache directory is given). */
+static void make_rve(size_t n, int near_jamming, pk_homog_rve *rve, pk_homog_state *relaxed)
+{
+    char path[512];
+    int cached = cache_path(n, near_jamming, path, sizeof path);
+    if (cached && cache_load(path, n, near_jamming, rve, relaxed)) {
+        printf("bench=homog case=jam_2d rve=%s n=%zu cached=%s contacts=%zu\n",
+               near_jamming ? "near_jamming" : "dense", n, path, relaxed->ncontact);
+        return;
+    }
+    build_rve(n, near_jamming, rve, relaxed);
+    if (cached)
+        cache_save(path, near_jamming, rve, relaxed);
 }
 
 /* Time of the contact evaluation a DR iteration runs (forces only) per
@@ -198,12 +324,12 @@ static double step_case(size_t n, int near_jamming)
     printf("bench=homog case=periodic_step_newton_2d rve=%s n=%zu factorisations=%zu qn_steps=%zu "
            "dr_iterations=%zu fire_iterations=%zu attempts=%zu shift_raises=%zu seconds=%.3f cpu_s=%.3f "
            "exit=%s stop=%s residual_rel=%.2g "
-           "contacts=%zu rattlers=%zu energy=%.12g speedup_vs_dr=%.2f\n",
+           "contacts=%zu rattlers=%zu energy=%.17g P11=%.17g P22=%.17g speedup_vs_dr=%.2f\n",
            kind, n, sn.newton.iterations, sn.newton.steps,
            sn.dr.iterations - sn.newton.fire_iterations, sn.newton.fire_iterations, sn.newton.attempts,
            sn.newton.shifts, tnw, cnw,
            pk_newton_exit_name(sn.newton.exit), pk_dr_stop_name(sn.dr.stop), sn.dr.f / sn.dr.f0,
-           sn.contacts, sn.rattlers, sn.energy, tdr > 0 ? tdr / tnw : -1);
+           sn.contacts, sn.rattlers, sn.energy, sn.P[0], sn.P[4], tdr > 0 ? tdr / tnw : -1);
     double A[81];
     pk_tangent_info ti;
     int rc = pk_homog_tangent(&rve, &o, &tn, &pk_sparse_cholmod, A, &ti);

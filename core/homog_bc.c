@@ -199,7 +199,7 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     } else if (o->newton && nfree) {
         out->used_newton = 1;
         rc = pk_homog_newton(&c, &g, trial->x, rve->r, n, o->E_n, is_free, &o->dr, o->newton,
-                             o->newton_max_iter, mon, &out->dr, &out->newton);
+                             o->newton_ctx, o->newton_max_iter, mon, &out->dr, &out->newton);
     } else {
         rc = pk_homog_relax(&c, &g, trial->x, rve->r, n, o->E_n, is_free, &o->dr, mon, &out->dr);
     }

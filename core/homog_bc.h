@@ -48,6 +48,7 @@ typedef struct pk_homog_opts {
     /* Equilibrium solver: NULL = dynamic relaxation (the thesis); a sparse
      * solver = Newton–Raphson with DR fallback (homog_newton.h). */
     const pk_sparse_solver *newton;
+    pk_sparse_ctx *newton_ctx; /* newton's context over the load path (NULL: none) */
     size_t newton_max_iter;
     /* Inter-particle friction (ch. 7, 2D): NULL = frictionless.  With
      * friction the equilibrium solver is always DR (newton is ignored; the

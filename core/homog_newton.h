@@ -43,6 +43,7 @@ const char *pk_newton_exit_name(pk_newton_exit e);
 
 typedef struct pk_newton_stats {
     size_t iterations;           /* factorisations of the stiffness */
+    size_t reused;               /* of them, those that reused the context's analysis */
     size_t steps, cuts;          /* quasi-Newton steps, line-search halvings */
     size_t attempts;             /* Newton attempts from DR's points */
     size_t shifts;               /* Levenberg–Marquardt shift raises in those attempts */
@@ -52,10 +53,13 @@ typedef struct pk_newton_stats {
 
 /* Same contract as pk_homog_relax (st describes the DR part, if any, with
  * st->f0 the initial and st->f the final residual of the whole solve).
- * max_newton caps the factorisations over all Newton phases. */
+ * max_newton caps the factorisations over all Newton phases.  sctx: the
+ * solver's context (solver->ctx_new) kept by the caller over the steps of a
+ * load path, so that a contact pattern seen before reuses its analysis; NULL:
+ * every factorisation analysed afresh (the numbers are the same). */
 int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
                     double E, const uint8_t *is_free, const pk_dr_params *prm,
-                    const pk_sparse_solver *solver, size_t max_newton, pk_monitor *mon,
-                    pk_dr_stats *st, pk_newton_stats *ns);
+                    const pk_sparse_solver *solver, pk_sparse_ctx *sctx, size_t max_newton,
+                    pk_monitor *mon, pk_dr_stats *st, pk_newton_stats *ns);
 
 #endif

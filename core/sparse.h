@@ -35,9 +35,16 @@ typedef struct pk_sparse_info {
     pk_sparse_status status;
     size_t npos, nneg, nzero;  /* inertia of the LDLᵀ pivots */
     double min_abs_pivot, max_abs_pivot;
+    int reused_analysis;       /* factor_pd_ctx: 1 = the context's analysis was used */
 } pk_sparse_info;
 
 typedef struct pk_sparse_factor pk_sparse_factor; /* solver-owned */
+/* A solver context kept over a sequence of factorisations (a relaxation, or
+ * the steps of a load path):
+ * it keeps the last symbolic analysis (fill-reducing ordering, supernodes)
+ * and reuses it when the next matrix has the same pattern — the same
+ * ordering gives the same numbers, bit for bit. */
+typedef struct pk_sparse_ctx pk_sparse_ctx;        /* solver-owned */
 
 typedef struct pk_sparse_solver {
     const char *name;
@@ -49,6 +56,13 @@ typedef struct pk_sparse_solver {
      * past an LLᵀ's first non-positive pivot need a second, LDLᵀ
      * factorisation, 15 % of a dense 10⁴ Newton step (bench/homog). */
     pk_sparse_factor *(*factor_pd)(const pk_sparse_sym *A, pk_sparse_info *info);
+    /* factor_pd with a context (NULL: the same as factor_pd): the analysis
+     * of the context is used when A has its pattern, else A is analysed and
+     * its analysis replaces the context's.  The factor outlives ctx. */
+    pk_sparse_factor *(*factor_pd_ctx)(pk_sparse_ctx *ctx, const pk_sparse_sym *A,
+                                       pk_sparse_info *info);
+    pk_sparse_ctx *(*ctx_new)(void);    /* NULL on failure (then use factor_pd) */
+    void (*ctx_free)(pk_sparse_ctx *ctx); /* NULL-safe */
     /* X = A⁻¹B, B and X column-major n × nrhs.  0 / -1. */
     int (*solve)(pk_sparse_factor *f, size_t nrhs, const double *B, double *X);
     void (*release)(pk_sparse_factor *f);
