@@ -2,6 +2,9 @@
  *   bench=edmd case=NAME n=N phi=F reason=R criterion=C events=E collisions=C
  *         seconds=S cpu_s=T collisions_per_cpu_s=X events_per_cpu_s=Y peak_rss_mb=M p=P
  *         runner_up=K (invalid events replaced by their runner-up, no prediction)
+ *         nlist=L (list rebuilds) invalid=I (partner changed course; runner_up of
+ *         them took no prediction) wall=W (events = collisions + nlist + invalid
+ *         + wall + others)
  * (job cases: rates per wall second of the placement, cpu_s of the whole job)
  * Cases: monodisperse 3D periodic N = 10^4 to φ = 0.60 and to jamming,
  * N = 2000 slow/fast (the MRJ band and the rate dependence), Fuller-like
@@ -52,11 +55,12 @@ static void line(const char *name, size_t n, const pk_edmd_stats *st, double cpu
 {
     printf("bench=edmd case=%s n=%zu phi=%.5f reason=%s criterion=%s events=%llu collisions=%llu "
            "seconds=%.3f cpu_s=%.3f collisions_per_cpu_s=%.3g events_per_cpu_s=%.3g "
-           "peak_rss_mb=%.1f p=%.3g runner_up=%llu\n",
+           "peak_rss_mb=%.1f p=%.3g runner_up=%llu nlist=%llu invalid=%llu wall=%llu\n",
            name, n, st->phi, pk_stop_reason_name(st->reason), pk_edmd_criterion_name(st->criterion),
            (unsigned long long)st->events, (unsigned long long)st->pair, st->seconds, cpu,
            (double)st->pair / cpu, (double)st->events / cpu, peak_mb(), st->pressure,
-           (unsigned long long)st->second);
+           (unsigned long long)st->second, (unsigned long long)st->nlist,
+           (unsigned long long)st->invalid, (unsigned long long)st->wall);
     fflush(stdout);
 }
 

@@ -28,6 +28,23 @@
  * 8740 → 9470 (×2) and 9200 (×3) instructions per collision.  Coarse
  * grains' skins ×0.5 (coarse lists 27 → 22.5 lanes per prediction):
  * +18 % list rebuilds, more instructions to φ = 0.70. */
+/* Round 7 account, Fuller-like 1–16 N = 10^4 to jamming (bench/edmd;
+ * callgrind, 4-lane path: 26.65G instructions, 8497 per collision).
+ * Events 5.90M: 3.14M collisions, 2.00M list rebuilds (by octave of the
+ * grain's d: 1–2 1.17M, 2–4 0.66M, 4–8 0.14M, 8–16 0.025M), 0.76M invalid
+ * (0.72M took the runner-up, 0.044M re-predicted), no walls.  Predictions
+ * 13.4G: d 8–16 3.12M (3.09M after a collision) × 54.7 neighbours (29 of
+ * d 1–2), 2810 instructions each = 8.8G, a third of the run; 4–8 1.62M ×
+ * 19.0, 1320; 2–4 1.54M × 6.9, 740; 1–2 2.06M × 5.9, 665.  Rebuilds 9.1G
+ * (queries 6.4G, re-filing 1.8G): 3230 instructions each for d 1–2, 4320
+ * for 2–4, 13.0k for 4–8, 24.0k for 8–16.  Heap 1.86G, collision rule
+ * 0.97G.  Masses are equal by default (pk_edmd_params.equal_masses), so a
+ * fine turns a coarse grain as much as any grain does: nothing a coarse
+ * grain predicted survives its collision, and an exact change cannot skip
+ * those 171M neighbour tests; fewer of them needs other skins (other
+ * events).  Kept: cover moves (grid_cover.c: −1.5 % instructions, the
+ * same events); dropped: culled rows in wide queries (grid_uniform.c), a
+ * reload-free heap step (edmd_queue.c). */
 /* From this many grains on (arrays beyond the caches) the grains are
  * renumbered along a Z-order curve every RESORT_WINDOWS·N events: they
  * diffuse away from their start order and each prediction then misses the

@@ -35,7 +35,10 @@ static void sift_up(edmd_state *s, size_t k)
  * the choice between the two pairs, taken at random.  Same choice, same
  * heap, same events; mono 3D N = 10^4, first 3M events (callgrind
  * --branch-sim): sift_down mispredictions 14.6M → 3.9M for +8.5 % of its
- * instructions (+79M against −10.7M mispredictions of ~15 cycles). */
+ * instructions (+79M against −10.7M mispredictions of ~15 cycles).  Round
+ * 7: the four keys loaded once and the pair minima kept (no reload of
+ * ch[a], ch[b], ch[m]): same choice, Fuller-like 1–16 N = 10^4 to jamming
+ * 26.4023G → 26.4023G instructions; dropped. */
 static void sift_down(edmd_state *s, size_t k)
 {
     edmd_hnode *h = s->heap;

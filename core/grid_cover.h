@@ -14,6 +14,10 @@ void pk_ugrid_cover_free(pk_ugrid *g);
 /* Grain j of a covered level, at x with radius r: listed / taken out. */
 int pk_ugrid_cover_add(pk_ugrid *g, size_t j, const double x[PK_MAXDIM], double r);
 void pk_ugrid_cover_remove(pk_ugrid *g, size_t j);
+/* Grain j of a covered level, listed, re-listed with its ball at x, r (the
+ * cells both balls touch are left alone): as remove + add but for j's
+ * place in those cells. */
+int pk_ugrid_cover_move(pk_ugrid *g, size_t j, const double x[PK_MAXDIM], double r);
 /* fn for every covered grain within r + r_j of x; r <= g->cov_r. */
 int pk_ugrid_cover_query(const pk_ugrid *g, const pk_particles *p, const double x[PK_MAXDIM],
                          double r, pk_grid_visit fn, void *ctx);

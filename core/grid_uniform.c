@@ -103,12 +103,31 @@ void pk_ugrid_free(pk_ugrid *g)
     memset(g, 0, sizeof *g);
 }
 
+/* i out of its cell's chain (registered). */
+static void unlink_grain(pk_ugrid *g, size_t i)
+{
+    int32_t nx = g->next[i], pv = g->prev[i];
+    if (pv >= 0)
+        g->next[pv] = nx;
+    else
+        g->lv[g->level[i]].head[g->cell[i]] = nx;
+    if (nx >= 0)
+        g->prev[nx] = pv;
+    g->cell[i] = -1;
+}
+
 int pk_ugrid_insert(pk_ugrid *g, const pk_particles *p, size_t i)
 {
     if (i >= g->cap)
         return -1;
-    pk_ugrid_remove(g, i);
     int l = level_of(g, p->r[i]);
+    /* a grain re-filed in its covered level: its cover cells are moved
+     * (pk_ugrid_cover_move), not walked out and in again */
+    const int move = g->covered[l] && g->cell[i] >= 0 && g->level[i] == l;
+    if (move)
+        unlink_grain(g, i);
+    else
+        pk_ugrid_remove(g, i);
     pk_ugrid_level *lv = &g->lv[l];
     const double *x = &p->x[3 * i];
     int32_t c = 0;
@@ -124,7 +143,8 @@ int pk_ugrid_insert(pk_ugrid *g, const pk_particles *p, size_t i)
     g->level[i] = (int8_t)l;
     if (p->r[i] > lv->r_max)
         lv->r_max = p->r[i];
-    if (g->covered[l] && pk_ugrid_cover_add(g, i, x, p->r[i]) != 0)
+    if (g->covered[l] && (move ? pk_ugrid_cover_move(g, i, x, p->r[i])
+                               : pk_ugrid_cover_add(g, i, x, p->r[i])) != 0)
         return -1;
     return 0;
 }
@@ -135,14 +155,7 @@ void pk_ugrid_remove(pk_ugrid *g, size_t i)
         return;
     if (g->cov_ball)
         pk_ugrid_cover_remove(g, i);
-    int32_t nx = g->next[i], pv = g->prev[i];
-    if (pv >= 0)
-        g->next[pv] = nx;
-    else
-        g->lv[g->level[i]].head[g->cell[i]] = nx;
-    if (nx >= 0)
-        g->prev[nx] = pv;
-    g->cell[i] = -1;
+    unlink_grain(g, i);
 }
 
 /* Query context of one level: the point, the radius and the box. */
@@ -201,7 +214,11 @@ static inline int scan_cells(const qctx *q, const int32_t *row, int32_t a, int32
  * levels; the cover (grid_uniform.h) reads one cell with ~7 grains instead:
  * same run (first 5.5M events, identical events), queries 10.2G → 6.4G
  * instructions, inserts 0.34G → 1.56G (coarse balls walked), total 26.3G →
- * 23.5G. */
+ * 23.5G.  Round 7: rows and row ends beyond the reach skipped only in boxes
+ * of 4+ cells along y or z (the coarse grains' queries, 0.31M calls, 13
+ * rows each; visits identical, bit-identical run): the whole run 26.40G →
+ * 26.87G instructions — few rows are culled, and gcc's second inlined copy
+ * of scan_cells came out slower.  Dropped. */
 static int query_level(const pk_ugrid *g, const pk_ugrid_level *lv, const pk_particles *p,
                        const double x[PK_MAXDIM], double r, pk_grid_visit fn, void *ctx)
 {

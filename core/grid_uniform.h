@@ -71,8 +71,10 @@ typedef struct pk_ugrid {
     pk_ugrid_cover cov_big;     /* grains grown past a bounded ball: tested by every cover query */
     double *cov_ball;           /* per grain: centre and radius it is listed with (0: not; < 0: in cov_big) */
     size_t cov_nmax;            /* most cells along an axis */
-    int64_t *cov_off;           /* scratch of the cover walks: 3 × cov_nmax cell offsets */
-    double *cov_e2;             /* and squared slab distances */
+    int64_t *cov_off;           /* scratch of the cover walks: 3 × 3 × cov_nmax cell offsets
+                                 * (two balls and their union) */
+    double *cov_e2;             /* and 4 × 3 × cov_nmax squared slab distances (two balls,
+                                 * and each over the union) */
 } pk_ugrid;
 
 /* Minimum image of d along the axes with inv_L[k] = 1/L[k] (walled axes:
