@@ -92,6 +92,22 @@ int pk_dem_pairs_stale(const pk_dem_pairs *c, const double *x, int dim);
 size_t pk_dem_eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
                    size_t np, double E, double *f, double *energy, double S[9]);
 
+/* The forces alone, f and the contact count as pk_dem_eval(.., f, NULL,
+ * NULL) bit for bit, but c->l, len, eps may be left as they were (the 2D
+ * periodic AVX2 path keeps each block's geometry in L1 buffers instead of
+ * writing ~40 B per candidate to the pair arrays): the relaxation
+ * iterations' evaluation.  Call pk_dem_eval at x before reading them (the
+ * values are a function of x: the same bits as if they had been stored).
+ * Measured (round 11, before eval_2d_loop was inlined per call): the 40 B
+ * per candidate not written, 2–9 % less time than pk_dem_eval on 10⁴
+ * random grains (noisy machine); the relaxation's figures at
+ * core/homog_relax.c (relax). */
+size_t pk_dem_eval_forces(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
+                          size_t np, double E, double *f);
+/* 1: pk_dem_eval_forces stores the geometry as pk_dem_eval does (tests:
+ * the relaxations must give the same bits either way). */
+extern int pk_dem_forces_store;
+
 /* The 2D evaluation takes the geometry of four candidates at once with AVX2
  * when the CPU has it (bit-identical to the scalar loop); set
  * pk_dem_scalar_only = 1 to force the scalar loop (tests).  1 when the

@@ -103,6 +103,7 @@ int pk_homog_fire_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const
     const double dt_max = fp->dt_scale * 2 / sqrt(st->lambda_max);
     double dt = 0.5 * dt_max, alpha = fp->alpha0;
     pk_progress pr = {.stage = "relax", .fraction = -1, .phi = -1, .eta_s = -1};
+    pk_relax_geom geo = {c, g, r, np, E, 1}; /* pk_dem_eval_forces */
     for (size_t k = 0;; k++) {
         double vv;
         if (s.fv > 0) { /* P = f·v > 0: downhill; v + Δt f is in w (fire_pass) */
@@ -138,12 +139,13 @@ int pk_homog_fire_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const
                 goto out;
             st->rebuilds++;
         }
-        pk_dem_eval(c, g, x, r, np, E, f, NULL, NULL);
+        pk_dem_eval_forces(c, g, x, r, np, E, f);
+        geo.fresh = 0;
         /* Δt of the next step should it be downhill (as in the branch above) */
         double dt_up = n_pos + 1 > fp->n_min ? fmin(dt * fp->f_inc, dt_max) : dt;
         s = fire_sums_at(f, v, w, is_free, np, dim, dt_up);
         st->f = sqrt(s.ff);
-        int e = pk_relax_iteration_end(st, prm, target, k, x, hook, mon, &pr);
+        int e = pk_relax_iteration_end_geom(st, prm, target, k, x, hook, mon, &pr, &geo);
         if (e < 0) {
             rc = e;
             goto out;
@@ -151,6 +153,7 @@ int pk_homog_fire_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const
         if (e)
             break;
     }
+    pk_relax_geom_refresh(&geo, x);
 out:
     free(f);
     free(v);

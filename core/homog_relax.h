@@ -99,6 +99,9 @@ typedef struct pk_relax_coef {
 } pk_relax_coef;
 int pk_relax_move(double *x, double *v, const double *f, const uint8_t *is_free, size_t np,
                   int dim, pk_relax_coef cf, const pk_dem_pairs *c);
+/* 1: pk_relax_move takes its generic loop in 2D too (tests: the SSE2 move
+ * must give the same bits). */
+extern int pk_relax_scalar_move;
 
 /* The end of one relaxation iteration, shared by DR and FIRE (homog_fire.h),
  * with st->f the residual after it: converged at target, the hook (if any),
@@ -107,6 +110,28 @@ int pk_relax_move(double *x, double *v, const double *f, const uint8_t *is_free,
  * hook's), < 0 the hook's error. */
 int pk_relax_iteration_end(pk_dr_stats *st, const pk_dr_params *prm, double target, size_t k,
                            double *x, pk_dr_hook *hook, pk_monitor *mon, pk_progress *pr);
+
+/* The pair geometry of a relaxation whose iterations evaluate the forces
+ * alone (pk_dem_eval_forces, after which fresh = 0): pk_relax_geom_refresh
+ * puts the geometry (l, |l|, ε) of x back when fresh = 0 (pk_dem_eval
+ * without outputs: the same bits as if it had been stored) — before its
+ * readers (rattlers, Gershgorin, Lanczos, the caller's stress and
+ * stiffness), before a hook (the pair data are then those of DR's last
+ * evaluation, whatever x the hook returns) and on return. */
+typedef struct pk_relax_geom {
+    pk_dem_pairs *c;
+    const pk_dem_geom *g;
+    const double *r;
+    size_t np;
+    double E;
+    int fresh;
+} pk_relax_geom;
+void pk_relax_geom_refresh(pk_relax_geom *gm, const double *x);
+
+/* pk_relax_iteration_end with pk_relax_geom_refresh(gm, x) before the hook. */
+int pk_relax_iteration_end_geom(pk_dr_stats *st, const pk_dr_params *prm, double target,
+                                size_t k, double *x, pk_dr_hook *hook, pk_monitor *mon,
+                                pk_progress *pr, pk_relax_geom *gm);
 
 /* pk_homog_relax with a hook (hook->at: the first threshold). */
 int pk_homog_relax_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,

@@ -34,7 +34,10 @@ static void *dup(const void *p, size_t bytes)
 
 /* Evaluate at x twice per mode: with energy and S (the checks' path) and
  * with forces only (the DR iteration's path; its forces must equal the
- * first's too). */
+ * first's too).  Then pk_dem_eval_forces (the relaxations' evaluation,
+ * geometry in block buffers) with the pair arrays poisoned: the same forces
+ * and count (it reads none of them), and pk_dem_eval without outputs puts
+ * the same geometry back (pk_relax_geom_refresh). */
 static void eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
                  size_t np, int scalar, outcome *o)
 {
@@ -44,11 +47,22 @@ static void eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const d
     o->nc = pk_dem_eval(c, g, x, r, np, 2.5, o->f, &o->energy, o->S);
     CHECK(pk_dem_eval(c, g, x, r, np, 2.5, f2, NULL, NULL) == o->nc);
     CHECK(memcmp(f2, o->f, 3 * np * sizeof *f2) == 0);
-    pk_dem_scalar_only = 0;
     o->n = c->n;
     o->l = dup(c->l, 3 * c->n * sizeof *c->l);
     o->len = dup(c->len, c->n * sizeof *c->len);
     o->eps = dup(c->eps, c->n * sizeof *c->eps);
+    for (size_t p = 0; p < c->n; p++) {
+        c->l[3 * p] = c->l[3 * p + 1] = c->l[3 * p + 2] = NAN;
+        c->len[p] = c->eps[p] = NAN;
+    }
+    memset(f2, 0x7f, 3 * np * sizeof *f2); /* overwritten, not accumulated into */
+    CHECK(pk_dem_eval_forces(c, g, x, r, np, 2.5, f2) == o->nc);
+    CHECK(memcmp(f2, o->f, 3 * np * sizeof *f2) == 0);
+    CHECK(pk_dem_eval(c, g, x, r, np, 2.5, NULL, NULL, NULL) == o->nc);
+    CHECK(memcmp(c->l, o->l, 3 * c->n * sizeof *c->l) == 0);
+    CHECK(memcmp(c->len, o->len, c->n * sizeof *c->len) == 0);
+    CHECK(memcmp(c->eps, o->eps, c->n * sizeof *c->eps) == 0);
+    pk_dem_scalar_only = 0;
     free(f2);
 }
 
