@@ -14,6 +14,13 @@
 BUILD   ?= build
 CC      ?= cc
 OPT     ?= -O2
+# Functions start on a cache line.  The hot loops here are sensitive to where
+# the linker happens to place them: the same dem_contact.o evaluated a 2D pair
+# in 5.1 or 8.4 ns depending on an unrelated object's size, and a 10^4-grain
+# homogenization step with 8-11 % fewer instructions measured slower than the
+# old code in one link and 8-10 % faster in the other (bench/homog, 2026-11-22).
+# Aligned, both links give the fast figures; RSA and EDMD rates are unchanged.
+ALIGN   ?= -falign-functions=64
 SAN     ?=
 VERSION := $(shell cat VERSION 2>/dev/null || echo 0.0.0)
 
@@ -22,7 +29,7 @@ DEPS_OK := $(BUILD)/.deps-ok
 
 WARN    := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wno-unused-parameter
 CSTD    := -std=c17 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
-BASE_CFLAGS := $(CSTD) $(OPT) -g $(WARN) $(SAN) -DPACKD_VERSION='"$(VERSION)"'
+BASE_CFLAGS := $(CSTD) $(OPT) $(ALIGN) -g $(WARN) $(SAN) -DPACKD_VERSION='"$(VERSION)"'
 
 # core/ is plain C17 + libm: compiled without any external include path.
 CORE_CFLAGS := $(BASE_CFLAGS)
