@@ -101,7 +101,13 @@ static void ref_diff(const pk_dem_geom *g, const double *xi, const double *xj, d
     ref_image(g, xi, xj, ds, t);
 }
 
-/* Candidate p's lattice shift in the current frame, sh = F̄ t (ref_image). */
+/* Candidate p's lattice shift in the current frame, sh = F̄ t (ref_image).
+ * Measured and dropped (fifth session, round 12): a uint16 code per pair into
+ * a table of the shifts for k in {-2..2}^dim formed once per F̄ (bit-identical,
+ * −0 kept; a per-pair fallback beyond |k| = 2): 24 → 2 B per pair read per
+ * evaluation, but +1.9 % instructions and no faster (seeds 6–8 of the cached
+ * 10⁴ RVEs, alternating runs; a synthetic 10⁴-grain evaluation 3.21 →
+ * 3.22–3.30 ns per pair — the shifts are read in order and prefetched). */
 static void set_shift(pk_dem_pairs *c, const pk_dem_geom *g, size_t p, const double t[3])
 {
     double *sh = &c->sh[3 * p];
