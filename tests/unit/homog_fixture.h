@@ -120,4 +120,54 @@ static inline void fixture_free(fixture *fx)
     pk_homog_state_free(&fx->s);
 }
 
+/* A relaxation problem for the solvers themselves (DR, FIRE): a dense
+ * 200-grain packing (φ 0.90, well above jamming: one minimum near the start,
+ * no plastic event) under 0.1 % compression; x0 the affine start, c the
+ * RVE's pair list (not yet built), is_free the grains the solvers move. */
+typedef struct relax_problem {
+    pk_particles p;
+    pk_homog_rve rve;
+    pk_homog_opts o;
+    pk_dem_geom g;
+    pk_dem_pairs c;
+    uint8_t *is_free;
+    double *x0;
+} relax_problem;
+
+static inline void relax_problem_make(relax_problem *pb)
+{
+    pk_box b;
+    make_jammed(2, 200, 0.90, 7, &b, &pb->p);
+    char err[128];
+    CHECK(pk_homog_rve_build(&b, &pb->p, PK_BC_PERIODIC, 1.0, &pb->rve, err, sizeof err) == 0);
+    pb->o = opts(1.0);
+    pb->o.dr.tol = 1e-10;
+    double F[9];
+    diagF(F, 0.999, 1.0, 1.0);
+    memset(&pb->g, 0, sizeof pb->g);
+    pb->g.dim = 2;
+    pb->g.periodic = 1;
+    memcpy(pb->g.L, pb->rve.L, sizeof pb->g.L);
+    pk_dem_geom_set_F(&pb->g, F);
+    memset(&pb->c, 0, sizeof pb->c);
+    pk_homog_pairs_setup(&pb->c, &pb->rve, &pb->o);
+    size_t n = pb->rve.n;
+    pb->is_free = malloc(n);
+    pb->x0 = malloc(3 * n * sizeof *pb->x0);
+    for (size_t i = 0; i < n; i++) {
+        pb->is_free[i] = !pb->rve.fixed[i];
+        pk_m3_vec(F, &pb->rve.X[3 * i], &pb->x0[3 * i]);
+        pb->x0[3 * i + 2] = 0;
+    }
+}
+
+static inline void relax_problem_free(relax_problem *pb)
+{
+    pk_dem_pairs_free(&pb->c);
+    pk_homog_rve_free(&pb->rve);
+    pk_particles_free(&pb->p);
+    free(pb->is_free);
+    free(pb->x0);
+}
+
 #endif

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "grid_fixture.h"
 #include "grid_uniform.h"
 #include "rng.h"
 
@@ -64,25 +65,10 @@ static size_t listed(const pk_ugrid *g)
 static size_t move_case(int dim, const bool periodic[3], uint64_t seed)
 {
     pk_box b;
-    memset(&b, 0, sizeof b);
-    b.dim = dim;
-    for (int k = 0; k < dim; k++) {
-        b.L[k] = (dim == 3 ? 24.0 : 14.0) + 2 * k;
-        b.periodic[k] = periodic[k];
-    }
-    const size_t n = dim == 3 ? 700 : 300;
     pk_particles p;
-    pk_particles_init(&p, dim, n);
     pk_rng rng;
-    pk_rng_seed(&rng, seed, 9);
-    for (size_t i = 0; i < n; i++) {
-        double x[3] = {0, 0, 0};
-        for (int k = 0; k < dim; k++)
-            x[k] = pk_rng_range(&rng, 0, b.L[k]);
-        /* inverse CDF of d^-2.5 on [1, 16], radii 0.25 .. 4 (test_grid_uniform) */
-        double u = pk_rng_range(&rng, 0, 1);
-        pk_particles_push(&p, x, 0.125 * pow(1 - u * (1 - pow(16, -1.5)), -1 / 1.5), 0);
-    }
+    fuller_scene(dim, periodic, seed, &b, &p, &rng); /* grid_fixture.h */
+    const size_t n = p.n;
     pk_ugrid g;
     CHECK(pk_ugrid_init(&g, &b, p.r, n, n) == 0);
     CHECK(g.cov_r > 0 && g.covered[0]);
@@ -114,16 +100,10 @@ static size_t move_case(int dim, const bool periodic[3], uint64_t seed)
     }
     /* reference: a grid with g's geometry (same init radii), every grain
      * filed once at its final place */
+    pk_box b0;
     pk_particles p0;
-    pk_particles_init(&p0, dim, n);
-    pk_rng_seed(&rng, seed, 9);
-    for (size_t i = 0; i < n; i++) {
-        double x[3] = {0, 0, 0};
-        for (int k = 0; k < dim; k++)
-            x[k] = pk_rng_range(&rng, 0, b.L[k]);
-        double u = pk_rng_range(&rng, 0, 1);
-        pk_particles_push(&p0, x, 0.125 * pow(1 - u * (1 - pow(16, -1.5)), -1 / 1.5), 0);
-    }
+    pk_rng rng0;
+    fuller_scene(dim, periodic, seed, &b0, &p0, &rng0); /* the same scene: its init radii */
     pk_ugrid ref;
     CHECK(pk_ugrid_init(&ref, &b, p0.r, n, n) == 0);
     CHECK(ref.cov_level == g.cov_level && ref.cov_r == g.cov_r);

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "grid_fixture.h"
 #include "grid_uniform.h"
 #include "rng.h"
 
@@ -129,25 +130,10 @@ static size_t cover_case(int dim, const bool periodic[3], uint64_t seed)
 {
     size_t big = 0;
     pk_box b;
-    memset(&b, 0, sizeof b);
-    b.dim = dim;
-    for (int k = 0; k < dim; k++) {
-        b.L[k] = (dim == 3 ? 24.0 : 14.0) + 2 * k;
-        b.periodic[k] = periodic[k];
-    }
-    const size_t n = dim == 3 ? 700 : 300;
     pk_particles p;
-    pk_particles_init(&p, dim, n);
     pk_rng rng;
-    pk_rng_seed(&rng, seed, 9);
-    for (size_t i = 0; i < n; i++) {
-        double x[3] = {0, 0, 0};
-        for (int k = 0; k < dim; k++)
-            x[k] = pk_rng_range(&rng, 0, b.L[k]);
-        /* inverse CDF of d^-2.5 on [1, 16], radii 0.25 .. 4 */
-        double u = pk_rng_range(&rng, 0, 1);
-        pk_particles_push(&p, x, 0.125 * pow(1 - u * (1 - pow(16, -1.5)), -1 / 1.5), 0);
-    }
+    fuller_scene(dim, periodic, seed, &b, &p, &rng);
+    const size_t n = p.n;
     pk_ugrid g;
     CHECK(pk_ugrid_init(&g, &b, p.r, n, n) == 0);
     CHECK(g.cov_r > 0 && g.covered[0]); /* the fines' level is the busiest: coarser ones covered */

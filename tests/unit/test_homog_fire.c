@@ -7,57 +7,8 @@
 #include "homog_fire.h"
 #include "homog_fixture.h"
 
-/* A relaxation problem: a dense 200-grain packing (φ 0.90, well above
- * jamming: one minimum near the start, no plastic event) under 0.1 %
- * compression, from the affine start. */
-typedef struct problem {
-    pk_particles p;
-    pk_homog_rve rve;
-    pk_homog_opts o;
-    pk_dem_geom g;
-    pk_dem_pairs c;
-    uint8_t *is_free;
-    double *x0;
-} problem;
-
-static void problem_make(problem *pb)
-{
-    pk_box b;
-    make_jammed(2, 200, 0.90, 7, &b, &pb->p);
-    char err[128];
-    CHECK(pk_homog_rve_build(&b, &pb->p, PK_BC_PERIODIC, 1.0, &pb->rve, err, sizeof err) == 0);
-    pb->o = opts(1.0);
-    pb->o.dr.tol = 1e-10;
-    double F[9];
-    diagF(F, 0.999, 1.0, 1.0);
-    memset(&pb->g, 0, sizeof pb->g);
-    pb->g.dim = 2;
-    pb->g.periodic = 1;
-    memcpy(pb->g.L, pb->rve.L, sizeof pb->g.L);
-    pk_dem_geom_set_F(&pb->g, F);
-    memset(&pb->c, 0, sizeof pb->c);
-    pk_homog_pairs_setup(&pb->c, &pb->rve, &pb->o);
-    size_t n = pb->rve.n;
-    pb->is_free = malloc(n);
-    pb->x0 = malloc(3 * n * sizeof *pb->x0);
-    for (size_t i = 0; i < n; i++) {
-        pb->is_free[i] = !pb->rve.fixed[i];
-        pk_m3_vec(F, &pb->rve.X[3 * i], &pb->x0[3 * i]);
-        pb->x0[3 * i + 2] = 0;
-    }
-}
-
-static void problem_free(problem *pb)
-{
-    pk_dem_pairs_free(&pb->c);
-    pk_homog_rve_free(&pb->rve);
-    pk_particles_free(&pb->p);
-    free(pb->is_free);
-    free(pb->x0);
-}
-
 /* Energy, stress sum and free residual at x. */
-static void measure(problem *pb, const double *x, double *phi, double S[9], double *fres)
+static void measure(relax_problem *pb, const double *x, double *phi, double S[9], double *fres)
 {
     size_t n = pb->rve.n;
     double *f = malloc(3 * n * sizeof *f);
@@ -67,7 +18,7 @@ static void measure(problem *pb, const double *x, double *phi, double S[9], doub
     free(f);
 }
 
-static double *copy_x(const problem *pb)
+static double *copy_x(const relax_problem *pb)
 {
     double *x = malloc(3 * pb->rve.n * sizeof *x);
     memcpy(x, pb->x0, 3 * pb->rve.n * sizeof *x);
@@ -81,8 +32,8 @@ static double *copy_x(const problem *pb)
  * printed; the reason it is there). */
 static void test_fire_reaches_dr_minimum(void)
 {
-    problem pb;
-    problem_make(&pb);
+    relax_problem pb;
+    relax_problem_make(&pb);
     size_t n = pb.rve.n;
     double *xd = copy_x(&pb), *xf = copy_x(&pb);
     pk_dr_stats sd, sf;
@@ -109,7 +60,7 @@ static void test_fire_reaches_dr_minimum(void)
            sf.iterations, sf.refreshes, (double)sd.iterations / (double)sf.iterations, dS / Sn);
     free(xd);
     free(xf);
-    problem_free(&pb);
+    relax_problem_free(&pb);
 }
 
 /* FIRE as first written (round 7): P = f·v, v ← v + Δt f, the mixed move
@@ -117,7 +68,7 @@ static void test_fire_reaches_dr_minimum(void)
  * (homog_fire.c: one pass after each evaluation), which must follow it bit
  * for bit: near jamming a difference in the last bit moves the plastic
  * events.  Runs exactly `iters` iterations; returns the restarts. */
-static size_t fire_reference(problem *pb, double *x, const pk_fire_params *fp, size_t iters)
+static size_t fire_reference(relax_problem *pb, double *x, const pk_fire_params *fp, size_t iters)
 {
     const size_t n = pb->rve.n;
     const double E = pb->o.E_n, dt_min_share = 0.02; /* DT_MIN_SHARE */
@@ -166,8 +117,8 @@ static size_t fire_reference(problem *pb, double *x, const pk_fire_params *fp, s
  * the same positions to the last bit and the same restarts. */
 static void test_fused_loop_is_the_reference(void)
 {
-    problem pb;
-    problem_make(&pb);
+    relax_problem pb;
+    relax_problem_make(&pb);
     size_t n = pb.rve.n;
     double F[9];
     diagF(F, 0.99, 1.0, 1.0);
@@ -191,7 +142,7 @@ static void test_fused_loop_is_the_reference(void)
            st.rebuilds);
     free(xr);
     free(xf);
-    problem_free(&pb);
+    relax_problem_free(&pb);
 }
 
 /* A hook that records its calls; `answer` is what it returns. */
@@ -218,8 +169,8 @@ static int spy_fn(void *ctx, double *x, double *fres, double *at)
  * with max_iter. */
 static void test_hook_and_cap(void)
 {
-    problem pb;
-    problem_make(&pb);
+    relax_problem pb;
+    relax_problem_make(&pb);
     size_t n = pb.rve.n;
     pk_fire_params fp = pk_fire_params_default();
     double *xa = copy_x(&pb), *xb = copy_x(&pb);
@@ -263,7 +214,7 @@ static void test_hook_and_cap(void)
     CHECK(sb.stop == PK_DR_MAX_ITER && sb.iterations == 5);
     free(xa);
     free(xb);
-    problem_free(&pb);
+    relax_problem_free(&pb);
 }
 
 int main(void)

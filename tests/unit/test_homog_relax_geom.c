@@ -11,57 +11,8 @@
 #include "homog_fire.h"
 #include "homog_fixture.h"
 
-typedef struct problem {
-    pk_particles p;
-    pk_homog_rve rve;
-    pk_homog_opts o;
-    pk_dem_geom g;
-    pk_dem_pairs c;
-    uint8_t *is_free;
-    double *x;
-} problem;
-
-/* A dense 200-grain packing under 0.1 % compression from the affine start
- * (as test_homog_fire.c): some hundred iterations, several estimates. */
-static void problem_make(problem *pb)
-{
-    pk_box b;
-    make_jammed(2, 200, 0.90, 7, &b, &pb->p);
-    char err[128];
-    CHECK(pk_homog_rve_build(&b, &pb->p, PK_BC_PERIODIC, 1.0, &pb->rve, err, sizeof err) == 0);
-    pb->o = opts(1.0);
-    pb->o.dr.tol = 1e-10;
-    pb->o.dr.refresh = 25; /* many estimates, each after a forces-only evaluation */
-    double F[9];
-    diagF(F, 0.999, 1.0, 1.0);
-    memset(&pb->g, 0, sizeof pb->g);
-    pb->g.dim = 2;
-    pb->g.periodic = 1;
-    memcpy(pb->g.L, pb->rve.L, sizeof pb->g.L);
-    pk_dem_geom_set_F(&pb->g, F);
-    memset(&pb->c, 0, sizeof pb->c);
-    pk_homog_pairs_setup(&pb->c, &pb->rve, &pb->o);
-    size_t n = pb->rve.n;
-    pb->is_free = malloc(n);
-    pb->x = malloc(3 * n * sizeof *pb->x);
-    for (size_t i = 0; i < n; i++) {
-        pb->is_free[i] = !pb->rve.fixed[i];
-        pk_m3_vec(F, &pb->rve.X[3 * i], &pb->x[3 * i]);
-        pb->x[3 * i + 2] = 0;
-    }
-}
-
-static void problem_free(problem *pb)
-{
-    pk_dem_pairs_free(&pb->c);
-    pk_homog_rve_free(&pb->rve);
-    pk_particles_free(&pb->p);
-    free(pb->is_free);
-    free(pb->x);
-}
-
 /* The pair data of c equal those of a fresh evaluation at x? */
-static int geometry_is_fresh(problem *pb, const double *x)
+static int geometry_is_fresh(relax_problem *pb, const double *x)
 {
     pk_dem_pairs *c = &pb->c;
     size_t n = c->n;
@@ -77,7 +28,7 @@ static int geometry_is_fresh(problem *pb, const double *x)
 }
 
 typedef struct hook_ctx {
-    problem *pb;
+    relax_problem *pb;
     int calls, stale;
 } hook_ctx;
 
@@ -100,28 +51,29 @@ typedef struct outcome {
 
 static outcome relax(int store, int fire)
 {
-    problem pb;
-    problem_make(&pb);
+    relax_problem pb; /* (homog_fixture.h) relaxed from its affine start x0 in place */
+    relax_problem_make(&pb);
+    pb.o.dr.refresh = 25; /* many estimates, each after a forces-only evaluation */
     hook_ctx h = {&pb, 0, 0};
     pk_dr_hook hook = {.fn = look, .ctx = &h, .at = 1e-3};
     outcome o = {0};
     pk_dem_forces_store = store;
     pk_fire_params fp = pk_fire_params_default();
-    int rc = fire ? pk_homog_fire_hooked(&pb.c, &pb.g, pb.x, pb.rve.r, pb.rve.n, pb.o.E_n,
+    int rc = fire ? pk_homog_fire_hooked(&pb.c, &pb.g, pb.x0, pb.rve.r, pb.rve.n, pb.o.E_n,
                                          pb.is_free, &pb.o.dr, &fp, &hook, NULL, &o.st)
-                  : pk_homog_relax_hooked(&pb.c, &pb.g, pb.x, pb.rve.r, pb.rve.n, pb.o.E_n,
+                  : pk_homog_relax_hooked(&pb.c, &pb.g, pb.x0, pb.rve.r, pb.rve.n, pb.o.E_n,
                                           pb.is_free, &pb.o.dr, &hook, NULL, &o.st);
     pk_dem_forces_store = 0;
     CHECK(rc == 0);
     CHECK(pk_dr_stop_ok(o.st.stop));
     o.calls = h.calls;
     o.stale_at_hook = h.stale;
-    o.fresh_at_return = geometry_is_fresh(&pb, pb.x);
+    o.fresh_at_return = geometry_is_fresh(&pb, pb.x0);
     o.n = pb.rve.n;
     size_t n3 = 3 * pb.rve.n;
     o.x = malloc(n3 * sizeof *o.x);
-    memcpy(o.x, pb.x, n3 * sizeof *o.x);
-    problem_free(&pb);
+    memcpy(o.x, pb.x0, n3 * sizeof *o.x);
+    relax_problem_free(&pb);
     return o;
 }
 
