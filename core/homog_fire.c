@@ -145,7 +145,7 @@ int pk_homog_fire_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const
         double dt_up = n_pos + 1 > fp->n_min ? fmin(dt * fp->f_inc, dt_max) : dt;
         s = fire_sums_at(f, v, w, is_free, np, dim, dt_up);
         st->f = sqrt(s.ff);
-        int e = pk_relax_iteration_end_geom(st, prm, target, k, x, hook, mon, &pr, &geo);
+        int e = pk_relax_iteration_end(st, prm, target, k, x, hook, mon, &pr, &geo);
         if (e < 0) {
             rc = e;
             goto out;

@@ -265,14 +265,8 @@ int pk_relax_begin(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const
 }
 
 int pk_relax_iteration_end(pk_dr_stats *st, const pk_dr_params *prm, double target, size_t k,
-                           double *x, pk_dr_hook *hook, pk_monitor *mon, pk_progress *pr)
-{
-    return pk_relax_iteration_end_geom(st, prm, target, k, x, hook, mon, pr, NULL);
-}
-
-int pk_relax_iteration_end_geom(pk_dr_stats *st, const pk_dr_params *prm, double target,
-                                size_t k, double *x, pk_dr_hook *hook, pk_monitor *mon,
-                                pk_progress *pr, pk_relax_geom *gm)
+                           double *x, pk_dr_hook *hook, pk_monitor *mon, pk_progress *pr,
+                           pk_relax_geom *gm)
 {
     if (st->f <= target) {
         st->stop = st->f <= prm->tol * st->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
@@ -394,7 +388,7 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
             goto out;
         }
         st->f = resid_norm(&sys, f, gu);
-        int e = pk_relax_iteration_end_geom(st, prm, target, k, x, hook, mon, &pr, &geo);
+        int e = pk_relax_iteration_end(st, prm, target, k, x, hook, mon, &pr, &geo);
         if (e < 0) {
             rc = e;
             goto out;

@@ -103,14 +103,6 @@ int pk_relax_move(double *x, double *v, const double *f, const uint8_t *is_free,
  * must give the same bits). */
 extern int pk_relax_scalar_move;
 
-/* The end of one relaxation iteration, shared by DR and FIRE (homog_fire.h),
- * with st->f the residual after it: converged at target, the hook (if any),
- * the iteration cap, and every 64th iteration (k & 63 == 63) the monitor.
- * Returns 0 to go on, 1 to stop (st->stop set, x maybe replaced by the
- * hook's), < 0 the hook's error. */
-int pk_relax_iteration_end(pk_dr_stats *st, const pk_dr_params *prm, double target, size_t k,
-                           double *x, pk_dr_hook *hook, pk_monitor *mon, pk_progress *pr);
-
 /* The pair geometry of a relaxation whose iterations evaluate the forces
  * alone (pk_dem_eval_forces, after which fresh = 0): pk_relax_geom_refresh
  * puts the geometry (l, |l|, ε) of x back when fresh = 0 (pk_dem_eval
@@ -128,10 +120,15 @@ typedef struct pk_relax_geom {
 } pk_relax_geom;
 void pk_relax_geom_refresh(pk_relax_geom *gm, const double *x);
 
-/* pk_relax_iteration_end with pk_relax_geom_refresh(gm, x) before the hook. */
-int pk_relax_iteration_end_geom(pk_dr_stats *st, const pk_dr_params *prm, double target,
-                                size_t k, double *x, pk_dr_hook *hook, pk_monitor *mon,
-                                pk_progress *pr, pk_relax_geom *gm);
+/* The end of one relaxation iteration, shared by DR and FIRE (homog_fire.h),
+ * with st->f the residual after it: converged at target, the hook (if any;
+ * the pair geometry gm refreshed at x before it, gm may be NULL), the
+ * iteration cap, and every 64th iteration (k & 63 == 63) the monitor.
+ * Returns 0 to go on, 1 to stop (st->stop set, x maybe replaced by the
+ * hook's), < 0 the hook's error. */
+int pk_relax_iteration_end(pk_dr_stats *st, const pk_dr_params *prm, double target, size_t k,
+                           double *x, pk_dr_hook *hook, pk_monitor *mon, pk_progress *pr,
+                           pk_relax_geom *gm);
 
 /* pk_homog_relax with a hook (hook->at: the first threshold). */
 int pk_homog_relax_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,

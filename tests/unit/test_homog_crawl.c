@@ -36,7 +36,7 @@ static void drive(double (*f)(size_t), size_t n, size_t crawl, spy *s)
     for (size_t k = 0; k < n; k++) {
         st->iterations = k + 1;
         st->f = f(k + 1);
-        CHECK(pk_relax_iteration_end(st, &prm, 1e-25, k, x, &h, NULL, &pr) == 0);
+        CHECK(pk_relax_iteration_end(st, &prm, 1e-25, k, x, &h, NULL, &pr, NULL) == 0);
     }
 }
 
