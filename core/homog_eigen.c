@@ -60,6 +60,29 @@ double pk_homog_dot_mask(const double *u, const double *v, const uint8_t *mask, 
     return dim == 2 ? dot_mask_loop(u, v, mask, np, 2) : dot_mask_loop(u, v, mask, np, dim);
 }
 
+/* dot_mask_loop's u·v (the same operations in the same order) and u·w in
+ * the same pass. */
+static inline double dot2_mask_loop(const double *u, const double *v, const double *w,
+                                    const uint8_t *mask, size_t np, const int dim, double *uw)
+{
+    double s = 0, t = 0;
+    for (size_t i = 0; i < np; i++)
+        if (mask[i])
+            for (int a = 0; a < dim; a++) {
+                s += u[3 * i + a] * v[3 * i + a];
+                t += u[3 * i + a] * w[3 * i + a];
+            }
+    *uw = t;
+    return s;
+}
+
+double pk_homog_dot2_mask(const double *u, const double *v, const double *w, const uint8_t *mask,
+                          size_t np, int dim, double *uw)
+{
+    return dim == 2 ? dot2_mask_loop(u, v, w, mask, np, 2, uw)
+                    : dot2_mask_loop(u, v, w, mask, np, dim, uw);
+}
+
 double pk_homog_rayleigh(const pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *mask,
                          const double *v, double *work)
 {

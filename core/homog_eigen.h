@@ -30,4 +30,8 @@ double pk_tridiag_min_eig(const double *a, const double *b, int m);
 /* u·v over the particles with mask[i] != 0 (stride-3 vectors, dim axes). */
 double pk_homog_dot_mask(const double *u, const double *v, const uint8_t *mask, size_t np, int dim);
 
+/* pk_homog_dot_mask(u, v, ...) bit for bit, and *uw = u·w from the same pass. */
+double pk_homog_dot2_mask(const double *u, const double *v, const double *w, const uint8_t *mask,
+                          size_t np, int dim, double *uw);
+
 #endif

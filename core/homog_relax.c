@@ -68,9 +68,12 @@ void pk_relax_geom_refresh(pk_relax_geom *gm, const double *x)
  * sums instead of one chain — it only decides stops and hand-overs, so the
  * path stayed the same — seed 7's cached 10⁴ step 1.93–1.99 → 1.94–2.02 s:
  * the chain is not what a DR iteration waits on.) */
-static double resid_norm(const relax_sys *s, const double *f, const double *gu)
+static double resid_norm(const relax_sys *s, const double *f, const double *gu, const double *v,
+                         double *fv)
 {
-    double a = sqrt(pk_homog_dot_mask(f, f, s->is_free, s->np, s->g->dim)), b = 0;
+    double a = sqrt(v ? pk_homog_dot2_mask(f, f, v, s->is_free, s->np, s->g->dim, fv)
+                      : pk_homog_dot_mask(f, f, s->is_free, s->np, s->g->dim)),
+           b = 0;
     if (s->fc)
         for (size_t i = 0; i < s->np; i++)
             b += gu[i] * gu[i];
@@ -125,15 +128,22 @@ static double fric_rayleigh(const relax_sys *s, double *x, double *u, const doub
  * relaxation).  A non-positive λ_min (indefinite block under large overlaps,
  * or no jammed grain) falls back to the residual's Rayleigh quotient on the
  * free grains, and only then to a tiny share of λ_max (flagged).
- * Measured and reverted (2026-11-22): λ_min also from the Rayleigh quotient
- * of DR's own increments, Σ −Δx·Δf / Σ Δx·Δx over the 200 steps between
- * estimates (adaptive DR, Underwood/Papadrakakis), its magnitude when
- * negative.  DR alone on cached 10⁴ near-jamming RVEs: 5–17x fewer
- * iterations, same minima.  But the Newton hybrid (with its hand-over at
- * 3e-4 instead of 1e-3) on the whole bench pipeline — whose RVEs are relaxed
- * at F̄ = 1 by the same DR — was slower on 4 of 5 seeds (near-jamming 10⁴,
- * seeds 5–9: 1.5/5.4/2.6/2.9/0.9 s → 4.8/6.9/3.6/2.4/1.0 s CPU).  A lead for
- * `relaxation.solver: dr` jobs, where it is a clear gain.
+ * λ_min also from the Rayleigh quotient of DR's own increments since the
+ * last estimate, Σ −Δx·Δf / Σ Δx·Δx (adaptive DR, Underwood 1983,
+ * Papadrakakis 1981), its magnitude when negative (DR then crosses a
+ * region of negative curvature: a plastic event), unless
+ * pk_dr_params.plain_lambda_min.  Late in a relaxation the increments run
+ * along the softest modes, which a 40-step Lanczos run misses by orders of
+ * magnitude near jamming (4e-3 against ~1e-5 at 10⁴ grains), so DR was
+ * over-damped there.  Measured (sixth session, cached bench RVEs,
+ * near-jamming 10⁴, one compression step): DR alone, seeds 6/7/8, 719,644 /
+ * 210,649 / 84,635 → 42,987 / 22,327 / 11,586 iterations (same minima on 6
+ * and 8; on 7 another one, ΔΦ/Φ −7.6e-4); the Newton hybrid, seeds 5–9,
+ * 1.23 / 2.30 / 1.90 / 1.77 / 0.77 s against 1.2–1.5 / 2.2–2.4 / 1.9–2.1 /
+ * 2.0–2.3 / 0.9–1.0 s (seed 7 in the lower minimum DR alone finds too).
+ * The two sums ride on the move and on the residual's pass.  (A fifth
+ * session's measurement of this on the uncached bench pipeline had it
+ * slower on 4 of 5 seeds — but there every variant relaxed its own RVEs.)
  * Cost (round 7, near-jamming 10⁴ step): one estimate 10.8 ms — rattlers
  * 4.7, Lanczos 5.6, Gershgorin and Rayleigh quotient 0.5 — against 0.18–0.25
  * ms per DR iteration: ~20 % of DR's time at refresh = 200 (seed 7: 35
@@ -144,7 +154,8 @@ static double fric_rayleigh(const relax_sys *s, double *x, double *u, const doub
  * same rattler sets and λ_min, so the same DR path. */
 static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *is_free,
                     const double *f, uint8_t *rat, uint8_t *mask, double *work, int lanczos,
-                    pk_dr_stats *st, const relax_sys *sys, double *x, double *u, const double *gu)
+                    pk_dr_stats *st, const relax_sys *sys, double *x, double *u, const double *gu,
+                    double inc_rq)
 {
     size_t nr = pk_dem_rattlers(c, dim, np, is_free, rat);
     if (nr == (size_t)-1)
@@ -165,6 +176,8 @@ static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t
     double rq = pk_homog_rayleigh(c, dim, np, E, m, f, work);
     if (rq > 0 && (rq < lmin || !(lmin > 0)))
         lmin = rq;
+    if (inc_rq != 0 && (fabs(inc_rq) < lmin || !(lmin > 0)))
+        lmin = fabs(inc_rq);
     if (sys->fric_active) {
         st->lambda_max += pk_dem_fric_gershgorin(c, sys->fc, np);
         double fq = fric_rayleigh(sys, x, u, f, gu, work);
@@ -183,12 +196,15 @@ static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t
 /* v ← cv·v + cf·f, x ← x + Δt·v on the free grains; stale = some grain
  * moved beyond half the skin since the pair list was built (held grains do
  * not move within a relaxation).  dim a constant (2 or 3) at the call: the
- * axis loops unrolled. */
+ * axis loops unrolled.  want (a constant too): acc[0] += v·v, acc[1] += v·f
+ * with the new v and the f given (the increments' Rayleigh quotient, see
+ * estimate), each axis summed apart and the axes added at the end. */
 static inline int move(double *restrict x, double *restrict v, const double *restrict f,
                        const uint8_t *restrict is_free, size_t np, const int dim, pk_relax_coef cf,
-                       const double *restrict xb, double lim2)
+                       const double *restrict xb, double lim2, const int want, double *acc)
 {
     int stale = 0;
+    double vv[3] = {0, 0, 0}, vf[3] = {0, 0, 0};
     for (size_t i = 0; i < np; i++) {
         if (!is_free[i])
             continue;
@@ -199,9 +215,16 @@ static inline int move(double *restrict x, double *restrict v, const double *res
             x[3 * i + a] += cf.dt * *vi;
             double d = x[3 * i + a] - xb[3 * i + a];
             s += d * d;
+            if (want) {
+                vv[a] += *vi * *vi;
+                vf[a] += *vi * f[3 * i + a];
+            }
         }
         stale |= s > lim2;
     }
+    if (want)
+        for (int a = 0; a < dim; a++)
+            acc[0] += vv[a], acc[1] += vf[a];
     return stale;
 }
 
@@ -216,17 +239,18 @@ static inline int move(double *restrict x, double *restrict v, const double *res
  * grain; the generic loop reloaded c->xb after every store to x, no
  * restrict); alone on 10⁴ grains 1.9–2.8 → 1.2–1.3 ns per grain.  The
  * branch on is_free is kept: nearly every grain is free (predicted). */
-static int move_2d_sse2(double *restrict x, double *restrict v, const double *restrict f,
-                        const uint8_t *restrict is_free, size_t np, pk_relax_coef cf,
-                        const double *restrict xb, double lim2)
+static inline int move_2d_sse2(double *restrict x, double *restrict v, const double *restrict f,
+                               const uint8_t *restrict is_free, size_t np, pk_relax_coef cf,
+                               const double *restrict xb, double lim2, const int want, double *acc)
 {
     const __m128d CV = _mm_set1_pd(cf.cv), CF = _mm_set1_pd(cf.cf), DT = _mm_set1_pd(cf.dt);
+    __m128d VV = _mm_setzero_pd(), VF = _mm_setzero_pd(); /* per axis, as move */
     int stale = 0;
     for (size_t i = 0; i < np; i++) {
         if (!is_free[i])
             continue;
-        __m128d vi = _mm_add_pd(_mm_mul_pd(CV, _mm_loadu_pd(&v[3 * i])),
-                                _mm_mul_pd(CF, _mm_loadu_pd(&f[3 * i])));
+        const __m128d fi = _mm_loadu_pd(&f[3 * i]);
+        __m128d vi = _mm_add_pd(_mm_mul_pd(CV, _mm_loadu_pd(&v[3 * i])), _mm_mul_pd(CF, fi));
         __m128d xi = _mm_add_pd(_mm_loadu_pd(&x[3 * i]), _mm_mul_pd(DT, vi));
         _mm_storeu_pd(&v[3 * i], vi);
         _mm_storeu_pd(&x[3 * i], xi);
@@ -234,6 +258,17 @@ static int move_2d_sse2(double *restrict x, double *restrict v, const double *re
         __m128d dd = _mm_mul_pd(d, d);
         double s = _mm_cvtsd_f64(_mm_add_sd(dd, _mm_unpackhi_pd(dd, dd)));
         stale |= s > lim2;
+        if (want) {
+            VV = _mm_add_pd(VV, _mm_mul_pd(vi, vi));
+            VF = _mm_add_pd(VF, _mm_mul_pd(vi, fi));
+        }
+    }
+    if (want) {
+        double a[2], b[2];
+        _mm_storeu_pd(a, VV);
+        _mm_storeu_pd(b, VF);
+        acc[0] += a[0], acc[0] += a[1];
+        acc[1] += b[0], acc[1] += b[1];
     }
     return stale;
 }
@@ -241,16 +276,26 @@ static int move_2d_sse2(double *restrict x, double *restrict v, const double *re
 
 int pk_relax_scalar_move = 0;
 
-int pk_relax_move(double *x, double *v, const double *f, const uint8_t *is_free, size_t np,
-                  int dim, pk_relax_coef cf, const pk_dem_pairs *c)
+int pk_relax_move_acc(double *x, double *v, const double *f, const uint8_t *is_free, size_t np,
+                      int dim, pk_relax_coef cf, const pk_dem_pairs *c, double acc[2])
 {
     const double lim2 = 0.25 * c->skin * c->skin;
 #if defined(__SSE2__)
     if (dim == 2 && !pk_relax_scalar_move)
-        return move_2d_sse2(x, v, f, is_free, np, cf, c->xb, lim2);
+        return acc ? move_2d_sse2(x, v, f, is_free, np, cf, c->xb, lim2, 1, acc)
+                   : move_2d_sse2(x, v, f, is_free, np, cf, c->xb, lim2, 0, NULL);
 #endif
-    return dim == 2 ? move(x, v, f, is_free, np, 2, cf, c->xb, lim2)
-                    : move(x, v, f, is_free, np, dim, cf, c->xb, lim2);
+    if (acc)
+        return dim == 2 ? move(x, v, f, is_free, np, 2, cf, c->xb, lim2, 1, acc)
+                        : move(x, v, f, is_free, np, dim, cf, c->xb, lim2, 1, acc);
+    return dim == 2 ? move(x, v, f, is_free, np, 2, cf, c->xb, lim2, 0, NULL)
+                    : move(x, v, f, is_free, np, dim, cf, c->xb, lim2, 0, NULL);
+}
+
+int pk_relax_move(double *x, double *v, const double *f, const uint8_t *is_free, size_t np,
+                  int dim, pk_relax_coef cf, const pk_dem_pairs *c)
+{
+    return pk_relax_move_acc(x, v, f, is_free, np, dim, cf, c, NULL);
 }
 
 int pk_relax_begin(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
@@ -342,24 +387,32 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
         rc = -1;
         goto out;
     }
-    st->f0 = st->f = resid_norm(&sys, f, gu);
+    st->f0 = st->f = resid_norm(&sys, f, gu, NULL, NULL);
     double target;
     if (pk_relax_settled(st, prm, nfree == 0 && !sys.fric_active, &target))
         goto out;
-    if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu) != 0) {
+    if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu, 0) != 0) {
         rc = -1;
         goto out;
     }
     pk_progress pr = {.stage = "relax", .fraction = -1, .phi = -1, .eta_s = -1};
     double fbest = st->f0;
     pk_relax_geom geo = {c, g, r, np, E, 1}; /* pk_dem_eval_forces */
+    /* Σ −Δx·Δf and Σ Δx·Δx over the iterations since the last estimate
+     * (frictionless: the increments of x alone), Δx = Δt v: the Rayleigh
+     * quotient of DR's own increments (estimate) */
+    struct {
+        double df, dd;
+    } inc = {0, 0};
     for (size_t k = 0;; k++) {
         double dt = st->dt, gm = st->gamma;
         /* one step of (4.39)–(4.41): cv = (2 − γΔt)/(2 + γΔt), cf = 2Δt/(2 + γΔt),
          * or cv = 0, cf = Δt/2 on the first step (4.41) */
         pk_relax_coef cf = {dt, k == 0 ? 0 : (2 - gm * dt) / (2 + gm * dt),
                             k == 0 ? 0.5 * dt : 2 * dt / (2 + gm * dt)};
-        int stale = pk_relax_move(x, v, f, is_free, np, dim, cf, c);
+        double mv[2] = {0, 0}; /* v·v, v·f before the evaluation */
+        const int incr = !sys.fric_active && !prm->plain_lambda_min;
+        int stale = pk_relax_move_acc(x, v, f, is_free, np, dim, cf, c, incr ? mv : NULL);
         if (sys.fric_active) /* the rotations, same scheme (unit pseudo-mass of u = rθ) */
             for (size_t i = 0; i < np; i++) {
                 vu[i] = cf.cv * vu[i] + cf.cf * gu[i];
@@ -387,7 +440,10 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
             rc = -1;
             goto out;
         }
-        st->f = resid_norm(&sys, f, gu);
+        double vf1 = 0;
+        st->f = resid_norm(&sys, f, gu, incr ? v : NULL, &vf1);
+        inc.df -= vf1 - mv[1]; /* Δx·Δf / Δt */
+        inc.dd += dt * mv[0];  /* Δx·Δx / Δt */
         int e = pk_relax_iteration_end(st, prm, target, k, x, hook, mon, &pr, &geo);
         if (e < 0) {
             rc = e;
@@ -398,7 +454,8 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
         if (!isfinite(st->f) || st->f > 1e3 * fbest) {
             /* diverging: the spectrum moved (new contacts) — fresh estimates, restart at rest */
             pk_relax_geom_refresh(&geo, x);
-            if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu) != 0) {
+            if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu,
+                         inc.dd > 0 ? inc.df / inc.dd : 0) != 0) {
                 rc = -1;
                 goto out;
             }
@@ -406,16 +463,19 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
             memset(vu, 0, np * sizeof *vu);
             fbest = st->f;
             st->refreshes++;
+            inc.df = inc.dd = 0;
             continue;
         }
         fbest = fmin(fbest, st->f);
         if (prm->refresh && st->iterations % prm->refresh == 0) {
             pk_relax_geom_refresh(&geo, x);
-            if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu) != 0) {
+            if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu,
+                         inc.dd > 0 ? inc.df / inc.dd : 0) != 0) {
                 rc = -1;
                 goto out;
             }
             st->refreshes++;
+            inc.df = inc.dd = 0;
         }
     }
     pk_relax_geom_refresh(&geo, x);

@@ -37,6 +37,8 @@ typedef struct pk_dr_params {
     int lanczos_steps;    /* for the initial λ_min (e.g. 40) */
     size_t refresh;       /* iterations between estimate refreshes (e.g. 200) */
     double skin;          /* Verlet skin (length) */
+    int plain_lambda_min; /* 1: λ_min without the Rayleigh quotient of DR's own
+                           * increments (homog_relax.c, estimate; tests, bench) */
 } pk_dr_params;
 
 typedef struct pk_dr_stats {
@@ -99,6 +101,11 @@ typedef struct pk_relax_coef {
 } pk_relax_coef;
 int pk_relax_move(double *x, double *v, const double *f, const uint8_t *is_free, size_t np,
                   int dim, pk_relax_coef cf, const pk_dem_pairs *c);
+/* The same move, and acc[0] += v·v, acc[1] += v·f with the new v (each
+ * axis summed apart, then the axes in order: the same bits in the SSE2 and
+ * the generic loop); acc NULL: pk_relax_move. */
+int pk_relax_move_acc(double *x, double *v, const double *f, const uint8_t *is_free, size_t np,
+                      int dim, pk_relax_coef cf, const pk_dem_pairs *c, double acc[2]);
 /* 1: pk_relax_move takes its generic loop in 2D too (tests: the SSE2 move
  * must give the same bits). */
 extern int pk_relax_scalar_move;
