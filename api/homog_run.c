@@ -11,6 +11,8 @@
 #include "homog_record.h"
 #include "homog_tangent.h"
 #include "homog_tensor.h"
+#include "par.h"
+#include "process.h"
 #include "sparse_cholmod.h"
 
 static void opts_of(const pk_homog_job *job, const pk_homog_rve *rve, pk_homog_opts *o)
@@ -148,6 +150,7 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
     pk_homog_rve rve = {0};
     pk_homog_state com = {0}, tr = {0};
     pk_sparse_ctx *nctx = NULL; /* Newton's solver context over the whole load path */
+    pk_par *pool = NULL;        /* the job's threads (NULL: serial; the same results) */
     json_t *rec = NULL;
     if (job.fdim && job.fdim != dim) {
         snprintf(err, errlen, "the load path is %dD but the RVE is %dD", job.fdim, dim);
@@ -168,6 +171,7 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
      * every factorisation is analysed afresh — the same numbers either way */
     if (o.newton && o.newton->ctx_new)
         o.newton_ctx = nctx = o.newton->ctx_new();
+    o.par = pool = pk_par_new(pk_job_threads());
     if (pk_homog_state_init(&rve, &o, &com) != 0) {
         snprintf(err, errlen, "out of memory");
         goto out;
@@ -286,6 +290,8 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
     json_object_set_new(sum, "rve_particles", json_integer((json_int_t)rve.n));
     json_object_set_new(sum, "dr_iterations_total", json_integer((json_int_t)total_iter));
     json_object_set_new(sum, "dr_iterations_max", json_integer((json_int_t)max_iter_step));
+    /* the threads the job ran with (not in the file: the results are the same for any) */
+    json_object_set_new(sum, "threads", json_integer(pk_par_threads(pool)));
     if (done) {
         json_object_set_new(sum, "F", tensor_json(com.F, dim));
         json_object_set_new(sum, "P", tensor_json(st.P, dim));
@@ -305,6 +311,7 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
     *summary = sum;
     rc = 0;
 out:
+    pk_par_free(pool);
     if (nctx)
         pk_sparse_cholmod.ctx_free(nctx);
     json_decref(rec);

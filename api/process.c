@@ -83,6 +83,12 @@ size_t pk_job_validate(json_t *job, const pk_process **proc, pk_schema_errors *e
     return errs->n - before;
 }
 
+static int job_threads = 1;
+
+void pk_job_set_threads(int n) { job_threads = n < 1 ? 1 : n; }
+
+int pk_job_threads(void) { return job_threads; }
+
 int pk_job_run(json_t *job, const char *out_path, pk_monitor *mon, json_t **summary,
                pk_schema_errors *errs, char *err, size_t errlen)
 {

@@ -37,6 +37,12 @@ size_t pk_process_validate_inputs(const pk_process *p, json_t *inputs, pk_schema
  * *proc is set.  Pointers in errors are relative to the job file root. */
 size_t pk_job_validate(json_t *job, const pk_process **proc, pk_schema_errors *errs);
 
+/* Threads of a job's parallel sections (core/par.h), for the jobs run by
+ * this process from now on (default 1).  The results are the same bits
+ * for any number: a deployment setting, not a job input. */
+void pk_job_set_threads(int n);
+int pk_job_threads(void);
+
 /* Validate and run a job (the one code path of `packd run` and the daemon's
  * workers).  Returns 0 on success; on invalid input returns 1 with errs
  * filled; on a runtime failure returns -1 with err. */

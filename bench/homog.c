@@ -6,6 +6,14 @@
  *   bench=homog case=tangent_periodic_2d rve=KIND n=N tangent_s=S free_dofs=D
  *   bench=homog case=contact_eval_2d rve=KIND n=N pairs=P ns_per_pair=T ... (the
  *     forces-only pk_dem_eval a DR iteration runs, on the relaxed state)
+ *   bench=homog case=contact_{eval,forces}_2d ... ns_per_pair=T threads=2
+ *     serial_ns_per_pair=T1 speedup=T1/T (pk_dem_eval and pk_dem_eval_forces
+ *     on a 2-thread core/par.h pool against the serial code, best of 9
+ *     alternating rounds; the same bits; parallel_path=0: the list is
+ *     below pk_dem_par_min_pairs, both serial)
+ *   bench=homog case=periodic_step_newton_2d ... threads=2 seconds=S
+ *     serial_seconds=S1 speedup=S1/S same_bits=B (the step again on a 2-thread
+ *     pool, pk_homog_opts.par; B = 1: the same energy, P̄ and iterations)
  * The step is 0.1 % uniaxial compression at tolerance 1e-8 (the thesis's),
  * solved by the Newton/DR/FIRE hybrid (core/homog_newton.h, CHOLMOD) and by DR
  * alone from the same committed state; the DR line carries the agreement of
@@ -27,6 +35,7 @@
 #include "edmd.h"
 #include "homog_tangent.h"
 #include "homog_tensor.h"
+#include "par.h"
 #include "rng.h"
 #include "sparse_cholmod.h"
 
@@ -252,6 +261,64 @@ static void make_rve(size_t n, int near_jamming, pk_homog_rve *rve, pk_homog_sta
         cache_save(path, near_jamming, rve, relaxed);
 }
 
+/* ns per candidate of reps evaluations of c at s (forces only; keep: the
+ * pair arrays stored, pk_dem_eval, else pk_dem_eval_forces). */
+static double eval_ns(pk_dem_pairs *c, const pk_dem_geom *g, const pk_homog_rve *rve,
+                      const pk_homog_state *s, double *f, size_t reps, int keep)
+{
+    double t0 = pk_wall_seconds();
+    for (size_t k = 0; k < reps; k++) {
+        if (keep)
+            pk_dem_eval(c, g, s->x, rve->r, rve->n, 1.0, f, NULL, NULL);
+        else
+            pk_dem_eval_forces(c, g, s->x, rve->r, rve->n, 1.0, f);
+    }
+    return 1e9 * (pk_wall_seconds() - t0) / ((double)reps * (double)c->n);
+}
+
+/* The evaluation on 2 threads (core/par.h pool in c->par) against the
+ * serial one, best of ROUNDS alternating rounds each (the machine is
+ * shared: ±20 % between single runs), for pk_dem_eval (case
+ * contact_eval_2d, the line above's function) and pk_dem_eval_forces (case
+ * contact_forces_2d, the DR/FIRE iterations' one); speedup = serial/2
+ * threads.  The results are bit-identical (tests/unit/test_dem_parallel.c). */
+#define ROUNDS 9
+static void parallel_eval_cases(pk_dem_pairs *c, const pk_dem_geom *g, const pk_homog_rve *rve,
+                                const pk_homog_state *s, double *f, const char *kind)
+{
+    pk_par *par = pk_par_new(2);
+    if (!par)
+        return;
+    size_t reps = 1 + 10000000 / c->n;
+    for (int keep = 1; keep >= 0; keep--) {
+        double ser = INFINITY, two = INFINITY;
+        for (int k = 0; k < ROUNDS; k++) {
+            c->par = NULL;
+            ser = fmin(ser, eval_ns(c, g, rve, s, f, reps, keep));
+            c->par = par;
+            two = fmin(two, eval_ns(c, g, rve, s, f, reps, keep));
+        }
+        /* the same bits (checked in tests/unit/test_dem_parallel.c; here on
+         * the bench's RVE too) */
+        double *f2 = malloc(3 * rve->n * sizeof *f2);
+        int same = 0;
+        if (f2) {
+            eval_ns(c, g, rve, s, f2, 1, keep); /* on the pool */
+            c->par = NULL;
+            eval_ns(c, g, rve, s, f, 1, keep);
+            same = memcmp(f, f2, 3 * rve->n * sizeof *f) == 0;
+            free(f2);
+        }
+        c->par = NULL;
+        printf("bench=homog case=%s rve=%s n=%zu pairs=%zu reps=%zu rounds=%d "
+               "ns_per_pair=%.2f threads=2 serial_ns_per_pair=%.2f speedup=%.2f same_bits=%d "
+               "parallel_path=%d\n",
+               keep ? "contact_eval_2d" : "contact_forces_2d", kind, rve->n, c->n, reps, ROUNDS,
+               two, ser, ser / two, same, c->n >= pk_dem_par_min_pairs);
+    }
+    pk_par_free(par);
+}
+
 /* Time of the contact evaluation a DR iteration runs (forces only) per
  * candidate pair, on the relaxed RVE under the step's F̄; the repetitions
  * make ~10⁷ pair evaluations (≈ 0.1 s). */
@@ -274,10 +341,36 @@ static void eval_case(const pk_homog_rve *rve, const pk_homog_state *s, const do
         nc = pk_dem_eval(&c, &g, s->x, rve->r, rve->n, 1.0, f, NULL, NULL);
     double t = pk_wall_seconds() - t0;
     printf("bench=homog case=contact_eval_2d rve=%s n=%zu pairs=%zu contacts=%zu reps=%zu "
-           "ns_per_pair=%.2f\n",
+           "ns_per_pair=%.2f threads=1\n",
            kind, rve->n, c.n, nc, reps, 1e9 * t / ((double)reps * (double)c.n));
+    parallel_eval_cases(&c, &g, rve, s, f, kind);
     free(f);
     pk_dem_pairs_free(&c);
+}
+
+/* The Newton/DR/FIRE step again with a 2-thread pool (pk_homog_opts.par):
+ * its time against the serial one (tnw, measured just before) and whether
+ * the step gives the same bits (energy, P̄, iterations). */
+static void step_threads_case(const pk_homog_rve *rve, const pk_homog_opts *on,
+                              const pk_homog_state *s0, const double F[9], const pk_homog_step *sn,
+                              double tnw, const char *kind)
+{
+    pk_homog_opts op = *on;
+    op.par = pk_par_new(2);
+    if (!op.par)
+        return;
+    pk_homog_state tp = {0};
+    pk_homog_step sp;
+    double t0 = pk_wall_seconds();
+    pk_homog_eval(rve, &op, s0, F, &tp, &sp, NULL);
+    double t = pk_wall_seconds() - t0;
+    int same = memcmp(&sp.energy, &sn->energy, sizeof sp.energy) == 0 &&
+               memcmp(sp.P, sn->P, sizeof sp.P) == 0 && sp.dr.iterations == sn->dr.iterations;
+    printf("bench=homog case=periodic_step_newton_2d rve=%s n=%zu threads=2 seconds=%.3f "
+           "serial_seconds=%.3f speedup=%.2f same_bits=%d\n",
+           kind, rve->n, t, tnw, tnw / t, same);
+    pk_homog_state_free(&tp);
+    pk_par_free(op.par);
 }
 
 static double step_case(size_t n, int near_jamming)
@@ -330,6 +423,7 @@ static double step_case(size_t n, int near_jamming)
            sn.newton.shifts, tnw, cnw,
            pk_newton_exit_name(sn.newton.exit), pk_dr_stop_name(sn.dr.stop), sn.dr.f / sn.dr.f0,
            sn.contacts, sn.rattlers, sn.energy, sn.P[0], sn.P[4], tdr > 0 ? tdr / tnw : -1);
+    step_threads_case(&rve, &on, &s0, F, &sn, tnw, kind);
     double A[81];
     pk_tangent_info ti;
     int rc = pk_homog_tangent(&rve, &o, &tn, &pk_sparse_cholmod, A, &ti);

@@ -16,6 +16,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "par.h"
+
 typedef struct pk_dem_geom {
     int dim;
     int periodic;        /* 1 = minimum image across the reference box L */
@@ -60,6 +62,24 @@ typedef struct pk_dem_pairs {
     double *sh;
     double sh_F[9], sh_L[3];
     int sh_dim, sh_periodic, sh_ok;
+    /* Parallel evaluation: with par != NULL (the caller's pool, core/par.h;
+     * not freed here, and cleared with the rest by pk_dem_pairs_free)
+     * pk_dem_eval and pk_dem_eval_forces share the work of a call with f
+     * between the pool's threads (lists of pk_dem_par_min_pairs candidates
+     * or more, in pk_dem_pairs_build's order), and give the serial results
+     * bit for bit — f, the count, l, |l|, ε, energy, S — for any number of
+     * threads (dem_contact.c, eval_par).  The fields below are its own: */
+    pk_par *par;
+    double *fa;          /* [n][dim] force on i of each candidate, 0 when not in contact */
+    int32_t *ord;        /* per part P of the grains, its grains k with candidates
+                            j = k by their number: ord[bofs[P] .. bofs[P+1]) */
+    int32_t *bofs;
+    int32_t *jofs, *jq;  /* ord[m]'s candidates with j = ord[m], pair order:
+                            jq[jofs[m] .. jofs[m+1]) */
+    int32_t *iofs;       /* k's own run of candidates: [iofs[k], iofs[k+1]) */
+    size_t csr_n, csr_np, csr_pcap, csr_gcap;
+    int csr_state, csr_dim, csr_parts; /* state 0 to build, 1 built, −1 the list is
+                                          not in build order: serial */
 } pk_dem_pairs;
 
 void pk_dem_pairs_free(pk_dem_pairs *c);
@@ -107,6 +127,10 @@ size_t pk_dem_eval_forces(pk_dem_pairs *c, const pk_dem_geom *g, const double *x
 /* 1: pk_dem_eval_forces stores the geometry as pk_dem_eval does (tests:
  * the relaxations must give the same bits either way). */
 extern int pk_dem_forces_store;
+/* The parallel evaluation takes lists of at least this many candidates
+ * (default 4096, ~1500 grains: 2 threads gave 1.2x at 4500 candidates and
+ * less below, where the hand-over weighs more); tests set 0. */
+extern size_t pk_dem_par_min_pairs;
 
 /* The 2D evaluation takes the geometry of four candidates at once with AVX2
  * when the CPU has it (bit-identical to the scalar loop); set

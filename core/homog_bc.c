@@ -80,6 +80,7 @@ void pk_homog_pairs_setup(pk_dem_pairs *c, const pk_homog_rve *rve, const pk_hom
 {
     pk_dem_pairs_stiffness(c, o->E_n_species ? rve->species : NULL, o->E_n_species, o->n_species,
                            o->E_n);
+    c->par = o->par;
 }
 
 static void geom_of(const pk_homog_rve *rve, pk_dem_geom *g)

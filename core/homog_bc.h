@@ -54,10 +54,14 @@ typedef struct pk_homog_opts {
      * friction the equilibrium solver is always DR (newton is ignored; the
      * job layer refuses the combination) and rotations are relaxed. */
     const pk_fric_law *friction;
+    /* Threads for the parallel sections (core/par.h; NULL: serial).  The
+     * results are the same bits for any pool: a deployment setting. */
+    pk_par *par;
 } pk_homog_opts;
 
 /* Give a contact list the RVE's stiffness classes (uniform when
- * o->E_n_species is NULL); call before its first build. */
+ * o->E_n_species is NULL) and the options' thread pool; call before its
+ * first build. */
 void pk_homog_pairs_setup(pk_dem_pairs *c, const pk_homog_rve *rve, const pk_homog_opts *o);
 
 typedef struct pk_homog_step {

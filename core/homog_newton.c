@@ -640,6 +640,7 @@ int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doub
     newton_work w;
     pk_dem_pairs c2 = {0};
     pk_dem_pairs_stiffness(&c2, c->kclass, c->kmat, c->nclass, c->kref);
+    c2.par = c->par;
     if (work_alloc(&w, np, dim) != 0) {
         rc = -1;
         goto out;

@@ -45,6 +45,11 @@ int cmd_run(int argc, char **argv)
 {
     const char *job_path = NULL, *out_path = NULL, *xdmf_path = NULL;
     int progress_fd = -1;
+    /* the parallel sections' threads: the results are the same for any
+     * number, so a batch run takes the machine's cores (the daemon passes
+     * its job_threads) */
+    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    int threads = ncpu < 1 ? 1 : ncpu > 64 ? 64 : (int)ncpu;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "-o") && i + 1 < argc)
             out_path = argv[++i];
@@ -54,6 +59,15 @@ int cmd_run(int argc, char **argv)
             progress_fd = 2;
         else if (!strcmp(argv[i], "--progress-fd") && i + 1 < argc)
             progress_fd = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
+            char *end;
+            long t = strtol(argv[++i], &end, 10);
+            if (*end || t < 1 || t > 64) {
+                fprintf(stderr, "packd run: --threads takes 1..64, not '%s'\n", argv[i]);
+                return 64;
+            }
+            threads = (int)t;
+        }
         else if (!job_path && argv[i][0] != '-')
             job_path = argv[i];
         else if (!job_path && !strcmp(argv[i], "-"))
@@ -65,7 +79,7 @@ int cmd_run(int argc, char **argv)
     }
     if (!job_path || !out_path) {
         fprintf(stderr, "usage: packd run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--progress] "
-                        "[--progress-fd N]\n");
+                        "[--progress-fd N] [--threads N]\n");
         return 64;
     }
     json_t *job = cli_load_json(job_path);
@@ -89,6 +103,7 @@ int cmd_run(int argc, char **argv)
     pk_schema_errors errs = {0};
     json_t *summary = NULL;
     char err[1024] = "";
+    pk_job_set_threads(threads);
     int rc = pk_job_run(job, out_path, &mon, &summary, &errs, err, sizeof err);
     int status;
     if (rc == 1) {

@@ -22,6 +22,7 @@ static const struct key {
     {"port", K_INT, F(port), 0, 65535, "TCP port (0 = any free port)"},
     {"data", K_STR, F(data), 0, 0, "data directory"},
     {"workers", K_INT, F(workers), 0, 1024, "concurrent worker processes (0 = accept but run nothing)"},
+    {"job_threads", K_INT, F(job_threads), 1, 64, "threads of each job's parallel sections (the results are the same for any)"},
     {"max_body_bytes", K_LONG, F(max_body_bytes), 1024, 1e12, "largest request body"},
     {"max_particles", K_LONG, F(max_particles), 1, 1e12, "cap on a job's limits.max_particles"},
     {"max_wall_time_s", K_DOUBLE, F(max_wall_time_s), 1, 1e9, "cap on a job's limits.wall_time_s"},
@@ -48,6 +49,7 @@ void pk_config_defaults(pk_config *c)
     snprintf(c->data, sizeof c->data, "var");
     long n = sysconf(_SC_NPROCESSORS_ONLN);
     c->workers = n > 0 ? (int)n : 1;
+    c->job_threads = 1; /* the workers take the cores already */
     c->max_body_bytes = 16L << 20;
     c->max_particles = 20000000;
     c->max_wall_time_s = 86400;

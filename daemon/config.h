@@ -15,6 +15,7 @@ typedef struct pk_config {
     int port;
     char data[1024];          /* data directory: queue.db, jobs/, files/ */
     int workers;              /* concurrent worker processes */
+    int job_threads;          /* threads of each job's parallel sections (same results for any) */
     long max_body_bytes;      /* largest request body (POST /files, /execution) */
     long max_particles;       /* cap on limits.max_particles of each job */
     double max_wall_time_s;   /* cap on limits.wall_time_s; the worker is killed 30 s after */

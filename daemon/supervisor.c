@@ -43,6 +43,7 @@ struct pk_supervisor {
     pthread_mutex_t mu;
     int workers;
     double max_wall_time_s;
+    int job_threads; /* --threads of each worker */
     int stopping;
     double grace_deadline;
     int wake[2];
@@ -130,6 +131,10 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
                              json_object_get(job, "inputs"));
     int wrote = write_job_file(job_path, file);
     json_decref(file);
+    char threads[16];
+    pthread_mutex_lock(&s->mu);
+    snprintf(threads, sizeof threads, "%d", s->job_threads);
+    pthread_mutex_unlock(&s->mu);
     int p[2];
     if (wrote != 0 || cloexec_pipe(p, 0) != 0) {
         pk_queue_finish(s->q, id, "failed", "cannot write the job file", NULL, NULL, 0);
@@ -159,7 +164,8 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
         if (so < 0 || se < 0 || dn < 0 || dup2(dn, 0) < 0 || dup2(so, 1) < 0 || dup2(se, 2) < 0 ||
             dup2(p[1], 3) < 0)
             _exit(125);
-        execl(s->exe, "packd", "run", job_path, "-o", out_path, "--progress-fd", "3", (char *)NULL);
+        execl(s->exe, "packd", "run", job_path, "-o", out_path, "--progress-fd", "3", "--threads",
+              threads, (char *)NULL);
         _exit(127);
     }
     close(p[1]);
@@ -387,7 +393,7 @@ static void *loop(void *arg)
 }
 
 pk_supervisor *pk_supervisor_start(pk_queue *q, const char *exe, const char *data, int workers,
-                                   double max_wall_time_s)
+                                   double max_wall_time_s, int job_threads)
 {
     pk_supervisor *s = calloc(1, sizeof *s);
     if (!s)
@@ -397,6 +403,7 @@ pk_supervisor *pk_supervisor_start(pk_queue *q, const char *exe, const char *dat
     snprintf(s->data, sizeof s->data, "%s", data);
     s->workers = workers > MAX_SLOTS ? MAX_SLOTS : workers;
     s->max_wall_time_s = max_wall_time_s;
+    s->job_threads = job_threads;
     pthread_mutex_init(&s->mu, NULL);
     if (cloexec_pipe(s->wake, 1) != 0 ||
         pthread_create(&s->thread, NULL, loop, s) != 0) {
@@ -406,11 +413,13 @@ pk_supervisor *pk_supervisor_start(pk_queue *q, const char *exe, const char *dat
     return s;
 }
 
-void pk_supervisor_configure(pk_supervisor *s, int workers, double max_wall_time_s)
+void pk_supervisor_configure(pk_supervisor *s, int workers, double max_wall_time_s,
+                             int job_threads)
 {
     pthread_mutex_lock(&s->mu);
     s->workers = workers > MAX_SLOTS ? MAX_SLOTS : workers;
     s->max_wall_time_s = max_wall_time_s;
+    s->job_threads = job_threads;
     pthread_mutex_unlock(&s->mu);
     pk_supervisor_wake(s);
 }

@@ -2,7 +2,7 @@
  *
  * One thread claims accepted jobs from the queue while fewer than `workers`
  * run, and starts each as a child process: fork/exec of this same binary,
- *   packd run DATA/jobs/<id>/job.json -o DATA/jobs/<id>/result.h5 --progress-fd 3
+ *   packd run DATA/jobs/<id>/job.json -o DATA/jobs/<id>/result.h5 --progress-fd 3 --threads T
  * with stdout -> summary.json, stderr -> worker.log.  The child
  *   - dies with the daemon (PR_SET_PDEATHSIG = SIGKILL, checked against a race),
  *   - holds an exclusive flock on DATA/jobs/<id>/worker.lock for its whole life,
@@ -19,12 +19,14 @@
 
 typedef struct pk_supervisor pk_supervisor;
 
-/* exe: path of the packd binary; data: data directory (jobs/ inside). */
+/* exe: path of the packd binary; data: data directory (jobs/ inside);
+ * job_threads: threads of each worker's parallel sections (T above). */
 pk_supervisor *pk_supervisor_start(pk_queue *q, const char *exe, const char *data, int workers,
-                                   double max_wall_time_s);
+                                   double max_wall_time_s, int job_threads);
 
 /* SIGHUP: new limits take effect for the next claims. */
-void pk_supervisor_configure(pk_supervisor *s, int workers, double max_wall_time_s);
+void pk_supervisor_configure(pk_supervisor *s, int workers, double max_wall_time_s,
+                             int job_threads);
 
 /* Look at the queue now (a job was submitted or dismissed). */
 void pk_supervisor_wake(pk_supervisor *s);

@@ -178,3 +178,28 @@ json.dump(j, open('fr_tangent.json', 'w'))"
 out=$("$PACKD" validate fr_tangent.json 2>/dev/null)
 rc=$?
 check refuse_friction_with_tangent sh -c "test $rc -eq 1 && printf '%s' '$out' | grep -q '/inputs/tangent'"
+
+# 10. --threads is a deployment setting: a homogenization large enough for the parallel contact
+#     evaluation (core/par.h; >= 4,096 candidate pairs: 2,000 grains have ~7,000) gives the same
+#     bits with 1 and 2 threads — the whole file but the tangent's timing (h5diff compares exactly
+#     without -d/-p)
+python3 -c "
+import json; j = json.load(open('$EX/rve-rsa-2d.json'))
+j['inputs']['count'] = 2000; j['inputs']['domain']['box']['size'] = [72.0, 72.0]
+json.dump(j, open('rve-big.json', 'w'))
+h = json.load(open('$EX/homogenize-periodic-2d.json'))
+h['inputs']['rve'] = {'file': 'rve-big.h5'}
+h['inputs']['load'] = {'type': 'simple_shear', 'precompression': 0.01, 'pre_steps': 1, 'shear': 0.01, 'steps': 2}
+h['inputs']['relaxation'] = {'tol': 1e-8, 'solver': 'newton'}
+h['inputs']['output'] = {'micro_state': True}
+json.dump(h, open('thr.json', 'w'))"
+"$PACKD" run rve-big.json -o rve-big.h5 >/dev/null 2>rve-big.err || fail pack_big_rve "$(cat rve-big.err)"
+for t in 1 2; do
+    "$PACKD" run thr.json -o "thr$t.h5" --threads $t >"thr$t.out" 2>"thr$t.err" ||
+        fail "run_threads_$t" "$(cat "thr$t.err")"
+done
+check threads_same_bits sh -c "grep -q '\"complete\": true' thr2.out &&
+    grep -q '\"threads\": 2' thr2.out && grep -q '\"threads\": 1' thr1.out &&
+    h5diff --exclude-path /observables/homogenize/tangent/seconds thr1.h5 thr2.h5"
+check threads_refused_out_of_range sh -c "! '$PACKD' run thr.json -o x.h5 --threads 0 2>err.txt &&
+    grep -q -- '--threads takes 1..64' err.txt"
