@@ -43,6 +43,17 @@ static inline int step_from_reference(const pk_homog_rve *rve, const pk_homog_op
     return rc;
 }
 
+/* max |ΔP̄| / max |P̄| of two steps */
+static inline double P_rel_diff(const pk_homog_step *a, const pk_homog_step *b)
+{
+    double Pn = 0, d = 0;
+    for (int k = 0; k < 9; k++) {
+        Pn = fmax(Pn, fabs(a->P[k]));
+        d = fmax(d, fabs(a->P[k] - b->P[k]));
+    }
+    return d / Pn;
+}
+
 /* Jammed periodic packing: n grains, radii in [0.8, 1.2], overlapping at
  * φ_nominal, relaxed to equilibrium (DR tol 1e-12). */
 static inline void make_jammed(int dim, size_t n, double phi, uint64_t seed, pk_box *b, pk_particles *p)

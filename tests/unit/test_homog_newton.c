@@ -71,16 +71,6 @@ static void affine_start(const pk_homog_rve *rve, const double F[9], double *x)
     }
 }
 
-static double P_rel_diff(const pk_homog_step *a, const pk_homog_step *b)
-{
-    double Pn = 0, d = 0;
-    for (int k = 0; k < 9; k++) {
-        Pn = fmax(Pn, fabs(a->P[k]));
-        d = fmax(d, fabs(a->P[k] - b->P[k]));
-    }
-    return d / Pn;
-}
-
 /* A jammed 2D periodic packing (make_jammed) and its RVE. */
 static void jammed_rve(size_t n, double phi, uint64_t seed, pk_particles *p, pk_homog_rve *rve)
 {

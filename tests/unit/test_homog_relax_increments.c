@@ -12,16 +12,6 @@
 #include "homog_fixture.h"
 #include "homog_relax.h"
 
-static double P_rel_diff(const pk_homog_step *a, const pk_homog_step *b)
-{
-    double Pn = 0, d = 0;
-    for (int k = 0; k < 9; k++) {
-        Pn = fmax(Pn, fabs(a->P[k]));
-        d = fmax(d, fabs(a->P[k] - b->P[k]));
-    }
-    return d / Pn;
-}
-
 /* One compression step from the reference by DR, plain and with the
  * increments: both converge to tol; returns the two step records. */
 static void both(size_t n, double phi, uint64_t seed, double strain, pk_homog_step *sp,
