@@ -61,6 +61,15 @@
  * 0.4 / 0.5 / 0.6 / 0.7: 6,073 / 4,711 / 4,066 / 3,786 / 3,587 DR+FIRE
  * iterations, 11 / 13 / 7 / 7 / 9 factorisations; every value from 0.3 to
  * 0.7 ends in DR's minimum on it and on test_homog_newton's cases. */
+/* Sixth session, with DR's increments in its λ_min (homog_relax.c): the
+ * failed attempts of the cached near-jamming 10⁴ steps all end with
+ * block_not_positive_definite — seed 7's two at their first factorisation,
+ * seed 6's four and seed 8's three at their second, after the residual
+ * climbed ×3–×60 from DR's point — and cost seed 6 8 of its 12
+ * factorisations and most of its 95 L-BFGS steps (~0.8 of ~2.1 s).
+ * Dropped: no attempt while the Rayleigh quotient of DR's increments since
+ * the last estimate is negative (DR inside a rearrangement) — it never was
+ * at an attempt (seeds 6–8: the same attempts, the same path). */
 #define HANDOVER 1e-3
 #define HANDOVER_STEP 0.5
 /* DR iterations after a failed attempt in which the residual neither
