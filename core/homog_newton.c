@@ -66,7 +66,8 @@
  * block_not_positive_definite — seed 7's two at their first factorisation,
  * seed 6's four and seed 8's three at their second, after the residual
  * climbed ×3–×60 from DR's point — and cost seed 6 8 of its 12
- * factorisations and most of its 95 L-BFGS steps (~0.8 of ~2.1 s).
+ * factorisations and most of its 95 L-BFGS steps (estimated from their
+ * unit costs, ~45 ms a factorisation and ~6 ms a step: ~0.8 of ~2.1 s).
  * Dropped: no attempt while the Rayleigh quotient of DR's increments since
  * the last estimate is negative (DR inside a rearrangement) — it never was
  * at an attempt (seeds 6–8: the same attempts, the same path). */
