@@ -64,7 +64,7 @@
 /* Sixth session, with DR's increments in its λ_min (homog_relax.c): the
  * failed attempts of the cached near-jamming 10⁴ steps all end with
  * block_not_positive_definite — seed 7's two at their first factorisation,
- * seed 6's four and seed 8's three at their second, after the residual
+ * seed 6's four and seed 8's three at their second or third, after the residual
  * climbed ×3–×60 from DR's point — and cost seed 6 8 of its 12
  * factorisations and most of its 95 L-BFGS steps (estimated from their
  * unit costs, ~45 ms a factorisation and ~6 ms a step: ~0.8 of ~2.1 s).
