@@ -70,7 +70,12 @@
  * unit costs, ~45 ms a factorisation and ~6 ms a step: ~0.8 of ~2.1 s).
  * Dropped: no attempt while the Rayleigh quotient of DR's increments since
  * the last estimate is negative (DR inside a rearrangement) — it never was
- * at an attempt (seeds 6–8: the same attempts, the same path). */
+ * at an attempt (seeds 6–8: the same attempts, the same path).  Dropped
+ * too: an attempt's factor refreshed as soon as its residual climbed above
+ * 2× / 4× that at the factorisation (instead of REFRESH_WINDOW steps on):
+ * the refreshed blocks were positive definite, the attempts went on and
+ * failed later — seeds 5–9, 7 / 12 / 7 / 11 / 5 → 17 / 24 / 7 / 13 / 7
+ * factorisations (2×), seed 6 2.3 → 4.0 s. */
 #define HANDOVER 1e-3
 #define HANDOVER_STEP 0.5
 /* DR iterations after a failed attempt in which the residual neither
