@@ -75,7 +75,10 @@
  * 2× / 4× that at the factorisation (instead of REFRESH_WINDOW steps on):
  * the refreshed blocks were positive definite, the attempts went on and
  * failed later — seeds 5–9, 7 / 12 / 7 / 11 / 5 → 17 / 24 / 7 / 13 / 7
- * factorisations (2×), seed 6 2.3 → 4.0 s. */
+ * factorisations (2×), seed 6 2.3 → 4.0 s.  And the next threshold halved
+ * once more after a failed attempt (×0.25): seed 6 12 → 8 factorisations but
+ * 2.06 → 2.21 s (DR runs longer before FIRE), seed 7 1.96 → 3.19 s (13,602
+ * creeping DR iterations), seeds 5/8/9 1.24/2.01/0.86 → 1.07/1.52/1.26 s. */
 #define HANDOVER 1e-3
 #define HANDOVER_STEP 0.5
 /* DR iterations after a failed attempt in which the residual neither
