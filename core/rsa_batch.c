@@ -270,6 +270,12 @@ static inline void mark_ahead(pk_rsa_region *reg, pk_rsa_region_spot *ring, size
  *    faults, -0.06 s system): draws per grain 34.7, CPU +15-20 %;
  *  - the marks' block pre-faulted (mmap MAP_POPULATE): the same faults and
  *    system time — the kernel's cost is per page, not per trap.
+ *  - transparent huge pages for every malloc (sixth session; this kernel has
+ *    THP on madvise: GLIBC_TUNABLES=glibc.malloc.hugetlb=1): 1,836-2,147
+ *    faults instead of 70,066, but 0.62-0.74 s of system time (zeroing and
+ *    compacting 2 MB pages) against 0.12-0.15 s: 0.63-0.71 against
+ *    1.08-1.09 M placements per s (three alternating pairs).  The same
+ *    session, quiet machine, no code change: 1.10-1.17 M per s in 5 of 5.
  * Round 6: where a 10^6 run's time goes (3D φ = 0.30, rdtsc per phase, best
  * of 3 on a quiet machine, 2.47 Gcycles): plain draws 16 %; region_start 20 %
  * (its marks 16 %, a third of that the 27 000 first touches of the marks'
