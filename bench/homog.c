@@ -413,6 +413,23 @@ static double step_case(size_t n, int near_jamming)
                "P_rel_diff_newton_vs_dr=%.2g energy_rel_diff_newton_vs_dr=%.2g\n",
                kind, n, sd.dr.iterations, tdr, rate, pk_dr_stop_name(sd.dr.stop), sd.contacts,
                sd.rattlers, sd.energy, d / Pn, (sn.energy - sd.energy) / sd.energy);
+        /* DR without its increments' λ_min (pk_dr_params.plain_lambda_min): the
+         * iterations and time that estimate saves, and where each ends */
+        pk_homog_opts op = o;
+        op.dr.plain_lambda_min = 1;
+        pk_homog_state tp = {0};
+        pk_homog_step sp;
+        t0 = pk_wall_seconds();
+        pk_homog_eval(&rve, &op, &s0, F, &tp, &sp, NULL);
+        double tpl = pk_wall_seconds() - t0;
+        d = 0;
+        for (int c = 0; c < 9; c++)
+            d = fmax(d, fabs(sd.P[c] - sp.P[c]));
+        printf("bench=homog case=periodic_step_dr_plain_2d rve=%s n=%zu iterations=%zu seconds=%.3f "
+               "stop=%s energy=%.12g P_rel_diff_vs_increments=%.2g speedup_of_increments=%.2f\n",
+               kind, n, sp.dr.iterations, tpl, pk_dr_stop_name(sp.dr.stop), sp.energy, d / Pn,
+               tpl / tdr);
+        pk_homog_state_free(&tp);
     }
     printf("bench=homog case=periodic_step_newton_2d rve=%s n=%zu factorisations=%zu qn_steps=%zu "
            "dr_iterations=%zu fire_iterations=%zu attempts=%zu shift_raises=%zu seconds=%.3f cpu_s=%.3f "
