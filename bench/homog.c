@@ -373,6 +373,17 @@ static void step_threads_case(const pk_homog_rve *rve, const pk_homog_opts *on,
     pk_par_free(op.par);
 }
 
+/* max |P̄_a − P̄_b| / max |P̄_a| */
+static double P_rel_diff(const pk_homog_step *a, const pk_homog_step *b)
+{
+    double d = 0, Pn = 0;
+    for (int c = 0; c < 9; c++) {
+        Pn = fmax(Pn, fabs(a->P[c]));
+        d = fmax(d, fabs(a->P[c] - b->P[c]));
+    }
+    return d / Pn;
+}
+
 static double step_case(size_t n, int near_jamming)
 {
     char name[64];
@@ -403,16 +414,11 @@ static double step_case(size_t n, int near_jamming)
         pk_homog_eval(&rve, &o, &s0, F, &td, &sd, NULL);
         tdr = pk_wall_seconds() - t0;
         rate = (double)n * (double)sd.dr.iterations / tdr;
-        double d = 0, Pn = 0;
-        for (int c = 0; c < 9; c++) {
-            Pn = fmax(Pn, fabs(sd.P[c]));
-            d = fmax(d, fabs(sd.P[c] - sn.P[c]));
-        }
         printf("bench=homog case=periodic_step_dr_2d rve=%s n=%zu iterations=%zu seconds=%.3f "
                "particle_iter_per_s=%.3g stop=%s contacts=%zu rattlers=%zu energy=%.12g "
                "P_rel_diff_newton_vs_dr=%.2g energy_rel_diff_newton_vs_dr=%.2g\n",
                kind, n, sd.dr.iterations, tdr, rate, pk_dr_stop_name(sd.dr.stop), sd.contacts,
-               sd.rattlers, sd.energy, d / Pn, (sn.energy - sd.energy) / sd.energy);
+               sd.rattlers, sd.energy, P_rel_diff(&sd, &sn), (sn.energy - sd.energy) / sd.energy);
         /* DR without its increments' λ_min (pk_dr_params.plain_lambda_min): the
          * iterations and time that estimate saves, and where each ends */
         pk_homog_opts op = o;
@@ -422,12 +428,10 @@ static double step_case(size_t n, int near_jamming)
         t0 = pk_wall_seconds();
         pk_homog_eval(&rve, &op, &s0, F, &tp, &sp, NULL);
         double tpl = pk_wall_seconds() - t0;
-        d = 0;
-        for (int c = 0; c < 9; c++)
-            d = fmax(d, fabs(sd.P[c] - sp.P[c]));
         printf("bench=homog case=periodic_step_dr_plain_2d rve=%s n=%zu iterations=%zu seconds=%.3f "
                "stop=%s energy=%.12g P_rel_diff_vs_increments=%.2g speedup_of_increments=%.2f\n",
-               kind, n, sp.dr.iterations, tpl, pk_dr_stop_name(sp.dr.stop), sp.energy, d / Pn,
+               kind, n, sp.dr.iterations, tpl, pk_dr_stop_name(sp.dr.stop), sp.energy,
+               P_rel_diff(&sd, &sp),
                tpl / tdr);
         pk_homog_state_free(&tp);
     }
