@@ -8,7 +8,11 @@
  * (job cases: rates per wall second of the placement, cpu_s of the whole job)
  * Cases: monodisperse 3D periodic N = 10^4 to φ = 0.60 and to jamming,
  * N = 2000 slow/fast (the MRJ band and the rate dependence), Fuller-like
- * 3D diameters 1–16 (counts ∝ d^-2.5) N = 10^4 to jamming, Meier's 2D
+ * 3D diameters 1–16 (counts ∝ d^-2.5) N = 10^4 to jamming — both from zero
+ * radii (Meier) and, …_rsa030, from an RSA start at φ = 0.30 (Titscher/Kansal:
+ * the dilute phase, where list rebuilds outnumber collisions, is skipped;
+ * its RSA time counts), with the monodisperse jammed case from the same
+ * start beside it for the ratio — Meier's 2D
  * quartz and A32 (nop = 1000) to jamming over 3 seeds; N = 10^5 to φ = 0.55
  * from zero radii and from an RSA start at φ = 0.30 (…_rsa030).  The N = 10^6
  * cases (to φ = 0.55, both starts) take minutes: opt in with PACKD_BENCH_LARGE=1.  peak_rss_mb is the
@@ -129,7 +133,7 @@ static double mono(const char *name, size_t n, double rate, int jammed, double p
 }
 
 /* Fuller-like: diameters 1..16, number density ∝ d^-2.5 (inverse CDF). */
-static void fuller(const char *name, size_t n, double rate)
+static void fuller(const char *name, size_t n, double rate, double rsa_phi)
 {
     if (!wanted(name))
         return;
@@ -142,7 +146,7 @@ static void fuller(const char *name, size_t n, double rate)
         r[n - 1 - i] = 0.5 * d; /* descending */
     }
     pk_edmd_stats st;
-    run_core(name, 3, r, n, 0.5, rate, 1, 0, 0, &st);
+    run_core(name, 3, r, n, 0.5, rate, 1, 0, rsa_phi, &st);
     free(r);
 }
 
@@ -220,7 +224,9 @@ int main(void)
     if (!isnan(slow) && !isnan(fast))
         printf("bench=edmd case=mono3d_2000_check band_0.634_0.652=%s faster_is_looser=%s\n",
                slow >= 0.634 && slow <= 0.652 ? "yes" : "no", fast < slow ? "yes" : "no");
-    fuller("fuller3d_d1to16_1e4_jam", 10000, 0.01);
+    fuller("fuller3d_d1to16_1e4_jam", 10000, 0.01, 0);
+    fuller("fuller3d_d1to16_1e4_jam_rsa030", 10000, 0.01, 0.30);
+    mono_from("mono3d_1e4_jam_rate0.02_rsa030", 10000, 0.02, 1, 0, 0.30);
     for (int s = 1; s <= 3; s++)
         meier("meier_quartz_2d_jam", QUARTZ, 3.0, s);
     for (int s = 1; s <= 3; s++)
