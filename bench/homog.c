@@ -352,8 +352,8 @@ static void eval_case(const pk_homog_rve *rve, const pk_homog_state *s, const do
  * its time against the serial one (tnw, measured just before) and whether
  * the step gives the same bits (energy, P̄, iterations). */
 static void step_threads_case(const pk_homog_rve *rve, const pk_homog_opts *on,
-                              const pk_homog_state *s0, const double F[9], const pk_homog_step *sn,
-                              double tnw, const char *kind)
+                              const pk_homog_state *s0, const double F[9], const pk_homog_state *tn,
+                              const pk_homog_step *sn, double tnw, const char *kind)
 {
     pk_homog_opts op = *on;
     op.par = pk_par_new(2);
@@ -364,8 +364,22 @@ static void step_threads_case(const pk_homog_rve *rve, const pk_homog_opts *on,
     double t0 = pk_wall_seconds();
     pk_homog_eval(rve, &op, s0, F, &tp, &sp, NULL);
     double t = pk_wall_seconds() - t0;
+    /* the same step: end point, stress, energy and the path's statistics */
     int same = memcmp(&sp.energy, &sn->energy, sizeof sp.energy) == 0 &&
-               memcmp(sp.P, sn->P, sizeof sp.P) == 0 && sp.dr.iterations == sn->dr.iterations;
+               memcmp(sp.P, sn->P, sizeof sp.P) == 0 &&
+               memcmp(tp.x, tn->x, 3 * rve->n * sizeof *tp.x) == 0 &&
+               sp.dr.iterations == sn->dr.iterations && sp.dr.rebuilds == sn->dr.rebuilds &&
+               sp.dr.stop == sn->dr.stop && sp.newton.iterations == sn->newton.iterations &&
+               sp.newton.steps == sn->newton.steps && sp.newton.attempts == sn->newton.attempts &&
+               sp.newton.fire_iterations == sn->newton.fire_iterations &&
+               sp.newton.exit == sn->newton.exit;
+    if (!same)
+        fprintf(stderr, "DIFF energy %d P %d x %d it %zu/%zu reb %zu/%zu stop %d/%d fac %zu/%zu steps %zu/%zu att %zu/%zu fire %zu/%zu exit %d/%d\n",
+                memcmp(&sp.energy, &sn->energy, sizeof sp.energy) == 0, memcmp(sp.P, sn->P, sizeof sp.P) == 0,
+                memcmp(tp.x, tn->x, 3 * rve->n * sizeof *tp.x) == 0, sp.dr.iterations, sn->dr.iterations,
+                sp.dr.rebuilds, sn->dr.rebuilds, sp.dr.stop, sn->dr.stop, sp.newton.iterations, sn->newton.iterations,
+                sp.newton.steps, sn->newton.steps, sp.newton.attempts, sn->newton.attempts,
+                sp.newton.fire_iterations, sn->newton.fire_iterations, sp.newton.exit, sn->newton.exit);
     printf("bench=homog case=periodic_step_newton_2d rve=%s n=%zu threads=2 seconds=%.3f "
            "serial_seconds=%.3f speedup=%.2f same_bits=%d\n",
            kind, rve->n, t, tnw, tnw / t, same);
@@ -444,7 +458,7 @@ static double step_case(size_t n, int near_jamming)
            sn.newton.shifts, tnw, cnw,
            pk_newton_exit_name(sn.newton.exit), pk_dr_stop_name(sn.dr.stop), sn.dr.f / sn.dr.f0,
            sn.contacts, sn.rattlers, sn.energy, sn.P[0], sn.P[4], tdr > 0 ? tdr / tnw : -1);
-    step_threads_case(&rve, &on, &s0, F, &sn, tnw, kind);
+    step_threads_case(&rve, &on, &s0, F, &tn, &sn, tnw, kind);
     double A[81];
     pk_tangent_info ti;
     int rc = pk_homog_tangent(&rve, &o, &tn, &pk_sparse_cholmod, A, &ti);

@@ -309,12 +309,22 @@ int pk_relax_begin(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const
     return pk_dem_pairs_build(c, g, x, r, np, prm->skin);
 }
 
+void pk_relax_hook_solved(pk_dr_stats *st, const pk_dr_params *prm, double fres)
+{
+    st->f = fres;
+    st->stop = fres <= prm->tol * st->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
+}
+
 int pk_relax_iteration_end(pk_dr_stats *st, const pk_dr_params *prm, double target, size_t k,
                            double *x, pk_dr_hook *hook, pk_monitor *mon, pk_progress *pr,
                            pk_relax_geom *gm)
 {
     if (st->f <= target) {
         st->stop = st->f <= prm->tol * st->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
+        return 1;
+    }
+    if (hook && hook->poll && hook->poll(hook->ctx)) {
+        st->stop = PK_DR_HANDED_OVER;
         return 1;
     }
     if (hook)
@@ -327,12 +337,13 @@ int pk_relax_iteration_end(pk_dr_stats *st, const pk_dr_params *prm, double targ
         double fh = st->f;
         if (gm)
             pk_relax_geom_refresh(gm, x);
+        hook->running = st;
         int h = hook->fn(hook->ctx, x, &fh, &hook->at);
+        hook->running = NULL;
         if (h < 0)
             return h;
         if (h == 1) { /* the hook solved the step from here */
-            st->f = fh;
-            st->stop = fh <= prm->tol * st->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
+            pk_relax_hook_solved(st, prm, fh);
             return 1;
         }
         if (h == 2) {

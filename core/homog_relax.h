@@ -74,11 +74,21 @@ typedef struct pk_dr_hook {
      * `at` nor rising above its value at that call — the relaxation creeps
      * (no rearrangement under way, no progress either).  0: never. */
     size_t crawl;
+    /* poll (may be NULL): asked after every iteration; nonzero stops the
+     * relaxation at once (stop PK_DR_HANDED_OVER, x as it is) — the hook's
+     * owner has solved the step elsewhere (homog_newton.c, speculative
+     * attempts).  It must be cheap. */
+    int (*poll)(void *ctx);
     /* the relaxation's book-keeping (zero at the start) */
     size_t last;   /* iteration of the last call (counted from 1; 0: not called yet) */
     double f_last; /* |f| at the last call */
     double f_peak; /* the largest |f| since */
+    const pk_dr_stats *running; /* during a call: the relaxation's statistics so far */
 } pk_dr_hook;
+
+/* st of a relaxation whose hook solved the step with residual fres (the
+ * hook returned 1): the residual and the stop it then ends with. */
+void pk_relax_hook_solved(pk_dr_stats *st, const pk_dr_params *prm, double fres);
 
 /* The start of a relaxation, shared by DR and FIRE: st cleared, the pair
  * list built at x (returns its rc), *nfree the number of free grains. */
