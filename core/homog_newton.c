@@ -737,7 +737,12 @@ static int relax_then_fire(pk_dem_pairs *c, const pk_dem_geom *g, double *x, con
  * time is about the longer of the two threads' work instead of the sum
  * (failed attempts were 40 % of the near-jamming 10⁴ bench step, seed 6).
  * A point copies 6·N doubles (x and the list's build positions); at most
- * SPEC_QUEUE wait, beyond that the relaxation waits for the worker. */
+ * SPEC_QUEUE wait, beyond that the relaxation waits for the worker.
+ * Measured and dropped: lending the relaxation the worker's thread for its
+ * parallel evaluation while the worker waits (pk_dem_pairs.par switched per
+ * iteration: the same bits) — seed 7 of the bench, whose attempts are few,
+ * 1.5–1.7 s → 1.7–2.4 s on 2 threads (the pool's worker and the attempts'
+ * thread then contend for the second core). */
 #define SPEC_QUEUE 8
 
 typedef struct spec_point {
