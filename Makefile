@@ -34,7 +34,7 @@ BASE_CFLAGS := $(CSTD) $(OPT) $(ALIGN) -g $(WARN) $(SAN) -DPACKD_VERSION='"$(VER
 # core/ is plain C17 + libm: compiled without any external include path.
 CORE_CFLAGS := $(BASE_CFLAGS)
 EXT_CFLAGS   = $(BASE_CFLAGS) $(shell pkg-config --cflags $(PKGS) 2>/dev/null) -I/usr/include/suitesparse -Icore -Iapi -I$(BUILD)/gen
-EXT_LIBS     = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lcholmod -lm -lpthread
+EXT_LIBS     = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lcholmod -lgomp -lm -lpthread
 
 CORE_SRC   := $(wildcard core/*.c)
 API_SRC    := $(wildcard api/*.c)

@@ -2,8 +2,24 @@
 
 #include <cholmod.h>
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* Debian's CHOLMOD is built with OpenMP: some of its loops open a team of
+ * up to 4 threads (num_threads clauses) — small ones on packd's blocks, so a
+ * team costs more to start, and its threads more in spinning (libgomp spins
+ * before it sleeps, on the cores the relaxation and the speculative attempts
+ * use), than it gives.  Measured (seventh session, near-jamming 10⁴ bench
+ * step, seed 6; OMP_THREAD_LIMIT=1 against none): 1.73–1.78 s against
+ * 2.32–2.55 s, serial.  So every entry point makes the calling thread's
+ * parallel regions inactive (max-active-levels 0: a team of one; the ICV is
+ * per thread, so each thread that calls in sets its own — a few ns).  The
+ * numbers do not change (the same operations, in one thread). */
+static void serial_regions(void)
+{
+    omp_set_max_active_levels(0);
+}
 
 struct pk_sparse_factor {
     cholmod_common c;
@@ -164,6 +180,7 @@ static pk_sparse_factor *factor_any(pk_sparse_ctx *ctx, const pk_sparse_sym *A, 
     info->npos = info->nneg = info->nzero = 0;
     info->min_abs_pivot = info->max_abs_pivot = 0;
     info->reused_analysis = 0;
+    serial_regions();
     pk_sparse_factor *f = calloc(1, sizeof *f);
     double *d = NULL;
     if (!f)
@@ -271,6 +288,7 @@ static void chol_ctx_free(pk_sparse_ctx *ctx)
 
 static int chol_solve(pk_sparse_factor *f, size_t nrhs, const double *B, double *X)
 {
+    serial_regions();
     cholmod_dense *b = cholmod_allocate_dense(f->n, nrhs, f->n, CHOLMOD_REAL, &f->c);
     if (!b)
         return -1;
