@@ -44,7 +44,16 @@
  * those 171M neighbour tests; fewer of them needs other skins (other
  * events).  Kept: cover moves (grid_cover.c: −1.5 % instructions, the
  * same events); dropped: culled rows in wide queries (grid_uniform.c), a
- * reload-free heap step (edmd_queue.c). */
+ * reload-free heap step (edmd_queue.c).
+ * Seventh session: the base skin (pk_edmd_params.skin, 0.6) at 0.45 gives
+ * the Fuller-like case 8.4–8.8e5 collisions per CPU s against 6.2–6.3e5
+ * (0.8: 6.3–6.8e5), but only because that run makes 5.10M collisions
+ * instead of 3.14M before the jamming test stops it (φ 0.7129 / 0.7108):
+ * the jammed packing takes 5.8–6.1 s instead of 5.0 — slower for the
+ * user, kept at 0.6.  From an RSA start at φ = 0.30 (bench/edmd …_rsa030,
+ * Titscher/Kansal) the same case makes 1.08–1.13e6 collisions per CPU s
+ * and jams in 3.5 s (the dilute phase, where rebuilds outnumber
+ * collisions, is skipped). */
 /* From this many grains on (arrays beyond the caches) the grains are
  * renumbered along a Z-order curve every RESORT_WINDOWS·N events: they
  * diffuse away from their start order and each prediction then misses the
