@@ -230,20 +230,21 @@ static inline int scan(const pk_grid *g, const pk_particles *p, const double *x,
                     hi[k] = n - 1;
             }
         }
+        /* a wrapped cell coordinate: the division only off [0, n) (two of
+         * them per cell were most of a 2D query's time: a DEM pair-list
+         * build 4.1 → 3.5 ms at 10⁴ grains, the same cells in the same order) */
+#define WRAPPED(c_, k_)                                                                        \
+    (wrap[k_] && ((c_) < 0 || (c_) >= lv->ncell[k_])                                          \
+         ? (((c_) % lv->ncell[k_]) + lv->ncell[k_]) % lv->ncell[k_]                             \
+         : (c_))
         for (int64_t cz = lo[2]; cz <= hi[2]; cz++) {
-            int64_t iz = cz;
-            if (wrap[2])
-                iz = ((cz % lv->ncell[2]) + lv->ncell[2]) % lv->ncell[2];
+            int64_t iz = WRAPPED(cz, 2);
             for (int64_t cy = lo[1]; cy <= hi[1]; cy++) {
-                int64_t iy = cy;
-                if (wrap[1])
-                    iy = ((cy % lv->ncell[1]) + lv->ncell[1]) % lv->ncell[1];
+                int64_t iy = WRAPPED(cy, 1);
                 uint64_t base = ((uint64_t)iz * (uint64_t)lv->ncell[1] + (uint64_t)iy) *
                                 (uint64_t)lv->ncell[0];
                 for (int64_t cx = lo[0]; cx <= hi[0]; cx++) {
-                    int64_t ix = cx;
-                    if (wrap[0])
-                        ix = ((cx % lv->ncell[0]) + lv->ncell[0]) % lv->ncell[0];
+                    int64_t ix = WRAPPED(cx, 0);
                     uint64_t lin = base + (uint64_t)ix;
                     for (int32_t j = lv->head[bucket_of(lv, lin)]; j >= 0; j = g->next[j]) {
                         if (g->cell[j] != lin)
@@ -273,6 +274,7 @@ static inline int scan(const pk_grid *g, const pk_particles *p, const double *x,
         }
     }
     return 0;
+#undef WRAPPED
 }
 
 int pk_grid_query(const pk_grid *g, const pk_particles *p, const double x[PK_MAXDIM], double r,
