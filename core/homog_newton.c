@@ -1,12 +1,9 @@
 #include "homog_newton.h"
+#include "homog_hybrid.h"
 
 #include <math.h>
-#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
-#if !defined(__STDC_NO_THREADS__)
-#include <threads.h>
-#endif
 
 #include "dem_rattler.h"
 #include "homog_eigen.h"
@@ -147,8 +144,6 @@
 #define SHIFT_MAX 1e-1
 #define SHIFT_MIN 1e-6
 #define SHIFT_RAISES 3
-/* L-BFGS memory (pairs). */
-#define MEMORY 8
 
 const char *pk_newton_exit_name(pk_newton_exit e)
 {
@@ -189,7 +184,7 @@ static int eval_at(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const
  * that touch a rattler, plus a small shift on rattler DOFs, which may have no
  * stiffness at all.  A rattler is thus pushed out of its overlaps along n in
  * one step instead of being left to a separate relaxation.  μ > 0: the
- * Levenberg–Marquardt shift of an attempt from DR's point (newton_phase). */
+ * Levenberg–Marquardt shift of an attempt from DR's point (pk_hybrid_newton_phase). */
 static int assemble(const pk_dem_pairs *c, int dim, double E, const int32_t *dof,
                     const uint8_t *rat, double mu, size_t np, pk_sparse_sym *K)
 {
@@ -221,12 +216,6 @@ static int assemble(const pk_dem_pairs *c, int dim, double E, const int32_t *dof
                     return -1;
     return 0;
 }
-
-/* L-BFGS memory in DOF space: ring of (s, y, 1/s·y). */
-typedef struct qn_memory {
-    size_t nd, count, head;
-    double *s, *y, rho[MEMORY], alpha[MEMORY];
-} qn_memory;
 
 static void qn_push(qn_memory *q, const double *sv, const double *yv)
 {
@@ -267,14 +256,6 @@ static int qn_direction(qn_memory *q, const pk_sparse_solver *solver, pk_sparse_
     return 0;
 }
 
-typedef struct newton_work {
-    double *x0, *f, *ft, *xt, *g, *gt, *d, *qv, *sv, *yv;
-    qn_memory mem;
-    uint8_t *rat;
-    int32_t *dof;
-    pk_sparse_sym K;
-} newton_work;
-
 static int work_alloc(newton_work *w, size_t np, int dim)
 {
     size_t n3 = 3 * (np ? np : 1), n1 = np ? np : 1, nd = (size_t)dim * n1;
@@ -310,21 +291,6 @@ static void gather_gradient(const double *f, const int32_t *dof, size_t np, int 
             for (int a = 0; a < dim; a++)
                 gv[dof[i] + a] = -f[3 * i + a];
 }
-
-/* The problem one solve works on. */
-typedef struct newton_sys {
-    pk_dem_pairs *c;
-    const pk_dem_geom *g;
-    const double *r;
-    size_t np;
-    double E;
-    const uint8_t *is_free;
-    const pk_dr_params *prm;
-    const pk_sparse_solver *solver;
-    pk_sparse_ctx *sctx; /* the solver's context over the load path; NULL: none */
-    pk_monitor *mon;
-    const atomic_int *abort; /* nonzero: stop as if cancelled (speculative attempts); NULL: none */
-} newton_sys;
 
 /* Rattlers at the current contacts, K + μ1 assembled and factorised (one
  * factorisation counted).  NULL with info->status FAILED on error. */
@@ -375,7 +341,7 @@ static pk_sparse_factor *factor_block(const newton_sys *sy, newton_work *w, doub
  * positive definite there (a minimum, not a saddle).
  * *budget factorisations at most (decremented).
  * Returns 0, -1 (memory), -2 (box), 1 (cancelled: st->stop set). */
-static int newton_phase(const newton_sys *sy, newton_work *w, double *x, double *phi, double *fn,
+int pk_hybrid_newton_phase(const newton_sys *sy, newton_work *w, double *x, double *phi, double *fn,
                         double target, size_t stall, int shift, size_t *budget,
                         pk_newton_stats *ns, pk_dr_stats *st)
 {
@@ -568,25 +534,8 @@ static int newton_phase(const newton_sys *sy, newton_work *w, double *x, double 
     return 0;
 }
 
-/* The Newton attempts DR (then FIRE) makes along its way (pk_dr_hook):
- * Newton runs on a copy of the relaxation's point with a pair list of its
- * own, so that a failed attempt leaves the point as it was; at the
- * fire_after-th attempt point that is not solved DR stops there (hook
- * result 2) for FIRE to go on. */
-typedef struct attempt_ctx {
-    newton_sys sy;     /* sy.c = the attempts' own pair list */
-    newton_work *w;
-    double target;
-    size_t *budget;
-    pk_newton_stats *ns;
-    pk_dr_stats *st;   /* for newton_phase's stop on a cancel (restored) */
-    size_t fire_after; /* unsolved attempt points after which DR stops and
-                        * FIRE goes on from there; 0: never */
-    size_t failed;
-} attempt_ctx;
-
 /* The threshold of the next attempt after one at *at. */
-static void next_threshold(double *at, double target)
+void pk_hybrid_next_threshold(double *at, double target)
 {
     *at *= HANDOVER_STEP;
     if (*at <= target)
@@ -596,7 +545,7 @@ static void next_threshold(double *at, double target)
 /* Newton from xn, a copy of a relaxation's point: 1 when it converged (xn
  * the solution, *fres its residual), 0 when not — or not tried, the budget
  * being spent —, < 0 on an error. */
-static int attempt_from(attempt_ctx *a, double *xn, double *fres)
+int pk_hybrid_attempt_from(attempt_ctx *a, double *xn, double *fres)
 {
     newton_work *w = a->w;
     const int dim = a->sy.g->dim;
@@ -611,7 +560,7 @@ static int attempt_from(attempt_ctx *a, double *xn, double *fres)
     double fn = sqrt(pk_homog_dot_mask(w->f, w->f, a->sy.is_free, np, dim));
     a->ns->attempts++;
     pk_dr_stop keep = a->st->stop;
-    rc = newton_phase(&a->sy, w, xn, &phi, &fn, a->target, ATTEMPT_STALL, 1, a->budget, a->ns,
+    rc = pk_hybrid_newton_phase(&a->sy, w, xn, &phi, &fn, a->target, ATTEMPT_STALL, 1, a->budget, a->ns,
                       a->st);
     if (rc < 0)
         return rc;
@@ -637,10 +586,10 @@ static int unsolved(attempt_ctx *a)
 static int newton_attempt(void *vctx, double *x, double *fres, double *at)
 {
     attempt_ctx *a = vctx;
-    next_threshold(at, a->target);
+    pk_hybrid_next_threshold(at, a->target);
     double *xn = a->w->x0;
     memcpy(xn, x, 3 * a->sy.np * sizeof *x);
-    int rc = attempt_from(a, xn, fres);
+    int rc = pk_hybrid_attempt_from(a, xn, fres);
     if (rc < 0)
         return rc;
     if (rc == 1) {
@@ -652,7 +601,7 @@ static int newton_attempt(void *vctx, double *x, double *fres, double *at)
 
 /* The parameters FIRE runs with after DR (fire_on): the step's target as
  * an absolute floor (it is relative to the step's |f⁰|, not FIRE's). */
-static pk_dr_params fire_params(const pk_dr_params *prm, double target, const pk_dr_stats *st)
+pk_dr_params pk_hybrid_fire_params(const pk_dr_params *prm, double target, const pk_dr_stats *st)
 {
     pk_dr_params p = *prm;
     p.tol = 0;
@@ -662,7 +611,7 @@ static pk_dr_params fire_params(const pk_dr_params *prm, double target, const pk
 }
 
 /* st (DR's statistics) with FIRE's fs after it added, and its end. */
-static void fire_merge(pk_dr_stats *st, const pk_dr_stats *fs, const pk_dr_params *prm,
+void pk_hybrid_fire_merge(pk_dr_stats *st, const pk_dr_stats *fs, const pk_dr_params *prm,
                        pk_newton_stats *ns)
 {
     st->iterations += fs->iterations;
@@ -701,17 +650,17 @@ static int fire_on(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doubl
                    pk_dr_hook *hook, pk_monitor *mon, pk_dr_stats *st, pk_newton_stats *ns)
 {
     pk_fire_params fp = pk_fire_params_default();
-    pk_dr_params p = fire_params(prm, target, st);
+    pk_dr_params p = pk_hybrid_fire_params(prm, target, st);
     pk_dr_stats fs;
     int rc = pk_homog_fire_hooked(c, g, x, r, np, E, is_free, &p, &fp, hook, mon, &fs);
-    fire_merge(st, &fs, prm, ns);
+    pk_hybrid_fire_merge(st, &fs, prm, ns);
     return rc;
 }
 
 /* DR from x with the hook, then FIRE from DR's point when the hook stops DR
  * (hook->fn returned 2; not when hook->poll stopped it: *handed_over = 0).
  * The path both hybrids share. */
-static int relax_then_fire(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
+int pk_hybrid_relax_then_fire(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
                            size_t np, double E, const uint8_t *is_free, const pk_dr_params *prm,
                            double target, pk_dr_hook *hook, size_t *fire_after, int *in_fire,
                            pk_monitor *mon, pk_dr_stats *st, pk_dr_stats *st_dr,
@@ -728,323 +677,6 @@ static int relax_then_fire(pk_dem_pairs *c, const pk_dem_geom *g, double *x, con
     return rc;
 }
 
-#if !defined(__STDC_NO_THREADS__)
-/* Speculative attempts (a pool of two threads or more: pk_dem_pairs.par).
- * An attempt that fails leaves DR's path as it was, so the path is that of
- * a hybrid whose attempts all fail until one converges: the relaxation runs
- * on along it on the calling thread while a worker thread makes the Newton
- * phase from the step's start and then the attempts, in order, each from a
- * copy of the point DR (or FIRE) had reached when it asked.  The first that
- * converges wins: the relaxation stops (pk_dr_hook.poll), and the step ends
- * as the serial hybrid ends there — its point, statistics and DR's pair list
- * as they were at that point (the list rebuilt where it had been built).
- * Without a winner the relaxation's own end stands.  Same bits as the
- * serial hybrid, on any machine (tests/unit/test_homog_speculative.c); the
- * time is about the longer of the two threads' work instead of the sum
- * (failed attempts were 40 % of the near-jamming 10⁴ bench step, seed 6).
- * A point copies 6·N doubles (x and the list's build positions); at most
- * SPEC_QUEUE wait, beyond that the relaxation waits for the worker.
- * Measured and dropped: lending the relaxation the worker's thread for its
- * parallel evaluation while the worker waits (pk_dem_pairs.par switched per
- * iteration: the same bits) — seed 7 of the bench, whose attempts are few,
- * 1.5–1.7 s → 1.7–2.4 s on 2 threads (the pool's worker and the attempts'
- * thread then contend for the second core). */
-#define SPEC_QUEUE 8
-
-typedef struct spec_point {
-    double *x;      /* the point (a copy); the solution when solved */
-    double *xb;     /* where the relaxation's pair list was built then */
-    pk_dr_stats st; /* the relaxation's statistics then (DR's or FIRE's) */
-    int fire;       /* a point of FIRE's (else DR's) */
-    int first;      /* the Newton phase from the step's start */
-    double fres;    /* the residual at the solution */
-} spec_point;
-
-typedef struct spec {
-    mtx_t m;
-    cnd_t cv;
-    spec_point **pt;
-    size_t n, cap, done; /* points queued, room, finished (in order) */
-    int closed;          /* no more points: the relaxation has ended */
-    int worker_done;
-    int worker_rc;       /* < 0: the worker's error */
-    atomic_int stop;     /* the worker solved the step or failed: the relaxation stops */
-    atomic_int abort;    /* the relaxation was cancelled or failed: the worker stops */
-    size_t solved;       /* 1 + the index of the point solved; 0: none */
-    attempt_ctx *a;      /* the worker's: its own pair list, work, budget, statistics */
-    const pk_dem_pairs *c; /* the relaxation's pair list */
-    pk_dr_hook *hook;
-    size_t points;       /* attempt points so far (fire_after) */
-    size_t fire_after;
-    int fire;            /* the relaxation is FIRE */
-    double phi0, f0;     /* the first phase's start (w->f holds its forces) */
-    double target;
-} spec;
-
-static void point_free(spec_point *p)
-{
-    if (p) {
-        free(p->x);
-        free(p->xb);
-        free(p);
-    }
-}
-
-/* A point: x and the build positions xb copied (xb NULL: none yet). */
-static spec_point *point_new(size_t np, const double *x, const double *xb)
-{
-    spec_point *p = calloc(1, sizeof *p);
-    if (!p)
-        return NULL;
-    p->x = malloc(3 * (np ? np : 1) * sizeof *p->x);
-    p->xb = malloc(3 * (np ? np : 1) * sizeof *p->xb);
-    if (!p->x || !p->xb) {
-        point_free(p);
-        return NULL;
-    }
-    memcpy(p->x, x, 3 * np * sizeof *x);
-    if (xb)
-        memcpy(p->xb, xb, 3 * np * sizeof *xb);
-    return p;
-}
-
-/* Queue p (the worker takes it in turn); -1 when out of memory. */
-static int spec_push(spec *s, spec_point *p)
-{
-    mtx_lock(&s->m);
-    while (s->n - s->done >= SPEC_QUEUE && !s->worker_done)
-        cnd_wait(&s->cv, &s->m);
-    if (s->n == s->cap) {
-        size_t cap = s->cap ? 2 * s->cap : 16;
-        spec_point **q = realloc(s->pt, cap * sizeof *q);
-        if (!q) {
-            mtx_unlock(&s->m);
-            return -1;
-        }
-        s->pt = q;
-        s->cap = cap;
-    }
-    s->pt[s->n++] = p;
-    cnd_broadcast(&s->cv);
-    mtx_unlock(&s->m);
-    return 0;
-}
-
-/* The Newton phase from the step's start on p->x: 1 converged, 0 not, < 0
- * an error; p->xb := where its pair list was built last (the serial
- * hybrid's list at its end). */
-static int spec_first(spec *s, spec_point *p)
-{
-    attempt_ctx *a = s->a;
-    double phi = s->phi0, fn = s->f0;
-    int rc = newton_phase(&a->sy, a->w, p->x, &phi, &fn, a->target, STALL_FACTORS, 0, a->budget,
-                          a->ns, a->st);
-    if (rc < 0)
-        return rc;
-    memcpy(p->xb, a->sy.c->xb, 3 * a->sy.np * sizeof *p->xb);
-    p->fres = fn;
-    return rc == 0 && a->ns->exit == PK_NEWTON_CONVERGED;
-}
-
-static int spec_worker(void *arg)
-{
-    spec *s = arg;
-    for (size_t k = 0;; k++) {
-        mtx_lock(&s->m);
-        while (k >= s->n && !s->closed && !atomic_load(&s->abort))
-            cnd_wait(&s->cv, &s->m);
-        spec_point *p = k < s->n && !atomic_load(&s->abort) ? s->pt[k] : NULL;
-        mtx_unlock(&s->m);
-        if (!p)
-            break;
-        int r = p->first ? spec_first(s, p) : attempt_from(s->a, p->x, &p->fres);
-        mtx_lock(&s->m);
-        s->done = k + 1;
-        if (r == 1)
-            s->solved = k + 1;
-        if (r < 0)
-            s->worker_rc = r;
-        if (r != 0)
-            atomic_store(&s->stop, 1);
-        cnd_broadcast(&s->cv);
-        mtx_unlock(&s->m);
-        if (r != 0)
-            break;
-    }
-    mtx_lock(&s->m);
-    s->worker_done = 1;
-    cnd_broadcast(&s->cv);
-    mtx_unlock(&s->m);
-    return 0;
-}
-
-/* The relaxation's hook: the point queued, the answer of an unsolved one. */
-static int spec_hook(void *vctx, double *x, double *fres, double *at)
-{
-    (void)fres;
-    spec *s = vctx;
-    next_threshold(at, s->target);
-    spec_point *p = point_new(s->a->sy.np, x, s->c->xb);
-    if (!p)
-        return -1;
-    p->st = *s->hook->running;
-    p->fire = s->fire;
-    if (spec_push(s, p) != 0) {
-        point_free(p);
-        return -1;
-    }
-    return s->fire_after && ++s->points >= s->fire_after ? 2 : 0;
-}
-
-static int spec_poll(void *vctx)
-{
-    spec *s = vctx;
-    return atomic_load_explicit(&s->stop, memory_order_relaxed);
-}
-
-/* Wait for the worker (the monitor ticked meanwhile: a cancel stops it). */
-static void spec_wait(spec *s, pk_monitor *mon)
-{
-    mtx_lock(&s->m);
-    s->closed = 1;
-    cnd_broadcast(&s->cv);
-    while (!s->worker_done) {
-        struct timespec ts;
-        timespec_get(&ts, TIME_UTC);
-        ts.tv_nsec += 100000000L; /* 0.1 s */
-        if (ts.tv_nsec >= 1000000000L) {
-            ts.tv_sec++;
-            ts.tv_nsec -= 1000000000L;
-        }
-        cnd_timedwait(&s->cv, &s->m, &ts);
-        if (!s->worker_done && mon) {
-            mtx_unlock(&s->m);
-            pk_progress pr = {.stage = "newton", .fraction = -1, .phi = -1, .eta_s = -1};
-            if (pk_monitor_tick(mon, &pr, 0))
-                atomic_store(&s->abort, 1);
-            mtx_lock(&s->m);
-        }
-    }
-    mtx_unlock(&s->m);
-}
-
-/* The step as the serial hybrid ends at the point solved, p: x, st, ns's
- * FIRE iterations and the relaxation's pair list c (rebuilt where it had
- * been built then; its geometry is the caller's to evaluate at x). */
-static int spec_apply(const spec *s, const spec_point *p, pk_dem_pairs *c, const pk_dem_geom *g,
-                      double *x, const double *r, const pk_dr_params *prm, const pk_dr_stats *st_dr,
-                      pk_dr_stats *st, pk_newton_stats *ns)
-{
-    const size_t np = s->a->sy.np;
-    memcpy(x, p->x, 3 * np * sizeof *x);
-    int rc = pk_dem_pairs_build(c, g, p->xb, r, np, prm->skin);
-    if (rc != 0)
-        return rc;
-    ns->fire_iterations = 0; /* unless the point is FIRE's (fire_merge) */
-    if (p->first) {
-        memset(st, 0, sizeof *st);
-        st->f0 = s->f0;
-        st->f = p->fres;
-        st->stop = p->fres <= prm->tol * s->f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
-        return 0;
-    }
-    if (!p->fire) {
-        *st = p->st;
-        pk_relax_hook_solved(st, prm, p->fres);
-    } else {
-        *st = *st_dr;
-        pk_dr_params fp = fire_params(prm, s->target, st);
-        pk_dr_stats fs = p->st;
-        pk_relax_hook_solved(&fs, &fp, p->fres);
-        fire_merge(st, &fs, prm, ns);
-    }
-    return 0;
-}
-
-/* The hybrid after the prologue of pk_homog_newton, speculatively (see
- * above): sy and w as the prologue left them (w->f the forces at x), c2 a
- * pair list of the worker's own. */
-static int hybrid_speculative(const newton_sys *sy, newton_work *w, pk_dem_pairs *c2, double *x,
-                              double phi0, double f0, double target, size_t *budget,
-                              pk_dr_stats *st, pk_newton_stats *ns)
-{
-    pk_dem_pairs *c = sy->c;
-    const size_t np = sy->np;
-    pk_par *par = c->par;
-    if (pk_par_threads(par) <= 2) /* the two threads are the relaxation's and the worker's */
-        c->par = c2->par = NULL;
-    /* c2 := c (the same build, the same geometry) for the first phase */
-    int rc = pk_dem_pairs_build(c2, sy->g, x, sy->r, np, sy->prm->skin);
-    if (rc == 0)
-        pk_dem_eval(c2, sy->g, x, sy->r, np, sy->E, NULL, NULL, NULL);
-    pk_newton_stats nsw = *ns;
-    pk_dr_stats stw = {0}, st_dr = {0};
-    spec s = {.f0 = f0, .phi0 = phi0, .target = target, .c = c, .fire_after = FIRE_AFTER};
-    atomic_init(&s.stop, 0);
-    atomic_init(&s.abort, 0);
-    attempt_ctx a = {*sy, w, target, budget, &nsw, &stw, FIRE_AFTER, 0};
-    a.sy.c = c2;
-    a.sy.mon = NULL; /* the relaxation ticks the monitor; the worker stops on s.abort */
-    a.sy.abort = &s.abort;
-    s.a = &a;
-    pk_dr_hook hook = {.fn = spec_hook, .ctx = &s, .poll = spec_poll,
-                       .at = HANDOVER * f0 > target ? HANDOVER * f0 : 0, .crawl = CRAWL};
-    s.hook = &hook;
-    spec_point *first = rc == 0 ? point_new(np, x, NULL) : NULL;
-    if (rc != 0 || !first) {
-        c->par = par;
-        return rc != 0 ? rc : -1;
-    }
-    first->first = 1;
-    thrd_t th;
-    if (mtx_init(&s.m, mtx_plain) != thrd_success) {
-        point_free(first);
-        c->par = par;
-        return -1;
-    }
-    if (cnd_init(&s.cv) != thrd_success) {
-        mtx_destroy(&s.m);
-        point_free(first);
-        c->par = par;
-        return -1;
-    }
-    int started = spec_push(&s, first) == 0 && thrd_create(&th, spec_worker, &s) == thrd_success;
-    if (!started) {
-        if (s.n == 0)
-            point_free(first);
-        rc = -1;
-    } else {
-        rc = relax_then_fire(c, sy->g, x, sy->r, np, sy->E, sy->is_free, sy->prm, target, &hook,
-                             &s.fire_after, &s.fire, sy->mon, st, &st_dr, ns);
-        /* the points queued are the serial hybrid's all the same (it made
-         * them before the end the relaxation reached alone) — unless this
-         * was a cancel or an error */
-        if (rc != 0 || st->stop == PK_DR_CANCELLED || st->stop == PK_DR_WALL_TIME)
-            atomic_store(&s.abort, 1);
-        spec_wait(&s, sy->mon);
-        thrd_join(th, NULL);
-    }
-    c->par = c2->par = par;
-    size_t fire_iterations = ns->fire_iterations;
-    *ns = nsw;
-    ns->fire_iterations = fire_iterations; /* the relaxation's (FIRE's) */
-    if (rc == 0 && s.worker_rc < 0)
-        rc = s.worker_rc;
-    const spec_point *won = rc == 0 && s.solved ? s.pt[s.solved - 1] : NULL;
-    if (won)
-        rc = spec_apply(&s, won, c, sy->g, x, sy->r, sy->prm, &st_dr, st, ns);
-    /* as the serial hybrid: after the relaxation (and an attempt from one of
-     * its points) c is refreshed where x left it; not after the first phase */
-    if (rc == 0 && !(won && won->first) && pk_dem_pairs_stale(c, x, sy->g->dim))
-        rc = pk_dem_pairs_build(c, sy->g, x, sy->r, np, sy->prm->skin);
-    for (size_t k = 0; k < s.n; k++)
-        point_free(s.pt[k]);
-    free(s.pt);
-    cnd_destroy(&s.cv);
-    mtx_destroy(&s.m);
-    return rc;
-}
-#endif
 
 int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
                     double E, const uint8_t *is_free, const pk_dr_params *prm,
@@ -1077,12 +709,14 @@ int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doub
     size_t budget = max_newton;
 #if !defined(__STDC_NO_THREADS__)
     if (pk_par_threads(c->par) >= 2 && fn > target) {
-        rc = hybrid_speculative(&sy, &w, &c2, x, phi, f0, target, &budget, st, ns);
+        pk_hybrid_plan plan = {STALL_FACTORS, FIRE_AFTER, HANDOVER * f0 > target ? HANDOVER * f0 : 0,
+                               CRAWL};
+        rc = pk_hybrid_speculative(&sy, &w, &c2, x, phi, f0, target, &budget, &plan, st, ns);
         goto out;
     }
 #endif
     memcpy(w.x0, x, 3 * np * sizeof *x);
-    rc = newton_phase(&sy, &w, x, &phi, &fn, target, STALL_FACTORS, 0, &budget, ns, st);
+    rc = pk_hybrid_newton_phase(&sy, &w, x, &phi, &fn, target, STALL_FACTORS, 0, &budget, ns, st);
     if (rc == 1) { /* cancelled */
         st->f0 = f0;
         st->f = fn;
@@ -1115,7 +749,7 @@ int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doub
                        .at = HANDOVER * f0 > target ? HANDOVER * f0 : 0, .crawl = CRAWL};
     pk_dr_stats st_dr;
     int in_fire = 0;
-    rc = relax_then_fire(c, g, x, r, np, E, is_free, prm, target, &hook, &a.fire_after, &in_fire,
+    rc = pk_hybrid_relax_then_fire(c, g, x, r, np, E, is_free, prm, target, &hook, &a.fire_after, &in_fire,
                          mon, st, &st_dr, ns);
     /* an attempt's point may be beyond DR's candidate list: the caller evaluates c at x */
     if (rc == 0 && pk_dem_pairs_stale(c, x, dim))
