@@ -81,6 +81,10 @@
  * once more after a failed attempt (×0.25): seed 6 12 → 8 factorisations but
  * 2.06 → 2.21 s (DR runs longer before FIRE), seed 7 1.96 → 3.19 s (13,602
  * creeping DR iterations), seeds 5/8/9 1.24/2.01/0.86 → 1.07/1.52/1.26 s. */
+/* Seventh session, measured and not kept: FIRE's thresholds ×0.25 apart
+ * instead of ×0.5 (one failing attempt fewer on seed 6: 1.71 → 1.60 s, the
+ * same minimum; seeds 5, 7–9 ±0.07 s); ×0.125 and ×0.05 slower (seed 6:
+ * 5,681 → 11,809 FIRE iterations) — a gain on one RVE is no rule. */
 #define HANDOVER 1e-3
 #define HANDOVER_STEP 0.5
 /* DR iterations after a failed attempt in which the residual neither
