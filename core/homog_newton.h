@@ -24,7 +24,10 @@
  * tolerance).  Newton only accepts steps that lower Φ_n and converges only
  * where the block it factorised last was positive definite: the end point is
  * a local minimum.  Which one, when the step crosses a plastic event, is
- * path dependent (docs/homogenization.md). */
+ * path dependent (docs/homogenization.md).
+ * With a pool of two threads or more (c->par) the attempts run on a second
+ * thread while the relaxation goes on (homog_speculative.c): the same
+ * result, bit for bit. */
 #ifndef PK_HOMOG_NEWTON_H
 #define PK_HOMOG_NEWTON_H
 
