@@ -76,8 +76,8 @@ typedef struct pk_dr_hook {
     size_t crawl;
     /* poll (may be NULL): asked after every iteration; nonzero stops the
      * relaxation at once (stop PK_DR_HANDED_OVER, x as it is) — the hook's
-     * owner has solved the step elsewhere (homog_newton.c, speculative
-     * attempts).  It must be cheap. */
+     * owner has solved the step elsewhere (homog_speculative.c: the
+     * attempts on a second thread).  It must be cheap. */
     int (*poll)(void *ctx);
     /* the relaxation's book-keeping (zero at the start) */
     size_t last;   /* iteration of the last call (counted from 1; 0: not called yet) */
