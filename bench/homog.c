@@ -13,7 +13,9 @@
  *     below pk_dem_par_min_pairs, both serial)
  *   bench=homog case=periodic_step_newton_2d ... threads=2 seconds=S
  *     serial_seconds=S1 speedup=S1/S same_bits=B (the step again on a 2-thread
- *     pool, pk_homog_opts.par; B = 1: the same energy, P̄ and iterations)
+ *     pool, pk_homog_opts.par: the attempts speculative on the second thread,
+ *     core/homog_speculative.c; B = 1: the same end point, energy, P̄ and
+ *     path statistics — on 0 the fields that differ go to stderr)
  * The step is 0.1 % uniaxial compression at tolerance 1e-8 (the thesis's),
  * solved by the Newton/DR/FIRE hybrid (core/homog_newton.h, CHOLMOD) and by DR
  * alone from the same committed state; the DR line carries the agreement of
