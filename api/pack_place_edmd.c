@@ -36,9 +36,10 @@ static void read_params(const pk_pack_job *job, const pk_pack_plan *plan, pk_edm
                       : PK_EDMD_GROW_RELATIVE;
     prm->until = maximize || strcmp(str(o, "until", "target"), "jammed") == 0 ? PK_EDMD_UNTIL_JAMMED
                                                                              : PK_EDMD_UNTIL_TARGET;
-    const char *start = str(o, "start", prm->growth == PK_EDMD_GROW_SHELL ? "rsa" : "zero");
-    prm->start_zero = strcmp(start, "zero") == 0;
-    prm->delta = prm->growth == PK_EDMD_GROW_SHELL ? 1.0 : num(o, "delta", prm->delta);
+    prm->start_zero = strcmp(str(o, "start", "rsa"), "zero") == 0;
+    /* NAN: the default δ, chosen by place_edmd from the drawn sizes
+     * (pk_edmd_start_delta) */
+    prm->delta = prm->growth == PK_EDMD_GROW_SHELL ? 1.0 : num(o, "delta", NAN);
     if (prm->growth == PK_EDMD_GROW_RELATIVE && job->has_phi)
         prm->phi_target = plan->phi_resolved;
     prm->growth_rate = num(o, "growth_rate", prm->growth_rate);
@@ -89,14 +90,16 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
 {
     pk_edmd_params prm;
     read_params(job, plan, &prm);
-    if (prm.start_zero) {
-        double x[3] = {0, 0, 0};
-        for (size_t i = 0; i < sz->n; i++)
-            if (pk_particles_push(p, x, 0.5 * sz->d[i], sz->species[i]) == (size_t)-1) {
-                snprintf(err, errlen, "out of memory for %zu grains", sz->n);
-                return -1;
-            }
-    } else {
+    /* the default δ: RSA at φ = PK_EDMD_START_PHI (core/edmd.h); should RSA
+     * still fall short (it does not below its saturation), the run starts
+     * from zero radii instead — a given δ is the user's: it fails */
+    const int delta_default = isnan(prm.delta);
+    if (delta_default)
+        prm.delta = pk_edmd_start_delta(job->box.dim, sz->d, sz->n, job->delta_d,
+                                        pk_box_measure(&job->box), PK_EDMD_START_PHI);
+    const int rsa_start = !prm.start_zero && prm.delta > 0;
+    double rsa_seconds = 0;
+    if (rsa_start) {
         pk_rsa_stats rs;
         double gap = prm.growth == PK_EDMD_GROW_SHELL ? 0.0 : job->delta_d;
         if (pk_edmd_start_rsa(&job->box, sz->d, sz->species, sz->n, prm.delta, gap, job->seed, mon,
@@ -104,18 +107,30 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
             snprintf(err, errlen, "RSA start configuration failed");
             return -1;
         }
+        rsa_seconds = rs.seconds;
         if (rs.reason == PK_STOP_CANCELLED || rs.reason == PK_STOP_WALL_TIME) {
             *st = (pk_place_stats){.reason = rs.reason, .placed = rs.placed,
                                    .requested = sz->n, .seconds = rs.seconds};
             return 0;
         }
-        if (rs.placed < sz->n) {
+        if (rs.placed < sz->n && !delta_default) {
             snprintf(err, errlen,
                      "RSA start placed only %zu of %zu grains at delta = %g: lower edmd.delta or use "
                      "start: zero",
                      rs.placed, sz->n, prm.delta);
             return -1;
         }
+        if (rs.placed < sz->n)
+            p->n = 0; /* the default start fell short: from zero radii */
+    }
+    prm.start_zero = p->n == 0; /* (shell growth: δ = 1 is given, never zero) */
+    if (prm.start_zero) {
+        double x[3] = {0, 0, 0};
+        for (size_t i = 0; i < sz->n; i++)
+            if (pk_particles_push(p, x, 0.5 * sz->d[i], sz->species[i]) == (size_t)-1) {
+                snprintf(err, errlen, "out of memory for %zu grains", sz->n);
+                return -1;
+            }
     }
     /* "wall_gap": "none" (Titscher §6.3: Δd between grains only): the shell
      * may reach Δd/2 of the job into the walls */
@@ -154,6 +169,11 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     json_object_set_new(obs, "termination_criterion", json_string(pk_edmd_criterion_name(es.criterion)));
     json_object_set_new(obs, "delta_d_reached", json_real(es.delta_d));
     json_object_set_new(obs, "wall_gap_guaranteed", json_real(fmax(0.5 * es.delta_d - w, 0)));
+    json_object_set_new(obs, "start", json_string(prm.start_zero ? "zero" : "rsa"));
+    if (!prm.start_zero) {
+        json_object_set_new(obs, "start_delta", json_real(prm.delta));
+        json_object_set_new(obs, "start_seconds", json_real(rsa_seconds));
+    }
     json_object_set_new(obs, "time_simulated", json_real(es.t_stop));
     if (isfinite(es.t_end))
         json_object_set_new(obs, "time_end", json_real(es.t_end));

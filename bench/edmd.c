@@ -9,10 +9,11 @@
  * Cases: monodisperse 3D periodic N = 10^4 to φ = 0.60 and to jamming,
  * N = 2000 slow/fast (the MRJ band and the rate dependence), Fuller-like
  * 3D diameters 1–16 (counts ∝ d^-2.5) N = 10^4 to jamming — both from zero
- * radii (Meier) and, …_rsa030, from an RSA start at φ = 0.30 (Titscher/Kansal:
- * the dilute phase, where list rebuilds outnumber collisions, is skipped;
- * its RSA time counts), with the monodisperse jammed case from the same
- * start beside it for the ratio — Meier's 2D
+ * radii (Meier) and, …_rsa030, from an RSA start at φ = 0.30 (Titscher/Kansal;
+ * the jobs' default start since the eighth session, δ by
+ * pk_edmd_start_delta: the dilute phase, where list rebuilds outnumber
+ * collisions, is skipped; its RSA time counts), with the monodisperse
+ * cases from the same start beside them for the ratio — Meier's 2D
  * quartz and A32 (nop = 1000) to jamming over 3 seeds; N = 10^5 to φ = 0.55
  * from zero radii and from an RSA start at φ = 0.30 (…_rsa030).  The N = 10^6
  * cases (to φ = 0.55, both starts) take minutes: opt in with PACKD_BENCH_LARGE=1.  peak_rss_mb is the
@@ -99,7 +100,8 @@ static void run_core(const char *name, int dim, const double *r, size_t n, doubl
             d[i] = 2 * r[i];
         pk_rsa_stats rs;
         prm.start_zero = 0;
-        prm.delta = pow(rsa_phi / phi0, 1.0 / dim);
+        /* the job's default start (api/pack_place_edmd.c) at rsa_phi */
+        prm.delta = pk_edmd_start_delta(dim, d, n, 0, pk_box_measure(&b), rsa_phi);
         pk_edmd_start_rsa(&b, d, sp, n, prm.delta, 0, prm.seed, NULL, &p, &rs);
         free(d);
         free(sp);
@@ -218,6 +220,7 @@ static void meier(const char *name, const char *grading, double L, int seed)
 int main(void)
 {
     mono("mono3d_1e4_to_phi060", 10000, 0.1, 0, 0.60);
+    mono_from("mono3d_1e4_to_phi060_rsa030", 10000, 0.1, 0, 0.60, 0.30);
     mono("mono3d_1e4_jam_rate0.02", 10000, 0.02, 1, 0);
     double slow = mono("mono3d_2000_jam_rate0.01", 2000, 0.01, 1, 0);
     double fast = mono("mono3d_2000_jam_rate0.1", 2000, 0.1, 1, 0);

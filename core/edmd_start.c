@@ -1,5 +1,6 @@
 /* edmd_start.c — EDMD parameters' defaults, criterion names and the RSA start
  * configuration at reduced size δ·d (Titscher §6.2, Kansal). */
+#include <math.h>
 #include <stdlib.h>
 
 #include "edmd.h"
@@ -9,7 +10,7 @@ void pk_edmd_params_default(pk_edmd_params *prm)
     *prm = (pk_edmd_params){
         .growth = PK_EDMD_GROW_RELATIVE,
         .until = PK_EDMD_UNTIL_TARGET,
-        .start_zero = 1,
+        .start_zero = 1, /* the engine's; jobs start from RSA (api/pack_place_edmd.c) */
         .delta = 0.9,
         .growth_rate = 0.01,
         .p_max = 1e12,
@@ -52,4 +53,40 @@ int pk_edmd_start_rsa(const pk_box *b, const double *d, const int32_t *species, 
     for (size_t i = first; i < p->n; i++)
         p->r[i] /= delta; /* back to the target radius; the engine starts at δ·r */
     return 0;
+}
+
+double pk_edmd_start_delta(int dim, const double *d, size_t n, double delta_d, double box_measure,
+                           double phi_start)
+{
+    if ((dim != 2 && dim != 3) || !(box_measure > 0) || !(phi_start > 0))
+        return 0;
+    /* Σ (δ a_i + h)^dim = Σ_k C(dim, k) δ^k h^(dim−k) Σ a_i^k, a_i = d_i/2 */
+    double mom[4] = {(double)n, 0, 0, 0};
+    for (size_t i = 0; i < n; i++) {
+        const double a = 0.5 * d[i];
+        mom[1] += a;
+        mom[2] += a * a;
+        mom[3] += a * a * a;
+    }
+    const double h = 0.5 * delta_d, unit = pk_ball_measure(dim, 1);
+    const double binom[2][4] = {{1, 2, 1, 0}, {1, 3, 3, 1}};
+    double c[4];
+    for (int k = 0; k <= dim; k++)
+        c[k] = unit * binom[dim - 2][k] * pow(h, dim - k) * mom[k] / box_measure;
+    const double want = phi_start;
+    double lo = 0, hi = PK_EDMD_START_DELTA_MAX;
+#define FILLED(x) (c[0] + (x) * (c[1] + (x) * (c[2] + (dim == 3 ? (x) * c[3] : 0))))
+    if (FILLED(hi) <= want)
+        return hi;
+    if (FILLED(lo) > want)
+        return 0;
+    for (int it = 0; it < 60; it++) {
+        const double mid = 0.5 * (lo + hi);
+        if (FILLED(mid) <= want)
+            lo = mid;
+        else
+            hi = mid;
+    }
+#undef FILLED
+    return lo;
 }

@@ -27,6 +27,21 @@ for ex in examples/*.json; do
     fi
 done
 
+# 1b. EDMD's default start is RSA at φ = 0.30 of the box (2D: δ = √(0.30/0.80)),
+#     Meier's zero start when asked; both end complete at φ = 0.80 with no overlap
+sed 's/"start": "zero", //' examples/edmd-quartz-2d.json >"$T/edmd-default.json"
+"$PACKD" run "$T/edmd-default.json" -o "$T/edmd-default.h5" >"$T/edmd-default.out" 2>&1
+check edmd_default_start_rsa python3 -c "
+import json; d=json.load(open('$T/edmd-default.out')); e=d['edmd']
+z=json.load(open('$T/edmd-quartz-2d.json'))['edmd']
+assert d['complete'] and e['start'] == 'rsa', e['start']
+assert abs(e['start_delta'] - (0.30/0.80)**0.5) < 1e-9, e['start_delta']
+assert e['history']['phi'][0] == 0.3 or abs(e['history']['phi'][0] - 0.3) < 1e-9
+assert z['start'] == 'zero' and 'start_delta' not in z
+for r in (d, json.load(open('$T/edmd-quartz-2d.json'))):
+    assert r['pairs_below_delta_d'] == 0 and r['smallest_gap'] >= 0 and abs(r['edmd']['phi_final'] - 0.8) < 1e-12
+"
+
 # 2. H5MD metadata values as h5dump prints them
 h5dump -a /h5md/version "$T/din-a16-3d-walled.h5" >"$T/ver" 2>&1
 check h5md_version grep -q '(0): 1, 1' "$T/ver"

@@ -319,6 +319,29 @@ static void test_rsa_start_relative_and_shell(void)
     free(sp);
 }
 
+/* The default start's δ (pk_edmd_start_delta): the start's spheres δ·d/2 +
+ * Δd/2, summed directly, fill exactly φ = 0.30 of the box (bisection to
+ * 2^-60 of δ: 1e-12 relative is far above it); δ is capped at Titscher's
+ * 0.9 when that fill stays below 0.30, and 0 when the shells alone exceed
+ * it. */
+static void test_start_delta(void)
+{
+    double d[300];
+    for (int i = 0; i < 300; i++)
+        d[i] = i < 30 ? 4.0 : i < 120 ? 2.0 : 1.0;
+    for (int dim = 2; dim <= 3; dim++) {
+        const double V = dim == 2 ? 40.0 * 40.0 : 14.0 * 14.0 * 14.0, dd = 0.05;
+        const double delta = pk_edmd_start_delta(dim, d, 300, dd, V, 0.30);
+        CHECK(delta > 0 && delta < 0.9);
+        double filled = 0;
+        for (int i = 0; i < 300; i++)
+            filled += pk_ball_measure(dim, 0.5 * delta * d[i] + 0.5 * dd);
+        CHECK_NEAR(filled / V, 0.30, 1e-12);
+        CHECK(pk_edmd_start_delta(dim, d, 300, dd, 10 * V, 0.30) == 0.9);
+        CHECK(pk_edmd_start_delta(dim, d, 300, 3.0, V, 0.30) == 0);
+    }
+}
+
 /* From RESORT_MIN_N = 32768 grains on the engine renumbers the grains along
  * a Z-order curve every 10·N events and rebuilds lists and events there:
  * the result must stay overlap-free, give every grain its own size in the
@@ -392,6 +415,7 @@ int main(void)
     RUN(test_walled_2d_delta_d);
     RUN(test_rescale_switch);
     RUN(test_rsa_start_relative_and_shell);
+    RUN(test_start_delta);
     RUN(test_renumbering_large_n);
     RUN(test_cancel);
     return check_summary();
