@@ -59,13 +59,12 @@ int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, cons
     size_t ne = b->dim == 3 ? (size_t)R->Q * R->Q * R->Q : (size_t)R->Q * R->Q;
     R->entry = (size_t)(2 * R->D + 1) * (size_t)(2 * R->D + 1) * (b->dim == 3 ? (size_t)(2 * R->D + 1) : 1);
     R->tab = malloc(ne * R->entry * sizeof *R->tab);
-    R->tidx = malloc(ne * R->entry);
+    R->trows = malloc(ne * sizeof *R->trows);
     R->tcnt = malloc(ne);
-    R->toff = malloc(R->entry * sizeof *R->toff);
     R->tdec = malloc(R->entry * 3);
     R->covered = calloc(nc, sizeof *R->covered);
     R->list = malloc(nc * sizeof *R->list);
-    if (!R->covered || !R->list || !R->tab || !R->tidx || !R->tcnt || !R->toff || !R->tdec) {
+    if (!R->covered || !R->list || !R->tab || !R->trows || !R->tcnt || !R->tdec) {
         pk_rsa_region_free(R);
         return -1;
     }
@@ -75,7 +74,6 @@ int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, cons
         for (int dy = 0; dy < W; dy++)
             for (int dx = 0; dx < W; dx++) {
                 const size_t q = (size_t)(dz * W + dy) * W + dx;
-                R->toff[q] = ((zr ? dz - D : 0) * R->n[1] + dy - D) * R->n[0] + dx - D;
                 R->tdec[3 * q] = (uint8_t)dx;
                 R->tdec[3 * q + 1] = (uint8_t)dy;
                 R->tdec[3 * q + 2] = (uint8_t)(zr ? dz : D);
@@ -93,9 +91,8 @@ void pk_rsa_region_free(pk_rsa_region *R)
     free(R->covered);
     free(R->list);
     free(R->tab);
-    free(R->tidx);
+    free(R->trows);
     free(R->tcnt);
-    free(R->toff);
     free(R->tdec);
     memset(R, 0, sizeof *R);
 }
@@ -260,15 +257,13 @@ static void make_entry(pk_rsa_region *R, size_t e, const double *p)
             }
         }
     }
-    /* keep the nonzero words only, with their cell numbers */
-    uint8_t *idx = &R->tidx[e * R->entry];
-    int cnt = 0;
-    for (size_t q = 0; q < R->entry; q++)
-        if (w[q]) {
-            w[cnt] = w[q];
-            idx[cnt++] = (uint8_t)q;
-        }
-    R->tcnt[e] = (uint8_t)cnt;
+    /* the rows (W words along x) holding a mark */
+    uint32_t rows = 0;
+    for (int r = 0; r < R->nrow; r++)
+        for (int q = 0; q < W; q++)
+            rows |= (uint32_t)(w[r * W + q] != 0) << r;
+    R->trows[e] = rows;
+    R->tcnt[e] = 1;
 }
 
 /* The cell of x and its table entry (the centre's step per axis). */
@@ -318,6 +313,32 @@ void pk_rsa_region_prefetch(const pk_rsa_region *R, pk_rsa_region_spot s)
     }
 }
 
+/* dst[0 .. 2D] |= src[0 .. 2D]: one row of a mark, two words at a time
+ * (SSE2, the x86-64 baseline; other targets get the same from the vector
+ * extension's lowering). */
+typedef uint64_t pk_u64x2 __attribute__((vector_size(16)));
+
+static inline void or_two(uint64_t *dst, const uint64_t *src)
+{
+    pk_u64x2 a, b;
+    memcpy(&a, dst, sizeof a);
+    memcpy(&b, src, sizeof b);
+    a |= b;
+    memcpy(dst, &a, sizeof a);
+}
+
+static inline void or_row(uint64_t *dst, const uint64_t *src, int D)
+{
+    if (D == 2) {
+        or_two(dst, src);
+        or_two(dst + 2, src + 2);
+        dst[4] |= src[4];
+    } else {
+        or_two(dst, src);
+        dst[2] |= src[2];
+    }
+}
+
 void pk_rsa_region_mark_at(pk_rsa_region *R, pk_rsa_region_spot s)
 {
     const int dim = R->dim, D = R->D;
@@ -328,15 +349,17 @@ void pk_rsa_region_mark_at(pk_rsa_region *R, pk_rsa_region_spot s)
         make_entry(R, e, p);
     }
     const uint64_t *w = &R->tab[e * R->entry];
-    const int cnt = R->tcnt[e];
+    const uint32_t rows = R->trows[e];
     if (s.inner) { /* the common case: no wrap, no wall — fixed offsets */
         uint64_t *base = &R->covered[s.word];
-        /* (the offsets by cell number: per-entry int32 offsets saved 1 % of
-         * the instructions at 10^6 grains but made the 16-step table 45 %
-         * larger, beyond the L2 cache: no faster) */
-        const uint8_t *idx = &R->tidx[e * R->entry];
-        for (int t = 0; t < cnt; t++)
-            base[R->toff[idx[t]]] |= w[t];
+        /* whole rows, two words per operation: against the entry's nonzero
+         * words one at a time (~80 of 125, each with its cell number's
+         * offset), 10^6 grains 3D φ = 0.30: user time −6.6 % (6 alternating
+         * pairs, 0.889 → 0.830 s), the same marks */
+        for (uint32_t m = rows; m; m &= m - 1) {
+            const int r = __builtin_ctz(m);
+            or_row(base + R->roff[r] - D, w + r * (2 * D + 1), D);
+        }
         return;
     }
     /* near a seam or a wall: each word's cell per axis, wrapped or dropped */
@@ -349,13 +372,12 @@ void pk_rsa_region_mark_at(pk_rsa_region *R, pk_rsa_region_spot s)
                                     : (j < 0 ? j + R->n[k] : j - R->n[k]); /* n >= 2D + 1 */
             c[k][d + D] = j;
         }
-    const uint8_t *idx = &R->tidx[e * R->entry];
-    for (int t = 0; t < cnt; t++) {
-        const uint8_t *dq = &R->tdec[3 * (size_t)idx[t]];
+    for (size_t q = 0; q < R->entry; q++) {
+        const uint8_t *dq = &R->tdec[3 * q];
         const int64_t cx = c[0][dq[0]], cy = c[1][dq[1]], cz = c[2][dq[2]];
-        if ((cx | cy | cz) < 0)
+        if (!w[q] || (cx | cy | cz) < 0)
             continue;
-        R->covered[(uint64_t)(cz * R->n[1] + cy) * (uint64_t)R->n[0] + (uint64_t)cx] |= w[t];
+        R->covered[(uint64_t)(cz * R->n[1] + cy) * (uint64_t)R->n[0] + (uint64_t)cx] |= w[q];
     }
 }
 

@@ -49,10 +49,9 @@ typedef struct pk_rsa_region {
     int Q, D;                   /* steps per axis; cells reached on each side */
     size_t entry;               /* words per entry: (2D + 1)^dim */
     double c, delta;
-    uint64_t *tab;              /* [Q^dim][entry]: an entry's nonzero words first */
-    uint8_t *tidx;              /* [Q^dim][entry]: their cell numbers in the entry */
-    uint8_t *tcnt;              /* [Q^dim]: how many; 0xff = not made yet */
-    int64_t *toff;              /* [entry]: index offset of cell number q (off the seams) */
+    uint64_t *tab;              /* [Q^dim][entry]: word ((dz+D)·W + dy+D)·W + dx+D, W = 2D + 1 */
+    uint32_t *trows;            /* [Q^dim]: bit r set when row r (W words along x) marks */
+    uint8_t *tcnt;              /* [Q^dim]: 1 made, 0xff = not made yet */
     uint8_t *tdec;              /* [entry][3]: cell number q's steps dx, dy, dz + D */
     int nrow;                   /* rows of 2D + 1 cells around a cell: (2D + 1)^(dim - 1) */
     int64_t roff[(2 * PK_RSA_REGION_MAX_REACH + 1) * (2 * PK_RSA_REGION_MAX_REACH + 1)];
@@ -68,7 +67,7 @@ typedef struct pk_rsa_region {
 /* Steps of the mark table per axis and cell: with cells of half the store's
  * edge (h ≈ c/2), delta = √3·h/(2·steps) ≈ 0.054 c at 8 steps (512 entries of
  * (2·2 + 1)³ words, 0.5 MB), 0.027 c at 16 (4096 entries, 4.6 MB; a mark
- * reads its entry's nonzero words and their cell numbers, ~80 in 3D). */
+ * reads the rows of its entry that mark, up to 25 of 5 words in 3D). */
 #define PK_RSA_REGION_MAX_STEPS 16
 
 /* For the draw range lo[], span[] cut into n[k] cells per axis (the store's
