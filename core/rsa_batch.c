@@ -322,7 +322,7 @@ static inline void mark_ahead(pk_rsa_region *reg, pk_rsa_region_spot *ring, size
  * phase places 513 000 grains from 1.27M draws, the region phase 487 000
  * from 17.8M draws, 2.62M attempts (85 % of its draws are certain
  * rejections), 534 000 survivors of step 2).  Kept: the marks OR whole
- * table rows (rsa_region.c: user time -6.6 %, the same marks).  Measured
+ * table rows (rsa_region.c: user time 0 to -7 %, the same marks).  Measured
  * and dropped (medians of 4-8 alternating runs, the same packings):
  * PICK_AHEAD 96, 128 or 192 instead of 64 (32: +8 % user time), mark
  * tables of at most 8 or 12 steps instead of 16 (draws per grain 20.8 and
