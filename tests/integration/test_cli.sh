@@ -42,6 +42,25 @@ for r in (d, json.load(open('$T/edmd-quartz-2d.json'))):
     assert r['pairs_below_delta_d'] == 0 and r['smallest_gap'] >= 0 and abs(r['edmd']['phi_final'] - 0.8) < 1e-12
 "
 
+# 1c. where RSA cannot place the default start (103 unit spheres in a walled
+#     10 x 10 x 1.2 slab: at δ = (0.30/0.45)^(1/3) RSA saturates near 91) the run
+#     starts from zero radii and completes; the same δ given by the user fails
+#     with the count placed
+cat >"$T/slab.json" <<'EOF2'
+{"process":"pack","inputs":{"dim":3,"domain":{"box":{"size":[10,10,1.2],"periodic":false}},
+ "grading":{"type":"classes","classes":[{"d":1.0,"volume_percent":100}]},"sampling":"discrete",
+ "count":103,"phi":{"value":0.45,"refers_to":"resolved"},"algorithm":"edmd","seed":1}}
+EOF2
+"$PACKD" run "$T/slab.json" -o "$T/slab.h5" >"$T/slab.out" 2>&1
+check edmd_default_start_falls_back_to_zero python3 -c "
+import json; d=json.load(open('$T/slab.out')); e=d['edmd']
+assert d['complete'] and d['count_placed'] == 103 and e['start'] == 'zero', (d['complete'], e['start'])
+assert d['pairs_below_delta_d'] == 0 and abs(e['phi_final'] - 0.45) < 1e-12
+"
+sed 's/"algorithm":"edmd"/"algorithm":"edmd","edmd":{"delta":0.8736}/' "$T/slab.json" >"$T/slab-delta.json"
+check edmd_given_delta_short_fails sh -c "! '$PACKD' run '$T/slab-delta.json' -o '$T/slab-delta.h5' 2>'$T/slab-delta.err' &&
+    grep -Eq 'placed only (8|9)[0-9] of 103 grains at delta = 0.8736' '$T/slab-delta.err' && [ ! -e '$T/slab-delta.h5' ]"
+
 # 2. H5MD metadata values as h5dump prints them
 h5dump -a /h5md/version "$T/din-a16-3d-walled.h5" >"$T/ver" 2>&1
 check h5md_version grep -q '(0): 1, 1' "$T/ver"
