@@ -78,8 +78,7 @@ static void state_free(edmd_state *s)
     free(s->m);
     free(s->ev);
     free(s->ncoll);
-    free(s->heap_mem);
-    free(s->hpos);
+    edmd_queue_free(s);
     free(s->skin);
     free(s->rref);
     free(s->ncoll_nl);
@@ -94,18 +93,13 @@ static int state_alloc(edmd_state *s, size_t n)
     s->m = calloc(c, sizeof *s->m);
     s->ev = aligned_alloc(32, c * sizeof *s->ev); /* sizeof = 32 */
     s->ncoll = calloc(c, sizeof *s->ncoll);
-    /* heap node k at heap_mem[k + 3]: the 4 children 4k+1..4k+4 of a node
-     * then share one 64-byte line (16-byte nodes); 3 sentinels follow the
-     * last node (edmd_queue.c) */
-    s->heap_mem = aligned_alloc(64, ((c + 3 + 3 + 3) / 4 + 1) * 64);
-    s->heap = s->heap_mem ? s->heap_mem + 3 : NULL;
-    s->hpos = calloc(c, sizeof *s->hpos);
+    const int queue = edmd_queue_alloc(s, c);
     s->skin = calloc(c, sizeof *s->skin);
     s->rref = calloc(c, sizeof *s->rref);
     s->ncoll_nl = calloc(c, sizeof *s->ncoll_nl);
     s->nl = calloc(c, sizeof *s->nl);
     s->nl_mark = calloc(c, sizeof *s->nl_mark);
-    if (!s->k || !s->m || !s->ev || !s->ncoll || !s->heap || !s->hpos || !s->skin || !s->rref ||
+    if (!s->k || !s->m || !s->ev || !s->ncoll || queue != 0 || !s->skin || !s->rref ||
         !s->ncoll_nl || !s->nl || !s->nl_mark)
         return -1;
     return pk_particles_init(&s->bs, s->dim, c);
@@ -233,8 +227,8 @@ static void rebase(edmd_state *s)
         k->a += k->g * T;
     }
     s->h0 += s->h1 * T;
-    edmd_queue_shift(s, T);
     s->t = 0;
+    edmd_queue_shift(s, T); /* (the queue is rebuilt about the new clock) */
 }
 
 /* Kinetic-energy rescaling: every trajectory changes, so all predictions are
@@ -471,7 +465,7 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
     pk_edmd_criterion crit = PK_EDMD_CRIT_NONE;
 
     for (;;) {
-        size_t i = (size_t)s->heap[0].i;
+        size_t i = edmd_queue_top(s);
         edmd_event *e = &s->ev[i];
         double te = e->t;
         if (te >= t_stop - t_base) {

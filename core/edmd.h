@@ -6,8 +6,8 @@
  * unequal masses), walls reflect in the co-moving sense.  Engine: delayed
  * states (each particle stores its position at its own last update time),
  * one pending event per particle (and its runner-up, taken without a new
- * prediction when the first is invalidated; Donev) in a 4-ary heap with
- * validity counters, pair times of four neighbours at once (AVX2 when the
+ * prediction when the first is invalidated; Donev) in a calendar queue of
+ * time slots (Paul 2007: O(1) per event) with validity counters, pair times of four neighbours at once (AVX2 when the
  * CPU has it, bit-identical to the scalar loop),
  * Donev-style per-particle neighbour lists (bounding spheres filed in the
  * dense cell levels of core/grid_uniform.h; skins shrink with the pressure

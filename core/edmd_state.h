@@ -53,6 +53,29 @@ typedef struct edmd_hnode {
 } edmd_hnode;
 _Static_assert(sizeof(edmd_hnode) == 16, "four heap nodes per cache line");
 
+/* The event queue (edmd_queue.c): a calendar of time slots after Paul
+ * (2007, J. Comput. Phys. 221, 615).  Slot of time t: floor((t − T0)/w).
+ * The events of the current slot sit in a small 4-ary heap; those of the
+ * next slots up to lap_end in unsorted bucket lists (bucket = slot mod nb),
+ * later ones in an overflow list, redistributed when a lap starts. */
+typedef struct edmd_queue {
+    double T0, inv_w;         /* slot origin and 1/width */
+    int64_t cur;              /* current slot: its events are in the heap */
+    int64_t lap_end;          /* first slot not in the buckets (<= cur + nb) */
+    uint32_t nb, mask;        /* buckets: a power of two */
+    int32_t *head;            /* [nb + 1] first grain of each bucket's list; [nb]: overflow */
+    uint64_t *occ;            /* [nb / 64] bucket holds a grain */
+    int32_t *nxt, *prv;       /* [n] list links (-1: none) */
+    int32_t *where;           /* [n] bucket, or EDMD_Q_HEAP / EDMD_Q_OVER */
+    int64_t *slot;            /* [n] slot at insertion */
+    edmd_hnode *heap;         /* current slot's events (4-ary, heap_mem + 3) */
+    edmd_hnode *heap_mem;
+    int32_t *hpos;            /* [n] node in the heap */
+    size_t hn;
+    int64_t *work;            /* [n] scratch of the redistributions */
+    double *sample;           /* scratch of the width estimate */
+} edmd_queue;
+
 typedef struct edmd_state {
     pk_box box;
     double Lp[3], inv_Lp[3];  /* L and 1/L on periodic axes, 0 otherwise (pk_min_image3) */
@@ -68,10 +91,7 @@ typedef struct edmd_state {
     /* events: one (and a runner-up) per particle, 32-byte aligned */
     edmd_event *ev;
     uint32_t *ncoll;          /* velocity changes of each particle (validity counter) */
-    edmd_hnode *heap;         /* 4-ary heap of (ev[i].t, particle), in heap_mem */
-    edmd_hnode *heap_mem;
-    int32_t *hpos;            /* node of each particle in the heap */
-    size_t hn;
+    edmd_queue q;
     /* neighbour lists */
     edmd_nlist *nl;           /* [n] slots in nl_pool */
     int32_t *nl_pool;         /* every list, in slots */
@@ -200,7 +220,10 @@ double edmd_collide_pair(edmd_state *s, size_t i, size_t j);   /* returns σ·J 
 void edmd_collide_wall(edmd_state *s, size_t i, int code);
 
 /* edmd_queue.c */
-int edmd_queue_init(edmd_state *s);
+int edmd_queue_alloc(edmd_state *s, size_t n);         /* 0 or -1 */
+void edmd_queue_free(edmd_state *s);
+void edmd_queue_init(edmd_state *s);                   /* every ev[i] anew (slots sized here) */
+size_t edmd_queue_top(edmd_state *s);                  /* the grain of the earliest event */
 void edmd_queue_update(edmd_state *s, size_t i);       /* after ev[i].t changed */
 void edmd_queue_shift(edmd_state *s, double dt);       /* all times −= dt */
 
