@@ -60,14 +60,13 @@ int edmd_queue_alloc(edmd_state *s, size_t n)
     q->where = malloc(n * sizeof *q->where);
     q->slot = malloc(n * sizeof *q->slot);
     q->hpos = malloc(n * sizeof *q->hpos);
-    q->work = malloc(n * sizeof *q->work);
     q->sample = malloc(SAMPLE_MAX * sizeof *q->sample);
     /* heap node k at heap_mem[k + 3]: the 4 children 4k+1..4k+4 of a node
      * share one 64-byte line (16-byte nodes); 3 sentinels follow the last */
     q->heap_mem = aligned_alloc(64, ((n + 3 + 3 + 3) / 4 + 1) * 64);
     q->heap = q->heap_mem ? q->heap_mem + 3 : NULL;
     if (!q->head || !q->occ || !q->nxt || !q->prv || !q->where || !q->slot || !q->hpos ||
-        !q->work || !q->sample || !q->heap)
+        !q->sample || !q->heap)
         return -1;
     return 0;
 }
@@ -82,7 +81,6 @@ void edmd_queue_free(edmd_state *s)
     free(q->where);
     free(q->slot);
     free(q->hpos);
-    free(q->work);
     free(q->sample);
     free(q->heap_mem);
     memset(q, 0, sizeof *q);
@@ -253,14 +251,12 @@ static void new_lap(edmd_state *s, int64_t start)
     edmd_queue *q = &s->q;
     q->cur = start;
     q->lap_end = start + q->nb;
-    size_t m = 0;
-    for (int32_t i = q->head[q->nb]; i >= 0; i = q->nxt[i])
-        if (q->slot[i] < q->lap_end)
-            q->work[m++] = i;
-    for (size_t k = 0; k < m; k++) {
-        const size_t i = (size_t)q->work[k];
-        list_unlink(q, q->nb, i);
-        file(s, i, q->slot[i]);
+    for (int32_t i = q->head[q->nb], nx; i >= 0; i = nx) {
+        nx = q->nxt[i]; /* (file() puts i in the heap or a bucket, not back here) */
+        if (q->slot[i] < q->lap_end) {
+            list_unlink(q, q->nb, (size_t)i);
+            file(s, (size_t)i, q->slot[i]);
+        }
     }
 }
 

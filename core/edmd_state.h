@@ -72,7 +72,6 @@ typedef struct edmd_queue {
     edmd_hnode *heap_mem;
     int32_t *hpos;            /* [n] node in the heap */
     size_t hn;
-    int64_t *work;            /* [n] scratch of the redistributions */
     double *sample;           /* scratch of the width estimate */
 } edmd_queue;
 
