@@ -31,8 +31,9 @@
  * change of the EDMD event order or of the relaxation moves them): figures
  * for a speed bar come from RVEs built by the commit measured (a fresh
  * DIR); a cache compares two builds on the same RVEs.  Eighth session:
- * the seventh session's cached seeds 5–9 took 0.6–1.9 s serial, the RVEs
- * of a clean checkout of its own commit 0.7–2.45 s. */
+ * the seventh session's cached seeds 5–9 took 0.6–1.9 s serial, but its
+ * own commit builds another seed 6 (2.4 s serial), and today's build
+ * (calendar event queue) seeds 5–9 of 0.74–2.2 s. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
