@@ -55,6 +55,12 @@ int pk_edmd_start_rsa(const pk_box *b, const double *d, const int32_t *species, 
     return 0;
 }
 
+/* The fraction filled at δ = x: the cubic (2D: c[3] = 0) of the moments. */
+static double start_filled(const double c[4], double x)
+{
+    return c[0] + x * (c[1] + x * (c[2] + x * c[3]));
+}
+
 double pk_edmd_start_delta(int dim, const double *d, size_t n, double delta_d, double box_measure,
                            double phi_start)
 {
@@ -70,23 +76,20 @@ double pk_edmd_start_delta(int dim, const double *d, size_t n, double delta_d, d
     }
     const double h = 0.5 * delta_d, unit = pk_ball_measure(dim, 1);
     const double binom[2][4] = {{1, 2, 1, 0}, {1, 3, 3, 1}};
-    double c[4];
+    double c[4] = {0, 0, 0, 0};
     for (int k = 0; k <= dim; k++)
         c[k] = unit * binom[dim - 2][k] * pow(h, dim - k) * mom[k] / box_measure;
-    const double want = phi_start;
     double lo = 0, hi = PK_EDMD_START_DELTA_MAX;
-#define FILLED(x) (c[0] + (x) * (c[1] + (x) * (c[2] + (dim == 3 ? (x) * c[3] : 0))))
-    if (FILLED(hi) <= want)
+    if (start_filled(c, hi) <= phi_start)
         return hi;
-    if (FILLED(lo) > want)
+    if (start_filled(c, lo) > phi_start)
         return 0;
-    for (int it = 0; it < 60; it++) {
+    for (int it = 0; it < 60; it++) { /* bisection: the fill grows with δ */
         const double mid = 0.5 * (lo + hi);
-        if (FILLED(mid) <= want)
+        if (start_filled(c, mid) <= phi_start)
             lo = mid;
         else
             hi = mid;
     }
-#undef FILLED
     return lo;
 }
