@@ -31,6 +31,8 @@
  * from there on plain draws are mostly wasted (φ ≈ 0.2 of 0.3 for equal
  * spheres), marking exclusion balls pays. */
 #define REGION_SWITCH_ACC 0.2
+/* Cost of a draw into a fully covered cell over a list entry's in a compaction. */
+#define STALE_PER_PASS 16
 #define REGION_MIN_LEFT 256
 /* Region cells per store cell and axis: edge ≈ c/2, fine voxels ≈ c/8 in 3D
  * (c/16 in 2D).  Halving the edge again (or 16 steps of the mark table) saved
@@ -85,6 +87,7 @@ typedef struct scratch {
     uint8_t *taken;     /* survivor accepted in step 3 */
     uint32_t *pid;      /* its index in the particle array (set where taken is) */
     uint32_t *count;    /* [MAX_BUCKETS + 1] */
+    size_t stale;       /* region draws of the last batch that fell in a fully covered cell */
     /* step 3: hash of the batch's accepted survivors by cell */
     int32_t *head;      /* [power of two >= 2 cap] */
     int32_t *hnext;     /* per survivor */
@@ -356,7 +359,7 @@ static size_t region_pick(const pk_rsa_region *reg, scratch *w, size_t B, pk_rng
                                                              list position 0, harmless */
     const uint32_t *list = reg->list;
     const uint64_t *covered = reg->covered;
-    size_t open = 0;
+    size_t open = 0, stale = 0;
     for (size_t d = 0; d < B; d++) {
         __builtin_prefetch(&list[w->rpos[d + PICK_AHEAD]]);
         __builtin_prefetch(&covered[list[w->rpos[d + PICK_AHEAD / 2]]]);
@@ -366,8 +369,11 @@ static size_t region_pick(const pk_rsa_region *reg, scratch *w, size_t B, pk_rng
         w->rpos[open] = cell;
         w->rbit[open] = (uint8_t)bit;
         w->rdraw[open] = (uint32_t)d;
-        open += !(covered[cell] >> bit & 1);
+        const uint64_t word = covered[cell];
+        open += !(word >> bit & 1);
+        stale += word == ~(uint64_t)0;
     }
+    w->stale = stale;
     return open;
 }
 
@@ -491,19 +497,16 @@ static int region_start(pk_rsa_region *reg, const pk_rsa_cells *C, const pk_box 
     }
     for (int64_t z = 0; z < C->n[2]; z++)
         for (int64_t y = 0; y < C->n[1]; y++) {
-            const pk_rsa_cell2 *row =
+            const pk_rsa_cell1 *row =
                 &C->cell[C->base + (uint64_t)z * C->stride[2] + (uint64_t)y * C->stride[1]];
             for (int64_t x = 0; x < C->n[0]; x++) {
-                uint32_t a = row[x].id[0], b2 = row[x].id[1];
+                const uint32_t a = row[x].id;
                 if (a == PK_RSA_CELLS_NONE)
                     continue;
-                ids[k++] = a;
-                if (b2 == PK_RSA_CELLS_NONE)
-                    continue;
-                if (!(b2 & PK_RSA_CELLS_MORE))
-                    ids[k++] = b2;
+                if (!(a & PK_RSA_CELLS_MORE))
+                    ids[k++] = a;
                 else
-                    for (int32_t e = (int32_t)(b2 & ~PK_RSA_CELLS_MORE); e >= 0;
+                    for (int32_t e = (int32_t)(a & ~PK_RSA_CELLS_MORE); e >= 0;
                          e = C->extra[e].next)
                         ids[k++] = C->extra[e].id;
             }
@@ -559,7 +562,7 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
     pk_rsa_region reg;
     memset(&reg, 0, sizeof reg);
     int region = 0, region_allowed = !prm->batch_plain_draws;
-    uint64_t cheap_since = 0; /* certain rejections since the last compaction */
+    uint64_t stale_since = 0; /* draws in fully covered cells since the last compaction */
 
     pk_stop_reason reason = PK_STOP_COMPLETE;
     size_t placed = 0;
@@ -705,9 +708,16 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
         }
         if (reason != PK_STOP_COMPLETE)
             break;
-        if (region && (cheap_since += B - A) >= reg.nlist) {
-            pk_rsa_region_compact(&reg); /* amortised: no dearer than the draws it saves */
-            cheap_since = 0;
+        /* Compaction passes over the list once (~0.6 ns an entry at 10^6 grains,
+         * sequential) and ends the draws into fully covered cells (~10 ns each,
+         * two misses): compact once those since the last compaction cost what a
+         * pass does.  (Before: once the certain rejections since then reached the
+         * list's length — one compaction at 10^6 grains, 53 % of the list stale by
+         * then; now three: draws per grain 19.0 -> 15.6, user time -2 %, medians of
+         * 8 alternating runs.) */
+        if (region && (stale_since += w.stale) * STALE_PER_PASS >= reg.nlist) {
+            pk_rsa_region_compact(&reg);
+            stale_since = 0;
         }
     }
     pk_rsa_region_free(&reg);

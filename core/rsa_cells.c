@@ -87,7 +87,7 @@ int pk_rsa_cells_init(pk_rsa_cells *C, const pk_box *b, double r, double gap, co
         stride *= (uint64_t)C->np[k];
     }
     set_offsets(C);
-    /* two records to a cache line; all slots empty (0xff bytes: PK_RSA_CELLS_NONE) */
+    /* four records to a cache line; all empty (0xff bytes: PK_RSA_CELLS_NONE) */
     C->cell = aligned_alloc(64, (nc * sizeof *C->cell + 63) / 64 * 64);
     if (!C->cell)
         return -1;
@@ -177,23 +177,11 @@ int pk_rsa_cells_around(const pk_rsa_cells *C, const double *x, uint64_t out[27]
     return cnt;
 }
 
-static int store(pk_rsa_cells *C, uint64_t lin, const float *f, uint32_t id)
+/* A new pool entry (offsets f, index id) in front of chain `next`; its number,
+ * or -1 when out of memory. */
+static int64_t pool_push(pk_rsa_cells *C, const float *f, uint32_t id, int32_t next)
 {
-    pk_rsa_cell2 *c = &C->cell[lin];
-    C->occ[lin >> 3] |= (uint8_t)(1u << (lin & 7));
-    if (c->id[0] == PK_RSA_CELLS_NONE) {
-        memcpy(c->x[0], f, 3 * sizeof *f);
-        c->id[0] = id;
-        return 0;
-    }
-    if (c->id[1] == PK_RSA_CELLS_NONE) {
-        memcpy(c->x[1], f, 3 * sizeof *f);
-        c->id[1] = id;
-        return 0;
-    }
-    /* a third grain: the second slot's grain moves to the pool, the chain starts there */
-    int first = !(c->id[1] & PK_RSA_CELLS_MORE);
-    if (C->nextra + 2 > C->capextra) {
+    if (C->nextra + 1 > C->capextra) {
         size_t cap = C->capextra ? 2 * C->capextra : 1024;
         pk_rsa_extra *e = realloc(C->extra, cap * sizeof *e);
         if (!e)
@@ -201,20 +189,37 @@ static int store(pk_rsa_cells *C, uint64_t lin, const float *f, uint32_t id)
         C->extra = e;
         C->capextra = cap;
     }
-    if (C->nextra + 2 >= PK_RSA_CELLS_MORE)
+    if (C->nextra + 1 >= PK_RSA_CELLS_MORE)
         return -1;
-    if (first) {
-        pk_rsa_extra *e = &C->extra[C->nextra];
-        memcpy(e->x, c->x[1], sizeof e->x);
-        e->id = c->id[1];
-        e->next = -1;
-        c->id[1] = PK_RSA_CELLS_MORE | (uint32_t)C->nextra++;
-    }
     pk_rsa_extra *e = &C->extra[C->nextra];
     memcpy(e->x, f, sizeof e->x);
     e->id = id;
-    e->next = (int32_t)(c->id[1] & ~PK_RSA_CELLS_MORE);
-    c->id[1] = PK_RSA_CELLS_MORE | (uint32_t)C->nextra++;
+    e->next = next;
+    return (int64_t)C->nextra++;
+}
+
+static int store(pk_rsa_cells *C, uint64_t lin, const float *f, uint32_t id)
+{
+    pk_rsa_cell1 *c = &C->cell[lin];
+    C->occ[lin >> 3] |= (uint8_t)(1u << (lin & 7));
+    if (c->id == PK_RSA_CELLS_NONE) {
+        memcpy(c->x, f, 3 * sizeof *f);
+        c->id = id;
+        return 0;
+    }
+    int32_t head;
+    if (c->id & PK_RSA_CELLS_MORE) {
+        head = (int32_t)(c->id & ~PK_RSA_CELLS_MORE);
+    } else { /* a second grain: the inline one moves to the pool, the chain starts there */
+        int64_t e = pool_push(C, c->x, c->id, -1);
+        if (e < 0)
+            return -1;
+        head = (int32_t)e;
+    }
+    int64_t e = pool_push(C, f, id, head);
+    if (e < 0)
+        return -1;
+    c->id = PK_RSA_CELLS_MORE | (uint32_t)e;
     return 0;
 }
 
@@ -269,17 +274,13 @@ static inline int near_one(const pk_rsa_cells *C, const float *f, uint32_t id, c
 
 /* The grains of a nonempty cell c (corner: x's cell corner + sh) against x
  * (offsets q0 from its own cell's corner). */
-static inline int cell_hits(const pk_rsa_cells *C, const pk_rsa_cell2 *c, const double *q0,
+static inline int cell_hits(const pk_rsa_cells *C, const pk_rsa_cell1 *c, const double *q0,
                             const double *sh, const double *px, const double *x)
 {
     const double q[3] = {q0[0] - sh[0], q0[1] - sh[1], q0[2] - sh[2]};
-    if (near_one(C, c->x[0], c->id[0], q, px, x))
-        return 1;
-    uint32_t b = c->id[1];
-    if (b == PK_RSA_CELLS_NONE)
-        return 0;
+    const uint32_t b = c->id;
     if (!(b & PK_RSA_CELLS_MORE))
-        return near_one(C, c->x[1], b, q, px, x);
+        return near_one(C, c->x, b, q, px, x);
     for (int32_t e = (int32_t)(b & ~PK_RSA_CELLS_MORE); e >= 0; e = C->extra[e].next)
         if (near_one(C, C->extra[e].x, C->extra[e].id, q, px, x))
             return 1;
@@ -301,8 +302,8 @@ size_t pk_rsa_cells_filter(const pk_rsa_cells *C, const double *px, const double
     const uint8_t *occ = C->occ;
     const size_t ahead = C->ncell * sizeof *C->cell > PREFETCH_BYTES ? PREFETCH_AHEAD : n;
     for (size_t i = 0; i < n; i++) {
-        if (i + ahead < n) { /* both cache lines of each row of records */
-            const pk_rsa_cell2 *p = &C->cell[pk_rsa_cells_index(key[i + ahead])];
+        if (i + ahead < n) { /* the one or two cache lines of each row of records */
+            const pk_rsa_cell1 *p = &C->cell[pk_rsa_cells_index(key[i + ahead])];
             const int64_t *row = C->row;
 #define PK_FETCH_ROW(r) (__builtin_prefetch(p + row[r]), __builtin_prefetch(p + row[r] + 2))
             PK_FETCH_ROW(0), PK_FETCH_ROW(1), PK_FETCH_ROW(2);
@@ -315,7 +316,7 @@ size_t pk_rsa_cells_filter(const pk_rsa_cells *C, const double *px, const double
         const double *x = &pos[3 * (idx ? (size_t)idx[i] : i)];
         const uint64_t lin = pk_rsa_cells_index(key[i]);
         const unsigned oct = pk_rsa_cells_octant(key[i]);
-        const pk_rsa_cell2 *c0 = &C->cell[lin];
+        const pk_rsa_cell1 *c0 = &C->cell[lin];
         const double *q = &qs[3 * i]; /* offsets of x from its cell's corner (the key's) */
         /* the cell itself first (offset 0, the likeliest overlap), then the
          * nonempty cells around, as bits of the near-first order off[oct] */

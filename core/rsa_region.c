@@ -69,6 +69,13 @@ int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, cons
         return -1;
     }
     memset(R->tcnt, NOT_MADE, ne);
+    /* Write one word of each page now: a mark's first access to a page is a
+     * read (|=), which maps the shared zero page, and its write then faults a
+     * second time (10^6 grains: 24 000 of 95 000 faults; -0.01 s of system
+     * time, medians of 4 alternating runs).  The pages are the marks', touched
+     * by the run anyway. */
+    for (uint64_t i = 0; i < nc; i += 4096 / sizeof *R->covered)
+        ((volatile uint64_t *)R->covered)[i] = 0;
     const int D = R->D, W = 2 * D + 1, zr = b->dim == 3;
     for (int dz = 0; dz < (zr ? W : 1); dz++)
         for (int dy = 0; dy < W; dy++)
