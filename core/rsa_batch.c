@@ -344,7 +344,24 @@ static inline void mark_ahead(pk_rsa_region *reg, pk_rsa_region_spot *ring, size
  * and dropped (medians of 4-8 alternating runs, the same packings):
  * PICK_AHEAD 96, 128 or 192 instead of 64 (32: +8 % user time), mark
  * tables of at most 8 or 12 steps instead of 16 (draws per grain 20.8 and
- * 19.6 instead of 19.0): all within the noise. */
+ * 19.6 instead of 19.0): all within the noise.
+ * Round 8 (ninth session; 10^6 grains, 3D φ = 0.30; wall time per phase, one
+ * run: plain batches 0.08 s, region_start 0.17, picks 0.15, region attempts
+ * (point, sort, filter) 0.22, step 3 0.09, step 4 0.17, compactions 0.02).
+ * Kept: compaction driven by the draws into fully covered cells (below),
+ * 16-byte store records (rsa_cells.h), the marks' pages written before
+ * their first read (rsa_region.c), scratch renewed without realloc's copies
+ * — together 95 000 -> 62 000 page faults, system time 0.18 -> 0.12 s, user
+ * time -5 %, 0.98 -> 1.07 M placements per s (medians of 10 alternating runs
+ * in a slow state of the machine; 1.02 -> 1.15 in a faster one).  Measured
+ * and dropped (medians of 4-6 alternating runs): prefetching covered[] in the
+ * compaction (34 ms either way, perf); the pick's prefetches as prefetcht2
+ * (within the noise); the region switch at a batch acceptance of 0.15-0.3
+ * (flat); B_MAX 2^19 or 2^21, SURVIVORS 16 384 or 65 536 (flat or slower);
+ * MAX_BUCKETS 1 024 to 262 144 (flat); no counting sort before the filter
+ * (user time +5 %).  The pool of cells with two or more grains (2.8 % of
+ * the nonempty cells at the end) now takes ~14 % of the filter's samples:
+ * a chase the 32-byte records did not make, paid for by half the store. */
 #define START_AHEAD 16
 /* Prefetch distance of step 4's store records (grains: sorted by cell, but
  * at 10^6 grains a batch's grains are far apart; -4..-6 % CPU at 10^6 grains,
