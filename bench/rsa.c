@@ -13,7 +13,9 @@
  * the placement's CPU time (user + system; on a loaded machine the wall
  * seconds wander 2-3x, compare cpu_s old vs new back to back); sys_s and
  * minflt: the placement's system time and page faults (a page's first touch
- * costs ~2 µs here: at 10^6 grains ~15 % of the run).
+ * costs ~2 µs here: at 10^6 grains ~15 % of the run); audit_s: the gap audit
+ * every job runs on its packing (core/gap_audit.h, horizon r_max as the jobs
+ * pass it), timed after the placement, with its ratio to the placement.
  * `rsa mono` runs only the default-path monodisperse cases (1e4, 1e5, 1e6)
  * and the scaling line: a quick re-measurement. */
 #include <math.h>
@@ -22,6 +24,7 @@
 #include <string.h>
 #include <sys/resource.h>
 
+#include "gap_audit.h"
 #include "pack_job.h"
 #include "process.h"
 #include "rsa.h"
@@ -60,11 +63,18 @@ static double mono(const char *name, int dim, size_t n, double phi, enum path pa
     pk_rsa_place(&b, d, sp, n, &prm, NULL, &p, &st);
     getrusage(RUSAGE_SELF, &ru);
     double rate = (double)st.placed / st.seconds;
+    /* the job's gap audit of the same packing (after the placement's clock) */
+    pk_gap_report gap;
+    double t0 = pk_wall_seconds();
+    int audited = pk_gap_audit(&b, &p, 0, 1e-12 * L, 0.5, &gap) == 0;
+    double audit_s = pk_wall_seconds() - t0;
     printf("bench=rsa case=%s n=%zu placed=%zu seconds=%.3f cpu_s=%.3f sys_s=%.3f minflt=%ld "
-           "rate=%.0f draws_per_grain=%.3f maxrss_kb=%ld\n",
+           "rate=%.0f draws_per_grain=%.3f maxrss_kb=%ld audit_s=%.3f audit_over_place=%.3f "
+           "smallest_gap=%.3g\n",
            name, n, st.placed, st.seconds, cpu_seconds(&ru) - cpu_seconds(&ru0),
            sys_seconds(&ru) - sys_seconds(&ru0), ru.ru_minflt - ru0.ru_minflt, rate,
-           (double)st.draws / (double)(st.placed ? st.placed : 1), (long)ru.ru_maxrss);
+           (double)st.draws / (double)(st.placed ? st.placed : 1), (long)ru.ru_maxrss,
+           audited ? audit_s : NAN, audit_s / st.seconds, audited ? gap.min_gap : NAN);
     fflush(stdout);
     free(d);
     free(sp);

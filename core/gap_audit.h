@@ -1,5 +1,6 @@
 /* gap_audit.h — an exact check of a finished packing, independent of the
- * placers' own neighbour structures (sort-and-sweep along x, minimum image).
+ * placers' own neighbour structures (its own multi-level cell grid, minimum
+ * image; gap_audit.c).
  * Every placer's result goes through it before it is written, so the
  * "smallest gap" in a result file is a measurement, not a promise. */
 #ifndef PK_GAP_AUDIT_H
@@ -16,7 +17,7 @@ typedef struct pk_gap_report {
     double min_wall_gap;     /* smallest grain–wall clearance over walled axes (INFINITY if none) */
     size_t pairs_below;      /* pairs with gap < required - tol */
     size_t walls_below;      /* grains with wall clearance < required/2 - tol */
-    size_t pairs_checked;    /* pairs closer than the horizon */
+    size_t pairs_checked;    /* pairs closer than the last pass's horizon (gap_audit.c) */
 } pk_gap_report;
 
 /* required: Δd; tol: absolute tolerance for the "below" counts; horizon:

@@ -10,7 +10,7 @@
 #include "gap_audit.h"
 #include "rng.h"
 
-/* Independent check (core/gap_audit: sort-and-sweep, not the engine's
+/* Independent check (core/gap_audit: its own cell grid, not the engine's
  * lists): no pair closer than Δd − 1e-9·d_min, no wall clearance below
  * Δd/2 − 1e-9·d_min.  1e-9 relative is the issue's bar; the engine's own
  * round-off is ~1e-15 relative. */
