@@ -61,10 +61,9 @@ int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, cons
     R->tab = malloc(ne * R->entry * sizeof *R->tab);
     R->trows = malloc(ne * sizeof *R->trows);
     R->tcnt = malloc(ne);
-    R->tdec = malloc(R->entry * 3);
     R->covered = calloc(nc, sizeof *R->covered);
     R->list = malloc(nc * sizeof *R->list);
-    if (!R->covered || !R->list || !R->tab || !R->trows || !R->tcnt || !R->tdec) {
+    if (!R->covered || !R->list || !R->tab || !R->trows || !R->tcnt) {
         pk_rsa_region_free(R);
         return -1;
     }
@@ -77,14 +76,6 @@ int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, cons
     for (uint64_t i = 0; i < nc; i += 4096 / sizeof *R->covered)
         ((volatile uint64_t *)R->covered)[i] = 0;
     const int D = R->D, W = 2 * D + 1, zr = b->dim == 3;
-    for (int dz = 0; dz < (zr ? W : 1); dz++)
-        for (int dy = 0; dy < W; dy++)
-            for (int dx = 0; dx < W; dx++) {
-                const size_t q = (size_t)(dz * W + dy) * W + dx;
-                R->tdec[3 * q] = (uint8_t)dx;
-                R->tdec[3 * q + 1] = (uint8_t)dy;
-                R->tdec[3 * q + 2] = (uint8_t)(zr ? dz : D);
-            }
     R->nlist = nc;
     R->nrow = 0; /* the rows of a mark's cells, for pk_rsa_region_prefetch */
     for (int dz = 0; dz < (zr ? W : 1); dz++)
@@ -100,7 +91,6 @@ void pk_rsa_region_free(pk_rsa_region *R)
     free(R->tab);
     free(R->trows);
     free(R->tcnt);
-    free(R->tdec);
     memset(R, 0, sizeof *R);
 }
 
@@ -380,12 +370,26 @@ void pk_rsa_region_mark_at(pk_rsa_region *R, pk_rsa_region_spot s)
                                     : (j < 0 ? j + R->n[k] : j - R->n[k]); /* n >= 2D + 1 */
             c[k][d + D] = j;
         }
-    for (size_t q = 0; q < R->entry; q++) {
-        const uint8_t *dq = &R->tdec[3 * q];
-        const int64_t cx = c[0][dq[0]], cy = c[1][dq[1]], cz = c[2][dq[2]];
-        if (!w[q] || (cx | cy | cz) < 0)
+    /* the entry's rows as in the inner case, each with its wrapped or dropped
+     * (y, z) cell; a row's words one by one only where x wraps or meets a wall
+     * (a word at a time over all 125 before: 16 % of the marks' time at 10^6
+     * grains for the 5 % of marks near a seam) */
+    const int W = 2 * D + 1;
+    const int x_whole = s.i[0] - D >= 0 && s.i[0] + D < R->n[0];
+    for (uint32_t m = rows; m; m &= m - 1) {
+        const int r = __builtin_ctz(m);
+        const int64_t cy = c[1][dim == 3 ? r % W : r], cz = c[2][dim == 3 ? r / W : D];
+        if ((cy | cz) < 0)
             continue;
-        R->covered[(uint64_t)(cz * R->n[1] + cy) * (uint64_t)R->n[0] + (uint64_t)cx] |= w[q];
+        uint64_t *row = &R->covered[(uint64_t)(cz * R->n[1] + cy) * (uint64_t)R->n[0]];
+        const uint64_t *src = w + r * W;
+        if (x_whole) {
+            or_row(row + s.i[0] - D, src, D);
+            continue;
+        }
+        for (int q = 0; q < W; q++)
+            if (c[0][q] >= 0)
+                row[c[0][q]] |= src[q];
     }
 }
 

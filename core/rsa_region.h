@@ -52,7 +52,6 @@ typedef struct pk_rsa_region {
     uint64_t *tab;              /* [Q^dim][entry]: word ((dz+D)·W + dy+D)·W + dx+D, W = 2D + 1 */
     uint32_t *trows;            /* [Q^dim]: bit r set when row r (W words along x) marks */
     uint8_t *tcnt;              /* [Q^dim]: 1 made, 0xff = not made yet */
-    uint8_t *tdec;              /* [entry][3]: cell number q's steps dx, dy, dz + D */
     int nrow;                   /* rows of 2D + 1 cells around a cell: (2D + 1)^(dim - 1) */
     int64_t roff[(2 * PK_RSA_REGION_MAX_REACH + 1) * (2 * PK_RSA_REGION_MAX_REACH + 1)];
                                 /* index offset of each row's middle cell (off the seams) */

@@ -114,14 +114,20 @@ static void test_marks_are_exact(void)
         const int steps = t == 1 ? PK_RSA_REGION_MAX_STEPS : (t == 0 ? 6 : 7);
         CHECK(pk_rsa_region_init(&table, b, n, lo, span, c, steps) == 0);
         CHECK(pk_rsa_region_init(&direct, b, n, lo, span, c, steps) == 0);
-        enum { NB = 12 };
+        enum { NB = 18 };
         double x[NB][3] = {{0}}, rad[NB];
         for (int i = 0; i < NB; i++) {
             for (int k = 0; k < b->dim; k++)
                 x[i][k] = lo[k] + span[k] * pk_rng_uniform(&g);
             if (i < 3) /* at the ends of the range: seams and walls */
                 x[i][i % b->dim] = i == 1 ? lo[i % b->dim] : lo[i % b->dim] + span[i % b->dim];
-            rad[i] = i % 4 == 3 ? c + 0.9 * pk_rng_uniform(&g) : c; /* every 4th an obstacle */
+            if (i >= 12) { /* in the second cell from either end of an axis: the marks
+                            * reach one cell past the range there */
+                const int k = (i - 12) % b->dim;
+                const double cell = i - 12 < b->dim ? (double)n[k] - 1.5 : 1.5;
+                x[i][k] = lo[k] + span[k] * cell / (double)n[k];
+            }
+            rad[i] = i % 4 == 3 && i < 12 ? c + 0.9 * pk_rng_uniform(&g) : c; /* obstacles */
             if (rad[i] == c)
                 pk_rsa_region_mark(&table, x[i]);
             else
