@@ -17,7 +17,12 @@
  * every job runs on its packing (core/gap_audit.h, horizon r_max as the jobs
  * pass it), timed after the placement, with its ratio to the placement.
  * `rsa mono` runs only the default-path monodisperse cases (1e4, 1e5, 1e6)
- * and the scaling line: a quick re-measurement. */
+ * and the scaling line: a quick re-measurement.
+ * The first line, case=machine, is the machine's state at the time: the
+ * latency of a dependent load from a 64 MB array (a random cycle).  The
+ * placer is bound by such loads, and this VM's latency wanders (150-200 ns
+ * per load, rates 0.8-1.15 M/s at 10^6 grains within an hour, the same
+ * binary): read a rate beside it, or compare binaries run alternately. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -40,6 +45,34 @@ static double cpu_seconds(const struct rusage *ru)
 static double sys_seconds(const struct rusage *ru)
 {
     return (double)ru->ru_stime.tv_sec + 1e-6 * (double)ru->ru_stime.tv_usec;
+}
+
+/* Nanoseconds per dependent load over a random cycle of 16M entries (64 MB,
+ * twice the last-level cache and far beyond the TLB's reach). */
+static double dram_chase_ns(void)
+{
+    const size_t n = (size_t)1 << 24;
+    uint32_t *a = malloc(n * sizeof *a);
+    if (!a)
+        return NAN;
+    for (size_t i = 0; i < n; i++)
+        a[i] = (uint32_t)i;
+    uint64_t s = 0x9E3779B97F4A7C15ull;
+    for (size_t i = n - 1; i > 0; i--) { /* Sattolo: one cycle through all entries */
+        s ^= s << 13, s ^= s >> 7, s ^= s << 17;
+        size_t k = (size_t)(s % i);
+        uint32_t t = a[i];
+        a[i] = a[k];
+        a[k] = t;
+    }
+    const long steps = 4000000;
+    uint32_t j = 0;
+    double t0 = pk_wall_seconds();
+    for (long q = 0; q < steps; q++)
+        j = a[j];
+    double ns = 1e9 * (pk_wall_seconds() - t0) / (double)steps;
+    free(a);
+    return j == UINT32_MAX ? NAN : ns; /* (j used: the loop stays) */
 }
 
 static double mono(const char *name, int dim, size_t n, double phi, enum path path)
@@ -114,6 +147,8 @@ static void job_case(const char *name, const char *path)
 
 int main(int argc, char **argv)
 {
+    printf("bench=rsa case=machine dram_chase_ns=%.1f\n", dram_chase_ns());
+    fflush(stdout);
     if (argc > 1 && strcmp(argv[1], "mono") == 0) {
         double r4 = mono("mono3d_phi030_1e4", 3, 10000, 0.30, BATCHED);
         double r5 = mono("mono3d_phi030_1e5", 3, 100000, 0.30, BATCHED);
