@@ -350,10 +350,13 @@ static inline void mark_ahead(pk_rsa_region *reg, pk_rsa_region_spot *ring, size
  * (point, sort, filter) 0.22, step 3 0.09, step 4 0.17, compactions 0.02).
  * Kept: compaction driven by the draws into fully covered cells (below),
  * 16-byte store records (rsa_cells.h), the marks' pages written before
- * their first read (rsa_region.c), scratch renewed without realloc's copies
- * — together 95 000 -> 62 000 page faults, system time 0.18 -> 0.12 s, user
- * time -5 %, 0.98 -> 1.07 M placements per s (medians of 10 alternating runs
- * in a slow state of the machine; 1.02 -> 1.15 in a faster one).  Measured
+ * their first read and the marks near a seam by whole rows (rsa_region.c),
+ * scratch renewed without realloc's copies — together 95 000 -> 62 000 page
+ * faults, system time 0.16-0.20 -> 0.11-0.13 s, user time -1 to -10 %;
+ * medians of 8-12 alternating runs, 10^6 grains: 0.85 -> 0.90 and
+ * 0.98 -> 1.07 M placements per s in slow states of the machine, 1.03 -> 1.09
+ * in a medium one, 1.07 -> 1.17 in a fast one (bench/rsa's case=machine line
+ * tells them apart).  Measured
  * and dropped (medians of 4-6 alternating runs): prefetching covered[] in the
  * compaction (34 ms either way, perf); the pick's prefetches as prefetcht2
  * (within the noise); the region switch at a batch acceptance of 0.15-0.3
@@ -740,13 +743,15 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
         }
         if (reason != PK_STOP_COMPLETE)
             break;
-        /* Compaction passes over the list once (~0.6 ns an entry at 10^6 grains,
-         * sequential) and ends the draws into fully covered cells (~10 ns each,
-         * two misses): compact once those since the last compaction cost what a
-         * pass does.  (Before: once the certain rejections since then reached the
-         * list's length — one compaction at 10^6 grains, 53 % of the list stale by
-         * then; now three: draws per grain 19.0 -> 15.6, user time -2 %, medians of
-         * 8 alternating runs.) */
+        /* Compaction passes over the list once (~1 ns an entry at 10^6 grains:
+         * 34 ms for the run's passes over 33 million entries, perf) and ends the
+         * draws into fully covered cells (~10 ns each, two misses): compact once
+         * those since the last compaction cost about what a pass does (16 and 8
+         * per pass measured alike; 2-4 compacted too often, 32 too late).  (Before:
+         * once the certain rejections since then reached the list's length — one
+         * compaction at 10^6 grains, 53 % of the list stale by then; now three:
+         * draws per grain 19.0 -> 15.6, user time -2 %, medians of 8 alternating
+         * runs.) */
         if (region && (stale_since += w.stale) * STALE_PER_PASS >= reg.nlist) {
             pk_rsa_region_compact(&reg);
             stale_since = 0;
