@@ -746,8 +746,9 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
         /* Compaction passes over the list once (~1 ns an entry at 10^6 grains:
          * 34 ms for the run's passes over 33 million entries, perf) and ends the
          * draws into fully covered cells (~10 ns each, two misses): compact once
-         * those since the last compaction cost about what a pass does (16 and 8
-         * per pass measured alike; 2-4 compacted too often, 32 too late).  (Before:
+         * those since the last compaction cost about what a pass does (8, 16 and
+         * 32 per pass measured alike; 2 and 4 compact too rarely: 19.5 and 17.7
+         * draws per grain).  (Before:
          * once the certain rejections since then reached the list's length — one
          * compaction at 10^6 grains, 53 % of the list stale by then; now three:
          * draws per grain 19.0 -> 15.6, user time -2 %, medians of 8 alternating
