@@ -549,7 +549,7 @@ static int region_start(pk_rsa_region *reg, const pk_rsa_cells *C, const pk_box 
                 if (!(a & PK_RSA_CELLS_MORE))
                     ids[k++] = a;
                 else
-                    for (int32_t e = (int32_t)(a & ~PK_RSA_CELLS_MORE); e >= 0;
+                    for (int32_t e = (int32_t)(a & PK_RSA_CELLS_POOL); e >= 0;
                          e = C->extra[e].next)
                         ids[k++] = C->extra[e].id;
             }

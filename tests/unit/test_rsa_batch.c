@@ -237,18 +237,21 @@ static void test_cells_predicate_and_neighbours(void)
 
 /* The store keeps float offsets and lets the double predicate decide within
  * a band around contact (rsa_cells.h): queries at distance s·(1 + δ) from a
- * stored centre, δ from -1e-4 to 1e-4 down to 0 and ±1 ulp-size, across
+ * stored centre, δ from -1e-3 to 1e-3 down to 0 and ±1 ulp-size, across
  * periodic seams (ghost copies) and next to walls, in 3D and 2D, must get
- * exactly the answers of the exact predicate over all stored centres (the
- * store holds 3+ centres per cell here too: its pool). */
+ * exactly the answers of the exact predicate over all stored centres.  The
+ * store holds a cell of four centres here (its pool) and two cells of two
+ * (their 16-bit offsets and its band of ±2^-12, δ = ±1.2e-4: the quick test
+ * decides beyond it, the pool within). */
 static void test_cells_band_matches_exact_predicate(void)
 {
     const pk_box boxes[2] = {
         {.dim = 3, .L = {7.9, 6.3, 5.2}, .periodic = {true, false, true}},
         {.dim = 2, .L = {9.7, 8.2, 0}, .periodic = {true, false}},
     };
-    const double delta[] = {-1e-4, -3e-5, -1e-6, -1e-9, -1e-13, -2e-16, 0,
-                            2e-16, 1e-13, 1e-9, 1e-6, 3e-5, 1e-4};
+    const double delta[] = {-1e-3, -2e-4, -1.3e-4, -1.1e-4, -1e-4, -3e-5, -1e-6, -1e-9,
+                            -1e-13, -2e-16, 0, 2e-16, 1e-13, 1e-9, 1e-6, 3e-5, 1e-4,
+                            1.1e-4, 1.3e-4, 2e-4, 1e-3};
     const int nd = (int)(sizeof delta / sizeof *delta);
     pk_rng g;
     pk_rng_seed(&g, 11, 2);
@@ -273,6 +276,9 @@ static void test_cells_band_matches_exact_predicate(void)
                                   : lo[k] + span[k] * pk_rng_uniform(&g);
             if (i >= 4 && i < 12)
                 pts[i][i % b->dim] = i % 4 < 2 ? lo[i % b->dim] : lo[i % b->dim] + span[i % b->dim];
+            for (int k = 0; i >= 12 && k < b->dim; k++) /* two cells of two: (2,1,1), (4,2,2) */
+                pts[i][k] = lo[k] + C.h[k] * ((i < 14 ? 1 + (k == 0) : 2 + 2 * (k == 0)) +
+                                              (i % 2 ? 0.8 : 0.15) + 0.05 * pk_rng_uniform(&g));
             CHECK(pk_rsa_cells_insert(&C, pts[i], (uint32_t)i) == 0);
         }
         int nq = 0;
@@ -318,8 +324,14 @@ static void test_cells_band_matches_exact_predicate(void)
         printf("  dim %d: %d queries, %d within 1e-6 of contact, %d kept, %d wrong\n", b->dim,
                NQ, band, open, wrong);
         CHECK_MSG(wrong == 0, "dim %d: %d answers differ from the exact predicate", b->dim, wrong);
-        CHECK(band > NQ / 8 && open > NQ / 20); /* the band and both answers are exercised */
+        CHECK(band > NQ / 12 && open > NQ / 20); /* the band and both answers are exercised */
         CHECK(C.nextra > 0);                    /* and the overflow pool */
+        for (int i = 0; i < 16; i += 12) { /* a cell of four, a cell of two */
+            double o[3];
+            const uint32_t id = C.cell[pk_rsa_cells_index(pk_rsa_cells_key_q(&C, pts[i], o))].id;
+            CHECK(id & PK_RSA_CELLS_MORE);
+            CHECK(!(id & PK_RSA_CELLS_THREE) == (i == 12));
+        }
         pk_rsa_cells_free(&C);
     }
 }
