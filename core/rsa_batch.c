@@ -372,7 +372,32 @@ static inline void mark_ahead(pk_rsa_region *reg, pk_rsa_region_spot *ring, size
  * MAX_BUCKETS 1 024 to 262 144 (flat); no counting sort before the filter
  * (user time +5 %).  The pool of cells with two or more grains (2.8 % of
  * the nonempty cells at the end) now takes ~14 % of the filter's samples:
- * a chase the 32-byte records did not make, paid for by half the store. */
+ * a chase the 32-byte records did not make, paid for by half the store.
+ * Round 9 (tenth session; 10^6 grains, 3D φ = 0.30; medians of 4-6
+ * alternating runs).  Kept: 512 survivors per batch instead of 32 768 (see
+ * B_MIN above: 10^6 +4.5 %, 10^5 +31 %, 10^4 +46 %); the 16-bit offsets of
+ * two-grain cells (rsa_cells.h: +6 %, the same packings).  Wall time per
+ * phase after both, one run in a fast state (0.77 s): picks 0.14 s,
+ * region_start 0.15 (its marks 0.08, the marks' first touches ~0.05), step 4
+ * of region batches (marks) 0.17, region attempts' filter 0.12, their points
+ * and sort 0.04, step 3 0.03, compactions 0.02, the plain phase 0.08.
+ * Measured and dropped:
+ *  - draws weighted by open fine voxels (cells in 7 classes by their open
+ *    count o, 2^ceil(log2 o) slots each, one uniform slot per draw, the s-th
+ *    open voxel by a broadword select): draws per grain 15.6 -> 6.6, but a
+ *    draw cost 22 instead of 9.5 ns (the same two misses, 3x the
+ *    instructions: fewer draws in flight) and a compaction became a
+ *    seven-stream scatter over all cells: 10-11 % slower;
+ *  - the filter in two passes (the near cells' rows first, the other rows
+ *    for the points the first pass kept: 40 % fewer lines fetched): 3 %
+ *    slower at 10^6, 16 % at 10^5;
+ *  - with 512 survivors: PICK_AHEAD 32 or 128, MARK_AHEAD 2 or 6, the
+ *    filter's look-ahead 4 or 16, STALE_PER_PASS 8 or 32, the region switch
+ *    at 0.12, 0.3 or 0.4, mark tables of cbrt(m/64) or cbrt(m/256) steps,
+ *    MAX_BUCKETS 256 or 1 024, B_MIN 1 024 or 2 048: all within the noise or
+ *    slower; -march=native: the same;
+ *  - transparent huge pages for the marks again: the same user time, system
+ *    time +0.25 s (a 2 MB page's first touch costs ~4.5 ms here). */
 #define START_AHEAD 16
 /* Prefetch distance of step 4's store records (grains: sorted by cell, but
  * at 10^6 grains a batch's grains are far apart; -4..-6 % CPU at 10^6 grains,
