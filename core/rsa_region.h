@@ -52,6 +52,8 @@ typedef struct pk_rsa_region {
     uint64_t *tab;              /* [Q^dim][entry]: word ((dz+D)·W + dy+D)·W + dx+D, W = 2D + 1 */
     uint32_t *trows;            /* [Q^dim]: bit r set when row r (W words along x) marks */
     uint8_t *tcnt;              /* [Q^dim]: 1 made, 0xff = not made yet */
+    int tab_far;                /* the table outgrows a core's cache (1 MB): entries are
+                                   fetched ahead with the marks' rows */
     int nrow;                   /* rows of 2D + 1 cells around a cell: (2D + 1)^(dim - 1) */
     int64_t roff[(2 * PK_RSA_REGION_MAX_REACH + 1) * (2 * PK_RSA_REGION_MAX_REACH + 1)];
                                 /* index offset of each row's middle cell (off the seams) */
@@ -103,9 +105,9 @@ pk_rsa_region_spot pk_rsa_region_locate(const pk_rsa_region *R, const double *x)
 /* pk_rsa_region_mark(R, x) for the spot s = pk_rsa_region_locate(R, x). */
 void pk_rsa_region_mark_at(pk_rsa_region *R, pk_rsa_region_spot s);
 
-/* Ask the memory system for the words the mark at spot s will write (a hint:
- * at 10^6 grains each mark's rows are misses; rsa_batch.c asks a few marks
- * ahead). */
+/* Ask the memory system for the words the mark at spot s will write and,
+ * for a large table, the table entry it reads (a hint: at 10^6 grains each
+ * mark's rows are misses; rsa_batch.c asks a few marks ahead). */
 void pk_rsa_region_prefetch(const pk_rsa_region *R, pk_rsa_region_spot s);
 
 /* Drop fully covered cells from the list (cost: the list's length); the
