@@ -255,13 +255,6 @@ static void make_entry(pk_rsa_region *R, size_t e, const double *p)
             }
         }
     }
-    /* the rows (W words along x) holding a mark */
-    uint32_t rows = 0;
-    for (int r = 0; r < R->nrow; r++)
-        for (int q = 0; q < W; q++)
-            rows |= (uint32_t)(w[r * W + q] != 0) << r;
-    R->trows[e] = rows;
-    R->tcnt[e] = 1;
 }
 
 /* The cell of x and its table entry (the centre's step per axis). */
@@ -297,6 +290,79 @@ static void step_centre(const pk_rsa_region *R, size_t e, double p[3])
         e /= (size_t)R->Q;
         p[k] = ((double)q + 0.5) / R->Q * R->h[k];
     }
+}
+
+/* Rows of entry e holding a mark (W words along x each); the entry is made. */
+static void finish_entry(pk_rsa_region *R, size_t e)
+{
+    const uint64_t *w = &R->tab[e * R->entry];
+    const int W = 2 * R->D + 1;
+    uint32_t rows = 0;
+    for (int r = 0; r < R->nrow; r++)
+        for (int q = 0; q < W; q++)
+            rows |= (uint32_t)(w[r * W + q] != 0) << r;
+    R->trows[e] = rows;
+    R->tcnt[e] = 1;
+}
+
+/* A 3D word's fine voxels (bit (lz·4 + ly)·4 + lx) mirrored along x, y, z. */
+static inline uint64_t flip_x(uint64_t v)
+{
+    return (v & 0x1111111111111111ull) << 3 | (v & 0x2222222222222222ull) << 1 |
+           (v >> 1 & 0x2222222222222222ull) | (v >> 3 & 0x1111111111111111ull);
+}
+static inline uint64_t flip_y(uint64_t v)
+{
+    return (v & 0x000f000f000f000full) << 12 | (v & 0x00f000f000f000f0ull) << 4 |
+           (v >> 4 & 0x00f000f000f000f0ull) | (v >> 12 & 0x000f000f000f000full);
+}
+static inline uint64_t flip_z(uint64_t v)
+{
+    return v << 48 | (v & 0xffff0000ull) << 16 | (v >> 16 & 0xffff0000ull) | v >> 48;
+}
+
+/* Make entry e.  In 3D an entry whose step lies in the upper half of an
+ * axis is the mirror image of the one with step Q - 1 - q there (the step
+ * centres, the fine voxels and the cells around are symmetric about the
+ * cell's middle): made once for the lower octant and mirrored.  Table time
+ * at 10^6 grains (16 steps, 4 096 entries) 16-27 -> 5-6 ms, at 10^5 (9)
+ * 2.7-4 -> 0.9-1.4 ms, at 10^4 (6) 0.6-1.0 -> 0.2-0.4 ms (2-6 % of the run).
+ * A mirrored mark lies within round-off of the direct one's; the margin
+ * keeps both inside the ball. */
+static void make_mirrored(pk_rsa_region *R, size_t e)
+{
+    const int Q = R->Q;
+    int q[3] = {0, 0, 0}, flip[3] = {0, 0, 0};
+    size_t rest = e, lower = 0;
+    for (int k = 0; k < R->dim; k++) {
+        q[k] = (int)(rest % (size_t)Q);
+        rest /= (size_t)Q;
+    }
+    for (int k = R->dim - 1; k >= 0; k--) {
+        flip[k] = R->dim == 3 && 2 * q[k] >= Q;
+        lower = lower * (size_t)Q + (size_t)(flip[k] ? Q - 1 - q[k] : q[k]);
+    }
+    if (R->tcnt[lower] == NOT_MADE) {
+        double p[3];
+        step_centre(R, lower, p);
+        make_entry(R, lower, p);
+        finish_entry(R, lower);
+    }
+    if (lower == e)
+        return;
+    const int W = 2 * R->D + 1;
+    const uint64_t *src = &R->tab[lower * R->entry];
+    uint64_t *dst = &R->tab[e * R->entry];
+    for (int z = 0; z < W; z++)
+        for (int y = 0; y < W; y++)
+            for (int x = 0; x < W; x++) {
+                uint64_t v = src[((flip[2] ? W - 1 - z : z) * W + (flip[1] ? W - 1 - y : y)) * W +
+                                 (flip[0] ? W - 1 - x : x)];
+                v = flip[0] ? flip_x(v) : v;
+                v = flip[1] ? flip_y(v) : v;
+                dst[(z * W + y) * W + x] = flip[2] ? flip_z(v) : v;
+            }
+    finish_entry(R, e);
 }
 
 void pk_rsa_region_prefetch(const pk_rsa_region *R, pk_rsa_region_spot s)
@@ -352,11 +418,8 @@ void pk_rsa_region_mark_at(pk_rsa_region *R, pk_rsa_region_spot s)
 {
     const int dim = R->dim, D = R->D;
     const size_t e = s.e;
-    if (R->tcnt[e] == NOT_MADE) {
-        double p[3];
-        step_centre(R, e, p);
-        make_entry(R, e, p);
-    }
+    if (R->tcnt[e] == NOT_MADE)
+        make_mirrored(R, e);
     const uint64_t *w = &R->tab[e * R->entry];
     const uint32_t rows = R->trows[e];
     if (s.inner) { /* the common case: no wrap, no wall — fixed offsets */
