@@ -206,9 +206,10 @@ void pk_rsa_region_cover(pk_rsa_region *R, const double *x, double rad)
     }
 }
 
-/* Table entry e: centre p (offset from its cell's lower corner, per axis), the
- * marks of the cells d = -D..D per axis, word ((dz+D)·W + dy+D)·W + dx+D,
- * W = 2D + 1 (dz = 0 in 2D). */
+/* Table entry e's words: centre p (offset from its cell's lower corner, per
+ * axis), the marks of the cells d = -D..D per axis, word
+ * ((dz+D)·W + dy+D)·W + dx+D, W = 2D + 1 (dz = 0 in 2D).  finish_entry then
+ * notes its rows; make_mirrored calls both. */
 static void make_entry(pk_rsa_region *R, size_t e, const double *p)
 {
     const int S = R->S, dim = R->dim, zr = dim == 3, D = R->D, W = 2 * D + 1;

@@ -45,7 +45,8 @@ typedef struct pk_rsa_region {
      * offset in its cell, quantised to Q steps per axis, selects the marks of
      * the 3^dim cells around, made for the ball of radius c - margin - delta
      * about the step's centre (delta: half the step's diagonal), so they hold
-     * for every centre in the step.  Entries are made when first needed. */
+     * for every centre in the step.  Entries are made when first needed (in
+     * 3D those of one octant; the others are their mirror images). */
     int Q, D;                   /* steps per axis; cells reached on each side */
     size_t entry;               /* words per entry: (2D + 1)^dim */
     double c, delta;
