@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "http_status_info.h"
+#include "json_schema.h"
 
 #ifndef PACKD_VERSION
 #define PACKD_VERSION "0.0.0"
@@ -80,7 +81,8 @@ void pk_process_apply_caps(const pk_process *p, json_t *inputs, long max_particl
     if (!json_is_object(limits))
         return; /* the schema will say so */
     json_t *np = json_object_get(limits, "max_particles");
-    if (has_np && (!np || (json_is_integer(np) && json_integer_value(np) > max_particles)))
+    long long np_v; /* 5e7 is an integer too (pk_json_int) */
+    if (has_np && (!np || (pk_json_int(np, &np_v) == 0 && np_v > max_particles)))
         json_object_set_new(limits, "max_particles", json_integer(max_particles));
     json_t *wt = json_object_get(limits, "wall_time_s");
     if (has_wt && (!wt || (json_is_number(wt) && json_number_value(wt) > max_wall_time_s)))

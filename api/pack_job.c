@@ -5,10 +5,31 @@
 #include <stdio.h>
 #include <string.h>
 
+/* + 0.0: a -0 in the job reads as +0 (no -0 in results or messages) */
 static double num(json_t *o, const char *key, double dflt)
 {
     json_t *v = json_object_get(o, key);
-    return json_is_number(v) ? json_number_value(v) : dflt;
+    return json_is_number(v) ? json_number_value(v) + 0.0 : dflt;
+}
+
+/* An integer field (pk_json_int: 500.0 is 500); a value that is no exact
+ * integer in [lo, hi] is an error naming the field (the schema's maxima
+ * normally catch it first). */
+static long long int_field(json_t *o, const char *key, const char *ptr, long long lo,
+                           long long hi, long long dflt, pk_schema_errors *errs)
+{
+    json_t *v = json_object_get(o, key);
+    long long x;
+    if (!v)
+        return dflt;
+    if (pk_json_int(v, &x) != 0 || x < lo || x > hi) {
+        char got[32];
+        snprintf(got, sizeof got, "%.17g", json_number_value(v));
+        pk_schema_errors_add(errs, ptr, "integer", "must be an integer in [%lld, %lld] (got %s)", lo,
+                             hi, got);
+        return dflt;
+    }
+    return x;
 }
 
 static int grading_from_json(json_t *g, pk_grading *out, int *default_discrete,
@@ -138,9 +159,7 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
 {
     size_t before = errs->n;
     memset(job, 0, sizeof *job);
-    job->dim = (int)json_integer_value(json_object_get(in, "dim"));
-    if (job->dim != 2 && job->dim != 3)
-        job->dim = (int)num(in, "dim", 3);
+    job->dim = (int)int_field(in, "dim", "/dim", 2, 3, 3, errs);
     const char *unit = json_string_value(json_object_get(in, "unit"));
     snprintf(job->unit, sizeof job->unit, "%s", unit ? unit : "mm");
 
@@ -195,8 +214,7 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
         const char *ref = json_string_value(json_object_get(phi, "refers_to"));
         job->phi_is_mix = ref && strcmp(ref, "mix") == 0;
     }
-    json_t *count = json_object_get(in, "count");
-    job->count = count ? (size_t)json_integer_value(count) : 0;
+    job->count = (size_t)int_field(in, "count", "/count", 1, PK_PACK_MAX_COUNT, 0, errs);
     job->delta_d = num(in, "delta_d", 0);
     const char *algo = json_string_value(json_object_get(in, "algorithm"));
     snprintf(job->algorithm, sizeof job->algorithm, "%s", algo ? algo : "rsa");
@@ -208,8 +226,10 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
                              "algorithm \"%s\" needs a box domain (a mesh needs \"tetfill\")",
                              job->algorithm);
     job->inputs = in;
-    job->seed = json_object_get(in, "seed") ? (uint64_t)json_integer_value(json_object_get(in, "seed")) : 1;
-    job->max_particles = (size_t)num(json_object_get(in, "limits"), "max_particles", 2e7);
+    job->seed = (uint64_t)int_field(in, "seed", "/seed", 0, 9007199254740991LL, 1, errs);
+    job->max_particles = (size_t)int_field(json_object_get(in, "limits"), "max_particles",
+                                           "/limits/max_particles", 1, PK_PACK_MAX_COUNT, 20000000,
+                                           errs);
     job->wall_time_s = num(json_object_get(in, "limits"), "wall_time_s", 0);
     return errs->n - before;
 }
@@ -312,6 +332,22 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
     if (job->has_phi && !(plan->phi_resolved < 1))
         pk_schema_errors_add(errs, "/phi/value", "resolvedBelow1",
                              "resolved solid fraction %.4g must be < 1", plan->phi_resolved);
+    else {
+        /* Grains kept Δd apart carry disjoint shells of diameter d + Δd inside
+         * the box widened by Δd/2 at each wall; their measure is at least
+         * φ (1 + Δd/d_max)^dim of the box: it must stay below 1. */
+        double widened = 1;
+        for (int k = 0; k < dim; k++)
+            widened *= job->box.L[k] / (job->box.L[k] + (job->box.periodic[k] ? 0 : job->delta_d));
+        double phi_shell = plan->phi_resolved * widened * pow(1 + job->delta_d / plan->d_max, dim);
+        if (!(phi_shell < 1)) {
+            const char *ptr = job->count && !job->has_phi ? "/count" : "/phi/value";
+            pk_schema_errors_add(errs, ptr, "resolvedBelow1",
+                                 "the grains would fill φ = %.4g of the box (%.4g with their gaps "
+                                 "Δd): must be < 1",
+                                 plan->phi_resolved, phi_shell);
+        }
+    }
     for (int k = 0; k < dim; k++) {
         char ptr[64];
         snprintf(ptr, sizeof ptr, "/domain/box/size/%d", k);

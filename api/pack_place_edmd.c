@@ -46,9 +46,9 @@ static void read_params(const pk_pack_job *job, const pk_pack_plan *plan, pk_edm
     json_t *jam = json_object_get(o, "jamming");
     prm->p_max = num(jam, "reduced_pressure", prm->p_max);
     prm->dphi_crit = num(jam, "delta_phi", prm->dphi_crit);
-    prm->dphi_events = (uint64_t)num(jam, "events", 0);
+    prm->dphi_events = (uint64_t)pk_json_int_or(jam, "events", 0);
     json_t *stall = json_object_get(o, "stall");
-    prm->stall_events = (uint64_t)num(stall, "events", (double)prm->stall_events);
+    prm->stall_events = (uint64_t)pk_json_int_or(stall, "events", (long long)prm->stall_events);
     prm->stall_growth = num(stall, "growth", prm->stall_growth);
     json_t *rs = json_object_get(o, "rescale");
     if (json_is_boolean(rs))
@@ -56,7 +56,7 @@ static void read_params(const pk_pack_job *job, const pk_pack_plan *plan, pk_edm
     prm->rescale_tol = num(o, "rescale_tolerance", prm->rescale_tol);
     prm->skin = num(o, "skin", prm->skin);
     prm->equal_masses = strcmp(str(o, "masses", "equal"), "equal") == 0;
-    prm->max_events = (uint64_t)num(o, "max_events", 0);
+    prm->max_events = (uint64_t)pk_json_int_or(o, "max_events", 0);
 }
 
 static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, pk_schema_errors *errs)
