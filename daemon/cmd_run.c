@@ -113,6 +113,8 @@ int cmd_run(int argc, char **argv)
         fprintf(stderr, "packd run: %s\n", err);
         status = 2;
     } else {
+        if (rc == 2) /* failed, with its partial file and summary */
+            fprintf(stderr, "packd run: failed: %s (partial result in %s)\n", err, out_path);
         json_object_set_new(summary, "output", json_string(out_path));
         if (xdmf_path) {
             /* the XML names the HDF5 file as it sits beside it */
@@ -124,7 +126,7 @@ int cmd_run(int argc, char **argv)
         }
         json_dumpf(summary, stdout, JSON_INDENT(2) | JSON_REAL_PRECISION(10));
         putchar('\n');
-        status = 0;
+        status = rc == 2 ? 3 : 0;
     }
     if (sink.out && sink.out != stderr)
         fclose(sink.out);

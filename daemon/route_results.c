@@ -8,8 +8,10 @@
 #include "sha256.h"
 #include "xdmf.h"
 
-/* The row of a successful job, or NULL after replying with the problem. */
-static json_t *successful_job(pk_req *r, enum MHD_Result *rc)
+/* The row of a successful job (or, with partial_ok, of a failed job that
+ * kept its partial result file), or NULL after replying with the problem:
+ * a failed job's results answer why it failed. */
+static json_t *successful_job(pk_req *r, int partial_ok, enum MHD_Result *rc)
 {
     json_t *row = pk_queue_get(r->svc->q, r->seg[1]);
     if (!row) {
@@ -17,6 +19,13 @@ static json_t *successful_job(pk_req *r, enum MHD_Result *rc)
         return NULL;
     }
     const char *st = json_string_value(json_object_get(row, "status"));
+    if (partial_ok && pk_has_partial_result(row))
+        return row;
+    if (!strcmp(st, "failed")) {
+        *rc = pk_send_problem_doc(r, 422, pk_failed_results_problem(row), 0);
+        json_decref(row);
+        return NULL;
+    }
     if (strcmp(st, "successful") != 0) {
         char d[400];
         snprintf(d, sizeof d, "the job is %s: %s", st, json_string_value(json_object_get(row, "message")));
@@ -31,7 +40,7 @@ static json_t *successful_job(pk_req *r, enum MHD_Result *rc)
 enum MHD_Result route_results(pk_req *r)
 {
     enum MHD_Result rc;
-    json_t *row = successful_job(r, &rc);
+    json_t *row = successful_job(r, 0, &rc);
     if (!row)
         return rc;
     json_t *doc = pk_results_document(row);
@@ -49,7 +58,7 @@ enum MHD_Result route_result_file(pk_req *r)
         return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output",
                                "outputs: result, xdmf", NULL, 0);
     enum MHD_Result rc;
-    json_t *row = successful_job(r, &rc);
+    json_t *row = successful_job(r, 1, &rc);
     if (!row)
         return rc;
     pk_config cfg = pk_service_config(r->svc);
