@@ -141,15 +141,9 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
         snprintf(err, errlen, "EDMD failed (bad parameters, periodic box too small or out of memory)");
         return -1;
     }
-    if (prm.growth == PK_EDMD_GROW_SHELL && es.delta_d < job->delta_d * (1 - 1e-12)) {
-        /* the shell did not reach the job's Δd (jammed, stalled, cancelled):
-         * no result honours the job's minimum gap */
-        snprintf(err, errlen,
-                 "EDMD shell growth stopped (%s) at delta_d = %.6g before reaching %.6g; lower phi or "
-                 "delta_d, or try a smaller edmd.growth_rate",
-                 pk_edmd_criterion_name(es.criterion), es.delta_d, job->delta_d);
-        return -1;
-    }
+    /* the shell short of the job's Δd (jammed, stalled, out of time): the
+     * packing is kept, audited at the Δd reached and says so */
+    const int dd_short = prm.growth == PK_EDMD_GROW_SHELL && es.delta_d < job->delta_d * (1 - 1e-12);
     pk_contact_stats cs;
     /* contact: gap within 1e-6 (r_i + r_j) of Δd — far above round-off,
      * far below any gap left by a run that stopped short of jamming */
@@ -159,7 +153,18 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
         return -1;
     }
     *st = (pk_place_stats){.reason = es.reason, .placed = p->n, .requested = sz->n,
-                           .seconds = es.seconds, .walls_touch = w > 0};
+                           .seconds = es.seconds, .walls_touch = w > 0,
+                           .goal_reached = prm.until == PK_EDMD_UNTIL_JAMMED &&
+                                           es.reason == PK_STOP_JAMMED};
+    if (dd_short) {
+        st->short_delta_d = 1;
+        st->audit_delta_d = es.delta_d;
+        snprintf(st->warning, sizeof st->warning,
+                 "shell growth stopped (%s) at Δd = %.6g, short of the job's delta_d = %.6g: every "
+                 "gap of the result is >= %.6g; lower phi or delta_d, or try a smaller "
+                 "edmd.growth_rate",
+                 pk_edmd_criterion_name(es.criterion), es.delta_d, job->delta_d, es.delta_d);
+    }
     json_t *obs = json_object();
     json_object_set_new(obs, "phi_final", json_real(es.phi));
     json_object_set_new(obs, "phi_shell", json_real(es.phi_sim));
