@@ -236,6 +236,41 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
 
 static double class_rep_measure(int dim, double d) { return pk_ball_measure(dim, 0.5 * d); }
 
+/* EDMD growing every diameter until jammed (relative growth) bounds the sizes
+ * only by φ <= 1 (core/edmd.c, spec §3.3d): the largest grain, shell included,
+ * may reach (d_max + Δd)·φ_s^(-1/dim), φ_s the shells' fraction at the target
+ * sizes.  On a periodic axis that must stay below L/2, or a pair could meet
+ * two images of each other (minimum image).  φ_s is bounded below by
+ * φ (1 + Δd/d_max)^dim, so the check errs on the refusing side. */
+static void check_periodic_jamming(const pk_pack_job *job, const pk_pack_plan *plan,
+                                   pk_schema_errors *errs)
+{
+    json_t *o = json_object_get(job->inputs, "edmd");
+    const char *until = json_string_value(json_object_get(o, "until"));
+    const char *growth = json_string_value(json_object_get(o, "growth"));
+    const char *maximize = json_string_value(json_object_get(o, "maximize"));
+    if (strcmp(job->algorithm, "edmd") != 0 || !until || strcmp(until, "jammed") != 0 ||
+        (growth && strcmp(growth, "shell") == 0) || (maximize && strcmp(maximize, "delta_d") == 0))
+        return;
+    const int dim = job->dim;
+    double phi_s = plan->phi_resolved * pow(1 + job->delta_d / plan->d_max, dim);
+    double reach = (plan->d_max + job->delta_d) * pow(fmax(phi_s, 1e-300), -1.0 / dim);
+    for (int k = 0; k < dim; k++) {
+        if (!job->box.periodic[k] || reach < 0.5 * job->box.L[k])
+            continue;
+        char ptr[64];
+        snprintf(ptr, sizeof ptr, "/domain/box/size/%d", k);
+        double need = pow((plan->d_max + job->delta_d) / (0.5 * job->box.L[k]), dim);
+        pk_schema_errors_add(errs, ptr, "periodicJamming",
+                             "until jammed the grains may grow to fill the box: the largest could "
+                             "reach d = %.4g, over half the periodic edge %g (minimum image); needs "
+                             "φ at the target sizes > %.3g (got %.3g): more grains, a walled axis "
+                             "or until: target",
+                             reach, job->box.L[k], need, phi_s);
+        return;
+    }
+}
+
 size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_errors *errs)
 {
     size_t before = errs->n;
@@ -362,6 +397,8 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
                                  "a walled edge must hold the largest grain plus Δd = %g (got %g)",
                                  need, job->box.L[k]);
     }
+    if (errs->n == before)
+        check_periodic_jamming(job, plan, errs);
     const pk_placer *placer = pk_placer_find(job->algorithm);
     if (placer && placer->check && errs->n == before)
         placer->check(job, plan, errs);
