@@ -209,6 +209,9 @@ int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_m
         pk_schema_errors_free(&errs);
         return -1;
     }
+    pk_monitor own = {0}; /* the job's wall time holds without a caller's monitor too */
+    if (!mon && job.wall_time_s > 0)
+        mon = &own;
     if (mon && job.wall_time_s > 0)
         mon->wall_limit_s = job.wall_time_s;
 
