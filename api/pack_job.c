@@ -336,8 +336,10 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
         double n1 = pk_grading_expected_count(&plan->resolved, dim, 1.0 / keep, NULL);
         mean_measure = n1 > 0 ? 1.0 / n1 : 0; /* unit resolved measure holds n1 grains */
     }
-    if (!(mean_measure > 0)) {
-        pk_schema_errors_add(errs, "/grading", "grading", "the grading holds no grains above d_min");
+    if (!(mean_measure > 0)) { /* material is left (keep > 0): the count overflowed */
+        pk_schema_errors_add(errs, "/d_min", "maxParticles",
+                             "the grading above d_min = %g holds too many grains to count: raise d_min",
+                             job->d_min);
         return errs->n - before;
     }
     if (job->count) {
@@ -361,28 +363,12 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
 
     if (plan->expected_n > (double)job->max_particles)
         pk_schema_errors_add(errs, job->count ? "/count" : "/phi", "maxParticles",
-                             "the job needs about %.0f grains, over the limit of %zu "
+                             "the job needs about %.4g grains, over the limit of %zu "
                              "(raise limits.max_particles or d_min)",
                              plan->expected_n, job->max_particles);
     if (job->has_phi && !(plan->phi_resolved < 1))
         pk_schema_errors_add(errs, "/phi/value", "resolvedBelow1",
                              "resolved solid fraction %.4g must be < 1", plan->phi_resolved);
-    else {
-        /* Grains kept Δd apart carry disjoint shells of diameter d + Δd inside
-         * the box widened by Δd/2 at each wall; their measure is at least
-         * φ (1 + Δd/d_max)^dim of the box: it must stay below 1. */
-        double widened = 1;
-        for (int k = 0; k < dim; k++)
-            widened *= job->box.L[k] / (job->box.L[k] + (job->box.periodic[k] ? 0 : job->delta_d));
-        double phi_shell = plan->phi_resolved * widened * pow(1 + job->delta_d / plan->d_max, dim);
-        if (!(phi_shell < 1)) {
-            const char *ptr = job->count && !job->has_phi ? "/count" : "/phi/value";
-            pk_schema_errors_add(errs, ptr, "resolvedBelow1",
-                                 "the grains would fill φ = %.4g of the box (%.4g with their gaps "
-                                 "Δd): must be < 1",
-                                 plan->phi_resolved, phi_shell);
-        }
-    }
     for (int k = 0; k < dim; k++) {
         char ptr[64];
         snprintf(ptr, sizeof ptr, "/domain/box/size/%d", k);
@@ -396,6 +382,25 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
             pk_schema_errors_add(errs, ptr, "wallSize",
                                  "a walled edge must hold the largest grain plus Δd = %g (got %g)",
                                  need, job->box.L[k]);
+    }
+    if (errs->n == before) {
+        /* Grains kept Δd apart carry disjoint shells of diameter d + Δd inside
+         * the box widened by Δd/2 at each wall; their measure is at least
+         * φ (1 + Δd/d_max)^dim of the box: it must stay below 1 (the field
+         * named: Δd when the grains alone fit) */
+        double widened = 1;
+        for (int k = 0; k < dim; k++)
+            widened *= job->box.L[k] / (job->box.L[k] + (job->box.periodic[k] ? 0 : job->delta_d));
+        double phi_shell = plan->phi_resolved * widened * pow(1 + job->delta_d / plan->d_max, dim);
+        if (!(phi_shell < 1)) {
+            const char *ptr = plan->phi_resolved < 1 && job->delta_d > 0 ? "/delta_d"
+                              : job->count && !job->has_phi         ? "/count"
+                                                                    : "/phi/value";
+            pk_schema_errors_add(errs, ptr, "resolvedBelow1",
+                                 "the grains would fill φ = %.4g of the box (%.4g with their gaps "
+                                 "Δd): must be < 1",
+                                 plan->phi_resolved, phi_shell);
+        }
     }
     if (errs->n == before)
         check_periodic_jamming(job, plan, errs);

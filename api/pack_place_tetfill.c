@@ -103,6 +103,12 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
                      "r_max >= r_min");
             return -1;
         }
+        double lmin = fmin(job->box.L[0], fmin(job->box.L[1], job->box.L[2]));
+        if (!(2 * prm->r_max <= lmin)) {
+            snprintf(err, errlen, "r_max = %g: the largest sphere must fit in the box (2 r_max <= %g)",
+                     prm->r_max, lmin);
+            return -1;
+        }
         *ptr = "/domain/box/periodic";
         *rule = "walledBox";
         for (int k = 0; k < 3; k++)

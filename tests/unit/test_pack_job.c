@@ -186,7 +186,7 @@ static void test_phi_implied_above_one(void)
 {
     CHECK(refused("{" MONO2D("20") ",\"count\":500}", "/count", "resolvedBelow1"));
     /* φ 0.353, with shells d + Δd = 4 in the 22-box (walls Δd/2): 1.17 */
-    CHECK(refused("{" MONO2D("20") ",\"count\":45,\"delta_d\":2}", "/count", "resolvedBelow1"));
+    CHECK(refused("{" MONO2D("20") ",\"count\":45,\"delta_d\":2}", "/delta_d", "resolvedBelow1"));
     pk_pack_plan plan;
     CHECK(plan_from("{" MONO2D("20") ",\"count\":45,\"delta_d\":0.5}", &plan) == 0);
 }
