@@ -309,10 +309,192 @@ static void test_non_finite_literals(void)
     }
 }
 
+/* Run an inputs text; the summary (new ref), rc in *rc. */
+static json_t *run_text(const char *inputs_json, int *rc)
+{
+    json_t *in = json_loads(inputs_json, 0, NULL);
+    json_t *sum = NULL;
+    *rc = in ? run_job(in, &sum) : -9;
+    json_decref(in);
+    return sum;
+}
+
+static long long placed(const json_t *sum)
+{
+    return json_integer_value(json_object_get(sum, "count_placed"));
+}
+
+static double phi_of(const json_t *sum) { return json_real_value(json_object_get(sum, "phi_resolved")); }
+
+/* N = 1, 2, 8 in walled and periodic boxes, 2D and 3D, RSA and EDMD: every
+ * grain placed, complete, the audit clean. */
+static void test_few_grains(void)
+{
+    const char *algs[] = {"rsa", "edmd"};
+    for (int dim = 2; dim <= 3; dim++)
+        for (int n = 1; n <= 8; n *= 2)
+            for (int per = 0; per < 2; per++)
+                for (int a = 0; a < 2; a++) {
+                    char buf[512];
+                    snprintf(buf, sizeof buf,
+                             "{\"dim\":%d,\"domain\":{\"box\":{\"size\":[10,10%s],\"periodic\":%s}},"
+                             "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]},"
+                             "\"count\":%d,\"delta_d\":0.1,\"algorithm\":\"%s\"}",
+                             dim, dim == 3 ? ",10" : "", per ? "true" : "false", n, algs[a]);
+                    int rc;
+                    json_t *sum = run_text(buf, &rc);
+                    CHECK_MSG(rc == 0 && sane(sum, rc) && placed(sum) == n &&
+                                  json_is_true(json_object_get(sum, "complete")),
+                              "dim %d N %d periodic %d %s: rc %d placed %lld", dim, n, per, algs[a], rc,
+                              placed(sum));
+                    json_decref(sum);
+                }
+}
+
+/* Size ratio 1:1000 in 3D: one grain of d = 1000 and 200 of d = 1 (RSA and
+ * EDMD), walled and (where the big grain allows) periodic. */
+static void test_size_ratio_1000(void)
+{
+    const char *algs[] = {"rsa", "edmd"};
+    for (int a = 0; a < 2; a++) {
+        char buf[512];
+        snprintf(buf, sizeof buf,
+                 "{\"dim\":3,\"domain\":{\"box\":{\"size\":[2500,2500,2500],\"periodic\":[true,false,true]}},"
+                 "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":1000,\"volume_percent\":99.99998},"
+                 "{\"d\":1,\"volume_percent\":0.00002}]},\"count\":201,\"algorithm\":\"%s\","
+                 "\"limits\":{\"wall_time_s\":20}}",
+                 algs[a]);
+        int rc;
+        json_t *sum = run_text(buf, &rc);
+        json_t *cls = json_object_get(sum, "classes");
+        CHECK_MSG(rc == 0 && sane(sum, rc) && placed(sum) == 201 &&
+                      json_integer_value(json_object_get(json_array_get(cls, 0), "placed")) == 1,
+                  "%s: rc %d placed %lld", algs[a], rc, placed(sum));
+        json_decref(sum);
+    }
+}
+
+/* Δd three times the smallest grain: every gap >= Δd. */
+static void test_gap_above_smallest_grain(void)
+{
+    const char *algs[] = {"rsa", "edmd"};
+    for (int a = 0; a < 2; a++) {
+        char buf[512];
+        snprintf(buf, sizeof buf,
+                 "{\"dim\":3,\"domain\":{\"box\":{\"size\":[20,20,20]}},"
+                 "\"grading\":{\"type\":\"sieve\",\"sizes\":[1,2],\"passing\":[0,100]},"
+                 "\"count\":50,\"delta_d\":3,\"algorithm\":\"%s\"}", algs[a]);
+        int rc;
+        json_t *sum = run_text(buf, &rc);
+        CHECK_MSG(rc == 0 && sane(sum, rc) && placed(sum) == 50 &&
+                      json_real_value(json_object_get(sum, "smallest_gap")) >= 3 * (1 - 1e-12),
+                  "%s: rc %d", algs[a], rc);
+        json_decref(sum);
+    }
+}
+
+/* A grading with one class, one with empty classes (0 %), a sieve with flat
+ * stretches: the empty classes place nothing, the rest as asked. */
+static void test_one_and_empty_classes(void)
+{
+    const char *gradings[] = {
+        "{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]}",
+        "{\"type\":\"classes\",\"classes\":[{\"d\":4,\"volume_percent\":0},{\"d\":2,\"volume_percent\":100},"
+        "{\"d\":1,\"volume_percent\":0}]}",
+        "{\"type\":\"sieve\",\"sizes\":[1,2,3,4],\"passing\":[0,0,100,100]}",
+    };
+    for (size_t g = 0; g < sizeof gradings / sizeof *gradings; g++)
+        for (int a = 0; a < 2; a++) {
+            char buf[512];
+            snprintf(buf, sizeof buf,
+                     "{\"dim\":2,\"domain\":{\"box\":{\"size\":[30,30]}},\"grading\":%s,"
+                     "\"phi\":{\"value\":0.2,\"refers_to\":\"mix\"},\"algorithm\":\"%s\"}",
+                     gradings[g], a ? "edmd" : "rsa");
+            int rc;
+            json_t *sum = run_text(buf, &rc);
+            CHECK_MSG(rc == 0 && sane(sum, rc) && json_is_true(json_object_get(sum, "complete")) &&
+                          fabs(phi_of(sum) - 0.2) < 0.02,
+                      "grading %zu %s: rc %d φ %g", g, a ? "edmd" : "rsa", rc, phi_of(sum));
+            size_t i;
+            json_t *c;
+            json_array_foreach(json_object_get(sum, "classes"), i, c)
+            {
+                if (json_real_value(json_object_get(c, "target_fraction")) == 0)
+                    CHECK(json_integer_value(json_object_get(c, "placed")) == 0);
+            }
+            json_decref(sum);
+        }
+}
+
+/* The same job in lengths × 1e-6 and × 1e6: the same counts and φ (RSA:
+ * the same packing, φ to 1e-9; EDMD: its target φ to 1e-9). */
+static void test_scale_invariance(void)
+{
+    const double scales[] = {1e-6, 1, 1e6};
+    for (int a = 0; a < 2; a++) {
+        long long n0 = -1;
+        double phi0 = -1;
+        for (int k = 0; k < 3; k++) {
+            double f = scales[k];
+            char buf[640];
+            snprintf(buf, sizeof buf,
+                     "{\"dim\":3,\"domain\":{\"box\":{\"size\":[%.17g,%.17g,%.17g],\"periodic\":[true,false,true]}},"
+                     "\"grading\":{\"type\":\"sieve\",\"sizes\":[%.17g,%.17g],\"passing\":[0,100]},"
+                     "\"phi\":{\"value\":0.3,\"refers_to\":\"resolved\"},\"delta_d\":%.17g,\"seed\":3,"
+                     "\"algorithm\":\"%s\"}",
+                     12 * f, 12 * f, 12 * f, 1 * f, 2 * f, 0.1 * f, a ? "edmd" : "rsa");
+            int rc;
+            json_t *sum = run_text(buf, &rc);
+            CHECK_MSG(rc == 0 && sane(sum, rc) && json_is_true(json_object_get(sum, "complete")),
+                      "%s × %g: rc %d", a ? "edmd" : "rsa", f, rc);
+            CHECK(json_real_value(json_object_get(sum, "smallest_gap")) >= 0.1 * f * (1 - 1e-9));
+            if (k == 0) {
+                n0 = placed(sum);
+                phi0 = phi_of(sum);
+            } else {
+                CHECK_MSG(placed(sum) == n0, "%s × %g: %lld grains, %lld at × 1e-6",
+                          a ? "edmd" : "rsa", f, placed(sum), n0);
+                CHECK_MSG(fabs(phi_of(sum) - phi0) <= 1e-9 * phi0, "%s × %g: φ %.12g vs %.12g",
+                          a ? "edmd" : "rsa", f, phi_of(sum), phi0);
+            }
+            json_decref(sum);
+        }
+    }
+}
+
+/* A target φ above what the algorithm reaches (RSA 0.95 of disks, EDMD 0.95
+ * of equal disks until target): successful, complete false, a warning with
+ * the φ reached and the target. */
+static void test_target_above_reachable(void)
+{
+    for (int a = 0; a < 2; a++) {
+        char buf[512];
+        snprintf(buf, sizeof buf,
+                 "{\"dim\":2,\"domain\":{\"box\":{\"size\":[20,20]}},"
+                 "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]},"
+                 "\"phi\":{\"value\":0.95,\"refers_to\":\"resolved\"},\"algorithm\":\"%s\"%s,"
+                 "\"limits\":{\"wall_time_s\":20}}",
+                 a ? "edmd" : "rsa", a ? "" : ",\"rsa\":{\"max_failed_draws\":10000}");
+        int rc;
+        json_t *sum = run_text(buf, &rc);
+        const char *w = json_string_value(json_array_get(json_object_get(sum, "warnings"), 0));
+        CHECK_MSG(rc == 0 && sane(sum, rc) && json_is_false(json_object_get(sum, "complete")) &&
+                      w && strstr(w, "0.95") && phi_of(sum) < 0.92,
+                  "%s: rc %d φ %g warning %s", a ? "edmd" : "rsa", rc, phi_of(sum), w ? w : "(none)");
+        json_decref(sum);
+    }
+}
+
 int main(void)
 {
     alarm(300); /* a hang is a failure, not a stuck suite */
     RUN(test_numeric_fields_walk);
     RUN(test_non_finite_literals);
+    RUN(test_few_grains);
+    RUN(test_size_ratio_1000);
+    RUN(test_gap_above_smallest_grain);
+    RUN(test_one_and_empty_classes);
+    RUN(test_scale_invariance);
+    RUN(test_target_above_reachable);
     return check_summary();
 }
