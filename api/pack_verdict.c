@@ -51,11 +51,16 @@ void pk_pack_verdict(const pk_pack_job *job, const pk_pack_plan *plan, const pk_
                         st->placed, st->requested);
         break;
     default:
-        if (!done)
+        if (!done && st->requested)
             pk_verdict_warn(summary,
                             "saturated: φ %.4g reached of the target %.4g (%s stopped: %s), %zu of "
                             "%zu grains placed",
                             phi, plan->phi_resolved, job->algorithm, why, st->placed, st->requested);
+        else if (!done) /* tetfill to a φ target: no count asked */
+            pk_verdict_warn(summary,
+                            "saturated: φ %.4g reached of the target %.4g (%s stopped: %s), %zu "
+                            "grains placed",
+                            phi, plan->phi_resolved, job->algorithm, why, st->placed);
         break;
     }
     if (st->warning[0])
