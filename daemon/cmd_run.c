@@ -117,9 +117,8 @@ int cmd_run(int argc, char **argv)
             fprintf(stderr, "packd run: failed: %s (partial result in %s)\n", err, out_path);
         json_object_set_new(summary, "output", json_string(out_path));
         if (xdmf_path) {
-            /* the XML names the HDF5 file as it sits beside it */
-            const char *base = strrchr(out_path, '/');
-            if (pk_xdmf_write(out_path, base ? base + 1 : out_path, xdmf_path, err, sizeof err) != 0)
+            /* the XML names the HDF5 file by its path relative to the XML */
+            if (pk_xdmf_write(out_path, NULL, xdmf_path, err, sizeof err) != 0)
                 fprintf(stderr, "packd run: %s\n", err);
             else
                 json_object_set_new(summary, "xdmf", json_string(xdmf_path));
