@@ -374,16 +374,17 @@ static void test_size_ratio_1000(void)
     }
 }
 
-/* Δd three times the smallest grain: every gap >= Δd. */
+/* Δd three times the smallest grain: every gap >= Δd (RSA, EDMD relative
+ * growth, EDMD shell growth). */
 static void test_gap_above_smallest_grain(void)
 {
-    const char *algs[] = {"rsa", "edmd"};
-    for (int a = 0; a < 2; a++) {
+    const char *algs[] = {"\"rsa\"", "\"edmd\"", "\"edmd\",\"edmd\":{\"growth\":\"shell\"}"};
+    for (int a = 0; a < 3; a++) {
         char buf[512];
         snprintf(buf, sizeof buf,
                  "{\"dim\":3,\"domain\":{\"box\":{\"size\":[20,20,20]}},"
                  "\"grading\":{\"type\":\"sieve\",\"sizes\":[1,2],\"passing\":[0,100]},"
-                 "\"count\":50,\"delta_d\":3,\"algorithm\":\"%s\"}", algs[a]);
+                 "\"count\":50,\"delta_d\":3,\"algorithm\":%s}", algs[a]);
         int rc;
         json_t *sum = run_text(buf, &rc);
         CHECK_MSG(rc == 0 && sane(sum, rc) && placed(sum) == 50 &&
