@@ -273,6 +273,7 @@ int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_m
     json_object_set_new(sum, "process", json_string("pack"));
     json_object_set_new(sum, "algorithm", json_string(job.algorithm));
     json_object_set_new(sum, "termination_reason", json_string(pk_stop_reason_name(st.reason)));
+    json_object_set_new(sum, "complete", json_false()); /* here in the listing; pk_pack_verdict sets it */
     json_object_set_new(sum, "count_placed", json_integer((json_int_t)st.placed));
     json_object_set_new(sum, "count_requested", json_integer((json_int_t)st.requested));
     json_object_set_new(sum, "count_expected", json_real(plan.expected_n));
