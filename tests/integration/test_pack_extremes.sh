@@ -59,3 +59,10 @@ printf '{"inputs": {%s, "count": 10, "delta_d": NaN}}' "$MONO" >"$T/nan-body.jso
 code=$(c -o "$T/nan.out" -w '%{http_code}' -H 'Content-Type: application/json' \
     --data-binary "@$T/nan-body.json" "$B/processes/pack/execution")
 check service_nan_400 sh -c "[ '$code' = 400 ] && grep -q 'line 1, column [0-9]' '$T/nan.out'"
+
+# 7. the service's max_particles cap holds for a cap written as a decimal
+#    (1e11 was no JSON integer to the cap, so the job's own limit stood)
+printf '{"inputs": {"dim": 2, "domain": {"box": {"size": [6000, 6000]}}, "grading": {"type": "classes", "classes": [{"d": 1, "volume_percent": 100}]}, "phi": {"value": 0.7, "refers_to": "resolved"}, "limits": {"max_particles": 1e11}}}' >"$T/cap-body.json"
+code=$(c -o "$T/cap.out" -w '%{http_code}' -H 'Content-Type: application/json' \
+    --data-binary "@$T/cap-body.json" "$B/processes/pack/execution")
+check service_cap_decimal_max_particles sh -c "[ '$code' -ge 400 ] && [ '$code' -lt 500 ] && grep -q maxParticles '$T/cap.out'"
