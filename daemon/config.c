@@ -31,6 +31,7 @@ static const struct key {
     {"max_attempts", K_INT, F(max_attempts), 1, 100, "starts of one job before an interrupted job fails"},
     {"grace_s", K_DOUBLE, F(grace_s), 0, 86400, "SIGTERM: time running jobs get to finish"},
     {"log_level", K_LEVEL, F(log_level), 0, 0, "debug | info | warn | error"},
+    {"public_url", K_STR, F(public_url), 0, 0, "base URL of absolute links (reverse proxy); unset: http://<Host header>"},
 #undef F
 };
 

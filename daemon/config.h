@@ -12,6 +12,7 @@ typedef enum { PK_LOG_DEBUG, PK_LOG_INFO, PK_LOG_WARN, PK_LOG_ERROR } pk_log_lev
 
 typedef struct pk_config {
     char bind[64];            /* listen address (IPv4 dotted quad) */
+    char public_url[256];     /* base of absolute links, e.g. https://packd.lab.example; "" = from Host */
     int port;
     char data[1024];          /* data directory: queue.db, jobs/, files/ */
     int workers;              /* concurrent worker processes */

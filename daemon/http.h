@@ -46,6 +46,13 @@ struct MHD_Daemon *pk_http_start(pk_service *svc, int *port, char *err, size_t e
 
 /* --- replies (each queues the response and counts it for /metrics) --- */
 enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp);
+/* Every "href" of doc that is a path ("/jobs/…") made absolute from the
+ * configured public_url, else the request's Host.  pk_send_json and the
+ * problem senders do it; pk_send makes a path Location header absolute. */
+void pk_absolute_links(pk_req *r, json_t *doc);
+/* The inverse for a request's inputs: links into this service given as
+ * absolute URLs (as its documents give them) become paths again. */
+void pk_own_links_as_paths(pk_req *r, json_t *inputs);
 /* JSON body (stolen); etag may be NULL. */
 enum MHD_Result pk_send_json(pk_req *r, unsigned status, json_t *body, const char *etag);
 /* A response with a JSON body (stolen, indented, ends with a newline). */
