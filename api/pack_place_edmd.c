@@ -109,8 +109,11 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
         }
         rsa_seconds = rs.seconds;
         if (rs.reason == PK_STOP_CANCELLED || rs.reason == PK_STOP_WALL_TIME) {
+            for (size_t i = 0; i < p->n; i++)
+                p->r[i] *= prm.delta; /* the start's sizes: the grains as they were placed */
             *st = (pk_place_stats){.reason = rs.reason, .placed = rs.placed,
-                                   .requested = sz->n, .seconds = rs.seconds};
+                                   .requested = sz->n, .seconds = rs.seconds,
+                                   .short_delta_d = 1, .audit_delta_d = gap};
             return 0;
         }
         if (rs.placed < sz->n && !delta_default) {

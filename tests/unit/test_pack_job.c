@@ -251,6 +251,48 @@ static void test_wall_time_fails(void)
     json_decref(sum);
 }
 
+/* Cancel once the RSA start of an EDMD run has placed some grains. */
+static int cancel_in_rsa(const pk_progress *pg, void *ctx)
+{
+    (void)ctx;
+    return pg->stage && !strcmp(pg->stage, "rsa") && pg->done > 0;
+}
+
+/* Stopped inside the EDMD's RSA start (grains placed at δ·d; shell growth at
+ * gap 0): failed, the partial file holds the grains as placed and passes its
+ * audit (was: radii at the target sizes, hundreds of overlapping pairs). */
+static void test_stop_in_rsa_start(void)
+{
+    const char *shapes[] = {"\"until\":\"jammed\"", "\"maximize\":\"delta_d\""};
+    for (int k = 0; k < 2; k++) {
+        char buf[640];
+        snprintf(buf, sizeof buf,
+                 "{\"process\":\"pack\",\"inputs\":{\"dim\":3,\"domain\":{\"box\":{\"size\":"
+                 "[30,30,30],\"periodic\":true}},\"grading\":{\"type\":\"classes\",\"classes\":"
+                 "[{\"d\":2,\"volume_percent\":100}]},\"phi\":{\"value\":0.5,\"refers_to\":"
+                 "\"resolved\"},\"delta_d\":0.1,\"algorithm\":\"edmd\",\"edmd\":{%s}}}",
+                 shapes[k]);
+        json_t *job = json_loads(buf, 0, NULL);
+        char out[] = "/tmp/packd-test-pack-XXXXXX";
+        int fd = mkstemp(out);
+        close(fd);
+        pk_monitor mon = {.fn = cancel_in_rsa, .interval_s = 1e-9};
+        pk_schema_errors errs = {0};
+        json_t *sum = NULL;
+        char err[512];
+        CHECK(pk_job_run(job, out, &mon, &sum, &errs, err, sizeof err) == 2);
+        const char *why = json_string_value(json_object_get(sum, "failure"));
+        CHECK_MSG(why && strstr(why, "cancelled"), "%s: failure %s", shapes[k], why ? why : "(none)");
+        long long placed = json_integer_value(json_object_get(sum, "count_placed"));
+        CHECK(placed > 0 && placed < 3223);
+        CHECK(json_integer_value(json_object_get(sum, "pairs_below_delta_d")) == 0);
+        json_decref(sum);
+        json_decref(job);
+        pk_schema_errors_free(&errs);
+        unlink(out);
+    }
+}
+
 /* Issue 21 item 10: maximize delta_d short of the job's delta_d keeps the
  * maximized packing (was: exit 2, no file), complete false with the Δd
  * reached; every gap of the file is >= that Δd. */
@@ -327,6 +369,7 @@ int main(void)
     RUN(test_periodic_jamming_rule);
     RUN(test_saturated_warns);
     RUN(test_wall_time_fails);
+    RUN(test_stop_in_rsa_start);
     RUN(test_maximize_short_keeps_file);
     RUN(test_until_jammed_complete);
     RUN(test_verdict_audit_and_non_finite);
