@@ -3,6 +3,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "auth.h"
 #include "http.h"
 #include "http_status_info.h"
 #include "sha256.h"
@@ -11,7 +12,7 @@
 /* The row of a successful job, or NULL after replying with the problem. */
 static json_t *successful_job(pk_req *r, enum MHD_Result *rc)
 {
-    json_t *row = pk_queue_get(r->svc->q, r->seg[1]);
+    json_t *row = pk_job_visible(r, r->seg[1]);
     if (!row) {
         *rc = pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
         return NULL;
