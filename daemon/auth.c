@@ -106,7 +106,9 @@ int pk_authorize(pk_req *r, pk_access access, enum MHD_Result *reply)
     }
     snprintf(r->owner, sizeof r->owner, "%s", named ? named : peer);
     if (access == PK_PUBLIC || !pk_auth_required(&cfg, NULL)) {
-        r->admin = 1; /* auth off: every client may do everything; the owner scopes quotas */
+        /* Public routes show no job data; with auth off every client may do
+         * everything, and the owner only scopes quotas and idempotency keys. */
+        r->admin = 1;
         return 1;
     }
     char buf[256], name[PK_TOKEN_NAME_MAX];
