@@ -28,14 +28,20 @@ typedef struct pk_req {
     size_t body_len, body_cap;
     int too_large;
     int first_call_done;
+    char owner[128];           /* who asks (auth.c): token name, proxy's X-Packd-Owner or address */
+    int admin;                 /* sees every owner's jobs and uploads */
 } pk_req;
 
 typedef enum MHD_Result (*pk_handler)(pk_req *r);
+
+/* Who may call a route once auth is on (auth.c). */
+typedef enum { PK_PUBLIC, PK_USER, PK_ADMIN } pk_access;
 
 typedef struct pk_route {
     const char *method;
     const char *pattern;       /* e.g. "/jobs/{*}": a star segment matches any one segment */
     pk_handler handler;
+    pk_access access;
 } pk_route;
 
 extern const pk_route pk_routes[];   /* terminated by {NULL} */
@@ -69,7 +75,7 @@ enum MHD_Result pk_send_problem_doc(pk_req *r, unsigned status, json_t *doc, int
 /* Request headers / query arguments (NULL if absent). */
 const char *pk_header(pk_req *r, const char *name);
 const char *pk_query(pk_req *r, const char *name);
-/* Who submits: the X-Packd-Owner header, else the client's IP address. */
+/* Who submits (r->owner, set by pk_authorize before the handler runs). */
 void pk_owner(pk_req *r, char *out, size_t n);
 
 /* Route handlers */

@@ -1,8 +1,6 @@
 /* http_reply.c — the reply helpers of http.h: JSON, problem+json, files
  * (Content-Length, ETag, SHA-256 headers, single byte ranges). */
-#include <arpa/inet.h>
 #include <fcntl.h>
-#include <netinet/in.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -179,18 +177,7 @@ const char *pk_query(pk_req *r, const char *name)
     return MHD_lookup_connection_value(r->conn, MHD_GET_ARGUMENT_KIND, name);
 }
 
-void pk_owner(pk_req *r, char *out, size_t n)
-{
-    const char *h = pk_header(r, "X-Packd-Owner");
-    if (h && *h) {
-        snprintf(out, n, "%s", h);
-        return;
-    }
-    const union MHD_ConnectionInfo *ci = MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
-    snprintf(out, n, "unknown");
-    if (ci && ci->client_addr && ci->client_addr->sa_family == AF_INET)
-        inet_ntop(AF_INET, &((const struct sockaddr_in *)ci->client_addr)->sin_addr, out, (socklen_t)n);
-}
+void pk_owner(pk_req *r, char *out, size_t n) { snprintf(out, n, "%s", r->owner); }
 
 static void base64(const unsigned char *in, size_t n, char *out)
 {

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "auth.h"
 #include "http.h"
 #include "input_refs.h"
 #include "http_process_doc.h"
@@ -78,7 +79,7 @@ enum MHD_Result route_execute(pk_req *r)
     pk_own_links_as_paths(r, inputs);
     char data_abs[PATH_MAX];
     const char *data = realpath(cfg.data, data_abs) ? data_abs : cfg.data;
-    if (pk_resolve_input_refs(inputs, data, svc->q, &errs) > 0 ||
+    if (pk_resolve_input_refs(inputs, data, svc->q, pk_scope(r), &errs) > 0 ||
         pk_process_validate_inputs(p, inputs, &errs) > 0) {
         for (size_t i = 0; i < errs.n; i++) { /* pointers relative to the body */
             char ptr[sizeof errs.items[i].pointer + 8];

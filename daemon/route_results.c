@@ -3,6 +3,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "auth.h"
 #include "http.h"
 #include "http_status_info.h"
 #include "picture.h"
@@ -24,7 +25,7 @@ static const struct {
  * a failed job's results answer why it failed. */
 static json_t *successful_job(pk_req *r, int partial_ok, enum MHD_Result *rc)
 {
-    json_t *row = pk_queue_get(r->svc->q, r->seg[1]);
+    json_t *row = pk_job_visible(r, r->seg[1]);
     if (!row) {
         *rc = pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
         return NULL;
