@@ -203,8 +203,7 @@ int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_m
         pk_schema_errors_free(&errs);
         return -1;
     }
-    if (mon && job.wall_time_s > 0)
-        mon->wall_limit_s = job.wall_time_s;
+    pk_monitor_start(mon, job.wall_time_s);
 
     double t0 = pk_wall_seconds();
     pk_sizes sz = {0};
