@@ -109,7 +109,7 @@ int cmd_run(int argc, char **argv)
     if (rc == 1) {
         cli_print_errors(job_path, &errs);
         status = 1;
-    } else if (rc != 0) {
+    } else if (rc != 0 && rc != 2) {
         fprintf(stderr, "packd run: %s\n", err);
         status = 2;
     } else {
