@@ -1,3 +1,5 @@
+/* http_process_doc.c — OGC process summaries and descriptions from the
+ * process table and its embedded schemas (contract in http_process_doc.h). */
 #include "http_process_doc.h"
 
 #include <stdio.h>
@@ -23,6 +25,46 @@ json_t *pk_process_summary(const pk_process *p)
                      "application/json");
 }
 
+/* Add to `into` every definition of `defs` that node refers to as
+ * "#/$defs/<name>", and theirs in turn. */
+static void collect_defs(json_t *node, json_t *defs, json_t *into)
+{
+    if (json_is_array(node)) {
+        size_t i;
+        json_t *e;
+        json_array_foreach(node, i, e) collect_defs(e, defs, into);
+        return;
+    }
+    const char *key;
+    json_t *v;
+    json_object_foreach(node, key, v) {
+        const char *ref = json_string_value(v);
+        if (!strcmp(key, "$ref") && ref && !strncmp(ref, "#/$defs/", 8)) {
+            json_t *def = json_object_get(defs, ref + 8);
+            if (def && !json_object_get(into, ref + 8)) {
+                json_object_set(into, ref + 8, def);
+                collect_defs(def, defs, into);
+            }
+        } else if (json_is_object(v) || json_is_array(v)) {
+            collect_defs(v, defs, into);
+        }
+    }
+}
+
+/* An input's schema that a client can use alone: a copy carrying the $defs
+ * its "#/$defs/…" references need, so they resolve with the input's schema
+ * as the document root. */
+static json_t *standalone_schema(json_t *ps, json_t *defs)
+{
+    json_t *need = json_object();
+    collect_defs(ps, defs, need);
+    json_t *out = json_deep_copy(ps);
+    if (json_object_size(need))
+        json_object_set(out, "$defs", need);
+    json_decref(need);
+    return out;
+}
+
 json_t *pk_process_description(const pk_process *p)
 {
     json_t *d = pk_process_summary(p);
@@ -40,8 +82,8 @@ json_t *pk_process_description(const pk_process *p)
             if (json_is_string(r) && !strcmp(json_string_value(r), name))
                 req = 1;
         }
-        json_t *in = json_pack("{s:s,s:i,s:i,s:O}", "title", name, "minOccurs", req, "maxOccurs", 1,
-                               "schema", ps);
+        json_t *in = json_pack("{s:s,s:i,s:i,s:o}", "title", name, "minOccurs", req, "maxOccurs", 1,
+                               "schema", standalone_schema(ps, json_object_get(schema, "$defs")));
         json_t *desc = json_object_get(ps, "description");
         if (json_is_string(desc))
             json_object_set(in, "description", desc);
