@@ -227,24 +227,52 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
                              "friction needs solver \"dr\" (Newton has no frictional stiffness)");
     if (job->friction && job->fdim == 3)
         pk_schema_errors_add(errs, "/friction", "semantic", "friction is 2D only (Meier 2009 ch. 7)");
-    /* every step: finite, det F̄ >= margin (spec H13) */
+    if (job->friction && pk_fric_law_active(&job->fric) && job->bc != PK_BC_TAYLOR)
+        pk_schema_errors_add(errs, "/friction", "semantic",
+                             "friction with rho_deg > 0 or h > 0 needs boundary_condition taylor "
+                             "(Meier 2009 §7.4): under %s sliding contacts make the relaxation "
+                             "diverge (their forces are not the gradient of the energy it "
+                             "minimises); use taylor or drop friction",
+                             pk_homog_bc_name(job->bc));
+    /* every step (on top of the pre-compression): finite, det F̄ > 0, the
+     * principal stretches within bounds (PK_HOMOG_MIN_STRETCH, spec H13) */
+    double F0[9];
+    pk_m3_identity(F0);
+    for (int a = 0; a < 3; a++)
+        F0[4 * a] = 1 - job->precompress;
     for (size_t k = 0; k < job->nstep && errs->n - before < 20; k++) {
-        const double *F = &job->F[9 * k];
-        double d = pk_m3_det(F);
-        int finite = 1;
-        for (int e = 0; e < 9; e++)
-            finite &= isfinite(F[e]) != 0;
+        double F[9];
+        pk_m3_mul(&job->F[9 * k], F0, F);
+        int d3 = job->fdim == 3 ? 3 : 2, finite = 1;
+        double fro = 0;
+        for (int a = 0; a < d3; a++)
+            for (int b = 0; b < d3; b++) {
+                finite &= isfinite(F[3 * a + b]) != 0;
+                fro += F[3 * a + b] * F[3 * a + b];
+            }
+        double d = pk_m3_det(F), smin = pk_m3_sigma_min(F, d3);
         char ptr[64];
         if (type && !strcmp(type, "list"))
             snprintf(ptr, sizeof ptr, "/load/F/%zu", k);
         else
             snprintf(ptr, sizeof ptr, "/load");
-        if (!finite)
-            pk_schema_errors_add(errs, ptr, "semantic", "F̄ of step %zu is not finite", k);
-        else if (!(d >= PK_HOMOG_MIN_DET))
+        const char *pre = job->precompress > 0 ? " (with the pre-compression)" : "";
+        if (!finite || !isfinite(fro))
+            pk_schema_errors_add(errs, ptr, "semantic", "F̄ of step %zu%s is not finite", k, pre);
+        else if (!(d > 0))
             pk_schema_errors_add(errs, ptr, "semantic",
-                                 "det F̄ of step %zu is %g: must be >= %g (no inversion or collapse)", k,
-                                 d, PK_HOMOG_MIN_DET);
+                                 "det F̄ of step %zu%s is %g: must be > 0 (no inversion or collapse "
+                                 "of the cell)", k, pre, d);
+        else if (!(smin >= PK_HOMOG_MIN_STRETCH))
+            pk_schema_errors_add(errs, ptr, "semantic",
+                                 "F̄ of step %zu%s has a principal stretch %.4g (det F̄ %.4g): each "
+                                 "must be >= %g; below, touching grains overlap by more than a "
+                                 "radius (the contact law needs ε ≪ r)", k, pre, smin, d,
+                                 PK_HOMOG_MIN_STRETCH);
+        else if (!(sqrt(fro) <= PK_HOMOG_MAX_STRETCH))
+            pk_schema_errors_add(errs, ptr, "semantic",
+                                 "|F̄| of step %zu%s is %.4g: must be <= %g (every contact is open "
+                                 "long before)", k, pre, sqrt(fro), PK_HOMOG_MAX_STRETCH);
     }
     if (errs->n != before)
         pk_homog_job_free(job);

@@ -10,7 +10,15 @@
 #include "json_schema.h"
 #include "progress.h"
 
-#define PK_HOMOG_MIN_DET 1e-3 /* det F̄ margin of every load step */
+/* Every load step's F̄ (with the pre-compression): det F̄ > 0 and every
+ * principal stretch (singular value) >= PK_HOMOG_MIN_STRETCH — at 0.5 an
+ * affinely moved touching pair of equal grains has ε = r, the overlap bound
+ * of the audit (homog_audit.h): beyond it a centre enters its neighbour and
+ * the linear contact law (ε ≪ r, spec H3/H13) has lost its meaning.  |F̄|
+ * (Frobenius) <= PK_HOMOG_MAX_STRETCH: every contact is open long before,
+ * and F̄X, J̄V stay far from overflow. */
+#define PK_HOMOG_MIN_STRETCH 0.5
+#define PK_HOMOG_MAX_STRETCH 100.0
 
 typedef struct pk_homog_job {
     char rve_file[1024];

@@ -1,5 +1,7 @@
 #include "homog_record.h"
 
+#include <float.h>
+#include <math.h>
 #include <stdio.h>
 
 /* "ab" (1-based digits) for indices a, b < 3 */
@@ -173,5 +175,42 @@ int pk_homog_record_tangent(json_t *rec, int dim, size_t step, const double A[81
                     comp4_name(nm, a, b, c, d);
                     rc |= put(At, nm, json_real(A[(3 * a + b) * 9 + 3 * c + d]));
                 }
+    return rc ? -1 : 0;
+}
+
+static const char *const audit_series[] = {"passed", "failed_checks", "residual_ratio",
+                                           "balance_ratio", "grains_outside", "escape_radii",
+                                           "overlap_ratio", NULL};
+
+json_t *pk_homog_record_audit_new(void)
+{
+    json_t *a = json_object();
+    for (int k = 0; audit_series[k]; k++)
+        json_object_set_new(a, audit_series[k], json_array());
+    json_object_set_new(a, "failed_check_bits",
+                        json_string("1 not converged, 2 unbalanced, 4 escaped, 8 not finite, "
+                                    "16 overlap"));
+    json_object_set_new(a, "overlap_ratio_bound", json_real(PK_AUDIT_OVERLAP_MAX));
+    json_object_set_new(a, "balance_ratio_bound", json_real(PK_AUDIT_BALANCE_SLACK));
+    json_object_set_new(a, "residual_ratio_bound", json_real(1));
+    return a;
+}
+
+/* non-finite figures as ±DBL_MAX (JSON, hence the record, has no NaN) */
+static json_t *real_fin(double v)
+{
+    return json_real(isfinite(v) ? v : v < 0 ? -DBL_MAX : DBL_MAX);
+}
+
+int pk_homog_record_audit(json_t *aud, const pk_homog_audit *a)
+{
+    int rc = 0;
+    rc |= put(aud, "passed", json_integer(a->failed == 0));
+    rc |= put(aud, "failed_checks", json_integer((json_int_t)a->failed));
+    rc |= put(aud, "residual_ratio", real_fin(a->residual_ratio));
+    rc |= put(aud, "balance_ratio", real_fin(a->balance_ratio));
+    rc |= put(aud, "grains_outside", json_integer((json_int_t)a->outside));
+    rc |= put(aud, "escape_radii", real_fin(a->escape));
+    rc |= put(aud, "overlap_ratio", real_fin(a->overlap_ratio));
     return rc ? -1 : 0;
 }

@@ -7,6 +7,7 @@
 
 #include <jansson.h>
 
+#include "homog_audit.h"
 #include "homog_bc.h"
 #include "homog_tangent.h"
 
@@ -17,5 +18,10 @@ int pk_homog_record_step(json_t *rec, int dim, const pk_homog_step *st);
 /* Append one step's tangent (index = step number) or its failure status. */
 int pk_homog_record_tangent(json_t *rec, int dim, size_t step, const double A[81],
                             const pk_tangent_info *info, int ok);
+
+/* The audit's series (/observables/audit: per step, with its bounds) and
+ * one step's figures (0 / -1 memory). */
+json_t *pk_homog_record_audit_new(void);
+int pk_homog_record_audit(json_t *aud, const pk_homog_audit *a);
 
 #endif

@@ -1,5 +1,6 @@
 /* homog_run.c — run a 'homogenize' job: RVE file → load path of relaxed,
  * committed steps (Table 4.1/4.2) → H5MD result with per-step observables. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -7,10 +8,12 @@
 
 #include "dem_rattler.h"
 #include "h5_result.h"
+#include "homog_audit.h"
 #include "homog_job.h"
 #include "homog_record.h"
 #include "homog_tangent.h"
 #include "homog_tensor.h"
+#include "job_verdict.h"
 #include "par.h"
 #include "process.h"
 #include "sparse_cholmod.h"
@@ -137,8 +140,7 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
         pk_schema_errors_free(&errs);
         return -1;
     }
-    if (mon && job.wall_time_s > 0)
-        mon->wall_limit_s = job.wall_time_s;
+    pk_monitor_start(mon, job.wall_time_s);
     pk_box box;
     pk_particles p;
     if (pk_h5_read_particles(job.rve_file, &box, &p, err, errlen) != 0) {
@@ -151,7 +153,7 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
     pk_homog_state com = {0}, tr = {0};
     pk_sparse_ctx *nctx = NULL; /* Newton's solver context over the whole load path */
     pk_par *pool = NULL;        /* the job's threads (NULL: serial; the same results) */
-    json_t *rec = NULL;
+    json_t *rec = NULL, *aud = NULL, *sum = NULL;
     if (job.fdim && job.fdim != dim) {
         snprintf(err, errlen, "the load path is %dD but the RVE is %dD", job.fdim, dim);
         goto out;
@@ -176,9 +178,15 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
         snprintf(err, errlen, "out of memory");
         goto out;
     }
+    size_t nfree = 0;
+    for (size_t i = 0; i < rve.n; i++)
+        nfree += !rve.fixed[i];
     double F0[9];
     pk_m3_identity(F0);
-    pk_homog_step st;
+    pk_homog_step st, last;
+    pk_homog_audit au;
+    const char *reason = "complete";
+    char failure[600] = "", what[400];
     if (job.precompress > 0) { /* initial-state policy: relaxed, committed, not recorded */
         for (int a = 0; a < dim; a++)
             F0[4 * a] = 1 - job.precompress;
@@ -187,15 +195,24 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
             snprintf(err, errlen, "pre-compression: %s", eval_error(e));
             goto out;
         }
-        pk_homog_commit(&com, &tr);
+        if (st.dr.stop == PK_DR_CANCELLED || st.dr.stop == PK_DR_WALL_TIME)
+            reason = pk_dr_stop_name(st.dr.stop);
+        else if (pk_homog_audit_step(&rve, &o, &tr, &st, &au)) {
+            pk_homog_audit_describe(&au, &st, what, sizeof what);
+            snprintf(failure, sizeof failure, "the pre-compression step failed its audit: %s", what);
+            reason = "audit_failed";
+        } else
+            pk_homog_commit(&com, &tr);
     }
     rec = pk_homog_record_new(dim, job.tangent);
-    const char *reason = "complete";
+    aud = pk_homog_record_audit_new();
+    size_t unjammed = 0;
+    double worst_resid = 0, worst_overlap = 0, worst_balance = 0;
     size_t done = 0, total_iter = 0, max_iter_step = 0, not_converged = 0;
     double A[81] = {0};
     int have_A = 0;
     pk_progress pr = {.stage = "homogenize", .phi = -1, .eta_s = -1, .total = job.nstep};
-    for (size_t k = 0; k < job.nstep; k++) {
+    for (size_t k = 0; !strcmp(reason, "complete") && k < job.nstep; k++) {
         double F[9];
         pk_m3_mul(&job.F[9 * k], F0, F); /* F̄ = F̄_load·F̄_0 */
         int e = pk_homog_eval(&rve, &o, &com, F, &tr, &st, mon);
@@ -207,14 +224,32 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
             reason = pk_dr_stop_name(st.dr.stop);
             break;
         }
-        if (pk_homog_commit(&com, &tr) != 0 || pk_homog_record_step(rec, dim, &st) != 0) {
+        unsigned bad = pk_homog_audit_step(&rve, &o, &tr, &st, &au);
+        if (pk_homog_record_audit(aud, &au) != 0 ||
+            (!(bad & PK_AUDIT_NOT_FINITE) && pk_homog_record_step(rec, dim, &st) != 0)) {
             snprintf(err, errlen, "out of memory");
             goto out;
         }
-        not_converged += !pk_dr_stop_ok(st.dr.stop);
+        worst_resid = fmax(worst_resid, au.residual_ratio);
+        worst_overlap = fmax(worst_overlap, au.overlap_ratio);
+        worst_balance = fmax(worst_balance, au.balance_ratio);
         total_iter += st.dr.iterations;
         if (st.dr.iterations > max_iter_step)
             max_iter_step = st.dr.iterations;
+        if (bad) { /* the committed history would carry the defect on: stop here */
+            pk_homog_audit_describe(&au, &st, what, sizeof what);
+            snprintf(failure, sizeof failure, "load step %zu of %zu failed its audit: %s", k,
+                     job.nstep, what);
+            not_converged += !!(bad & PK_AUDIT_NOT_CONVERGED);
+            reason = "audit_failed";
+            break;
+        }
+        unjammed += st.contacts == 0 || (nfree && st.rattlers >= nfree);
+        if (pk_homog_commit(&com, &tr) != 0) {
+            snprintf(err, errlen, "out of memory");
+            goto out;
+        }
+        last = st;
         if (job.tangent) {
             pk_tangent_info ti;
             int t = pk_homog_tangent(&rve, &o, &com, &pk_sparse_cholmod, A, &ti);
@@ -266,25 +301,12 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
     json_object_set_new(rec, "radius_factor", json_real(job.radius_factor));
     json_object_set_new(rec, "precompression", json_real(job.precompress));
 
-    pk_h5 *h = pk_h5_create(out_path, err, errlen);
-    if (!h)
-        goto out;
-    int w = pk_h5_write_particles(h, &box, &p, "1");
-    w |= pk_h5_write_parameters(h, "homogenize", job_json, 0);
-    w |= pk_h5_obs_json(h, "homogenize", rec);
-    if (w != 0) {
-        pk_h5_abort(h);
-        snprintf(err, errlen, "writing %s failed", out_path);
-        goto out;
-    }
-    if (pk_h5_commit(h, err, errlen) != 0)
-        goto out;
-
-    json_t *sum = json_object();
+    /* the verdict (api/job_verdict.h): every recorded step audited */
+    sum = json_object();
     json_object_set_new(sum, "process", json_string("homogenize"));
     json_object_set_new(sum, "boundary_condition", json_string(pk_homog_bc_name(job.bc)));
     json_object_set_new(sum, "termination_reason", json_string(reason));
-    json_object_set_new(sum, "complete", json_boolean(!strcmp(reason, "complete") && !not_converged));
+    json_object_set_new(sum, "complete", json_boolean(done == job.nstep));
     json_object_set_new(sum, "steps", json_integer((json_int_t)done));
     json_object_set_new(sum, "steps_not_converged", json_integer((json_int_t)not_converged));
     json_object_set_new(sum, "rve_particles", json_integer((json_int_t)rve.n));
@@ -292,13 +314,34 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
     json_object_set_new(sum, "dr_iterations_max", json_integer((json_int_t)max_iter_step));
     /* the threads the job ran with (not in the file: the results are the same for any) */
     json_object_set_new(sum, "threads", json_integer(pk_par_threads(pool)));
+    json_t *sa = json_object();
+    json_object_set_new(sa, "passed", json_boolean(!failure[0]));
+    json_object_set_new(sa, "steps_audited", json_integer((json_int_t)json_array_size(
+                                                  json_object_get(aud, "passed"))));
+    json_object_set_new(sa, "max_residual_ratio", json_real(isfinite(worst_resid) ? worst_resid : DBL_MAX));
+    json_object_set_new(sa, "max_balance_ratio", json_real(isfinite(worst_balance) ? worst_balance : DBL_MAX));
+    json_object_set_new(sa, "max_overlap_ratio", json_real(isfinite(worst_overlap) ? worst_overlap : DBL_MAX));
+    json_object_set_new(sa, "overlap_ratio_bound", json_real(PK_AUDIT_OVERLAP_MAX));
+    json_object_set_new(sum, "audit", sa);
+    if (failure[0])
+        pk_verdict_fail(sum, "%s (the result file holds the %zu steps before it and the failed "
+                        "step's audit)", failure, done);
+    else if (!strcmp(reason, "wall_time"))
+        pk_verdict_fail(sum, "ran out of wall time (limits.wall_time_s %g s) after %zu of %zu load "
+                        "steps", job.wall_time_s, done, job.nstep);
+    else if (!strcmp(reason, "cancelled"))
+        pk_verdict_fail(sum, "cancelled after %zu of %zu load steps", done, job.nstep);
+    if (unjammed)
+        pk_verdict_warn(sum, "%zu of %zu load steps had no jammed grain (every free grain a "
+                        "rattler or no contact at all): their stresses are those of a loose "
+                        "packing (zero without contacts)", unjammed, done);
     if (done) {
         json_object_set_new(sum, "F", tensor_json(com.F, dim));
-        json_object_set_new(sum, "P", tensor_json(st.P, dim));
-        json_object_set_new(sum, "sigma", tensor_json(st.sigma, dim));
-        json_object_set_new(sum, "energy_density", json_real(st.energy_density));
-        json_object_set_new(sum, "contacts", json_integer((json_int_t)st.contacts));
-        json_object_set_new(sum, "rattlers", json_integer((json_int_t)st.rattlers));
+        json_object_set_new(sum, "P", tensor_json(last.P, dim));
+        json_object_set_new(sum, "sigma", tensor_json(last.sigma, dim));
+        json_object_set_new(sum, "energy_density", json_real(last.energy_density));
+        json_object_set_new(sum, "contacts", json_integer((json_int_t)last.contacts));
+        json_object_set_new(sum, "rattlers", json_integer((json_int_t)last.rattlers));
         if (have_A) {
             json_t *a = json_array();
             for (int i = 0; i < dim * dim; i++)
@@ -308,13 +351,32 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
             json_object_set_new(sum, "tangent", a);
         }
     }
+
+    pk_h5 *h = pk_h5_create(out_path, err, errlen);
+    if (!h)
+        goto out;
+    int w = pk_h5_write_particles(h, &box, &p, "1");
+    w |= pk_h5_write_parameters(h, "homogenize", job_json, 0);
+    w |= pk_h5_obs_json(h, "homogenize", rec);
+    w |= pk_h5_obs_json(h, "audit", aud);
+    w |= pk_verdict_write_h5(h, sum);
+    if (w != 0) {
+        pk_h5_abort(h);
+        snprintf(err, errlen, "writing %s failed", out_path);
+        goto out;
+    }
+    if (pk_h5_commit(h, err, errlen) != 0)
+        goto out;
     *summary = sum;
+    sum = NULL;
     rc = 0;
 out:
     pk_par_free(pool);
     if (nctx)
         pk_sparse_cholmod.ctx_free(nctx);
     json_decref(rec);
+    json_decref(aud);
+    json_decref(sum);
     pk_homog_state_free(&com);
     pk_homog_state_free(&tr);
     pk_homog_rve_free(&rve);

@@ -140,14 +140,9 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     json_t *o = json_object_get(job->inputs, "edmd");
     double w = strcmp(str(o, "wall_gap", "half"), "none") == 0 ? 0.5 * job->delta_d : 0;
     pk_edmd_stats es;
-    /* the job's wall time covers the RSA start too (each stage restarts the
-     * monitor's clock) */
-    const double wall_limit = mon ? mon->wall_limit_s : 0;
-    if (wall_limit > 0)
-        mon->wall_limit_s = fmax(wall_limit - rsa_seconds, 1e-3);
+    /* the monitor's wall limit counts from the job's start (pk_monitor_start),
+     * so it covers the RSA start too */
     int run_rc = pk_edmd_run_shell_in_walls(&job->box, w, p, &prm, mon, &es);
-    if (wall_limit > 0)
-        mon->wall_limit_s = wall_limit;
     if (run_rc != 0) {
         snprintf(err, errlen, "EDMD failed (bad parameters, periodic box too small or out of memory)");
         return -1;

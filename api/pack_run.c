@@ -212,8 +212,7 @@ int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_m
     pk_monitor own = {0}; /* the job's wall time holds without a caller's monitor too */
     if (!mon && job.wall_time_s > 0)
         mon = &own;
-    if (mon && job.wall_time_s > 0)
-        mon->wall_limit_s = job.wall_time_s;
+    pk_monitor_start(mon, job.wall_time_s); /* across all stages, from now */
 
     double t0 = pk_wall_seconds();
     pk_sizes sz = {0};

@@ -237,11 +237,13 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     for (int a = 0; a < 3; a++)
         for (int b = 0; b < 3; b++)
             out->sigma_skew[3 * a + b] = 0.5 * (out->sigma[3 * a + b] - out->sigma[3 * b + a]);
-    double sf[3] = {0, 0, 0};
+    double sf[3] = {0, 0, 0}, ff = 0;
     memset(out->P_reaction, 0, sizeof out->P_reaction);
     for (size_t i = 0; i < n; i++) {
-        for (int a = 0; a < dim; a++)
+        for (int a = 0; a < dim; a++) {
             sf[a] += f[3 * i + a];
+            ff += is_free[i] ? f[3 * i + a] * f[3 * i + a] : 0;
+        }
         if (rve->fixed[i] && !rve->periodic)
             for (int a = 0; a < dim; a++)
                 for (int b = 0; b < dim; b++)
@@ -250,6 +252,7 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     if (rve->periodic)
         memcpy(out->P_reaction, out->P, sizeof out->P);
     out->sum_force = sqrt(sf[0] * sf[0] + sf[1] * sf[1] + sf[2] * sf[2]);
+    out->free_force = sqrt(ff);
     double dP = 0, nP = 0;
     for (int k = 0; k < 9; k++) {
         dP += (out->P_reaction[k] - out->P[k]) * (out->P_reaction[k] - out->P[k]);

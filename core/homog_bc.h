@@ -75,6 +75,7 @@ typedef struct pk_homog_step {
     double dissipation;        /* Σ Δλ f_n tan ρ of this step (7.13), friction */
     size_t sliding;            /* contacts on the Coulomb limit, friction */
     double sum_force;          /* |Σ_i f_i| (global equilibrium) */
+    double free_force;         /* |(f_i)_free| at the final state, recomputed (the audit) */
     double max_overlap_ratio;  /* max ε_ij / min(r_i, r_j) (spec H3) */
     size_t contacts, formed, broken, rattlers;
     double coordination;       /* 2·contacts / particles */

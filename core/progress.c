@@ -19,18 +19,33 @@ void pk_monitor_begin(pk_monitor *m)
     m->t_start = pk_wall_seconds();
     m->t_last = m->t_start - m->interval_s; /* first tick reports */
     m->cancelled = 0;
+    if (!m->begun) {
+        m->t_job = m->t_start;
+        m->begun = 1;
+    }
+}
+
+void pk_monitor_start(pk_monitor *m, double wall_limit_s)
+{
+    if (!m)
+        return;
+    m->wall_limit_s = wall_limit_s > 0 ? wall_limit_s : 0;
+    m->begun = 0;
+    pk_monitor_begin(m);
 }
 
 int pk_monitor_tick(pk_monitor *m, pk_progress *p, int force)
 {
     if (!m)
         return 0;
+    if (!m->begun)
+        pk_monitor_begin(m);
     if (m->cancelled)
         return m->cancelled;
     if (m->cancel && *m->cancel)
         return m->cancelled = 1;
     double now = pk_wall_seconds();
-    if (m->wall_limit_s > 0 && now - m->t_start > m->wall_limit_s)
+    if (m->wall_limit_s > 0 && now - m->t_job > m->wall_limit_s)
         return m->cancelled = 2;
     if (!force && now - m->t_last < m->interval_s)
         return 0;

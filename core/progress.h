@@ -31,16 +31,25 @@ typedef struct pk_monitor {
     void *ctx;
     volatile sig_atomic_t *cancel;     /* may be NULL; non-zero = stop now */
     double interval_s;                 /* min wall time between callbacks (default 0.5) */
-    double wall_limit_s;               /* 0 = none; exceeded => stop with reason */
+    double wall_limit_s;               /* 0 = none; exceeded => stop with reason.  Set it
+                                        * with pk_monitor_start: it counts from there */
     /* private */
-    double t_start, t_last;
-    int cancelled;
+    double t_start, t_last, t_job;
+    int cancelled, begun;
 } pk_monitor;
 
 /* Wall clock in seconds (monotonic where the C library offers it). */
 double pk_wall_seconds(void);
 
+/* A stage begins: elapsed_s counts from here.  The job's clock (the wall
+ * limit's origin) starts at the first begin, start or tick, whichever comes
+ * first: a monitor never begun does not compare its limit with the
+ * machine's uptime. */
 void pk_monitor_begin(pk_monitor *m);
+
+/* The job begins: its clock starts now, with this wall-time limit (0 =
+ * none), across all its stages. */
+void pk_monitor_start(pk_monitor *m, double wall_limit_s);
 
 /* Returns 0 to continue, 1 if cancelled (flag or callback), 2 if the wall limit
  * was exceeded.  `p->elapsed_s` is filled in by the monitor.  Cheap when the
