@@ -3,12 +3,17 @@
  * recorded; "status" events carry {status, progress, message}, "progress"
  * events the worker's object (stage, fraction, phi, done, total, ...,
  * progress).  A comment line every KEEPALIVE_S keeps proxies open.  The
- * stream ends once the job is final and every event has been sent. */
+ * stream ends once the job is final and every event has been sent.
+ *
+ * The reader never blocks: with nothing to send it parks the connection
+ * (http_park.h) until the queue records an event or the keep-alive is due,
+ * so a listener costs a socket and a few KiB, not a thread. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "http.h"
+#include "http_park.h"
 #include "queue.h"
 
 #define KEEPALIVE_S 10.0
@@ -16,11 +21,14 @@
 
 typedef struct sse {
     pk_service *svc;
+    pk_parked *park;
     char id[37];
     long long last;        /* last event id sent */
+    long long fetched_at;  /* event sequence of the last fetch that got everything */
     char *pending;         /* formatted text not yet handed to MHD */
     size_t len, off;
     double last_write;
+    int check_final;       /* a status event (or a keep-alive) since the last look at the job row */
     int done;
 } sse;
 
@@ -48,8 +56,8 @@ static int job_final(sse *s)
     return final;
 }
 
-/* Fill s->pending with new events; 1 if something was added. */
-static int fetch(sse *s)
+/* Fill s->pending with new events; how many were added (at most BATCH). */
+static size_t fetch(sse *s)
 {
     json_t *ev = pk_queue_events(s->svc->q, s->id, s->last, BATCH);
     size_t i;
@@ -65,10 +73,12 @@ static int fetch(sse *s)
         free(buf);
         free(data);
         s->last = id;
+        if (!strcmp(json_string_value(json_object_get(e, "kind")), "status"))
+            s->check_final = 1;
     }
     size_t got = json_array_size(ev);
     json_decref(ev);
-    return got > 0;
+    return got;
 }
 
 static ssize_t reader(void *cls, uint64_t pos, char *buf, size_t max)
@@ -87,25 +97,42 @@ static ssize_t reader(void *cls, uint64_t pos, char *buf, size_t max)
         }
         if (s->done || __atomic_load_n(&s->svc->stopping, __ATOMIC_RELAXED))
             return MHD_CONTENT_READER_END_OF_STREAM;
+        /* Read the sequence before looking, so an event recorded after the
+         * look moves it and pk_park refuses or the waker resumes. */
         long long seq = pk_queue_event_seq(s->svc->q);
-        if (fetch(s))
-            continue;
-        if (job_final(s)) { /* recheck: an event may have landed in between */
-            if (!fetch(s))
-                s->done = 1;
-            continue;
+        if (seq != s->fetched_at) {
+            size_t got = fetch(s);
+            if (got < BATCH)
+                s->fetched_at = seq;
+            if (got)
+                continue;
+        }
+        /* A job becomes final with a status event: look at its row then. */
+        if (s->check_final) {
+            s->check_final = 0;
+            if (job_final(s)) { /* recheck: an event may have landed in between */
+                if (!fetch(s))
+                    s->done = 1;
+                continue;
+            }
         }
         if (pk_queue_now() - s->last_write >= KEEPALIVE_S) {
             append(s, ": keep-alive\n\n");
+            s->check_final = 1; /* and a look at the row now and then, whatever happened */
             continue;
         }
-        pk_queue_wait_event(s->svc->q, seq, 1000);
+        int rc = s->park ? pk_park(s->park, seq, s->last_write + KEEPALIVE_S) : -1;
+        if (rc > 0)
+            return 0; /* parked: MHD calls again once resumed */
+        if (rc < 0)
+            s->done = 1;
     }
 }
 
 static void release(void *cls)
 {
     sse *s = cls;
+    pk_park_unregister(s->park);
     free(s->pending);
     free(s);
 }
@@ -125,6 +152,9 @@ enum MHD_Result route_events(pk_req *r)
         last = pk_query(r, "lastEventId");
     s->last = last ? strtoll(last, NULL, 10) : 0;
     s->last_write = pk_queue_now();
+    s->fetched_at = -1;
+    s->check_final = 1;
+    s->park = pk_park_register(r->conn);
     append(s, "retry: 2000\n\n");
     struct MHD_Response *resp = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 8192, reader, s, release);
     MHD_add_response_header(resp, "Content-Type", "text/event-stream");
