@@ -5,21 +5,21 @@
         N slow-loris connections (a request whose header grows by one byte per
         second per connection, never finished) and M idle ones (connected, silent),
         spread over source addresses 127.0.0.I, 127.0.0.I+1, ... with K connections
-        each.  Writes FILE ({"slow", "idle", "closed"}) once all are open, keeps
+        each.  Writes FILE (slow=, idle=, closed=, failed=) once all are open, keeps
         them S seconds (or until SIGTERM), prints the final counts.
   sse   PORT PATH --n N [--per-src K] [--src-from I] --ready FILE --seconds S
         N Server-Sent Events listeners of PATH; FILE is written once every stream
         has sent its first line (or S seconds passed).  Then waits until every
-        stream has ended (or S seconds): prints {"n", "started", "ended",
-        "last_end_s" (after FILE was written), "status_events"}.
+        stream has ended (or S seconds): prints n=, started=, ended=,
+        last_end_s= (after FILE was written), status_events=.
   probe PORT [--path P] [--n N] [--src A]
-        N sequential GETs, a new connection each: {"n", "fail", "p50_ms",
-        "p99_ms", "max_ms"} (a failure: no answer within 2 s or not a 200).
+        N sequential GETs, a new connection each: n=, fail=, p50_ms=, p99_ms=,
+        max_ms= (a failure: no answer within 2 s or not a 200).
   open  PORT --n N --src A --wait W
         N connections from source A, then after W seconds: how many the server
-        has closed {"n", "closed"} (per-IP limit, idle timeout).
+        has closed: n=, closed= (per-IP limit, idle timeout).
+Every answer is one line of key=value pairs.
 """
-import json
 import os
 import resource
 import selectors
@@ -62,9 +62,14 @@ def sources(first, per_src):
         i += 1
 
 
+def kv(doc):
+    """One line of key=value pairs (what the shell scripts grep)."""
+    return " ".join("%s=%s" % (k, v) for k, v in doc.items())
+
+
 def write_ready(path, doc):
     with open(path + ".tmp", "w") as f:
-        json.dump(doc, f)
+        f.write(kv(doc) + "\n")
     os.rename(path + ".tmp", path)
 
 
@@ -123,7 +128,7 @@ def hold(args):
                 pump(min(t0 + 1.0 * (i + 1) / max(len(slow), 1), end))
         pump(min(t0 + 1.0, end))
     doc["closed"] = closed
-    print(json.dumps(doc))
+    print(kv(doc))
 
 
 def sse(args):
@@ -178,10 +183,10 @@ def sse(args):
     if t_ready is None and ready:
         write_ready(ready, {"started": sum(1 for v in state.values() if v["started"])})
     ends = [v["ended"] for v in state.values() if v["ended"] is not None]
-    print(json.dumps({
+    print(kv({
         "n": n, "started": sum(1 for v in state.values() if v["started"]),
         "ended": len(ends),
-        "last_end_s": round(max(ends) - t_ready, 3) if ends and t_ready else None,
+        "last_end_s": round(max(ends) - t_ready, 3) if ends and t_ready else -1,
         "status_events": status_events}))
 
 
@@ -219,7 +224,7 @@ def probe(args):
     def pct(p):
         return round(times[min(len(times) - 1, int(p * len(times)))], 2)
 
-    print(json.dumps({"n": n, "fail": fail, "p50_ms": pct(0.5), "p99_ms": pct(0.99),
+    print(kv({"n": n, "fail": fail, "p50_ms": pct(0.5), "p99_ms": pct(0.99),
                       "max_ms": round(times[-1], 2)}))
 
 
@@ -242,7 +247,7 @@ def open_conns(args):
             pass
         except OSError:
             closed += 1
-    print(json.dumps({"n": n, "closed": closed}))
+    print(kv({"n": n, "closed": closed}))
 
 
 def main():
