@@ -12,9 +12,15 @@
         has sent its first line (or S seconds passed).  Then waits until every
         stream has ended (or S seconds): prints n=, started=, ended=,
         last_end_s= (after FILE was written), status_events=.
-  probe PORT [--path P] [--n N] [--src A]
-        N sequential GETs, a new connection each: n=, fail=, p50_ms=, p99_ms=,
+  probe PORT [--path P] [--n N] [--src A] [--interval I]
+        N sequential GETs (--interval seconds apart), a new connection each: n=, fail=, p50_ms=, p99_ms=,
         max_ms= (a failure: no answer within 2 s or not a 200).
+  burst PORT PATH BODYFILE --n N --conc C --out FILE
+        N POSTs of BODYFILE (application/json), C at a time; the id of every
+        201 is appended to FILE as it arrives.  n=, answered=, failed=.
+  jobs  PORT IDFILE --timeout S
+        Waits until every job in IDFILE is final: total=, successful=,
+        failed=, dismissed=, missing=, pending=.
   open  PORT --n N --src A --wait W
         N connections from source A, then after W seconds: how many the server
         has closed: n=, closed= (per-IP limit, idle timeout).
@@ -193,6 +199,7 @@ def sse(args):
 def probe(args):
     port = int(args[0])
     path, n, src = opt(args, "--path", "/healthz"), opt(args, "--n", 50), opt(args, "--src", "127.0.0.1")
+    interval = opt(args, "--interval", 0.0)
     times, fail = [], 0
     req = ("GET %s HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n" % path).encode()
     for _ in range(n):
@@ -214,6 +221,8 @@ def probe(args):
         except OSError:
             ok = False
         dt = (time.perf_counter() - t0) * 1000
+        if interval > 0:
+            time.sleep(interval)
         if ok:
             times.append(dt)
         else:
@@ -226,6 +235,80 @@ def probe(args):
 
     print(kv({"n": n, "fail": fail, "p50_ms": pct(0.5), "p99_ms": pct(0.99),
                       "max_ms": round(times[-1], 2)}))
+
+
+def http(port, method, path, body=None, timeout=10.0):
+    """(status, body) of one request on a new connection; (0, b"") when it failed."""
+    import http.client
+    try:
+        c = http.client.HTTPConnection("127.0.0.1", port, timeout=timeout)
+        headers = {"Content-Type": "application/json"} if body is not None else {}
+        c.request(method, path, body=body, headers=headers)
+        r = c.getresponse()
+        data = r.read()
+        c.close()
+        return r.status, data
+    except (OSError, http.client.HTTPException):
+        return 0, b""
+
+
+def burst(args):
+    import threading
+    port, path, bodyfile = int(args[0]), args[1], args[2]
+    n, conc, out = opt(args, "--n", 200), opt(args, "--conc", 20), opt(args, "--out", "")
+    body = open(bodyfile, "rb").read()
+    lock = threading.Lock()
+    counts = {"answered": 0, "failed": 0}
+    todo = list(range(n))
+    f = open(out, "a")
+
+    def run():
+        while True:
+            with lock:
+                if not todo:
+                    return
+                todo.pop()
+            status, data = http(port, "POST", path, body)
+            with lock:
+                if status == 201:
+                    counts["answered"] += 1
+                    job = data.split(b'"jobID": "', 1)[1].split(b'"', 1)[0].decode()
+                    f.write(job + "\n")
+                    f.flush()
+                else:
+                    counts["failed"] += 1
+
+    threads = [threading.Thread(target=run) for _ in range(conc)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    f.close()
+    print(kv({"n": n, "answered": counts["answered"], "failed": counts["failed"]}))
+
+
+def jobs(args):
+    port, idfile = int(args[0]), args[1]
+    timeout = opt(args, "--timeout", 120.0)
+    ids = [l.strip() for l in open(idfile) if l.strip()]
+    final = {}
+    end = time.time() + timeout
+    while time.time() < end and len(final) < len(ids):
+        for i in ids:
+            if i in final:
+                continue
+            status, data = http(port, "GET", "/jobs/" + i)
+            if status == 404:
+                final[i] = "missing"
+            elif status == 200:
+                st = data.split(b'"status": "', 1)[1].split(b'"', 1)[0].decode()
+                if st in ("successful", "failed", "dismissed"):
+                    final[i] = st
+        time.sleep(0.5)
+    vals = list(final.values())
+    print(kv({"total": len(ids), "successful": vals.count("successful"), "failed": vals.count("failed"),
+              "dismissed": vals.count("dismissed"), "missing": vals.count("missing"),
+              "pending": len(ids) - len(final)}))
 
 
 def open_conns(args):
@@ -253,7 +336,7 @@ def open_conns(args):
 def main():
     raise_nofile()
     cmd, args = sys.argv[1], sys.argv[2:]
-    {"hold": hold, "sse": sse, "probe": probe, "open": open_conns}[cmd](args)
+    {"hold": hold, "sse": sse, "probe": probe, "open": open_conns, "burst": burst, "jobs": jobs}[cmd](args)
 
 
 if __name__ == "__main__":
