@@ -32,7 +32,7 @@ start_daemon bench --workers 2 --max-queued-per-owner 1000 || exit 1
 PORT=${B##*:}
 
 # --- poll_status
-edmd_slow_body 60 >"$T/edmd.json"
+edmd_slow_body 600 >"$T/edmd.json" # ended by DELETE after the sse case
 J1=$(submit "$T/edmd.json")
 J2=$(submit "$T/edmd.json")
 wait_status "$J1" running 30

@@ -178,9 +178,9 @@ def sse(args):
                 sel.unregister(s)
                 s.close()
                 continue
-            v["buf"] = (v["buf"] + data)[-256:]
-            if b"retry: 2000" in v["buf"]:
+            if b"retry: 2000" in v["buf"] + data:
                 v["started"] = True
+            v["buf"] = (v["buf"] + data)[-256:]
             status_events += data.count(b"event: status")
             if v["buf"].endswith(b"\r\n0\r\n\r\n"):  # the last chunk: the stream is over
                 v["ended"] = time.time()
