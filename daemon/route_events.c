@@ -8,6 +8,7 @@
  * The reader never blocks: with nothing to send it parks the connection
  * (http_park.h) until the queue records an event or the keep-alive is due,
  * so a listener costs a socket and a few KiB, not a thread. */
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -56,28 +57,62 @@ static int job_final(sse *s)
     return final;
 }
 
-/* Fill s->pending with new events; how many were added (at most BATCH). */
-static size_t fetch(sse *s)
+/* The last batch of events read, formatted.  Listeners of one job at the
+ * same event id while the queue is at the same sequence get the same batch,
+ * so waking N listeners of a job costs one query, not N. */
+static struct {
+    pthread_mutex_t mu;
+    char job[37];
+    long long after, seq;   /* the batch: events of job after `after`, read at `seq` */
+    long long last;         /* id of its last event */
+    size_t got;
+    int status;             /* it holds a status event */
+    char *text;
+} batch = {.mu = PTHREAD_MUTEX_INITIALIZER, .seq = -1};
+
+static void read_batch(pk_queue *q, const char *job, long long after, long long seq)
 {
-    json_t *ev = pk_queue_events(s->svc->q, s->id, s->last, BATCH);
-    size_t i;
+    json_t *ev = pk_queue_events(q, job, after, BATCH);
+    char *text = NULL;
+    size_t len = 0, i;
+    FILE *f = open_memstream(&text, &len);
     json_t *e;
+    batch.last = after;
+    batch.status = 0;
     json_array_foreach(ev, i, e) {
         char *data = json_dumps(json_object_get(e, "data"), JSON_COMPACT | JSON_REAL_PRECISION(10));
-        long long id = json_integer_value(json_object_get(e, "id"));
-        size_t n = strlen(data ? data : "{}") + 128;
-        char *buf = malloc(n);
-        snprintf(buf, n, "id: %lld\nevent: %s\ndata: %s\n\n", id,
-                 json_string_value(json_object_get(e, "kind")), data ? data : "{}");
-        append(s, buf);
-        free(buf);
+        const char *kind = json_string_value(json_object_get(e, "kind"));
+        batch.last = json_integer_value(json_object_get(e, "id"));
+        if (f)
+            fprintf(f, "id: %lld\nevent: %s\ndata: %s\n\n", batch.last, kind, data ? data : "{}");
+        batch.status |= !strcmp(kind, "status");
         free(data);
-        s->last = id;
-        if (!strcmp(json_string_value(json_object_get(e, "kind")), "status"))
-            s->check_final = 1;
     }
-    size_t got = json_array_size(ev);
+    if (f)
+        fclose(f);
+    batch.got = text ? json_array_size(ev) : 0;
     json_decref(ev);
+    free(batch.text);
+    batch.text = text;
+    snprintf(batch.job, sizeof batch.job, "%s", job);
+    batch.after = after;
+    batch.seq = seq;
+}
+
+/* Add the events after s->last (read at event sequence seq) to s->pending;
+ * how many (at most BATCH). */
+static size_t fetch(sse *s, long long seq)
+{
+    pthread_mutex_lock(&batch.mu);
+    if (batch.seq != seq || batch.after != s->last || strcmp(batch.job, s->id) != 0)
+        read_batch(s->svc->q, s->id, s->last, seq);
+    size_t got = batch.got;
+    if (got) {
+        append(s, batch.text);
+        s->last = batch.last;
+        s->check_final |= batch.status;
+    }
+    pthread_mutex_unlock(&batch.mu);
     return got;
 }
 
@@ -101,7 +136,7 @@ static ssize_t reader(void *cls, uint64_t pos, char *buf, size_t max)
          * look moves it and pk_park refuses or the waker resumes. */
         long long seq = pk_queue_event_seq(s->svc->q);
         if (seq != s->fetched_at) {
-            size_t got = fetch(s);
+            size_t got = fetch(s, seq);
             if (got < BATCH)
                 s->fetched_at = seq;
             if (got)
@@ -111,7 +146,7 @@ static ssize_t reader(void *cls, uint64_t pos, char *buf, size_t max)
         if (s->check_final) {
             s->check_final = 0;
             if (job_final(s)) { /* recheck: an event may have landed in between */
-                if (!fetch(s))
+                if (!fetch(s, pk_queue_event_seq(s->svc->q)))
                     s->done = 1;
                 continue;
             }

@@ -26,6 +26,7 @@
         has closed: n=, closed= (per-IP limit, idle timeout).
 Every answer is one line of key=value pairs.
 """
+import math
 import os
 import resource
 import selectors
@@ -230,8 +231,8 @@ def probe(args):
             times.append(2000.0)
     times.sort()
 
-    def pct(p):
-        return round(times[min(len(times) - 1, int(p * len(times)))], 2)
+    def pct(p):  # nearest rank
+        return round(times[max(0, math.ceil(p * len(times)) - 1)], 2)
 
     print(kv({"n": n, "fail": fail, "p50_ms": pct(0.5), "p99_ms": pct(0.99),
                       "max_ms": round(times[-1], 2)}))

@@ -44,7 +44,7 @@ HOLD=$!
 wait_file "$T/hold.ready" 40
 echo "# flood: $(cat "$T/hold.ready")"
 check flood_all_connections_kept test "$(kv "$T/hold.ready" slow) $(kv "$T/hold.ready" idle) $(kv "$T/hold.ready" closed)" = "$N $N 0"
-timeout 60 $CL probe "$PORT" --n 50 >"$T/probe1"
+timeout 60 $CL probe "$PORT" --n 100 >"$T/probe1"
 echo "# healthz under the flood: $(cat "$T/probe1"), threads $(threads)"
 check flood_healthz_p99 probe_ok "$T/probe1"
 # one address beyond max_connections_per_ip: the rest are closed at once
@@ -64,7 +64,7 @@ check sse_300_started test "$(kv "$T/sse.ready" started)" = 300
 th=$(threads)
 echo "# daemon threads with 300 listeners: $th"
 check sse_threads_bounded test "${th:-999}" -le 16
-timeout 60 $CL probe "$PORT" --n 50 >"$T/probe2"
+timeout 60 $CL probe "$PORT" --n 100 >"$T/probe2"
 echo "# healthz with 300 listeners: $(cat "$T/probe2")"
 check sse_healthz_p99 probe_ok "$T/probe2"
 c -o /dev/null -X DELETE "$B/jobs/$ID"
