@@ -100,11 +100,12 @@ static void read_batch(pk_queue *q, const char *job, long long after, long long 
 }
 
 /* Add the events after s->last (read at event sequence seq) to s->pending;
- * how many (at most BATCH). */
-static size_t fetch(sse *s, long long seq)
+ * how many (at most BATCH).  fresh: query even if a batch of that sequence
+ * is at hand (a commit is visible a moment before its sequence moves). */
+static size_t fetch(sse *s, long long seq, int fresh)
 {
     pthread_mutex_lock(&batch.mu);
-    if (batch.seq != seq || batch.after != s->last || strcmp(batch.job, s->id) != 0)
+    if (fresh || batch.seq != seq || batch.after != s->last || strcmp(batch.job, s->id) != 0)
         read_batch(s->svc->q, s->id, s->last, seq);
     size_t got = batch.got;
     if (got) {
@@ -136,7 +137,7 @@ static ssize_t reader(void *cls, uint64_t pos, char *buf, size_t max)
          * look moves it and pk_park refuses or the waker resumes. */
         long long seq = pk_queue_event_seq(s->svc->q);
         if (seq != s->fetched_at) {
-            size_t got = fetch(s, seq);
+            size_t got = fetch(s, seq, 0);
             if (got < BATCH)
                 s->fetched_at = seq;
             if (got)
@@ -146,7 +147,7 @@ static ssize_t reader(void *cls, uint64_t pos, char *buf, size_t max)
         if (s->check_final) {
             s->check_final = 0;
             if (job_final(s)) { /* recheck: an event may have landed in between */
-                if (!fetch(s, pk_queue_event_seq(s->svc->q)))
+                if (!fetch(s, pk_queue_event_seq(s->svc->q), 1))
                     s->done = 1;
                 continue;
             }
