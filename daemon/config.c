@@ -34,7 +34,7 @@ static const struct key {
     {"max_connections", K_INT, F(max_connections), 16, 1000000, "open HTTP connections in total (restart to change)"},
     {"max_connections_per_ip", K_INT, F(max_connections_per_ip), 0, 1000000, "open HTTP connections per client address, 0 = no limit (restart to change)"},
     {"idle_timeout_s", K_INT, F(idle_timeout_s), 1, 86400, "close a connection silent this long (restart to change)"},
-    {"body_timeout_s", K_DOUBLE, F(body_timeout_s), 1, 86400, "time a request body may take after its headers (beyond: 408)"},
+    {"body_timeout_s", K_DOUBLE, F(body_timeout_s), 1, 86400, "seconds a request body may take after its headers (beyond: connection closed)"},
     {"log_level", K_LEVEL, F(log_level), 0, 0, "debug | info | warn | error"},
 #undef F
 };
