@@ -5,7 +5,8 @@
 #   make test     build and run every unit and integration test (the benchmarks
 #                 are built too, so they cannot rot, but not run)
 #   make sanitize the same tests under AddressSanitizer + UBSan (build-san/)
-#   make bench    build and run the benchmarks in bench/
+#   make bench    build and run the benchmarks in bench/ (bench/service.sh wants
+#                 wrk: PACKD_BENCH_DEPS=1 sh deploy/install-deps.sh)
 #   make run      build and start the daemon with its embedded defaults
 #
 # Source files are found by wildcard: a new core/foo.c or tests/unit/test_foo.c
@@ -105,6 +106,7 @@ sanitize:
 
 bench: $(DEPS_OK) $(BUILD)/packd $(BENCH_BIN)
 	@for b in $(BENCH_BIN); do echo "== $$b"; $$b || exit 1; done
+	@echo "== bench/service.sh"; PACKD=$(BUILD)/packd sh bench/service.sh
 
 run: $(DEPS_OK) $(BUILD)/packd
 	$(BUILD)/packd serve

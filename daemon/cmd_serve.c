@@ -169,7 +169,7 @@ int cmd_serve(int argc, char **argv)
     pk_supervisor_stop(svc.sup, cfg.grace_s);
     __atomic_store_n(&svc.stopping, 1, __ATOMIC_RELAXED);
     pk_queue_wake_all(svc.q);
-    MHD_stop_daemon(http);
+    pk_http_stop(http);
     pk_supervisor_free(svc.sup);
     pk_tokens_close(svc.tokens);
     pk_queue_close(svc.q);

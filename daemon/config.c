@@ -42,6 +42,11 @@ static const struct key {
     {"max_queued_per_owner", K_INT, F(max_queued_per_owner), 1, 1e9, "waiting jobs per owner (beyond: 429)"},
     {"max_attempts", K_INT, F(max_attempts), 1, 100, "starts of one job before an interrupted job fails"},
     {"grace_s", K_DOUBLE, F(grace_s), 0, 86400, "SIGTERM: time running jobs get to finish"},
+    {"http_threads", K_INT, F(http_threads), 1, 64, "HTTP event-loop threads (restart to change)"},
+    {"max_connections", K_INT, F(max_connections), 16, 1000000, "open HTTP connections in total (restart to change)"},
+    {"max_connections_per_ip", K_INT, F(max_connections_per_ip), 0, 1000000, "open HTTP connections per client address, 0 = no limit (restart to change)"},
+    {"idle_timeout_s", K_INT, F(idle_timeout_s), 1, 86400, "close a connection silent this long (restart to change)"},
+    {"body_timeout_s", K_DOUBLE, F(body_timeout_s), 1, 86400, "seconds a request body may take after its headers (beyond: connection closed)"},
     {"log_level", K_LEVEL, F(log_level), 0, 0, "debug | info | warn | error"},
     {"public_url", K_STR, F(public_url), 0, 0, "base URL of absolute links (reverse proxy); unset: http://<Host header>"},
     {"auth", K_AUTH, F(auth), 0, 0, "bearer tokens required: auto (unless bind is loopback) | on | off"},
@@ -75,6 +80,11 @@ void pk_config_defaults(pk_config *c)
     c->max_queued_per_owner = 100;
     c->max_attempts = 3;
     c->grace_s = 30;
+    c->http_threads = 4;
+    c->max_connections = 4096;
+    c->max_connections_per_ip = 128;
+    c->idle_timeout_s = 20;
+    c->body_timeout_s = 120;
     c->log_level = PK_LOG_INFO;
 }
 

@@ -26,6 +26,11 @@ typedef struct pk_config {
     int max_queued_per_owner; /* accepted jobs per owner; beyond: 429 */
     int max_attempts;         /* runs of one job interrupted by daemon deaths before it fails */
     double grace_s;           /* SIGTERM: time running jobs get to finish */
+    int http_threads;         /* HTTP event-loop threads (epoll each) */
+    int max_connections;      /* open HTTP connections in total */
+    int max_connections_per_ip; /* open HTTP connections of one client address (0: no limit) */
+    int idle_timeout_s;       /* a connection silent this long is closed (headers, body, keep-alive) */
+    double body_timeout_s;    /* a request body must arrive within this time after its headers */
     pk_log_level log_level;
     pk_auth_mode auth;        /* bearer tokens required (daemon/auth.c) */
     char trusted_proxy[64];   /* peer whose X-Packd-Owner is honoured; "" = none */

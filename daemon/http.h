@@ -30,6 +30,8 @@ typedef struct pk_req {
     int first_call_done;
     char owner[128];           /* who asks (auth.c): token name, proxy's X-Packd-Owner or address */
     int admin;                 /* sees every owner's jobs and uploads */
+    int answered;              /* answered from the headers alone (413, 415): the body is not read */
+    double started;            /* when the headers were complete (pk_queue_now clock) */
 } pk_req;
 
 typedef enum MHD_Result (*pk_handler)(pk_req *r);
@@ -49,6 +51,8 @@ extern const pk_route pk_routes[];   /* terminated by {NULL} */
 /* Start/stop the listener.  Returns NULL with err on failure.  *port gets the
  * bound port (useful with port 0). */
 struct MHD_Daemon *pk_http_start(pk_service *svc, int *port, char *err, size_t errlen);
+/* End the streams (svc->stopping must be set), then stop the listener. */
+void pk_http_stop(struct MHD_Daemon *d);
 
 /* --- replies (each queues the response and counts it for /metrics) --- */
 enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp);

@@ -9,6 +9,8 @@ if ! command -v dpkg-query >/dev/null 2>&1 || ! command -v apt-get >/dev/null 2>
     exit 0
 fi
 PKGS="build-essential pkg-config libmicrohttpd-dev libjansson-dev libsqlite3-dev libssl-dev libhdf5-dev hdf5-tools curl python3 python3-jsonschema libsuitesparse-dev libopenblas0-serial procps libcairo2-dev fonts-dejavu-core"
+# Optional: what bench/service.sh drives the daemon with (PACKD_BENCH_DEPS=1).
+[ "${PACKD_BENCH_DEPS:-0}" = 1 ] && PKGS="$PKGS wrk sqlite3"
 missing=""
 for p in $PKGS; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
