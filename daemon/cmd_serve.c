@@ -69,6 +69,11 @@ int cmd_serve(int argc, char **argv)
         fprintf(stderr, "packd serve: %s\n", err);
         return usage(stderr);
     }
+    /* Every file the daemon and its workers create (queue database and its
+     * WAL, job.json, results, logs, uploads) is 0640 at most, directories
+     * 0750: a lab server's other accounts read none of it.  The workers
+     * inherit the mask. */
+    umask(027);
     pthread_mutex_init(&svc.mu, NULL);
     pk_log_set_level(svc.cfg.log_level);
     svc.started = pk_queue_now();

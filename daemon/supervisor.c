@@ -86,14 +86,43 @@ static void remove_tmp_files(const char *dir)
     closedir(d);
 }
 
+/* job.json by temp file and rename: 0, or -1 with errno (no temp file left). */
 static int write_job_file(const char *path, json_t *job)
 {
     char tmp[1300];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
+    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp) {
+        errno = ENAMETOOLONG;
         return -1;
-    if (json_dump_file(job, tmp, JSON_INDENT(2) | JSON_SORT_KEYS) != 0)
+    }
+    char *text = json_dumps(job, JSON_INDENT(2) | JSON_SORT_KEYS);
+    if (!text) {
+        errno = ENOMEM;
         return -1;
-    return rename(tmp, path);
+    }
+    size_t n = strlen(text), off = 0;
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640), rc = fd < 0 ? -1 : 0;
+    while (rc == 0 && off < n) {
+        ssize_t w = write(fd, text + off, n - off);
+        if (w > 0)
+            off += (size_t)w;
+        else if (!(w < 0 && errno == EINTR))
+            rc = -1;
+    }
+    int saved = errno;
+    if (fd >= 0 && close(fd) != 0 && rc == 0) {
+        rc = -1;
+        saved = errno;
+    }
+    free(text);
+    if (rc == 0 && rename(tmp, path) != 0) {
+        rc = -1;
+        saved = errno;
+    }
+    if (rc != 0) {
+        unlink(tmp);
+        errno = saved;
+    }
+    return rc;
 }
 
 /* pipe2(O_CLOEXEC) without _GNU_SOURCE. */
@@ -121,8 +150,10 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
     snprintf(sum_path, sizeof sum_path, "%s/summary.json", dir);
     snprintf(log_path, sizeof log_path, "%s/worker.log", dir);
     snprintf(lock_path, sizeof lock_path, "%s/worker.lock", dir);
+    char why[1400];
     if (mkdirs(dir) != 0) {
-        pk_queue_finish(s->q, id, "failed", "cannot create the job directory", NULL, NULL, 0);
+        snprintf(why, sizeof why, "cannot create the job directory: %s", strerror(errno));
+        pk_queue_finish(s->q, id, "failed", why, NULL, NULL, 0);
         return -1;
     }
     remove_tmp_files(dir);
@@ -130,6 +161,7 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
     json_t *file = json_pack("{s:O,s:O}", "process", json_object_get(job, "process"), "inputs",
                              json_object_get(job, "inputs"));
     int wrote = write_job_file(job_path, file);
+    int wrote_errno = errno;
     json_decref(file);
     char threads[16];
     pthread_mutex_lock(&s->mu);
@@ -137,7 +169,9 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
     pthread_mutex_unlock(&s->mu);
     int p[2];
     if (wrote != 0 || cloexec_pipe(p, 0) != 0) {
-        pk_queue_finish(s->q, id, "failed", "cannot write the job file", NULL, NULL, 0);
+        snprintf(why, sizeof why, "cannot write the job file: %s",
+                 strerror(wrote != 0 ? wrote_errno : errno));
+        pk_queue_finish(s->q, id, "failed", why, NULL, NULL, 0);
         return -1;
     }
     pid_t parent = getpid();
