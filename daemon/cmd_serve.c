@@ -54,6 +54,7 @@ static void reload(pk_service *svc, int argc, char **argv)
     pthread_mutex_unlock(&svc->mu);
     pk_log_set_level(next.log_level);
     pk_supervisor_configure(svc->sup, next.workers, next.max_wall_time_s, next.job_threads);
+    pk_supervisor_set_checkpoint_interval(svc->sup, next.checkpoint_interval_s);
     pk_log(PK_LOG_INFO, "configuration reloaded", "{s:s,s:i,s:s}", "file", next.config_file, "workers",
            next.workers, "log_level", pk_log_level_name(next.log_level));
 }
@@ -121,6 +122,8 @@ int cmd_serve(int argc, char **argv)
 
     svc.sup = pk_supervisor_start(svc.q, exe, svc.cfg.data, svc.cfg.workers, svc.cfg.max_wall_time_s,
                                   svc.cfg.job_threads);
+    if (svc.sup)
+        pk_supervisor_set_checkpoint_interval(svc.sup, svc.cfg.checkpoint_interval_s);
     int port = 0;
     struct MHD_Daemon *http = svc.sup ? pk_http_start(&svc, &port, err, sizeof err) : NULL;
     if (!http) {

@@ -23,6 +23,7 @@ typedef struct pk_config {
     int max_queued_per_owner; /* accepted jobs per owner; beyond: 429 */
     int max_attempts;         /* runs of one job interrupted by daemon deaths before it fails */
     double grace_s;           /* SIGTERM: time running jobs get to finish */
+    double checkpoint_interval_s; /* between two checkpoints of a long job (job dir checkpoint.h5) */
     pk_log_level log_level;
     char config_file[1024];   /* the file read, "" if none (kept for SIGHUP) */
 } pk_config;

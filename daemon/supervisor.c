@@ -44,6 +44,7 @@ struct pk_supervisor {
     int workers;
     double max_wall_time_s;
     int job_threads; /* --threads of each worker */
+    double checkpoint_interval_s;
     int stopping;
     double grace_deadline;
     int wake[2];
@@ -143,13 +144,16 @@ static void set_nonblock(int fd) { fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NON
 static int launch(pk_supervisor *s, slot *sl, json_t *job)
 {
     const char *id = json_string_value(json_object_get(job, "id"));
-    char dir[1200], job_path[1300], out_path[1300], sum_path[1300], log_path[1300], lock_path[1300];
+    char dir[1200], job_path[1300], out_path[1300], sum_path[1300], log_path[1300], lock_path[1300],
+        ckpt_path[1300];
     pk_job_dir(s->data, id, dir, sizeof dir);
     snprintf(job_path, sizeof job_path, "%s/job.json", dir);
     snprintf(out_path, sizeof out_path, "%s/result.h5", dir);
     snprintf(sum_path, sizeof sum_path, "%s/summary.json", dir);
     snprintf(log_path, sizeof log_path, "%s/worker.log", dir);
     snprintf(lock_path, sizeof lock_path, "%s/worker.lock", dir);
+    /* kept across attempts: a re-queued job resumes from it */
+    snprintf(ckpt_path, sizeof ckpt_path, "%s/checkpoint.h5", dir);
     char why[1400];
     if (mkdirs(dir) != 0) {
         snprintf(why, sizeof why, "cannot create the job directory: %s", strerror(errno));
@@ -163,9 +167,10 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
     int wrote = write_job_file(job_path, file);
     int wrote_errno = errno;
     json_decref(file);
-    char threads[16];
+    char threads[16], interval[32];
     pthread_mutex_lock(&s->mu);
     snprintf(threads, sizeof threads, "%d", s->job_threads);
+    snprintf(interval, sizeof interval, "%g", s->checkpoint_interval_s > 0 ? s->checkpoint_interval_s : 30);
     pthread_mutex_unlock(&s->mu);
     int p[2];
     if (wrote != 0 || cloexec_pipe(p, 0) != 0) {
@@ -199,7 +204,7 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
             dup2(p[1], 3) < 0)
             _exit(125);
         execl(s->exe, "packd", "run", job_path, "-o", out_path, "--progress-fd", "3", "--threads",
-              threads, (char *)NULL);
+              threads, "--checkpoint", ckpt_path, "--checkpoint-interval", interval, (char *)NULL);
         _exit(127);
     }
     close(p[1]);
@@ -456,6 +461,13 @@ void pk_supervisor_configure(pk_supervisor *s, int workers, double max_wall_time
     s->job_threads = job_threads;
     pthread_mutex_unlock(&s->mu);
     pk_supervisor_wake(s);
+}
+
+void pk_supervisor_set_checkpoint_interval(pk_supervisor *s, double seconds)
+{
+    pthread_mutex_lock(&s->mu);
+    s->checkpoint_interval_s = seconds;
+    pthread_mutex_unlock(&s->mu);
 }
 
 void pk_supervisor_wake(pk_supervisor *s)
