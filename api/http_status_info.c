@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "http_problem.h"
 #include "http_time.h"
 
 static void set_time(json_t *o, const char *key, json_t *row, const char *col)
@@ -47,9 +48,48 @@ json_t *pk_status_info(json_t *row)
         snprintf(href, sizeof href, "/jobs/%s/results", id);
         json_array_append_new(links, mklink(href, "http://www.opengis.net/def/rel/ogc/1.0/results",
                                           "application/json", "results"));
+    } else if (pk_has_partial_result(row)) {
+        snprintf(href, sizeof href, "/jobs/%s/results/result", id);
+        json_array_append_new(links, mklink(href, "partial-result", PK_RESULT_MEDIA_TYPE,
+                                          "the failed job's partial result file"));
     }
     json_object_set_new(s, "links", links);
+    /* the verdict (job_verdict.h): complete, warnings, failure */
+    json_t *summary = json_object_get(row, "summary");
+    static const char *const verdict[] = {"complete", "warnings", "failure"};
+    for (size_t i = 0; i < sizeof verdict / sizeof *verdict; i++) {
+        json_t *v = json_object_get(summary, verdict[i]);
+        if (v)
+            json_object_set(s, verdict[i], v);
+    }
     return s;
+}
+
+int pk_has_partial_result(json_t *row)
+{
+    const char *status = json_string_value(json_object_get(row, "status"));
+    return status && !strcmp(status, "failed") &&
+           json_is_string(json_object_get(row, "result_sha256"));
+}
+
+json_t *pk_failed_results_problem(json_t *row)
+{
+    const char *id = json_string_value(json_object_get(row, "id"));
+    json_t *summary = json_object_get(row, "summary");
+    json_t *doc = json_pack("{s:s,s:s,s:i,s:O,s:s,s:s}", "type", PK_PROBLEM_JOB_FAILED, "title",
+                            "Job failed", "status", 422, "detail", json_object_get(row, "message"),
+                            "jobID", id, "jobStatus", "failed");
+    if (json_is_object(summary))
+        json_object_set(doc, "summary", summary);
+    if (pk_has_partial_result(row)) {
+        char href[128];
+        snprintf(href, sizeof href, "/jobs/%s/results/result", id);
+        json_object_set_new(doc, "partial_result",
+                            json_pack("{s:s,s:s,s:O,s:O}", "href", href, "type", PK_RESULT_MEDIA_TYPE,
+                                      "size", json_object_get(row, "result_size"), "sha256",
+                                      json_object_get(row, "result_sha256")));
+    }
+    return doc;
 }
 
 json_t *pk_results_document(json_t *row)

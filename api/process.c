@@ -6,6 +6,7 @@
 
 #include "homog_job.h"
 #include "input_links.h"
+#include "job_verdict.h"
 #include "pack_job.h"
 
 static const pk_process pack_process = {
@@ -122,5 +123,9 @@ int pk_job_run(json_t *job, const char *out_path, pk_monitor *mon, json_t **summ
     }
     int rc = p->run(json_object_get(job, "inputs"), text, out_path, mon, summary, err, errlen);
     free(text);
+    if (rc == 0 && pk_verdict_failed(*summary)) {
+        snprintf(err, errlen, "%s", json_string_value(json_object_get(*summary, "failure")));
+        return 2;
+    }
     return rc;
 }

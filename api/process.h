@@ -19,7 +19,9 @@ typedef struct pk_process {
      * Appends errors with JSON pointers relative to the inputs object. */
     void (*check)(json_t *inputs, pk_schema_errors *errs);
     /* Run validated inputs, write the result file, return a summary object
-     * (new reference) in *summary.  0 on success; -1 with err on failure. */
+     * (new reference) in *summary carrying the verdict (job_verdict.h).
+     * 0 whenever a result file and a summary were written, failed verdict
+     * included; -1 with err when there is no result file at all. */
     int (*run)(json_t *inputs, const char *job_json, const char *out_path, pk_monitor *mon,
                json_t **summary, char *err, size_t errlen);
 } pk_process;
@@ -51,8 +53,10 @@ void pk_job_set_checkpoint(const char *path, const char *digest, double interval
 const char *pk_job_checkpoint(const char **digest, double *interval_s);
 
 /* Validate and run a job (the one code path of `packd run` and the daemon's
- * workers).  Returns 0 on success; on invalid input returns 1 with errs
- * filled; on a runtime failure returns -1 with err. */
+ * workers).  Returns 0 when the job is successful (complete or not); 2 when
+ * it failed but wrote its partial result file and a summary whose "failure"
+ * says why (err holds the same text); 1 on invalid input with errs filled;
+ * -1 on a runtime failure without a result file, with err. */
 int pk_job_run(json_t *job, const char *out_path, pk_monitor *mon, json_t **summary,
                pk_schema_errors *errs, char *err, size_t errlen);
 

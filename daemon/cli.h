@@ -8,6 +8,8 @@ int cmd_run(int argc, char **argv);
 int cmd_validate(int argc, char **argv);
 int cmd_inspect(int argc, char **argv);
 int cmd_serve(int argc, char **argv);
+int cmd_picture(int argc, char **argv);
+int cmd_token(int argc, char **argv);
 
 /* Load a JSON file ("-" = stdin); NULL with a message on stderr. */
 #include <jansson.h>

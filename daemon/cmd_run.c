@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "picture.h"
 #include "process.h"
 #include "sha256.h"
 #include "xdmf.h"
@@ -44,7 +45,8 @@ static int print_progress(const pk_progress *p, void *ctx)
 
 int cmd_run(int argc, char **argv)
 {
-    const char *job_path = NULL, *out_path = NULL, *xdmf_path = NULL, *ckpt_path = NULL;
+    const char *job_path = NULL, *out_path = NULL, *xdmf_path = NULL, *pictures_dir = NULL;
+    const char *ckpt_path = NULL;
     double ckpt_interval = 30;
     int progress_fd = -1;
     /* the parallel sections' threads (the daemon passes its job_threads):
@@ -57,6 +59,8 @@ int cmd_run(int argc, char **argv)
             out_path = argv[++i];
         else if (!strcmp(argv[i], "--xdmf") && i + 1 < argc)
             xdmf_path = argv[++i];
+        else if (!strcmp(argv[i], "--pictures") && i + 1 < argc)
+            pictures_dir = argv[++i];
         else if (!strcmp(argv[i], "--progress"))
             progress_fd = 2;
         else if (!strcmp(argv[i], "--progress-fd") && i + 1 < argc)
@@ -90,7 +94,7 @@ int cmd_run(int argc, char **argv)
         }
     }
     if (!job_path || !out_path) {
-        fprintf(stderr, "usage: packd run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--progress] "
+        fprintf(stderr, "usage: packd run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--pictures DIR] [--progress] "
                         "[--progress-fd N] [--threads N] [--checkpoint FILE [--checkpoint-interval S]]\n");
         return 64;
     }
@@ -141,22 +145,25 @@ int cmd_run(int argc, char **argv)
     if (rc == 1) {
         cli_print_errors(job_path, &errs);
         status = 1;
-    } else if (rc != 0) {
+    } else if (rc != 0 && rc != 2) { /* 2: failed, partial file and summary (below) */
         fprintf(stderr, "packd run: %s\n", err);
         status = 2;
     } else {
+        if (rc == 2) /* failed, with its partial file and summary */
+            fprintf(stderr, "packd run: failed: %s (partial result in %s)\n", err, out_path);
         json_object_set_new(summary, "output", json_string(out_path));
         if (xdmf_path) {
-            /* the XML names the HDF5 file as it sits beside it */
-            const char *base = strrchr(out_path, '/');
-            if (pk_xdmf_write(out_path, base ? base + 1 : out_path, xdmf_path, err, sizeof err) != 0)
+            /* the XML names the HDF5 file by its path relative to the XML */
+            if (pk_xdmf_write(out_path, NULL, xdmf_path, err, sizeof err) != 0)
                 fprintf(stderr, "packd run: %s\n", err);
             else
                 json_object_set_new(summary, "xdmf", json_string(xdmf_path));
         }
+        if (pictures_dir && pk_picture_write_set(out_path, pictures_dir, err, sizeof err) == 0)
+            fprintf(stderr, "packd run: no picture drawn: %s\n", err);
         json_dumpf(summary, stdout, JSON_INDENT(2) | JSON_REAL_PRECISION(10));
         putchar('\n');
-        status = 0;
+        status = rc == 2 ? 3 : 0;
     }
     if (sink.out && sink.out != stderr)
         fclose(sink.out);

@@ -20,6 +20,9 @@ static const struct {
     {"validate", cmd_validate, "validate JOB.json                                 check a job, print its plan or errors"},
     {"inspect", cmd_inspect, "inspect OUT.h5 [--full]                          print a result file's summary as JSON"},
     {"serve", cmd_serve, "serve [--config F] [--bind A] [--port N] [--data DIR] run the job service"},
+    {"picture", cmd_picture, "picture OUT.h5 -o FILE.svg|png [--kind packing|grading] draw a result"},
+    {"token", cmd_token, "token add NAME [--admin] | list | revoke NAME [--config F] [--data DIR]\n"
+                         "                                                    the service's bearer tokens"},
 };
 
 static int usage(FILE *f)

@@ -204,7 +204,8 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
             dup2(p[1], 3) < 0)
             _exit(125);
         execl(s->exe, "packd", "run", job_path, "-o", out_path, "--progress-fd", "3", "--threads",
-              threads, "--checkpoint", ckpt_path, "--checkpoint-interval", interval, (char *)NULL);
+              threads, "--pictures", dir, "--checkpoint", ckpt_path, "--checkpoint-interval", interval,
+              (char *)NULL);
         _exit(127);
     }
     close(p[1]);
@@ -284,18 +285,33 @@ static void finished(pk_supervisor *s, slot *sl, int wstatus)
     char dir[1200], path[1300], msg[1200], tail[1024];
     pk_job_dir(s->data, sl->id, dir, sizeof dir);
     const char *ended;
-    if (WIFEXITED(wstatus) && WEXITSTATUS(wstatus) == 0) {
+    /* exit 0: successful; exit 3: failed with a partial result file whose
+     * summary says why (docs/job-format.md, "Status") */
+    int code = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1;
+    if (code == 0 || code == 3) {
         snprintf(path, sizeof path, "%s/summary.json", dir);
         json_t *sum = json_load_file(path, 0, NULL);
         json_object_del(sum, "output"); /* a path inside the data directory */
+        json_object_del(sum, "xdmf");
         char *text = sum ? json_dumps(sum, JSON_COMPACT | JSON_REAL_PRECISION(10)) : NULL;
+        const char *status = code == 0 ? "successful" : "failed";
+        json_t *w = json_object_get(sum, "warnings");
+        if (code == 3)
+            snprintf(msg, sizeof msg, "failed: %s",
+                     json_is_string(json_object_get(sum, "failure"))
+                         ? json_string_value(json_object_get(sum, "failure"))
+                         : "the job's own checks failed");
+        else if (json_array_size(w))
+            snprintf(msg, sizeof msg, "finished with %zu warning%s: %s", json_array_size(w),
+                     json_array_size(w) > 1 ? "s" : "", json_string_value(json_array_get(w, 0)));
+        else
+            snprintf(msg, sizeof msg, "finished");
         json_decref(sum);
         char hex[65];
         struct stat st;
         snprintf(path, sizeof path, "%s/result.h5", dir);
         if (pk_sha256_file_hex(path, hex) == 0 && stat(path, &st) == 0)
-            ended = pk_queue_finish(s->q, sl->id, "successful", "finished", text, hex,
-                                    (long long)st.st_size);
+            ended = pk_queue_finish(s->q, sl->id, status, msg, text, hex, (long long)st.st_size);
         else
             ended = pk_queue_finish(s->q, sl->id, "failed", "the worker wrote no result file", text,
                                     NULL, 0);
