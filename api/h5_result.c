@@ -16,6 +16,7 @@ struct pk_h5 {
     hid_t file;
     hid_t obs;            /* /observables */
     hid_t lcpl;           /* link creation: intermediate groups */
+    int fd;               /* the temporary file, written at commit */
     char *path, *tmp;
 };
 
@@ -133,11 +134,28 @@ pk_h5 *pk_h5_create(const char *path, char *err, size_t errlen)
     }
     snprintf(h->tmp, n, "%s.tmp.%ld", path, (long)getpid());
     unlink(h->tmp);
-    hid_t fcpl = H5Pcreate(H5P_FILE_CREATE);
-    h->file = H5Fcreate(h->tmp, H5F_ACC_EXCL, fcpl, H5P_DEFAULT);
+    /* The file is built in memory (HDF5's core driver, no backing store) and
+     * written out by pk_h5_commit with plain write(2): a full disk is then an
+     * errno of ours, and HDF5 never holds a file it failed to flush (its exit
+     * handler would close it again and crash).  The temporary file is created
+     * now so a directory that cannot take it fails before the work. */
+    h->fd = open(h->tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0640);
+    if (h->fd < 0) {
+        snprintf(err, errlen, "cannot create %s: %s", h->tmp, strerror(errno));
+        free(h->path);
+        free(h->tmp);
+        free(h);
+        return NULL;
+    }
+    hid_t fcpl = H5Pcreate(H5P_FILE_CREATE), fapl = H5Pcreate(H5P_FILE_ACCESS);
+    H5Pset_fapl_core(fapl, (size_t)1 << 20, 0);
+    h->file = H5Fcreate(h->tmp, H5F_ACC_TRUNC, fcpl, fapl);
     H5Pclose(fcpl);
+    H5Pclose(fapl);
     if (h->file < 0) {
-        snprintf(err, errlen, "cannot create %s: %s", h->tmp, strerror(errno ? errno : EIO));
+        snprintf(err, errlen, "cannot create %s in memory", h->tmp);
+        close(h->fd);
+        unlink(h->tmp);
         free(h->path);
         free(h->tmp);
         free(h);
@@ -337,20 +355,53 @@ static void h5_close_all(pk_h5 *h)
     H5Fclose(h->file);
 }
 
+/* All of buf to fd: 0, or -1 with errno. */
+static int write_all(int fd, const unsigned char *buf, size_t n)
+{
+    while (n > 0) {
+        ssize_t w = write(fd, buf, n);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0) {
+            if (w == 0)
+                errno = EIO;
+            return -1;
+        }
+        buf += w;
+        n -= (size_t)w;
+    }
+    return 0;
+}
+
 int pk_h5_commit(pk_h5 *h, char *err, size_t errlen)
 {
-    H5Fflush(h->file, H5F_SCOPE_GLOBAL);
+    unsigned char *img = NULL;
+    ssize_t n = H5Fflush(h->file, H5F_SCOPE_GLOBAL) < 0 ? -1 : H5Fget_file_image(h->file, NULL, 0);
+    if (n > 0 && (img = malloc((size_t)n)) != NULL &&
+        H5Fget_file_image(h->file, img, (size_t)n) != n) {
+        free(img);
+        img = NULL;
+    }
     h5_close_all(h);
-    int fd = open(h->tmp, O_RDONLY);
-    int rc = fd < 0 ? -1 : fsync(fd);
-    if (fd >= 0)
-        close(fd);
-    if (rc == 0)
-        rc = rename(h->tmp, h->path);
+    int rc = -1, saved = ENOMEM;
+    if (img) {
+        rc = write_all(h->fd, img, (size_t)n) != 0 || fsync(h->fd) != 0 ? -1 : 0;
+        saved = errno;
+    }
+    free(img);
+    if (close(h->fd) != 0 && rc == 0) {
+        rc = -1;
+        saved = errno;
+    }
+    if (rc == 0 && rename(h->tmp, h->path) != 0) {
+        rc = -1;
+        saved = errno;
+    }
     if (rc != 0) {
-        snprintf(err, errlen, "cannot finish %s: %s", h->path, strerror(errno));
+        snprintf(err, errlen, "cannot write %s: %s", h->path, strerror(saved));
         unlink(h->tmp);
         h5_free(h);
+        errno = saved;
         return -1;
     }
     /* make the rename itself durable */
@@ -378,6 +429,7 @@ void pk_h5_abort(pk_h5 *h)
     if (!h)
         return;
     h5_close_all(h);
+    close(h->fd);
     unlink(h->tmp);
     h5_free(h);
 }

@@ -9,9 +9,11 @@
  *   /parameters                 attrs job (JSON text), process, seed, packd_version
  *   /observables/<name>         scalars, arrays and strings written by the process
  *
- * A file is written under a temporary name in the same directory and renamed
- * into place by pk_h5_commit() after an fsync, so a reader never sees a half
- * file and a crash leaves at most a *.tmp.* file behind. */
+ * A file is built in memory (HDF5's core driver), written by pk_h5_commit()
+ * under a temporary name in the same directory with write(2), fsync'd and
+ * renamed into place, so a reader never sees a half file, a crash leaves at
+ * most a *.tmp.* file behind, and a full disk is an errno in the message
+ * ("No space left on device") with the temporary file removed. */
 #ifndef PK_H5_RESULT_H
 #define PK_H5_RESULT_H
 

@@ -9,6 +9,7 @@
 #include "dem_rattler.h"
 #include "h5_result.h"
 #include "homog_audit.h"
+#include "homog_checkpoint.h"
 #include "homog_job.h"
 #include "homog_record.h"
 #include "homog_tangent.h"
@@ -183,13 +184,24 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
         nfree += !rve.fixed[i];
     double F0[9];
     pk_m3_identity(F0);
+    for (int a = 0; job.precompress > 0 && a < dim; a++)
+        F0[4 * a] = 1 - job.precompress;
     pk_homog_step st, last;
     pk_homog_audit au;
     const char *reason = "complete";
     char failure[600] = "", what[400];
-    if (job.precompress > 0) { /* initial-state policy: relaxed, committed, not recorded */
-        for (int a = 0; a < dim; a++)
-            F0[4 * a] = 1 - job.precompress;
+    /* a re-queued job continues after its last saved step (checkpoint file
+     * of `packd run --checkpoint`: committed state, record, counters) */
+    pk_homog_ckpt ck = {0};
+    const char *ck_digest;
+    double ck_every, ck_last = pk_wall_seconds();
+    const char *ck_path = pk_job_checkpoint(&ck_digest, &ck_every);
+    char ck_err[300] = "";
+    int ck_loaded = ck_path ? pk_homog_ckpt_load(ck_path, ck_digest, &ck, &com, &rec, ck_err, sizeof ck_err) : 1;
+    const size_t first = ck_loaded == 0 ? ck.done : 0;
+    if (ck_loaded == 0)
+        st = last = ck.last;
+    if (job.precompress > 0 && ck_loaded != 0) { /* initial-state policy: relaxed, committed, not recorded */
         int e = pk_homog_eval(&rve, &o, &com, F0, &tr, &st, mon);
         if (e != 0) {
             snprintf(err, errlen, "pre-compression: %s", eval_error(e));
@@ -204,15 +216,18 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
         } else
             pk_homog_commit(&com, &tr);
     }
-    rec = pk_homog_record_new(dim, job.tangent);
+    if (!rec)
+        rec = pk_homog_record_new(dim, job.tangent);
     aud = pk_homog_record_audit_new();
     size_t unjammed = 0;
     double worst_resid = 0, worst_overlap = 0, worst_balance = 0;
-    size_t done = 0, total_iter = 0, max_iter_step = 0, not_converged = 0;
-    double A[81] = {0};
-    int have_A = 0;
+    size_t done = first, total_iter = ck.total_iter, max_iter_step = ck.max_iter_step,
+           not_converged = ck.not_converged;
+    double A[81];
+    memcpy(A, ck.A, sizeof A);
+    int have_A = ck.have_A;
     pk_progress pr = {.stage = "homogenize", .phi = -1, .eta_s = -1, .total = job.nstep};
-    for (size_t k = 0; !strcmp(reason, "complete") && k < job.nstep; k++) {
+    for (size_t k = first; !strcmp(reason, "complete") && k < job.nstep; k++) {
         double F[9];
         pk_m3_mul(&job.F[9 * k], F0, F); /* F̄ = F̄_load·F̄_0 */
         int e = pk_homog_eval(&rve, &o, &com, F, &tr, &st, mon);
@@ -268,6 +283,12 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
             pk_homog_record_tangent(rec, dim, k, A, &ti, t == 0);
         }
         done = k + 1;
+        if (ck_path && done < job.nstep && pk_wall_seconds() - ck_last >= ck_every) {
+            ck = (pk_homog_ckpt){done, not_converged, total_iter, max_iter_step, have_A, {0}, st};
+            memcpy(ck.A, A, sizeof A);
+            pk_homog_ckpt_save(ck_path, ck_digest, &ck, &com, rec, ck_err, sizeof ck_err);
+            ck_last = pk_wall_seconds();
+        }
         pr.done = done;
         pr.fraction = (double)done / (double)job.nstep;
         if (mon) {
@@ -298,6 +319,15 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
         json_object_set_new(fj, "h", json_real(job.fric.h));
         json_object_set_new(rec, "friction", fj);
     }
+    if (ck_path) {
+        json_object_set_new(rec, "resumed", json_boolean(ck_loaded == 0));
+        if (ck_loaded == 0)
+            json_object_set_new(rec, "resumed_from_step", json_integer((json_int_t)first));
+        if (ck_err[0])
+            json_object_set_new(rec, "checkpoint_error", json_string(ck_err));
+        if (!strcmp(reason, "complete")) /* the path reached its end: nothing to resume */
+            remove(ck_path);
+    }
     json_object_set_new(rec, "radius_factor", json_real(job.radius_factor));
     json_object_set_new(rec, "precompression", json_real(job.precompress));
 
@@ -309,6 +339,8 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
     json_object_set_new(sum, "complete", json_boolean(done == job.nstep));
     json_object_set_new(sum, "steps", json_integer((json_int_t)done));
     json_object_set_new(sum, "steps_not_converged", json_integer((json_int_t)not_converged));
+    if (ck_loaded == 0)
+        json_object_set_new(sum, "resumed_from_step", json_integer((json_int_t)first));
     json_object_set_new(sum, "rve_particles", json_integer((json_int_t)rve.n));
     json_object_set_new(sum, "dr_iterations_total", json_integer((json_int_t)total_iter));
     json_object_set_new(sum, "dr_iterations_max", json_integer((json_int_t)max_iter_step));

@@ -7,9 +7,11 @@
 #include <string.h>
 
 #include "edmd.h"
+#include "edmd_checkpoint_h5.h"
 #include "edmd_contacts.h"
 #include "edmd_walls.h"
 #include "pack_placer.h"
+#include "process.h"
 
 static double num(json_t *o, const char *key, double def)
 {
@@ -76,6 +78,19 @@ static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, pk_sche
     /* the periodic edge > 2 (d_max + Δd) rule is the plan's (pack_job.c) */
 }
 
+/* The job's checkpoint file (pk_job_checkpoint): saved by the run, loaded
+ * to resume. */
+typedef struct ckpt_file {
+    const char *path, *digest;
+    char err[300];
+} ckpt_file;
+
+static int save_ckpt(const pk_edmd_snapshot *snap, void *ctx)
+{
+    ckpt_file *f = ctx;
+    return pk_edmd_ckpt_save(f->path, f->digest, snap, f->err, sizeof f->err);
+}
+
 static json_t *doubles(const double *a, size_t n)
 {
     json_t *arr = json_array();
@@ -139,14 +154,39 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
      * may reach Δd/2 of the job into the walls */
     json_t *o = json_object_get(job->inputs, "edmd");
     double w = strcmp(str(o, "wall_gap", "half"), "none") == 0 ? 0.5 * job->delta_d : 0;
+    ckpt_file cf = {0};
+    pk_edmd_checkpoint ck = {0};
+    pk_edmd_snapshot snap = {0};
+    cf.path = pk_job_checkpoint(&cf.digest, &ck.interval_s);
+    int loaded = 1;
+    if (cf.path) {
+        ck.save = save_ckpt;
+        ck.ctx = &cf;
+        loaded = pk_edmd_ckpt_load(cf.path, cf.digest, &snap, cf.err, sizeof cf.err);
+        if (loaded == 0)
+            ck.resume = &snap;
+        prm.checkpoint = &ck;
+    }
     pk_edmd_stats es;
     /* the monitor's wall limit counts from the job's start (pk_monitor_start),
      * so it covers the RSA start too */
     int run_rc = pk_edmd_run_shell_in_walls(&job->box, w, p, &prm, mon, &es);
+    if (run_rc != 0 && ck.resume && !ck.resumed) { /* a snapshot that does not fit: from the start */
+        snprintf(cf.err, sizeof cf.err, "checkpoint %s does not fit this job; started anew", cf.path);
+        loaded = -1;
+        ck.resume = NULL;
+        run_rc = pk_edmd_run_shell_in_walls(&job->box, w, p, &prm, mon, &es);
+    }
+    pk_edmd_snapshot_free(&snap);
     if (run_rc != 0) {
         snprintf(err, errlen, "EDMD failed (bad parameters, periodic box too small or out of memory)");
         return -1;
     }
+    /* a run that reached its end needs no checkpoint; a stopped one (cancel,
+     * wall time) keeps it for the next attempt */
+    if (cf.path && (es.reason == PK_STOP_COMPLETE || es.reason == PK_STOP_JAMMED ||
+                    es.reason == PK_STOP_STALLED))
+        remove(cf.path);
     /* the shell short of the job's Δd (jammed, stalled, out of time): the
      * packing is kept, audited at the Δd reached and says so */
     const int dd_short = prm.growth == PK_EDMD_GROW_SHELL && es.delta_d < job->delta_d * (1 - 1e-12);
@@ -186,6 +226,16 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
         json_object_set_new(obs, "start_seconds", json_real(rsa_seconds));
     }
     json_object_set_new(obs, "time_simulated", json_real(es.t_stop));
+    if (cf.path) {
+        json_object_set_new(obs, "resumed", json_boolean(ck.resumed));
+        if (ck.resumed) {
+            json_object_set_new(obs, "resumed_from_events", json_integer((json_int_t)ck.resumed_events));
+            json_object_set_new(obs, "resumed_from_time", json_real(ck.resumed_time));
+        }
+        json_object_set_new(obs, "checkpoints_saved", json_integer(ck.saved));
+        if (ck.save_failures || loaded < 0)
+            json_object_set_new(obs, "checkpoint_error", json_string(cf.err));
+    }
     if (isfinite(es.t_end))
         json_object_set_new(obs, "time_end", json_real(es.t_end));
     json_object_set_new(obs, "events", json_integer((json_int_t)es.events));

@@ -90,6 +90,23 @@ void pk_job_set_threads(int n) { job_threads = n < 1 ? 1 : n; }
 
 int pk_job_threads(void) { return job_threads; }
 
+static const char *ckpt_path, *ckpt_digest;
+static double ckpt_interval_s = 30;
+
+void pk_job_set_checkpoint(const char *path, const char *digest, double interval_s)
+{
+    ckpt_path = path;
+    ckpt_digest = digest;
+    ckpt_interval_s = interval_s;
+}
+
+const char *pk_job_checkpoint(const char **digest, double *interval_s)
+{
+    *digest = ckpt_digest ? ckpt_digest : "";
+    *interval_s = ckpt_interval_s;
+    return ckpt_path;
+}
+
 int pk_job_run(json_t *job, const char *out_path, pk_monitor *mon, json_t **summary,
                pk_schema_errors *errs, char *err, size_t errlen)
 {

@@ -45,6 +45,13 @@ size_t pk_job_validate(json_t *job, const pk_process **proc, pk_schema_errors *e
 void pk_job_set_threads(int n);
 int pk_job_threads(void);
 
+/* Checkpoints of long runs (EDMD): the file, the job's digest stored in it
+ * (a checkpoint of another job is never resumed) and the wall seconds
+ * between two saves; path NULL = none (default).  A run resumes from the
+ * file when it exists and its digest matches. */
+void pk_job_set_checkpoint(const char *path, const char *digest, double interval_s);
+const char *pk_job_checkpoint(const char **digest, double *interval_s);
+
 /* Validate and run a job (the one code path of `packd run` and the daemon's
  * workers).  Returns 0 when the job is successful (complete or not); 2 when
  * it failed but wrote its partial result file and a summary whose "failure"

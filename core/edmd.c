@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "edmd_checkpoint.h"
 #include "edmd_state.h"
 #include "rng.h"
 
@@ -428,8 +429,12 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
     for (size_t i = 0; i < p->n; i++)
         hcell += 2 * p->r[i] / (double)p->n;
     perm = malloc(p->n * sizeof *perm);
+    /* a resumed run takes the engine order of its snapshot */
+    pk_edmd_checkpoint *ckpt = prm->checkpoint;
+    const int resume = ckpt && ckpt->resume;
     if (!perm || pk_particles_init(&q, p->dim, p->n) != 0 ||
-        edmd_spatial_order(b, p->x, p->n, hcell > 0 ? hcell : 1, perm) != 0)
+        (resume ? edmd_checkpoint_perm(ckpt->resume, p->n, p->dim, perm)
+                : edmd_spatial_order(b, p->x, p->n, hcell > 0 ? hcell : 1, perm)) != 0)
         goto out;
     for (size_t k = 0; k < p->n; k++)
         pk_particles_push(&q, &p->x[3 * perm[k]], p->r[perm[k]], p->species[perm[k]]);
@@ -437,11 +442,14 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
     if (isnan(t_stop))
         goto out;
     s->skin_scale = 1;
-    double skin_built = 1;
+    edmd_ckpt_loop L = {.hist_stride = 1, .fraction = -1};
+    if (resume)
+        edmd_checkpoint_restore(s, st, &L, ckpt);
+    double skin_built = s->skin_scale;
     if (edmd_nlist_build_all(s) != 0)
         goto out;
     s->K = kinetic(s);
-    const double K0 = s->K;
+    const double K0 = resume ? L.K0 : s->K;
     const double K_hi = K0 * (1 + prm->rescale_tol), K_lo = K0 / (1 + prm->rescale_tol);
     predict_all(s);
 
@@ -450,18 +458,20 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
     uint64_t stall_win = prm->stall_events ? prm->stall_events : 1000;
     if (stall_win < (uint64_t)s->n)
         stall_win = (uint64_t)s->n;
-    uint64_t next_check = c_win, hist_stride = 1, hist_count = 0, stall_ev = 0;
-    uint64_t last_rebase = 0, rebase_win = REBASE_WINDOWS * (uint64_t)s->n;
+    uint64_t next_check = st->events + c_win, hist_stride = L.hist_stride, hist_count = L.hist_count;
+    uint64_t stall_ev = st->events;
+    uint64_t last_rebase = st->events, rebase_win = REBASE_WINDOWS * (uint64_t)s->n;
     const uint64_t resort_win = s->n >= RESORT_MIN_N ? RESORT_WINDOWS * (uint64_t)s->n : 0;
-    uint64_t next_resort = resort_win;
-    double t_base = 0;           /* absolute time of the re-based origin t = 0 */
-    double stall_acc = 0, phi_prev = phi_sim(s, 0), pressure = 0;
-    pk_progress pr = {.stage = "edmd", .fraction = -1, .phi = phi_true(s, 0), .eta_s = -1};
+    uint64_t next_resort = st->events + resort_win;
+    double t_base = L.t_base;    /* absolute time of the re-based origin t = 0 */
+    double stall_acc = 0, phi_prev = phi_sim(s, 0), pressure = L.pressure;
+    pk_progress pr = {.stage = "edmd", .fraction = L.fraction, .phi = phi_true(s, 0), .eta_s = -1};
     char msg[160];
     pk_monitor_begin(mon);
     s->mon = mon; /* ticked inside the full list builds from here on */
     s->pr = &pr;
-    hist_push(st, &hist_stride, 0, 0, pr.phi, 0);
+    if (!resume)
+        hist_push(st, &hist_stride, 0, 0, pr.phi, 0);
     pk_edmd_criterion crit = PK_EDMD_CRIT_NONE;
 
     for (;;) {
@@ -546,6 +556,11 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
             if (isfinite(t_stop)) {
                 pr.fraction = fmin(1, (t_base + s->t) / t_stop);
                 pr.eta_s = pr.fraction > 0 ? (pk_wall_seconds() - w0) * (1 - pr.fraction) / pr.fraction : -1;
+            } else { /* until jammed: the reduced pressure on its way to p_max, on a log scale */
+                double f = pressure > 1 && prm->p_max > 1 ? log(pressure) / log(prm->p_max) : 0;
+                if (prm->max_events)
+                    f = fmax(f, (double)st->events / (double)prm->max_events);
+                pr.fraction = fmax(pr.fraction, fmin(f, 0.99));
             }
             snprintf(msg, sizeof msg, "events=%llu collisions=%llu reduced_pressure=%.4g",
                      (unsigned long long)st->events, (unsigned long long)st->pair, pressure);
@@ -591,6 +606,14 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
                     break;
             }
             phi_prev = phis;
+            if (edmd_checkpoint_due(ckpt)) { /* re-based first: the snapshot starts at t = 0 */
+                t_base += s->t;
+                rebase(s);
+                st->rebases++;
+                last_rebase = st->events;
+                edmd_ckpt_loop now = {t_base, K0, pressure, pr.fraction, hist_stride, hist_count};
+                edmd_checkpoint_take(s, perm, st, &now, ckpt);
+            }
         }
         if (st->events - last_rebase >= rebase_win) {
             /* positions are p + v·t: keep |v·t| small */

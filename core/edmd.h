@@ -56,6 +56,7 @@ typedef struct pk_edmd_params {
     int equal_masses;          /* 1: m_i = 1 (Meier); 0: m_i ∝ final volume */
     uint64_t max_events;       /* 0 = unlimited */
     uint64_t seed;             /* velocities: stream 2; zero-start positions: stream 3 */
+    struct pk_edmd_checkpoint *checkpoint; /* snapshots / resume (core/edmd_checkpoint.h); NULL = none */
 } pk_edmd_params;
 
 /* Defaults documented in docs/job-format.md. */

@@ -8,6 +8,7 @@
 #include "cli.h"
 #include "picture.h"
 #include "process.h"
+#include "sha256.h"
 #include "xdmf.h"
 
 static volatile sig_atomic_t cancel_requested;
@@ -45,6 +46,8 @@ static int print_progress(const pk_progress *p, void *ctx)
 int cmd_run(int argc, char **argv)
 {
     const char *job_path = NULL, *out_path = NULL, *xdmf_path = NULL, *pictures_dir = NULL;
+    const char *ckpt_path = NULL;
+    double ckpt_interval = 30;
     int progress_fd = -1;
     /* the parallel sections' threads (the daemon passes its job_threads):
      * the results are the same for any number.  Default 1: on this 2-core
@@ -62,6 +65,16 @@ int cmd_run(int argc, char **argv)
             progress_fd = 2;
         else if (!strcmp(argv[i], "--progress-fd") && i + 1 < argc)
             progress_fd = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--checkpoint") && i + 1 < argc)
+            ckpt_path = argv[++i];
+        else if (!strcmp(argv[i], "--checkpoint-interval") && i + 1 < argc) {
+            char *end;
+            ckpt_interval = strtod(argv[++i], &end);
+            if (*end || !(ckpt_interval > 0 && ckpt_interval <= 1e6)) {
+                fprintf(stderr, "packd run: --checkpoint-interval takes seconds in (0, 1e6], not '%s'\n", argv[i]);
+                return 64;
+            }
+        }
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
             char *end;
             long t = strtol(argv[++i], &end, 10);
@@ -82,7 +95,7 @@ int cmd_run(int argc, char **argv)
     }
     if (!job_path || !out_path) {
         fprintf(stderr, "usage: packd run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--pictures DIR] [--progress] "
-                        "[--progress-fd N] [--threads N]\n");
+                        "[--progress-fd N] [--threads N] [--checkpoint FILE [--checkpoint-interval S]]\n");
         return 64;
     }
     json_t *job = cli_load_json(job_path);
@@ -107,6 +120,26 @@ int cmd_run(int argc, char **argv)
     json_t *summary = NULL;
     char err[1024] = "";
     pk_job_set_threads(threads);
+    /* a checkpoint resumes only the job (and packd version) that wrote it */
+    char digest[65];
+    if (ckpt_path) {
+        char *text = json_dumps(job, JSON_SORT_KEYS | JSON_COMPACT);
+        size_t n = text ? strlen(text) : 0;
+        char *src = text ? malloc(n + sizeof PACKD_VERSION + 1) : NULL;
+        if (!src) {
+            free(text);
+            fprintf(stderr, "packd run: out of memory\n");
+            json_decref(job);
+            return 2;
+        }
+        memcpy(src, text, n);
+        src[n] = '\n';
+        memcpy(src + n + 1, PACKD_VERSION, sizeof PACKD_VERSION);
+        pk_sha256_hex(src, n + sizeof PACKD_VERSION, digest);
+        free(src);
+        free(text);
+        pk_job_set_checkpoint(ckpt_path, digest, ckpt_interval);
+    }
     int rc = pk_job_run(job, out_path, &mon, &summary, &errs, err, sizeof err);
     int status;
     if (rc == 1) {

@@ -68,6 +68,7 @@ static void reload(pk_service *svc, int argc, char **argv)
     pthread_mutex_unlock(&svc->mu);
     pk_log_set_level(next.log_level);
     pk_supervisor_configure(svc->sup, next.workers, next.max_wall_time_s, next.job_threads);
+    pk_supervisor_set_checkpoint_interval(svc->sup, next.checkpoint_interval_s);
     log_auth(svc);
     pk_log(PK_LOG_INFO, "configuration reloaded", "{s:s,s:i,s:s}", "file", next.config_file, "workers",
            next.workers, "log_level", pk_log_level_name(next.log_level));
@@ -84,6 +85,11 @@ int cmd_serve(int argc, char **argv)
         fprintf(stderr, "packd serve: %s\n", err);
         return usage(stderr);
     }
+    /* Every file the daemon and its workers create (queue database and its
+     * WAL, job.json, results, logs, uploads) is 0640 at most, directories
+     * 0750: a lab server's other accounts read none of it.  The workers
+     * inherit the mask. */
+    umask(027);
     pthread_mutex_init(&svc.mu, NULL);
     pk_log_set_level(svc.cfg.log_level);
     svc.started = pk_queue_now();
@@ -137,6 +143,8 @@ int cmd_serve(int argc, char **argv)
 
     svc.sup = pk_supervisor_start(svc.q, exe, svc.cfg.data, svc.cfg.workers, svc.cfg.max_wall_time_s,
                                   svc.cfg.job_threads);
+    if (svc.sup)
+        pk_supervisor_set_checkpoint_interval(svc.sup, svc.cfg.checkpoint_interval_s);
     int port = 0;
     struct MHD_Daemon *http = svc.sup ? pk_http_start(&svc, &port, err, sizeof err) : NULL;
     if (!http) {

@@ -41,6 +41,7 @@ static const struct key {
     {"max_queued", K_INT, F(max_queued), 1, 1e9, "waiting jobs in total (beyond: 503)"},
     {"max_queued_per_owner", K_INT, F(max_queued_per_owner), 1, 1e9, "waiting jobs per owner (beyond: 429)"},
     {"max_attempts", K_INT, F(max_attempts), 1, 100, "starts of one job before an interrupted job fails"},
+    {"checkpoint_interval_s", K_DOUBLE, F(checkpoint_interval_s), 0.1, 1e6, "wall seconds between checkpoints of a long EDMD job (resumed after a restart)"},
     {"grace_s", K_DOUBLE, F(grace_s), 0, 86400, "SIGTERM: time running jobs get to finish"},
     {"http_threads", K_INT, F(http_threads), 1, 64, "HTTP event-loop threads (restart to change)"},
     {"max_connections", K_INT, F(max_connections), 16, 1000000, "open HTTP connections in total (restart to change)"},
@@ -85,6 +86,7 @@ void pk_config_defaults(pk_config *c)
     c->max_connections_per_ip = 128;
     c->idle_timeout_s = 20;
     c->body_timeout_s = 120;
+    c->checkpoint_interval_s = 30;
     c->log_level = PK_LOG_INFO;
 }
 

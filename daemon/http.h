@@ -79,6 +79,10 @@ enum MHD_Result pk_send_problem_doc(pk_req *r, unsigned status, json_t *doc, int
 /* Request headers / query arguments (NULL if absent). */
 const char *pk_header(pk_req *r, const char *name);
 const char *pk_query(pk_req *r, const char *name);
+/* Integer query parameter name in min..max (def when absent): 0, or -1 with
+ * a detail naming the parameter and its range (for a 400). */
+int pk_query_int(pk_req *r, const char *name, long long def, long long min, long long max,
+                 long long *out, char *detail, size_t n);
 /* Who submits (r->owner, set by pk_authorize before the handler runs). */
 void pk_owner(pk_req *r, char *out, size_t n);
 

@@ -2,6 +2,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <pthread.h>
 #include <sqlite3.h>
 #include <stdarg.h>
@@ -19,6 +20,10 @@ struct pk_queue {
     pthread_mutex_t ev_mu;
     pthread_cond_t ev_cond;
     long long ev_seq;     /* bumped on every inserted event / state change */
+    /* The last failed write (disk or database full, I/O error) until a
+     * commit succeeds again: /healthz is not ready meanwhile. */
+    double write_failed_at, probed_at;
+    char write_error[160];
 };
 
 
@@ -80,6 +85,8 @@ static sqlite3_stmt *prep(pk_queue *q, const char *sql, const char *types, ...)
     return st;
 }
 
+static void note_write(pk_queue *q, int ok);
+
 /* Run a statement to completion; returns sqlite3_changes or -1. */
 static int run(pk_queue *q, sqlite3_stmt *st)
 {
@@ -91,6 +98,8 @@ static int run(pk_queue *q, sqlite3_stmt *st)
     sqlite3_finalize(st);
     if (rc != SQLITE_DONE) {
         fprintf(stderr, "packd: sql step: %s\n", sqlite3_errmsg(q->db));
+        if ((rc & 0xff) == SQLITE_FULL || (rc & 0xff) == SQLITE_IOERR)
+            note_write(q, 0);
         return -1;
     }
     return sqlite3_changes(q->db);
@@ -176,10 +185,26 @@ static void add_status_event(pk_queue *q, const char *id)
 }
 
 static int begin(pk_queue *q) { return sqlite3_exec(q->db, "BEGIN IMMEDIATE", NULL, NULL, NULL); }
-static void commit(pk_queue *q)
+
+/* Remember whether the database takes writes (under q->mu). */
+static void note_write(pk_queue *q, int ok)
 {
-    if (sqlite3_exec(q->db, "COMMIT", NULL, NULL, NULL) != SQLITE_OK)
+    if (ok) {
+        q->write_failed_at = 0;
+        return;
+    }
+    snprintf(q->write_error, sizeof q->write_error, "%s", sqlite3_errmsg(q->db));
+    q->write_failed_at = pk_queue_now();
+}
+
+/* 0 when committed; -1 (rolled back, remembered) otherwise. */
+static int commit(pk_queue *q)
+{
+    int ok = sqlite3_exec(q->db, "COMMIT", NULL, NULL, NULL) == SQLITE_OK;
+    note_write(q, ok);
+    if (!ok)
         sqlite3_exec(q->db, "ROLLBACK", NULL, NULL, NULL);
+    return ok ? 0 : -1;
 }
 static void rollback(pk_queue *q) { sqlite3_exec(q->db, "ROLLBACK", NULL, NULL, NULL); }
 
@@ -216,8 +241,11 @@ int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37])
 {
     int rc = PK_Q_ERROR;
     pthread_mutex_lock(&q->mu);
-    if (begin(q) != SQLITE_OK)
+    if (begin(q) != SQLITE_OK) {
+        note_write(q, 0);
+        rc = PK_Q_UNWRITABLE;
         goto out;
+    }
     if (s->idempotency_key) {
         json_t *k = one_row(prep(q, "SELECT request_sha256, job_id FROM idempotency WHERE owner=? AND key=?",
                                  "ss", s->owner, s->idempotency_key));
@@ -251,12 +279,17 @@ int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37])
          run(q, prep(q, "INSERT INTO idempotency(owner, key, request_sha256, job_id, created) VALUES (?,?,?,?,?)",
                      "ssssd", s->owner, s->idempotency_key, s->request_sha256 ? s->request_sha256 : "",
                      id, now)) != 1)) {
+        int code = sqlite3_errcode(q->db);
+        if (code == SQLITE_FULL || code == SQLITE_IOERR || code == SQLITE_READONLY) {
+            note_write(q, 0);
+            rc = PK_Q_UNWRITABLE;
+        }
         rollback(q);
         goto out;
     }
     add_status_event(q, id);
-    commit(q);
-    rc = PK_Q_OK;
+    /* only a committed job is answered 201 */
+    rc = commit(q) == 0 ? PK_Q_OK : PK_Q_UNWRITABLE;
 out:
     pthread_mutex_unlock(&q->mu);
     if (rc == PK_Q_OK)
@@ -532,6 +565,28 @@ json_t *pk_queue_stats(pk_queue *q)
     }
     json_decref(by);
     return json_pack("{s:o,s:o,s:b}", "jobs", jobs, "durations", dur, "ok", ok);
+}
+
+int pk_queue_writable(pk_queue *q, char *why, size_t n)
+{
+    pthread_mutex_lock(&q->mu);
+    double now = pk_queue_now();
+    /* while writes fail, a real commit at most once a second says when they
+     * work again (space freed); rewriting page 1 with the same id is cheap */
+    if (q->write_failed_at > 0 && now - q->probed_at >= 1.0) {
+        q->probed_at = now;
+        if (begin(q) == SQLITE_OK &&
+            sqlite3_exec(q->db, "PRAGMA application_id = 1885889636", NULL, NULL, NULL) == SQLITE_OK)
+            commit(q);
+        else
+            rollback(q);
+    }
+    int ok = q->write_failed_at == 0;
+    if (!ok)
+        snprintf(why, n, "%s; last failed write %.0f s ago", q->write_error,
+                 fmax(now - q->write_failed_at, 0));
+    pthread_mutex_unlock(&q->mu);
+    return ok;
 }
 
 int pk_queue_add_file(pk_queue *q, const char *id, const char *sha256, long long size,

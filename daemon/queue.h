@@ -19,6 +19,7 @@ enum {
     PK_Q_FULL = -2,       /* max_queued waiting jobs */
     PK_Q_OWNER_FULL = -3, /* max_queued_per_owner waiting jobs of this owner */
     PK_Q_KEY_CONFLICT = -4, /* idempotency key reused with another request */
+    PK_Q_UNWRITABLE = -5, /* the database takes no writes now (disk full, I/O error) */
     PK_Q_ERROR = -1,
 };
 
@@ -91,6 +92,11 @@ void pk_queue_wake_all(pk_queue *q);
 /* Metrics: {"jobs": {status: n}, "durations": {status: {"count", "sum"}},
  *           "ok": whether the database answered}. */
 json_t *pk_queue_stats(pk_queue *q);
+
+/* 1 when the last write committed; 0 while writes fail (why: the error and
+ * how long), re-tried by a probe commit at most once a second so the state
+ * clears by itself once space returns. */
+int pk_queue_writable(pk_queue *q, char *why, size_t n);
 
 /* Uploaded files: one row per (id, owner) — the bytes are stored once, each
  * owner who sent them owns the upload.  get_file with owner NULL: any owner's. */

@@ -125,6 +125,14 @@ enum MHD_Result route_execute(pk_req *r)
     case PK_Q_FULL:
         return pk_send_problem(r, 503, PK_PROBLEM_PACKD "queue-full", "Queue full",
                                "max_queued jobs are waiting; try again later", NULL, 30);
+    case PK_Q_UNWRITABLE: {
+        char why[200], d[300];
+        pk_queue_writable(svc->q, why, sizeof why);
+        snprintf(d, sizeof d, "the queue database cannot be written (%s); try again later", why);
+        pk_log(PK_LOG_ERROR, "job refused: queue not writable", "{s:s}", "error", why);
+        return pk_send_problem(r, 503, PK_PROBLEM_PACKD "queue-unwritable", "Service Unavailable", d,
+                               NULL, 30);
+    }
     case PK_Q_OWNER_FULL:
         return pk_send_problem(r, 429, PK_PROBLEM_PACKD "owner-queue-full", "Too many queued jobs",
                                "max_queued_per_owner of your jobs are waiting", NULL, 30);

@@ -22,13 +22,15 @@ static int valid_status(const char *s)
 enum MHD_Result route_jobs(pk_req *r)
 {
     const char *status = pk_query(r, "status"), *process = pk_query(r, "processID");
-    const char *lim = pk_query(r, "limit"), *off = pk_query(r, "offset");
-    char *end;
-    long limit = lim ? strtol(lim, &end, 10) : 100, offset = off ? strtol(off, &end, 10) : 0;
-    if ((lim && (limit < 1 || limit > 1000)) || offset < 0 || (status && !valid_status(status)))
+    long long limit, offset;
+    char d[160];
+    /* offset bounded so offset + limit stays far from any overflow */
+    if (pk_query_int(r, "limit", 100, 1, 1000, &limit, d, sizeof d) != 0 ||
+        pk_query_int(r, "offset", 0, 0, 1000000000, &offset, d, sizeof d) != 0)
+        return pk_send_problem(r, 400, PK_PROBLEM_INVALID_INPUT, "Invalid query", d, NULL, 0);
+    if (status && !valid_status(status))
         return pk_send_problem(r, 400, PK_PROBLEM_INVALID_INPUT, "Invalid query",
-                               "status in accepted|running|successful|failed|dismissed, limit in 1..1000, offset >= 0",
-                               NULL, 0);
+                               "status in accepted|running|successful|failed|dismissed", NULL, 0);
     int total = 0;
     json_t *rows = pk_queue_list(r->svc->q, status, process, pk_scope(r), (int)limit, (int)offset, &total);
     json_t *jobs = json_array();
@@ -40,10 +42,10 @@ enum MHD_Result route_jobs(pk_req *r)
     char self[400], qs[300];
     snprintf(qs, sizeof qs, "%s%s%s%s", status ? "&status=" : "", status ? status : "",
              process ? "&processID=" : "", process ? process : "");
-    snprintf(self, sizeof self, "/jobs?limit=%ld&offset=%ld%s", limit, offset, qs);
+    snprintf(self, sizeof self, "/jobs?limit=%lld&offset=%lld%s", limit, offset, qs);
     json_array_append_new(links, json_pack("{s:s,s:s,s:s}", "href", self, "rel", "self", "type", "application/json"));
     if (offset + limit < total) {
-        snprintf(self, sizeof self, "/jobs?limit=%ld&offset=%ld%s", limit, offset + limit, qs);
+        snprintf(self, sizeof self, "/jobs?limit=%lld&offset=%lld%s", limit, offset + limit, qs);
         json_array_append_new(links, json_pack("{s:s,s:s,s:s}", "href", self, "rel", "next", "type", "application/json"));
     }
     return pk_send_json(r, 200, json_pack("{s:o,s:i,s:o}", "jobs", jobs, "numberMatched", total, "links", links), NULL);

@@ -83,15 +83,16 @@ enum MHD_Result route_healthz(pk_req *r)
 {
     pk_service *svc = r->svc;
     json_t *st = pk_queue_stats(svc->q); /* a real query: the database answers */
-    int db_ok = json_is_true(json_object_get(st, "ok"));
+    char why[200] = "";
+    int db_ok = json_is_true(json_object_get(st, "ok")) && pk_queue_writable(svc->q, why, sizeof why);
     json_decref(st);
     int draining = __atomic_load_n(&svc->draining, __ATOMIC_RELAXED);
     int ready = db_ok && !draining;
-    return pk_send_json(r, ready ? 200 : 503,
-                        json_pack("{s:s,s:b,s:b,s:s,s:{s:i,s:i},s:f}", "status", ready ? "ok" : "unavailable",
-                                  "live", 1, "ready", ready, "database", db_ok ? "ok" : "error",
-                                  "workers", "busy", pk_supervisor_busy(svc->sup), "max",
-                                  pk_supervisor_capacity(svc->sup), "uptime_s",
-                                  pk_queue_now() - svc->started),
-                        NULL);
+    json_t *doc = json_pack("{s:s,s:b,s:b,s:s,s:{s:i,s:i},s:f}", "status", ready ? "ok" : "unavailable",
+                            "live", 1, "ready", ready, "database", db_ok ? "ok" : "error", "workers",
+                            "busy", pk_supervisor_busy(svc->sup), "max", pk_supervisor_capacity(svc->sup),
+                            "uptime_s", pk_queue_now() - svc->started);
+    if (why[0])
+        json_object_set_new(doc, "database_error", json_string(why));
+    return pk_send_json(r, ready ? 200 : 503, doc, NULL);
 }

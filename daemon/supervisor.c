@@ -44,6 +44,7 @@ struct pk_supervisor {
     int workers;
     double max_wall_time_s;
     int job_threads; /* --threads of each worker */
+    double checkpoint_interval_s;
     int stopping;
     double grace_deadline;
     int wake[2];
@@ -86,14 +87,43 @@ static void remove_tmp_files(const char *dir)
     closedir(d);
 }
 
+/* job.json by temp file and rename: 0, or -1 with errno (no temp file left). */
 static int write_job_file(const char *path, json_t *job)
 {
     char tmp[1300];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
+    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp) {
+        errno = ENAMETOOLONG;
         return -1;
-    if (json_dump_file(job, tmp, JSON_INDENT(2) | JSON_SORT_KEYS) != 0)
+    }
+    char *text = json_dumps(job, JSON_INDENT(2) | JSON_SORT_KEYS);
+    if (!text) {
+        errno = ENOMEM;
         return -1;
-    return rename(tmp, path);
+    }
+    size_t n = strlen(text), off = 0;
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640), rc = fd < 0 ? -1 : 0;
+    while (rc == 0 && off < n) {
+        ssize_t w = write(fd, text + off, n - off);
+        if (w > 0)
+            off += (size_t)w;
+        else if (!(w < 0 && errno == EINTR))
+            rc = -1;
+    }
+    int saved = errno;
+    if (fd >= 0 && close(fd) != 0 && rc == 0) {
+        rc = -1;
+        saved = errno;
+    }
+    free(text);
+    if (rc == 0 && rename(tmp, path) != 0) {
+        rc = -1;
+        saved = errno;
+    }
+    if (rc != 0) {
+        unlink(tmp);
+        errno = saved;
+    }
+    return rc;
 }
 
 /* pipe2(O_CLOEXEC) without _GNU_SOURCE. */
@@ -114,15 +144,20 @@ static void set_nonblock(int fd) { fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NON
 static int launch(pk_supervisor *s, slot *sl, json_t *job)
 {
     const char *id = json_string_value(json_object_get(job, "id"));
-    char dir[1200], job_path[1300], out_path[1300], sum_path[1300], log_path[1300], lock_path[1300];
+    char dir[1200], job_path[1300], out_path[1300], sum_path[1300], log_path[1300], lock_path[1300],
+        ckpt_path[1300];
     pk_job_dir(s->data, id, dir, sizeof dir);
     snprintf(job_path, sizeof job_path, "%s/job.json", dir);
     snprintf(out_path, sizeof out_path, "%s/result.h5", dir);
     snprintf(sum_path, sizeof sum_path, "%s/summary.json", dir);
     snprintf(log_path, sizeof log_path, "%s/worker.log", dir);
     snprintf(lock_path, sizeof lock_path, "%s/worker.lock", dir);
+    /* kept across attempts: a re-queued job resumes from it */
+    snprintf(ckpt_path, sizeof ckpt_path, "%s/checkpoint.h5", dir);
+    char why[1400];
     if (mkdirs(dir) != 0) {
-        pk_queue_finish(s->q, id, "failed", "cannot create the job directory", NULL, NULL, 0);
+        snprintf(why, sizeof why, "cannot create the job directory: %s", strerror(errno));
+        pk_queue_finish(s->q, id, "failed", why, NULL, NULL, 0);
         return -1;
     }
     remove_tmp_files(dir);
@@ -130,14 +165,18 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
     json_t *file = json_pack("{s:O,s:O}", "process", json_object_get(job, "process"), "inputs",
                              json_object_get(job, "inputs"));
     int wrote = write_job_file(job_path, file);
+    int wrote_errno = errno;
     json_decref(file);
-    char threads[16];
+    char threads[16], interval[32];
     pthread_mutex_lock(&s->mu);
     snprintf(threads, sizeof threads, "%d", s->job_threads);
+    snprintf(interval, sizeof interval, "%g", s->checkpoint_interval_s > 0 ? s->checkpoint_interval_s : 30);
     pthread_mutex_unlock(&s->mu);
     int p[2];
     if (wrote != 0 || cloexec_pipe(p, 0) != 0) {
-        pk_queue_finish(s->q, id, "failed", "cannot write the job file", NULL, NULL, 0);
+        snprintf(why, sizeof why, "cannot write the job file: %s",
+                 strerror(wrote != 0 ? wrote_errno : errno));
+        pk_queue_finish(s->q, id, "failed", why, NULL, NULL, 0);
         return -1;
     }
     pid_t parent = getpid();
@@ -165,7 +204,8 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
             dup2(p[1], 3) < 0)
             _exit(125);
         execl(s->exe, "packd", "run", job_path, "-o", out_path, "--progress-fd", "3", "--threads",
-              threads, "--pictures", dir, (char *)NULL);
+              threads, "--pictures", dir, "--checkpoint", ckpt_path, "--checkpoint-interval", interval,
+              (char *)NULL);
         _exit(127);
     }
     close(p[1]);
@@ -437,6 +477,13 @@ void pk_supervisor_configure(pk_supervisor *s, int workers, double max_wall_time
     s->job_threads = job_threads;
     pthread_mutex_unlock(&s->mu);
     pk_supervisor_wake(s);
+}
+
+void pk_supervisor_set_checkpoint_interval(pk_supervisor *s, double seconds)
+{
+    pthread_mutex_lock(&s->mu);
+    s->checkpoint_interval_s = seconds;
+    pthread_mutex_unlock(&s->mu);
 }
 
 void pk_supervisor_wake(pk_supervisor *s)

@@ -29,6 +29,9 @@ void pk_supervisor_configure(pk_supervisor *s, int workers, double max_wall_time
                              int job_threads);
 
 /* Look at the queue now (a job was submitted or dismissed). */
+/* Wall seconds between a worker's checkpoints (default 30). */
+void pk_supervisor_set_checkpoint_interval(pk_supervisor *s, double seconds);
+
 void pk_supervisor_wake(pk_supervisor *s);
 
 /* Workers running now, and the configured maximum. */
