@@ -132,10 +132,28 @@ static int is_json_media_type(const char *ct)
     return *ct == 0 || *ct == ';';
 }
 
-/* First call of a request (headers complete): answers that need no body. */
+/* The route of a request with a body (POST), or NULL. */
+static const pk_route *body_route(pk_req *r)
+{
+    if (strcmp(r->method, "POST") != 0 || split_path(r, r->url) != 0)
+        return NULL;
+    for (const pk_route *rt = pk_routes; rt->method; rt++)
+        if (!strcmp(rt->method, r->method) && match(r, rt->pattern))
+            return rt;
+    return NULL;
+}
+
+/* First call of a request (headers complete): answers that need no body —
+ * a request that may not call its route is refused before its body is read. */
 static enum MHD_Result on_headers(pk_req *r)
 {
     pk_config cfg = pk_service_config(r->svc);
+    const pk_route *rt = body_route(r);
+    enum MHD_Result refused;
+    if (rt && !pk_authorize(r, rt->access, &refused)) {
+        r->answered = 1;
+        return refused;
+    }
     if (wants_json_body(r) && !is_json_media_type(pk_header(r, "Content-Type"))) {
         r->answered = 1;
         return pk_send_problem(r, 415, PK_PROBLEM_GENERIC, "Unsupported Media Type",

@@ -41,6 +41,16 @@ code=$(as wrong "$B/jobs")
 check wrong_token_401 sh -c "test $code = 401 && grep -qi '^WWW-Authenticate: Bearer.*error=\"invalid_token\"' '$T/as.h'"
 printf 'Authorization: Basic YWxpY2U6eA==\n' >"$T/basic.h"
 check other_scheme_401 test "$(as basic "$B/jobs")" = 401
+# refused from its headers: a client without a token cannot make the daemon read a body
+check no_token_refused_before_body python3 -c "
+import socket, sys, time
+host, port = '$B'.split('//')[1].split(':')
+s = socket.create_connection((host, int(port)), timeout=5)
+s.sendall(b'POST /files HTTP/1.1\\r\\nHost: x\\r\\nContent-Type: application/octet-stream\\r\\n'
+          b'Content-Length: 10000000\\r\\n\\r\\n' + b'x' * 1000)
+head = s.recv(200).decode('latin-1')
+assert head.startswith('HTTP/1.1 401'), head
+"
 check submit_without_token_401 test "$(as nobody -H 'Content-Type: application/json' --data-binary "@$T/fast.json" \
     "$B/processes/pack/execution")" = 401
 check metrics_user_403 test "$(as alice "$B/metrics")" = 403
