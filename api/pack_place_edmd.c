@@ -50,6 +50,10 @@ static void read_params(const pk_pack_job *job, const pk_pack_plan *plan, pk_edm
     json_t *stall = json_object_get(o, "stall");
     prm->stall_events = (uint64_t)num(stall, "events", (double)prm->stall_events);
     prm->stall_growth = num(stall, "growth", prm->stall_growth);
+    const char *rule = str(o, "collision_rule", "elastic");
+    prm->rule = strcmp(rule, "meier") == 0  ? PK_EDMD_RULE_MEIER
+                : strcmp(rule, "lift") == 0 ? PK_EDMD_RULE_LIFT
+                                            : PK_EDMD_RULE_ELASTIC;
     json_t *rs = json_object_get(o, "rescale");
     if (json_is_boolean(rs))
         prm->rescale = json_is_true(rs);
@@ -73,6 +77,9 @@ static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, pk_sche
     if (strcmp(str(o, "wall_gap", "half"), "none") == 0 && !(job->delta_d > 0))
         pk_schema_errors_add(errs, "/edmd/wall_gap", "consistent",
                              "wall_gap none lets the shell reach delta_d/2 into the walls: needs delta_d > 0");
+    if (prm.rule == PK_EDMD_RULE_MEIER && !prm.equal_masses)
+        pk_schema_errors_add(errs, "/edmd/collision_rule", "consistent",
+                             "Meier's Eq. (9) is an equal-mass rule: use masses: equal");
     /* the periodic edge > 2 (d_max + Δd) rule is the plan's (pack_job.c) */
 }
 
@@ -151,19 +158,41 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
         return -1;
     }
     pk_contact_stats cs;
-    /* contact: gap within 1e-6 (r_i + r_j) of Δd — far above round-off,
-     * far below any gap left by a run that stopped short of jamming */
-    double ctol = 1e-6;
+    /* contact: gap within tol·(r_i + r_j) of Δd, tol from the final
+     * reduced pressure (pk_contact_tolerance) */
+    double ctol = pk_contact_tolerance(job->box.dim, es.pressure);
     if (pk_contact_stats_compute(&job->box, p, es.delta_d, ctol, &cs) != 0) {
         snprintf(err, errlen, "out of memory in the contact analysis");
         return -1;
     }
     *st = (pk_place_stats){.reason = es.reason, .placed = p->n, .requested = sz->n,
                            .seconds = es.seconds, .walls_touch = w > 0};
+    if (prm.until == PK_EDMD_UNTIL_JAMMED) {
+        /* "jammed" when the pressure test held, or the Δφ test the job
+         * chose; a stall below the pressure target, or max_events, is said */
+        st->jam_is_goal = es.criterion == PK_EDMD_CRIT_PRESSURE ||
+                          es.criterion == PK_EDMD_CRIT_DELTA_PHI ||
+                          (es.criterion == PK_EDMD_CRIT_STALL && es.pressure >= prm.p_max);
+        if (!st->jam_is_goal && (es.criterion == PK_EDMD_CRIT_STALL ||
+                                 es.criterion == PK_EDMD_CRIT_MAX_EVENTS))
+            snprintf(st->warning, sizeof st->warning,
+                     "EDMD stopped on %s at reduced pressure %.3g, below "
+                     "jamming.reduced_pressure %.3g: the packing (phi %.6f) is not proven jammed",
+                     pk_edmd_criterion_name(es.criterion), es.pressure, prm.p_max, es.phi);
+    }
     json_t *obs = json_object();
     json_object_set_new(obs, "phi_final", json_real(es.phi));
     json_object_set_new(obs, "phi_shell", json_real(es.phi_sim));
     json_object_set_new(obs, "reduced_pressure", json_real(es.pressure));
+    if (prm.until == PK_EDMD_UNTIL_JAMMED) {
+        json_object_set_new(obs, "reduced_pressure_target", json_real(prm.p_max));
+        json_object_set_new(obs, "jammed", json_boolean(es.reason == PK_STOP_JAMMED));
+    }
+    json_object_set_new(obs, "collision_rule",
+                        json_string(prm.rule == PK_EDMD_RULE_MEIER  ? "meier"
+                                    : prm.rule == PK_EDMD_RULE_LIFT ? "lift"
+                                                                    : "elastic"));
+    json_object_set_new(obs, "kinetic_energy_ratio", json_real(es.kinetic_ratio));
     if (isfinite(es.phi_jam_estimate))
         json_object_set_new(obs, "phi_jamming_estimate", json_real(es.phi_jam_estimate));
     json_object_set_new(obs, "termination_criterion", json_string(pk_edmd_criterion_name(es.criterion)));
@@ -188,6 +217,7 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
                         json_real(es.seconds > 0 ? (double)es.pair / es.seconds : 0));
     json_object_set_new(obs, "contacts", json_integer((json_int_t)cs.contacts));
     json_object_set_new(obs, "mean_contact_number", json_real(cs.mean_contacts));
+    json_object_set_new(obs, "rattlers", json_integer((json_int_t)cs.rattlers));
     json_object_set_new(obs, "rattler_fraction", json_real(cs.rattler_fraction));
     json_object_set_new(obs, "contact_tolerance", json_real(ctol));
     json_t *h = json_object();

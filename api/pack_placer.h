@@ -30,6 +30,8 @@ typedef struct pk_place_stats {
     pk_box domain_box;
     double domain_measure;
     double overlap_tol;   /* overlaps the placer allows by design (0 = hard grains) */
+    int jam_is_goal;      /* 1: the job asked to grow until jammed: PK_STOP_JAMMED is done */
+    char warning[512];    /* what fell short and by how much (job verdict), or "" */
     int walls_touch;      /* 1: Δd between grains only, grains may touch the walls
                            * (edmd "wall_gap": "none", Titscher §6.3); 0: walls ≥ Δd/2 */
     /* Bulk datasets too large for obs (e.g. the mesh): written under

@@ -6,6 +6,7 @@
 
 #include "gap_audit.h"
 #include "h5_result.h"
+#include "job_verdict.h"
 #include "pack_job.h"
 #include "pack_placer.h"
 #include "particles.h"
@@ -263,7 +264,11 @@ int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_m
     json_object_set_new(sum, "process", json_string("pack"));
     json_object_set_new(sum, "algorithm", json_string(job.algorithm));
     json_object_set_new(sum, "termination_reason", json_string(pk_stop_reason_name(st.reason)));
-    json_object_set_new(sum, "complete", json_boolean(st.reason == PK_STOP_COMPLETE));
+    json_object_set_new(sum, "complete",
+                        json_boolean(st.reason == PK_STOP_COMPLETE ||
+                                     (st.reason == PK_STOP_JAMMED && st.jam_is_goal)));
+    if (st.warning[0])
+        pk_verdict_warn(sum, "%s", st.warning);
     json_object_set_new(sum, "count_placed", json_integer((json_int_t)st.placed));
     json_object_set_new(sum, "count_requested", json_integer((json_int_t)st.requested));
     json_object_set_new(sum, "count_expected", json_real(plan.expected_n));
