@@ -46,6 +46,7 @@ static void read_params(const pk_pack_job *job, const pk_pack_plan *plan, pk_edm
     json_t *jam = json_object_get(o, "jamming");
     prm->p_max = num(jam, "reduced_pressure", prm->p_max);
     prm->dphi_crit = num(jam, "delta_phi", prm->dphi_crit);
+    prm->jam_rate_factor = num(jam, "rate_factor", prm->jam_rate_factor);
     prm->dphi_events = (uint64_t)num(jam, "events", 0);
     json_t *stall = json_object_get(o, "stall");
     prm->stall_events = (uint64_t)num(stall, "events", (double)prm->stall_events);
