@@ -187,7 +187,7 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     json_object_set_new(obs, "reduced_pressure", json_real(es.pressure));
     if (prm.until == PK_EDMD_UNTIL_JAMMED) {
         json_object_set_new(obs, "reduced_pressure_target", json_real(prm.p_max));
-        json_object_set_new(obs, "jammed", json_boolean(es.reason == PK_STOP_JAMMED));
+        json_object_set_new(obs, "jammed", json_boolean(es.reason == PK_STOP_JAMMED && st->jam_is_goal));
     }
     json_object_set_new(obs, "collision_rule",
                         json_string(prm.rule == PK_EDMD_RULE_MEIER  ? "meier"
