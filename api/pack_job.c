@@ -242,15 +242,22 @@ static double class_rep_measure(int dim, double d) { return pk_ball_measure(dim,
  * sizes.  On a periodic axis that must stay below L/2, or a pair could meet
  * two images of each other (minimum image).  φ_s is bounded below by
  * φ (1 + Δd/d_max)^dim, so the check errs on the refusing side. */
-static void check_periodic_jamming(const pk_pack_job *job, const pk_pack_plan *plan,
-                                   pk_schema_errors *errs)
+/* EDMD growing the grains themselves until jammed: the given sizes are
+ * ratios, the final sizes are set by jamming. */
+static int grows_until_jammed(const pk_pack_job *job)
 {
     json_t *o = json_object_get(job->inputs, "edmd");
     const char *until = json_string_value(json_object_get(o, "until"));
     const char *growth = json_string_value(json_object_get(o, "growth"));
     const char *maximize = json_string_value(json_object_get(o, "maximize"));
-    if (strcmp(job->algorithm, "edmd") != 0 || !until || strcmp(until, "jammed") != 0 ||
-        (growth && strcmp(growth, "shell") == 0) || (maximize && strcmp(maximize, "delta_d") == 0))
+    return !strcmp(job->algorithm, "edmd") && until && !strcmp(until, "jammed") &&
+           !(growth && !strcmp(growth, "shell")) && !(maximize && !strcmp(maximize, "delta_d"));
+}
+
+static void check_periodic_jamming(const pk_pack_job *job, const pk_pack_plan *plan,
+                                   pk_schema_errors *errs)
+{
+    if (!grows_until_jammed(job))
         return;
     const int dim = job->dim;
     double phi_s = plan->phi_resolved * pow(1 + job->delta_d / plan->d_max, dim);
@@ -392,7 +399,7 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
         for (int k = 0; k < dim; k++)
             widened *= job->box.L[k] / (job->box.L[k] + (job->box.periodic[k] ? 0 : job->delta_d));
         double phi_shell = plan->phi_resolved * widened * pow(1 + job->delta_d / plan->d_max, dim);
-        if (!(phi_shell < 1)) {
+        if (!(phi_shell < 1) && !grows_until_jammed(job)) {
             const char *ptr = plan->phi_resolved < 1 && job->delta_d > 0 ? "/delta_d"
                               : job->count && !job->has_phi         ? "/count"
                                                                     : "/phi/value";

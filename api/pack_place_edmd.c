@@ -48,10 +48,15 @@ static void read_params(const pk_pack_job *job, const pk_pack_plan *plan, pk_edm
     json_t *jam = json_object_get(o, "jamming");
     prm->p_max = num(jam, "reduced_pressure", prm->p_max);
     prm->dphi_crit = num(jam, "delta_phi", prm->dphi_crit);
+    prm->jam_rate_factor = num(jam, "rate_factor", prm->jam_rate_factor);
     prm->dphi_events = (uint64_t)pk_json_int_or(jam, "events", 0);
     json_t *stall = json_object_get(o, "stall");
     prm->stall_events = (uint64_t)pk_json_int_or(stall, "events", (long long)prm->stall_events);
     prm->stall_growth = num(stall, "growth", prm->stall_growth);
+    const char *rule = str(o, "collision_rule", "elastic");
+    prm->rule = strcmp(rule, "meier") == 0  ? PK_EDMD_RULE_MEIER
+                : strcmp(rule, "lift") == 0 ? PK_EDMD_RULE_LIFT
+                                            : PK_EDMD_RULE_ELASTIC;
     json_t *rs = json_object_get(o, "rescale");
     if (json_is_boolean(rs))
         prm->rescale = json_is_true(rs);
@@ -75,6 +80,9 @@ static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, pk_sche
     if (strcmp(str(o, "wall_gap", "half"), "none") == 0 && !(job->delta_d > 0))
         pk_schema_errors_add(errs, "/edmd/wall_gap", "consistent",
                              "wall_gap none lets the shell reach delta_d/2 into the walls: needs delta_d > 0");
+    if (prm.rule == PK_EDMD_RULE_MEIER && !prm.equal_masses)
+        pk_schema_errors_add(errs, "/edmd/collision_rule", "consistent",
+                             "Meier's Eq. (9) is an equal-mass rule: use masses: equal");
     /* the periodic edge > 2 (d_max + Δd) rule is the plan's (pack_job.c) */
 }
 
@@ -191,17 +199,42 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
      * packing is kept, audited at the Δd reached and says so */
     const int dd_short = prm.growth == PK_EDMD_GROW_SHELL && es.delta_d < job->delta_d * (1 - 1e-12);
     pk_contact_stats cs;
-    /* contact: gap within 1e-6 (r_i + r_j) of Δd — far above round-off,
-     * far below any gap left by a run that stopped short of jamming */
-    double ctol = 1e-6;
+    /* contact: gap within tol·(r_i + r_j) of Δd, tol from the final
+     * reduced pressure (pk_contact_tolerance) */
+    double ctol = pk_contact_tolerance(job->box.dim, es.pressure);
     if (pk_contact_stats_compute(&job->box, p, es.delta_d, ctol, &cs) != 0) {
         snprintf(err, errlen, "out of memory in the contact analysis");
         return -1;
     }
     *st = (pk_place_stats){.reason = es.reason, .placed = p->n, .requested = sz->n,
-                           .seconds = es.seconds, .walls_touch = w > 0,
-                           .goal_reached = prm.until == PK_EDMD_UNTIL_JAMMED &&
-                                           es.reason == PK_STOP_JAMMED};
+                           .seconds = es.seconds, .walls_touch = w > 0};
+    if (prm.until == PK_EDMD_UNTIL_JAMMED) {
+        /* "jammed" when the pressure test held, or the Δφ test the job
+         * chose; a stall below the pressure target, or max_events, is said */
+        int jam_ok = es.criterion == PK_EDMD_CRIT_PRESSURE ||
+                     es.criterion == PK_EDMD_CRIT_DELTA_PHI ||
+                     (es.criterion == PK_EDMD_CRIT_STALL && es.pressure >= prm.p_max);
+        if (!jam_ok && (es.criterion == PK_EDMD_CRIT_STALL ||
+                        es.criterion == PK_EDMD_CRIT_MAX_EVENTS))
+            snprintf(st->warning, sizeof st->warning,
+                     "EDMD stopped on %s at reduced pressure %.3g, below "
+                     "jamming.reduced_pressure %.3g: the packing (phi %.6f) is not proven jammed",
+                     pk_edmd_criterion_name(es.criterion), es.pressure, prm.p_max, es.phi);
+        int periodic = 1; /* (contacts with walls are not counted: walled boxes are exempt) */
+        for (int k = 0; k < job->box.dim; k++)
+            periodic &= job->box.periodic[k];
+        if (jam_ok && periodic && p->n > 1 && cs.rattlers == p->n) {
+            /* caged fines can carry the pressure with no rigid backbone (3D
+             * diameters 1–16 at one rate γ = 0.03: p 10^12, every grain a
+             * rattler; with rate_factor 0.1 an isostatic backbone) */
+            jam_ok = 0;
+            snprintf(st->warning, sizeof st->warning,
+                     "EDMD reached reduced pressure %.3g but no grain has dim + 1 contacts at "
+                     "tolerance %.3g (no rigid backbone, phi %.6f): lower growth_rate or "
+                     "jamming.rate_factor", es.pressure, ctol, es.phi);
+        }
+        st->goal_reached = jam_ok && es.reason == PK_STOP_JAMMED;
+    }
     if (dd_short) {
         st->short_delta_d = 1;
         st->audit_delta_d = es.delta_d;
@@ -215,6 +248,15 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     json_object_set_new(obs, "phi_final", json_real(es.phi));
     json_object_set_new(obs, "phi_shell", json_real(es.phi_sim));
     json_object_set_new(obs, "reduced_pressure", json_real(es.pressure));
+    if (prm.until == PK_EDMD_UNTIL_JAMMED) {
+        json_object_set_new(obs, "reduced_pressure_target", json_real(prm.p_max));
+        json_object_set_new(obs, "jammed", json_boolean(st->goal_reached));
+    }
+    json_object_set_new(obs, "collision_rule",
+                        json_string(prm.rule == PK_EDMD_RULE_MEIER  ? "meier"
+                                    : prm.rule == PK_EDMD_RULE_LIFT ? "lift"
+                                                                    : "elastic"));
+    json_object_set_new(obs, "kinetic_energy_ratio", json_real(es.kinetic_ratio));
     if (isfinite(es.phi_jam_estimate))
         json_object_set_new(obs, "phi_jamming_estimate", json_real(es.phi_jam_estimate));
     json_object_set_new(obs, "termination_criterion", json_string(pk_edmd_criterion_name(es.criterion)));
@@ -249,6 +291,7 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
                         json_real(es.seconds > 0 ? (double)es.pair / es.seconds : 0));
     json_object_set_new(obs, "contacts", json_integer((json_int_t)cs.contacts));
     json_object_set_new(obs, "mean_contact_number", json_real(cs.mean_contacts));
+    json_object_set_new(obs, "rattlers", json_integer((json_int_t)cs.rattlers));
     json_object_set_new(obs, "rattler_fraction", json_real(cs.rattler_fraction));
     json_object_set_new(obs, "contact_tolerance", json_real(ctol));
     json_t *h = json_object();

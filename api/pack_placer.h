@@ -34,12 +34,14 @@ typedef struct pk_place_stats {
     int walls_touch;      /* 1: Δd between grains only, grains may touch the walls
                            * (edmd "wall_gap": "none", Titscher §6.3); 0: walls ≥ Δd/2 */
     int goal_reached;     /* 1: the stop reason is what the job asked for (edmd
-                           * "until": "jammed" and jammed), though not PK_STOP_COMPLETE */
+                           * "until": "jammed" and jammed at its own test: the reduced
+                           * pressure, or the Δφ test the job chose), though not
+                           * PK_STOP_COMPLETE */
     int short_delta_d;    /* 1: the placer could not reach the job's Δd (edmd shell
                            * growth): the result is audited at audit_delta_d, the gap
                            * it guarantees, and the placer's warning says so */
     double audit_delta_d;
-    char warning[320];    /* a placer's own "stopped short" sentence, or "" */
+    char warning[512];    /* a placer's own "stopped short" sentence, or "" */
     /* Bulk datasets too large for obs (e.g. the mesh): written under
      * /observables/<algorithm>/ by write_extra, released by free_extra. */
     void *extra;

@@ -51,6 +51,8 @@ void pk_pack_verdict(const pk_pack_job *job, const pk_pack_plan *plan, const pk_
                         st->placed, st->requested);
         break;
     default:
+        if (st->warning[0]) /* the placer's own sentence says what fell short */
+            break;
         if (!done && st->requested)
             pk_verdict_warn(summary,
                             "saturated: φ %.4g reached of the target %.4g (%s stopped: %s), %zu of "

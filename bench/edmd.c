@@ -92,6 +92,11 @@ static void run_core(const char *name, int dim, const double *r, size_t n, doubl
     prm.growth_rate = rate;
     prm.until = jammed ? PK_EDMD_UNTIL_JAMMED : PK_EDMD_UNTIL_TARGET;
     prm.phi_target = phi_target;
+    if (jammed) { /* the speed series: Meier's Δφ stop at one rate (the
+                   * pressure stop at 10^12: bench/edmd_jam) */
+        prm.dphi_crit = 1e-9;
+        prm.jam_rate_factor = 1;
+    }
     double c0 = cpu_s();
     if (rsa_phi > 0) {
         double *d = malloc(n * sizeof *d);

@@ -1,9 +1,9 @@
 /* edmd.h — event-driven growth packing (Lubachevsky–Stillinger; spec §3).
  *
  * Hard disks/spheres fly freely and grow linearly, ρ_i(t) = a_i + g_i t
- * (simulated radius, shell Δd/2 included); collisions use the growth-aware,
- * momentum-conserving rule of spec §3.4 (Meier Eq. 3.9 generalised to
- * unequal masses), walls reflect in the co-moving sense.  Engine: delayed
+ * (simulated radius, shell Δd/2 included); collisions follow one of the
+ * pk_edmd_rule rules below (all momentum-conserving except Meier's Eq. 9),
+ * walls reflect in the co-moving sense.  Engine: delayed
  * states (each particle stores its position at its own last update time),
  * one pending event per particle (and its runner-up, taken without a new
  * prediction when the first is invalidated; Donev) in a calendar queue of
@@ -37,6 +37,28 @@ typedef enum pk_edmd_until {
     PK_EDMD_UNTIL_JAMMED       /* grow on until a jamming criterion holds */
 } pk_edmd_until;
 
+/* Pair collision rules.  w = normal separation speed of the centres,
+ * G = g_i + g_j the growth of the contact distance; at contact the gap
+ * closes (w ≤ G).  Every rule leaves the gap opening afterwards. */
+typedef enum pk_edmd_rule {
+    /* Elastic in the frame of the growing surfaces (Lubachevsky–Stillinger,
+     * Donev): the gap rate is reversed, w' = 2G − w (+ε_v).  Every
+     * collision separates the pair at the speed it approached, so near
+     * jamming no pair is left touching: the reduced pressure rises to
+     * 10^12 instead of collapsing into event storms. */
+    PK_EDMD_RULE_ELASTIC = 0,
+    /* Elastic reversal, then the smallest lift w' = max(−w, G + ε_v): a
+     * pair approaching slower than G leaves at ε_v (restitution 0 in the
+     * growing frame; clusters of such pairs collide at vanishing intervals
+     * near jamming).  Kept to measure against. */
+    PK_EDMD_RULE_LIFT,
+    /* Meier–Kuhl–Steinmann 2007 Eq. (9) (dissertation Eq. 3.9): equal-mass
+     * swap of the normal speeds, then i loses g_i and j gains g_j, so the
+     * pair gains g_i + g_j at every collision (w' = |w| + G); momentum is
+     * not conserved when g_i ≠ g_j. */
+    PK_EDMD_RULE_MEIER
+} pk_edmd_rule;
+
 typedef struct pk_edmd_params {
     pk_edmd_growth growth;
     pk_edmd_until until;
@@ -46,10 +68,15 @@ typedef struct pk_edmd_params {
     double delta_d;            /* minimum surface gap Δd (shell Δd/2); SHELL+TARGET grows it to this */
     double growth_rate;        /* γ: d(diameter)/dt of a mean grain over the rms speed per axis */
     double p_max;              /* reduced pressure criterion (e.g. 1e12) */
+    double jam_rate_factor;    /* until jammed: the growth rate × this once p > 10^3 (1 = constant) */
     double dphi_crit;          /* Meier Eq. 3.11: Δφ over c events below this => jammed (0 = off) */
     uint64_t dphi_events;      /* c (0 = number of grains) */
-    double stall_growth;       /* stall: relative size growth γ·Δt over the window below this */
+    double stall_growth;       /* stall: relative size growth γ·Δt over the window below this;
+                                * NAN = the default: 1e-12, and until jammed also below
+                                * 1e-2·γ/p of the window's pressure p (a packing at p grows
+                                * ~γ/p per window: the stall never preempts the pressure stop) */
     uint64_t stall_events;     /* window of the stall detector (Titscher: 1000; at least N) */
+    pk_edmd_rule rule;         /* pair collision rule */
     int rescale;               /* 1: hold the kinetic energy near its start value */
     double rescale_tol;        /* rescale when K leaves [K0/(1+tol), K0(1+tol)] */
     double skin;               /* neighbour-list skin as a fraction of a radius */
@@ -82,9 +109,11 @@ typedef struct pk_edmd_stats {
     double t_stop, t_end;       /* simulated times (unit d̄/u) */
     double seconds;
     uint64_t events, pair, wall, nlist, invalid, rescales, rebases, overlaps;
+    uint64_t growth_changes;    /* growth-rate reductions of the jamming schedule */
     uint64_t resorts;           /* renumberings along the Z-order (large N) */
     uint64_t second;            /* invalid events replaced by their runner-up (no prediction) */
     double max_overlap_rel;     /* largest overlap seen by the predictor, relative to R */
+    double kinetic_ratio;       /* K/K0 at the stop (grows without rescaling) */
     size_t nhist;               /* φ(t) history: events, time, φ, p */
     double hist_events[PK_EDMD_HIST_MAX], hist_t[PK_EDMD_HIST_MAX];
     double hist_phi[PK_EDMD_HIST_MAX], hist_p[PK_EDMD_HIST_MAX];

@@ -22,14 +22,14 @@
 enum {
     PK_EDMD_SNAP_T_BASE, PK_EDMD_SNAP_H0, PK_EDMD_SNAP_H1, PK_EDMD_SNAP_K0,
     PK_EDMD_SNAP_PRESSURE, PK_EDMD_SNAP_SKIN_SCALE, PK_EDMD_SNAP_MAX_OVERLAP,
-    PK_EDMD_SNAP_FRACTION, PK_EDMD_SNAP_NSCAL
+    PK_EDMD_SNAP_FRACTION, PK_EDMD_SNAP_GROWTH_RATE, PK_EDMD_SNAP_NSCAL
 };
 /* cnt[] members */
 enum {
     PK_EDMD_SNAP_EVENTS, PK_EDMD_SNAP_PAIR, PK_EDMD_SNAP_WALL, PK_EDMD_SNAP_NLIST,
     PK_EDMD_SNAP_INVALID, PK_EDMD_SNAP_RESCALES, PK_EDMD_SNAP_REBASES, PK_EDMD_SNAP_OVERLAPS,
     PK_EDMD_SNAP_RESORTS, PK_EDMD_SNAP_SECOND, PK_EDMD_SNAP_HIST_STRIDE, PK_EDMD_SNAP_HIST_COUNT,
-    PK_EDMD_SNAP_NCNT
+    PK_EDMD_SNAP_SLOWED, PK_EDMD_SNAP_GROWTH_CHANGES, PK_EDMD_SNAP_NCNT
 };
 #define PK_EDMD_SNAP_KIN 8 /* p[3], a, v[3], g per grain */
 
@@ -71,6 +71,8 @@ struct edmd_state;
 typedef struct edmd_ckpt_loop {
     double t_base, K0, pressure, fraction;
     uint64_t hist_stride, hist_count;
+    double growth_rate;          /* the run's current γ (slowed near jamming) */
+    int slowed;                  /* the jamming slowdown has been applied */
 } edmd_ckpt_loop;
 
 /* 1 when a snapshot is due (its interval has passed since the last one or

@@ -7,6 +7,13 @@
 
 #include "grid.h"
 
+double pk_contact_tolerance(int dim, double p)
+{
+    if (!(p > 0))
+        return 1e-3;
+    return fmin(fmax(1e3 * dim / p, 1e-12), 1e-3);
+}
+
 typedef struct cctx {
     const pk_particles *p;
     size_t self;
@@ -129,8 +136,6 @@ int pk_contact_stats_compute(const pk_box *b, const pk_particles *p, double delt
             if (!gone[i])
                 z += deg[i];
         cs->mean_contacts = z / (double)backbone;
-    } else {
-        cs->mean_contacts = 2.0 * (double)c.n / (double)p->n;
     }
     rc = 0;
 out:

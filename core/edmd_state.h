@@ -87,6 +87,7 @@ typedef struct edmd_state {
     double h0, h1;            /* shell h(t) = h0 + h1 t */
     double t;                 /* current time (re-based) */
     double eps_v;             /* extra separation speed (spec §3.4) */
+    pk_edmd_rule rule;        /* pair (and wall) collision rule */
     /* events: one (and a runner-up) per particle, 32-byte aligned */
     edmd_event *ev;
     uint32_t *ncoll;          /* velocity changes of each particle (validity counter) */

@@ -37,6 +37,10 @@ static void run(int dim, int n, double ratio, path via, outcome *o)
     prm.until = PK_EDMD_UNTIL_JAMMED;
     prm.growth_rate = 0.05;
     prm.seed = 7;
+    /* the cheap Δφ stop (Meier Eq. 11) at one rate: this test is about the
+     * engine's bookkeeping, not the jamming criterion (test_edmd_jam) */
+    prm.dphi_crit = 1e-9;
+    prm.jam_rate_factor = 1;
     edmd_scalar_only = via == PATH_SCALAR;
     edmd_lanes4_only = via == PATH_LANES4;
     CHECK(pk_edmd_run(&b, &o->p, &prm, NULL, &o->st) == 0);

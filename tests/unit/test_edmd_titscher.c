@@ -194,6 +194,10 @@ static void test_a16_with_half_wall_gap_jams_short(void)
     pk_edmd_params prm;
     shell_params(&prm, 1.0, 1);
     prm.until = PK_EDMD_UNTIL_JAMMED;
+    /* Titscher §6.4's signal: the stall (10^-12 over 1000 events) at one
+     * rate, not the default pressure stop (10^12 takes minutes here) */
+    prm.stall_growth = 1e-12;
+    prm.jam_rate_factor = 1;
     pk_edmd_stats st;
     CHECK(pk_edmd_run_shell_in_walls(&b, 0, &p, &prm, NULL, &st) == 0);
     CHECK(st.reason == PK_STOP_JAMMED);

@@ -38,7 +38,7 @@ static const char *const bases[] = {
     "{\"dim\":2,\"domain\":{\"box\":{\"size\":[20,20]}},"
     "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]},\"count\":30,"
     "\"delta_d\":0.1,\"algorithm\":\"edmd\",\"limits\":{\"wall_time_s\":5},"
-    "\"edmd\":{\"delta\":0.5,\"growth_rate\":0.05,\"jamming\":{\"reduced_pressure\":1e6,"
+    "\"edmd\":{\"delta\":0.5,\"growth_rate\":0.05,\"jamming\":{\"reduced_pressure\":1e6,\"rate_factor\":0.1,"
     "\"delta_phi\":1e-9,\"events\":100},\"stall\":{\"events\":1000,\"growth\":1e-12},"
     "\"rescale_tolerance\":0.1,\"skin\":0.6,\"max_events\":1000000}}",
 

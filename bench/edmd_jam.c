@@ -1,0 +1,154 @@
+/* bench/edmd_jam — "until jammed" criteria side by side (issue 21).  One
+ * machine-readable line per case:
+ *   bench=edmd_jam case=NAME mode=M n=N phi=F p=P criterion=C events=E
+ *         cpu_s=T z=Z rattlers=R tol=TOL kinetic_ratio=K growth_changes=G
+ * Modes: default (pressure stop at 10^12, rate × 0.1 past p = 10^3), const
+ * (pressure stop, one rate), dphi (Meier's Δφ < 10^-9 over N events, one
+ * rate), stall (Titscher's stall, 10^-12 over max(1000, N) events, one rate),
+ * lift_dphi (the former default: the lift rule and the Δφ stop), meier (Eq. 9,
+ * no rescaling, Δφ stop: Meier's protocol).  z: mean contact number of the
+ * non-rattlers at pk_contact_tolerance(dim, p).  Cases: 3D monodisperse
+ * N = 10^4 (γ = 0.02) and Fuller-like diameters 1–16 (counts ∝ d^-2.5,
+ * γ = 0.03), both from the jobs' RSA start at φ = 0.30; 2D Meier A32 and
+ * quartz (nop = 1000, γ = 0.02, zero start).  PACKD_BENCH_CASE=TEXT runs the
+ * cases whose "case/mode" contains TEXT; the default modes of the 10^4
+ * cases take minutes each. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+
+#include "edmd.h"
+#include "edmd_contacts.h"
+#include "rsa.h"
+
+static double cpu_s(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+           (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+}
+
+static int wanted(const char *name, const char *mode)
+{
+    char nm[128];
+    snprintf(nm, sizeof nm, "%s/%s", name, mode);
+    const char *f = getenv("PACKD_BENCH_CASE");
+    return !f || !*f || strstr(nm, f) != NULL;
+}
+
+static void set_mode(pk_edmd_params *prm, const char *mode)
+{
+    if (strcmp(mode, "default") == 0)
+        return;
+    prm->jam_rate_factor = 1;
+    if (strcmp(mode, "dphi") == 0 || strcmp(mode, "lift_dphi") == 0 || strcmp(mode, "meier") == 0)
+        prm->dphi_crit = 1e-9;
+    if (strcmp(mode, "stall") == 0)
+        prm->stall_growth = 1e-12;
+    if (strcmp(mode, "lift_dphi") == 0)
+        prm->rule = PK_EDMD_RULE_LIFT;
+    if (strcmp(mode, "meier") == 0) {
+        prm->rule = PK_EDMD_RULE_MEIER;
+        prm->rescale = 0;
+    }
+}
+
+/* radii r (n) in a periodic box filled to φ = 0.5 at those radii; from an
+ * RSA start at φ = rsa_phi (> 0) or from zero radii */
+static void run(const char *name, const char *mode, int dim, const double *r, size_t n, double rate,
+                double rsa_phi)
+{
+    if (!wanted(name, mode))
+        return;
+    double vol = 0;
+    for (size_t i = 0; i < n; i++)
+        vol += pk_ball_measure(dim, r[i]);
+    pk_box b;
+    memset(&b, 0, sizeof b);
+    b.dim = dim;
+    for (int k = 0; k < dim; k++) {
+        b.L[k] = pow(vol / 0.5, 1.0 / dim);
+        b.periodic[k] = true;
+    }
+    pk_particles p;
+    pk_particles_init(&p, dim, n);
+    pk_edmd_params prm;
+    pk_edmd_params_default(&prm);
+    prm.growth_rate = rate;
+    prm.until = PK_EDMD_UNTIL_JAMMED;
+    set_mode(&prm, mode);
+    double c0 = cpu_s();
+    if (rsa_phi > 0) {
+        double *d = malloc(n * sizeof *d);
+        int32_t *sp = calloc(n, sizeof *sp);
+        for (size_t i = 0; i < n; i++)
+            d[i] = 2 * r[i];
+        pk_rsa_stats rs;
+        prm.start_zero = 0;
+        prm.delta = pk_edmd_start_delta(dim, d, n, 0, pk_box_measure(&b), rsa_phi);
+        pk_edmd_start_rsa(&b, d, sp, n, prm.delta, 0, prm.seed, NULL, &p, &rs);
+        free(d);
+        free(sp);
+    } else {
+        double x[3] = {0, 0, 0};
+        for (size_t i = 0; i < n; i++)
+            pk_particles_push(&p, x, r[i], 0);
+    }
+    pk_edmd_stats st;
+    pk_edmd_run(&b, &p, &prm, NULL, &st);
+    double cpu = cpu_s() - c0;
+    double tol = pk_contact_tolerance(dim, st.pressure);
+    pk_contact_stats cs;
+    pk_contact_stats_compute(&b, &p, 0, tol, &cs);
+    printf("bench=edmd_jam case=%s mode=%s n=%zu phi=%.5f p=%.3g criterion=%s events=%llu cpu_s=%.2f "
+           "z=%.3f rattlers=%.4f tol=%.2g kinetic_ratio=%.3g growth_changes=%llu\n",
+           name, mode, n, st.phi, st.pressure, pk_edmd_criterion_name(st.criterion),
+           (unsigned long long)st.events, cpu, cs.mean_contacts, cs.rattler_fraction, tol,
+           st.kinetic_ratio, (unsigned long long)st.growth_changes);
+    fflush(stdout);
+    pk_particles_free(&p);
+}
+
+/* Meier 2007 Tables I/II column IV: counts per class of nop = 1000 */
+static size_t meier_radii(const double *d, const int *count, int classes, double *r)
+{
+    size_t n = 0;
+    for (int c = 0; c < classes; c++)
+        for (int k = 0; k < count[c]; k++)
+            r[n++] = 0.5 * d[c];
+    return n;
+}
+
+int main(void)
+{
+    static const char *modes[] = {"default", "const", "dphi", "stall", "lift_dphi", "meier"};
+    enum { N = 10000 };
+    static double r[N];
+    for (size_t i = 0; i < N; i++)
+        r[i] = 0.5;
+    for (int m = 0; m < 5; m++)
+        run("mono3d_1e4_rate0.02", modes[m], 3, r, N, 0.02, 0.30);
+    const double a = 1.5, lo = 1, hi = pow(16, -a);
+    for (size_t i = 0; i < N; i++) {
+        double u = ((double)i + 0.5) / (double)N;
+        r[N - 1 - i] = 0.5 * pow(lo - u * (lo - hi), -1 / a);
+    }
+    for (int m = 0; m < 5; m++)
+        run("fuller3d_d1to16_1e4_rate0.03", modes[m], 3, r, N, 0.03, 0.30);
+    static const double a32_d[] = {16, 8, 4, 2, 1};
+    static const int a32_n[] = {8, 21, 53, 127, 791};
+    static const double qz_d[] = {0.25, 0.16, 0.125, 0.1, 0.063, 0.05};
+    static const int qz_n[] = {6, 242, 441, 149, 145, 17};
+    size_t na = meier_radii(a32_d, a32_n, 5, r);
+    for (int m = 0; m < 6; m++)
+        if (m != 3)
+            run("meier_a32_2d_rate0.02", modes[m], 2, r, na, 0.02, 0);
+    size_t nq = meier_radii(qz_d, qz_n, 6, r);
+    for (int m = 0; m < 6; m++)
+        if (m != 3)
+            run("meier_quartz_2d_rate0.02", modes[m], 2, r, nq, 0.02, 0);
+    return 0;
+}
