@@ -2,11 +2,14 @@
 #include "mesh_io.h"
 
 #include <ctype.h>
+#include <errno.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "input_open.h"
 
 /* ---- a whitespace tokenizer with line numbers ('#' comments for TetGen) */
 typedef struct reader {
@@ -292,6 +295,10 @@ static int msh41_nodes(reader *r, raw_mesh *w, char *err, size_t errlen)
                 return -1;
             }
         }
+        if (dim < 0 || dim > 3) {
+            snprintf(err, errlen, "%s:%ld: entity dimension %lld", r->path, r->line + 1, dim);
+            return -1;
+        }
         int extra = par ? (int)dim : 0;
         for (long long i = 0; i < cnt; i++) {
             double *x = &w->x[3 * (first + (size_t)i)], u;
@@ -328,11 +335,9 @@ static int msh41_elements(reader *r, raw_mesh *w, size_t max_tets, char *err, si
 int pk_mesh_read_msh(const char *path, size_t max_tets, pk_mesh *m, char *err, size_t errlen)
 {
     reader r = {.path = path};
-    r.f = fopen(path, "r");
-    if (!r.f) {
-        snprintf(err, errlen, "%s: cannot open", path);
+    r.f = pk_input_fopen(path, 0, err, errlen);
+    if (!r.f)
         return -1;
-    }
     raw_mesh w = {0};
     int rc = -1, major = 0;
     double version = 0, ftype = 0, dsize = 0;
@@ -384,6 +389,9 @@ out:
     return rc;
 }
 
+/* Attributes per TetGen node or tet: far more than any mesh carries. */
+#define MAX_ATTRS 1000
+
 /* TetGen: <base>.node ("n 3 nattr nbm", then "i x y z attrs [bm]") and
  * <base>.ele ("n 4|10 nattr", then "i n1..n4 [...] attrs"); the first index
  * sets the base (0 or 1).  The first tet attribute is the region. */
@@ -398,17 +406,20 @@ int pk_mesh_read_tetgen(const char *path, size_t max_tets, pk_mesh *m, char *err
     int rc = -1;
     reader r = {.hash_comments = 1, .path = fn};
     snprintf(fn, sizeof fn, "%s.node", base);
-    r.f = fopen(fn, "r");
-    if (!r.f) {
-        snprintf(err, errlen, "%s: cannot open", fn);
+    r.f = pk_input_fopen(fn, 0, err, errlen);
+    if (!r.f)
         return -1;
-    }
     long long n, dim, nattr, nbm, idx;
     if (next_int(&r, &n, err, errlen) || next_int(&r, &dim, err, errlen) ||
         next_int(&r, &nattr, err, errlen) || next_int(&r, &nbm, err, errlen))
         goto out;
     if (dim != 3) {
         snprintf(err, errlen, "%s: dimension %lld, expected 3", fn, dim);
+        goto out;
+    }
+    if (nattr < 0 || nattr > MAX_ATTRS || nbm < 0 || nbm > 1) {
+        snprintf(err, errlen, "%s: %lld attributes and %lld boundary markers per node (at most %d "
+                 "and 1)", fn, nattr, nbm, MAX_ATTRS);
         goto out;
     }
     for (long long i = 0; i < n; i++) {
@@ -427,9 +438,8 @@ int pk_mesh_read_tetgen(const char *path, size_t max_tets, pk_mesh *m, char *err
     fclose(r.f);
     snprintf(fn, sizeof fn, "%s.ele", base);
     r.line = 0;
-    r.f = fopen(fn, "r");
+    r.f = pk_input_fopen(fn, 0, err, errlen);
     if (!r.f) {
-        snprintf(err, errlen, "%s: cannot open", fn);
         raw_free(&w);
         return -1;
     }
@@ -437,6 +447,10 @@ int pk_mesh_read_tetgen(const char *path, size_t max_tets, pk_mesh *m, char *err
     if (next_int(&r, &nt, err, errlen) || next_int(&r, &npt, err, errlen) ||
         next_int(&r, &nattr, err, errlen))
         goto out;
+    if (nattr < 0 || nattr > MAX_ATTRS) {
+        snprintf(err, errlen, "%s: %lld attributes per tet (at most %d)", fn, nattr, MAX_ATTRS);
+        goto out;
+    }
     if (npt != 4 && npt != 10) {
         snprintf(err, errlen, "%s: %lld nodes per tet, expected 4 or 10", fn, npt);
         goto out;
@@ -520,21 +534,24 @@ static int ends_with(const char *s, const char *suffix)
 }
 
 /* Gmsh by name (.msh) or by content ($MeshFormat first): uploaded files
- * (the service stores them under their SHA-256) have no extension. */
-static int is_gmsh(const char *file)
+ * (the service stores them under their SHA-256) have no extension.  Looks at
+ * the first 4 KiB only.  1 Gmsh, 0 not (or no such file: a TetGen base
+ * name), -1 with err when the file cannot be read (e.g. not a regular file). */
+static int is_gmsh(const char *file, char *err, size_t errlen)
 {
     if (ends_with(file, ".msh"))
         return 1;
-    FILE *f = fopen(file, "r");
-    char line[64] = "";
-    int yes = 0;
-    if (f) {
-        while (fgets(line, sizeof line, f) && line[strspn(line, " \t\r\n")] == 0)
-            ;
-        yes = strncmp(line + strspn(line, " \t"), "$MeshFormat", 11) == 0;
-        fclose(f);
-    }
-    return yes;
+    FILE *f = pk_input_fopen(file, 0, err, errlen);
+    if (!f)
+        return errno == ENOENT ? 0 : -1;
+    char head[4096];
+    size_t n = fread(head, 1, sizeof head - 1, f);
+    fclose(f);
+    head[n] = 0;
+    size_t i = 0;
+    while (i < n && isspace((unsigned char)head[i]))
+        i++;
+    return n - i >= 11 && memcmp(head + i, "$MeshFormat", 11) == 0;
 }
 
 int pk_mesh_from_json(json_t *j, size_t max_tets, pk_mesh *m, pk_mesh_report *rep, char *err,
@@ -542,10 +559,12 @@ int pk_mesh_from_json(json_t *j, size_t max_tets, pk_mesh *m, pk_mesh_report *re
 {
     const char *file = json_string_value(json_object_get(j, "file"));
     int rc;
-    if (file)
-        rc = is_gmsh(file) ? pk_mesh_read_msh(file, max_tets, m, err, errlen)
-                                     : pk_mesh_read_tetgen(file, max_tets, m, err, errlen);
-    else {
+    if (file) {
+        int gmsh = is_gmsh(file, err, errlen);
+        rc = gmsh < 0   ? -1
+             : gmsh > 0 ? pk_mesh_read_msh(file, max_tets, m, err, errlen)
+                        : pk_mesh_read_tetgen(file, max_tets, m, err, errlen);
+    } else {
         if (max_tets && json_array_size(json_object_get(j, "tets")) > max_tets) {
             snprintf(err, errlen, "the mesh has %zu tets, over the limit of %zu",
                      json_array_size(json_object_get(j, "tets")), max_tets);

@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "box.h"
+#include "check_ctx.h"
 #include "json_schema.h"
 #include "progress.h"
 #include "psd.h"
@@ -27,6 +28,7 @@ typedef struct pk_pack_job {
     uint64_t seed;
     size_t max_particles;
     double wall_time_s;          /* 0 = none */
+    int read_files;              /* 1: checks may open the input files (check_ctx.h); 0 by default */
 } pk_pack_job;
 
 /* What the job implies before anything is drawn. */
@@ -49,7 +51,7 @@ size_t pk_pack_job_from_json(json_t *inputs, pk_pack_job *job, pk_schema_errors 
 size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_errors *errs);
 
 /* process table hooks (see process.h) */
-void pk_pack_check(json_t *inputs, pk_schema_errors *errs);
+void pk_pack_check(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
 int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_monitor *mon,
                 json_t **summary, char *err, size_t errlen);
 

@@ -140,6 +140,9 @@ static void check_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, pk_s
     tetfill_setup S;
     const char *ptr, *rule;
     char err[512];
+    json_t *mesh = json_object_get(json_object_get(job->inputs, "domain"), "mesh");
+    if (!job->read_files && json_object_get(mesh, "file"))
+        return; /* a request to the daemon: the worker reads and checks the file */
     if (setup(job, &S, &ptr, &rule, err, sizeof err) != 0) {
         pk_schema_errors_add(errs, ptr, rule, "%s", err);
         return;

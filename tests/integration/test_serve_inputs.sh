@@ -1,0 +1,73 @@
+#!/bin/sh
+# test_serve_inputs.sh — files named by path in a request never reach
+# outside the data directory (issue 20).  Without input_dir a server path
+# (rve.file, domain.mesh.file) is refused with 422 naming the field; with
+# input_dir, a file inside is taken and runs, while "..", a symlink out, an
+# absolute path elsewhere, a FIFO and /dev/zero are refused at once — the
+# HTTP threads never open them, so /healthz answers right after 30 of them.
+. "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
+
+# post PROCESS BODYFILE OUT: prints the status code
+post() { c -o "$3" -w '%{http_code}' -H 'Content-Type: application/json' --data-binary "@$2" "$B/processes/$1/execution"; }
+# has_error OUT POINTER RULE (the daemon's indented JSON: pointer, then rule)
+has_error() { grep -A1 "\"pointer\": \"$2\"" "$1" | grep -q "\"rule\": \"$3\""; }
+
+MESH="$SRC/tests/data/meshes/cylinder41.msh"
+IN="$T/in"
+OUT="$T/outside"
+CASES="dotdot:../outside/secret.msh symlink_out:escape.msh absolute_out:$OUT/secret.msh
+dev_zero:/dev/zero symlink_dev_zero:zero.msh fifo:fifo.msh directory:sub missing:nope.msh"
+# every body at once (python starts slowly on a loaded machine)
+python3 -c "
+import json,sys
+src, mesh, t = sys.argv[1:4]
+def inputs(f): return json.load(open(src + '/examples/' + f))['inputs']
+def put(name, i): json.dump({'inputs': i}, open(t + '/' + name + '.json', 'w'))
+h = inputs('homogenize/homogenize-periodic-2d.json'); h['rve'] = {'file': mesh}; put('rve_path', h)
+for name, path in [('mesh_path', mesh), ('inside', 'sub/cyl.msh')] + [c.split(':', 1) for c in sys.argv[4:]]:
+    i = inputs('tetfill-cylinder.json'); i['domain']['mesh'] = {'file': path}; put(name, i)
+" "$SRC" "$MESH" "$T" $CASES
+
+start_daemon closed --workers 0 || { fail serve_starts; exit 1; }
+code=$(post homogenize "$T/rve_path.json" "$T/o1.json")
+check rve_server_path_422 test "$code" = 422
+check rve_server_path_names_field has_error "$T/o1.json" /inputs/rve/file serverPath
+code=$(post pack "$T/mesh_path.json" "$T/o2.json")
+check mesh_server_path_422 test "$code" = 422
+check mesh_server_path_names_field has_error "$T/o2.json" /inputs/domain/mesh/file serverPath
+
+mkdir -p "$IN/sub" "$OUT"
+cp "$MESH" "$IN/sub/cyl.msh"
+cp "$MESH" "$OUT/secret.msh"
+ln -s "$OUT/secret.msh" "$IN/escape.msh"
+ln -s /dev/zero "$IN/zero.msh"
+mkfifo "$IN/fifo.msh"
+start_daemon open --workers 1 --input-dir "$IN" || { fail serve_starts_input_dir; exit 1; }
+
+code=$(post pack "$T/inside.json" "$T/o3.json")
+check inside_accepted test "$code" = 201
+check inside_runs wait_status "$(member "$T/o3.json" jobID)" successful 120
+
+for case in $CASES; do
+    nm=${case%%:*}
+    code=$(post pack "$T/$nm.json" "$T/$nm.out")
+    check "${nm}_refused" test "$code" = 422
+    check "${nm}_names_field" has_error "$T/$nm.out" /inputs/domain/mesh/file inputDir
+done
+check refusal_hides_target sh -c "! grep -q secret '$T/symlink_out.out'"
+
+# 30 hostile requests at once (a FIFO and /dev/zero), then /healthz within 1 s
+i=0
+pids=""
+while [ $i -lt 30 ]; do
+    f="$T/fifo.json"
+    [ $((i % 2)) -eq 0 ] && f="$T/symlink_dev_zero.json"
+    curl -s --max-time 10 -o /dev/null -w '%{http_code}\n' -H 'Content-Type: application/json' \
+        --data-binary "@$f" "$B/processes/pack/execution" >"$T/burst.$i" &
+    pids="$pids $!"
+    i=$((i + 1))
+done
+for p in $pids; do wait "$p"; done
+check burst_all_refused sh -c "test \$(cat '$T'/burst.* | grep -c '^422$') -eq 30"
+check healthz_after_burst sh -c "test \"\$(curl -s --max-time 1 -o /dev/null -w '%{http_code}' '$B/healthz')\" = 200"
+exit 0
