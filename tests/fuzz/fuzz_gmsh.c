@@ -1,0 +1,10 @@
+/* fuzz_gmsh.c — libFuzzer harness of the 'gmsh' target (targets.h). */
+#include "targets.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    fuzz_gmsh(data, size);
+    return 0;
+}

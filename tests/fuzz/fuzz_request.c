@@ -1,0 +1,10 @@
+/* fuzz_request.c — libFuzzer harness of the 'request' target (targets.h). */
+#include "targets.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    fuzz_request(data, size);
+    return 0;
+}

@@ -1,0 +1,10 @@
+/* fuzz_tetgen.c — libFuzzer harness of the 'tetgen' target (targets.h). */
+#include "targets.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    fuzz_tetgen(data, size);
+    return 0;
+}
