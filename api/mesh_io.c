@@ -535,8 +535,9 @@ static int ends_with(const char *s, const char *suffix)
 
 /* Gmsh by name (.msh) or by content ($MeshFormat first): uploaded files
  * (the service stores them under their SHA-256) have no extension.  Looks at
- * the first 4 KiB only.  1 Gmsh, 0 not (or no such file: a TetGen base
- * name), -1 with err when the file cannot be read (e.g. not a regular file). */
+ * the first 4 KiB only.  1 Gmsh, 2 a file but not Gmsh, 0 no such file (a
+ * TetGen base name), -1 with err when it cannot be read (e.g. not a regular
+ * file). */
 static int is_gmsh(const char *file, char *err, size_t errlen)
 {
     if (ends_with(file, ".msh"))
@@ -551,7 +552,7 @@ static int is_gmsh(const char *file, char *err, size_t errlen)
     size_t i = 0;
     while (i < n && isspace((unsigned char)head[i]))
         i++;
-    return n - i >= 11 && memcmp(head + i, "$MeshFormat", 11) == 0;
+    return n - i >= 11 && memcmp(head + i, "$MeshFormat", 11) == 0 ? 1 : 2;
 }
 
 int pk_mesh_from_json(json_t *j, size_t max_tets, pk_mesh *m, pk_mesh_report *rep, char *err,
@@ -561,9 +562,13 @@ int pk_mesh_from_json(json_t *j, size_t max_tets, pk_mesh *m, pk_mesh_report *re
     int rc;
     if (file) {
         int gmsh = is_gmsh(file, err, errlen);
-        rc = gmsh < 0   ? -1
-             : gmsh > 0 ? pk_mesh_read_msh(file, max_tets, m, err, errlen)
-                        : pk_mesh_read_tetgen(file, max_tets, m, err, errlen);
+        rc = gmsh < 0    ? -1
+             : gmsh == 1 ? pk_mesh_read_msh(file, max_tets, m, err, errlen)
+                         : pk_mesh_read_tetgen(file, max_tets, m, err, errlen);
+        if (rc != 0 && gmsh == 2 && !ends_with(file, ".node") && !ends_with(file, ".ele") &&
+            strstr(err, ".node: cannot open")) /* e.g. an upload that is no mesh */
+            snprintf(err, errlen, "%s: neither a Gmsh MSH file (no $MeshFormat at the start) nor "
+                     "the base name of a TetGen .node/.ele pair", file);
     } else {
         if (max_tets && json_array_size(json_object_get(j, "tets")) > max_tets) {
             snprintf(err, errlen, "the mesh has %zu tets, over the limit of %zu",

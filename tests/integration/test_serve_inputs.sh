@@ -26,6 +26,7 @@ def put(name, i): json.dump({'inputs': i}, open(t + '/' + name + '.json', 'w'))
 h = inputs('homogenize/homogenize-periodic-2d.json'); h['rve'] = {'file': mesh}; put('rve_path', h)
 for name, path in [('mesh_path', mesh), ('inside', 'sub/cyl.msh')] + [c.split(':', 1) for c in sys.argv[4:]]:
     i = inputs('tetfill-cylinder.json'); i['domain']['mesh'] = {'file': path}; put(name, i)
+i = inputs('tetfill-cylinder.json'); i['domain']['mesh'] = {'href': 'HREF'}; put('upload', i)
 " "$SRC" "$MESH" "$T" $CASES
 
 start_daemon closed --workers 0 || { fail serve_starts; exit 1; }
@@ -47,6 +48,16 @@ start_daemon open --workers 1 --input-dir "$IN" || { fail serve_starts_input_dir
 code=$(post pack "$T/inside.json" "$T/o3.json")
 check inside_accepted test "$code" = 201
 check inside_runs wait_status "$(member "$T/o3.json" jobID)" successful 120
+
+# an upload that is no mesh: accepted (nothing is read in the request), the worker fails it with the reason
+printf 'no mesh here\n' >"$T/junk"
+c -o "$T/up.json" -H 'Content-Type: application/octet-stream' --data-binary "@$T/junk" "$B/files"
+sed "s|HREF|$(member "$T/up.json" href)|" "$T/upload.json" >"$T/upload2.json"
+code=$(post pack "$T/upload2.json" "$T/o4.json")
+check junk_upload_accepted test "$code" = 201
+J=$(member "$T/o4.json" jobID)
+check junk_upload_fails wait_status "$J" failed 60
+check junk_upload_reason grep -q 'neither a Gmsh MSH file' "$T/st.json"
 
 for case in $CASES; do
     nm=${case%%:*}
