@@ -348,7 +348,6 @@ int pk_mesh_read_msh(const char *path, size_t max_tets, pk_mesh *m, char *err, s
     if (next_num(&r, &version, err, errlen) || next_num(&r, &ftype, err, errlen) ||
         next_num(&r, &dsize, err, errlen))
         goto out;
-    major = (int)version;
     if (ftype != 0) {
         snprintf(err, errlen, "%s: binary MSH is not supported (save as ASCII)", path);
         goto out;
@@ -357,6 +356,7 @@ int pk_mesh_read_msh(const char *path, size_t max_tets, pk_mesh *m, char *err, s
         snprintf(err, errlen, "%s: MSH version %g is not supported (2.2 or 4.1)", path, version);
         goto out;
     }
+    major = (int)version; /* in range now (a forged 2e11 would not fit an int) */
     if (msh_skip_section(&r, "$MeshFormat", err, errlen))
         goto out;
     int have_nodes = 0, have_elems = 0;
