@@ -9,6 +9,8 @@
 #include "check.h"
 #include "fuzz/targets.h"
 
+FUZZ_SANITIZER_OPTIONS
+
 static const char *current = "";
 
 static void on_alarm(int sig)
