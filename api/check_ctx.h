@@ -4,12 +4,13 @@
  * machine (`packd run`, `packd validate`, the daemon's workers) has its mesh
  * read and checked; a request to the daemon is checked in the HTTP thread,
  * which never opens a file a request names (the worker reads it, and the job
- * fails with the reason if the file is bad). */
+ * fails with the reason if the file is bad) nor builds a mesh (a box domain's
+ * tets are counted, not made). */
 #ifndef PK_CHECK_CTX_H
 #define PK_CHECK_CTX_H
 
 typedef struct pk_check_ctx {
-    int service;   /* 1: a request to the daemon: open no input file */
+    int service;   /* 1: a request to the daemon: open no input file, build no mesh */
 } pk_check_ctx;
 
 #endif

@@ -337,7 +337,7 @@ void pk_pack_check(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *er
     pk_pack_job job;
     if (pk_pack_job_from_json(inputs, &job, errs) != 0)
         return;
-    job.read_files = !ctx->service;
+    job.service = ctx->service;
     pk_pack_plan plan;
     pk_pack_plan_make(&job, &plan, errs);
 }

@@ -28,7 +28,8 @@ typedef struct pk_pack_job {
     uint64_t seed;
     size_t max_particles;
     double wall_time_s;          /* 0 = none */
-    int read_files;              /* 1: checks may open the input files (check_ctx.h); 0 by default */
+    int service;                 /* 1: checked for a request to the daemon (check_ctx.h): the
+                                  * placer's check opens no file and builds no mesh */
 } pk_pack_job;
 
 /* What the job implies before anything is drawn. */

@@ -109,6 +109,21 @@ static void test_service_checks_open_nothing(void)
           strstr(errs.items[0].message, "FIFO") && !strcmp(errs.items[0].pointer, "/domain/mesh"));
     pk_schema_errors_free(&errs);
     json_decref(in);
+    /* a box domain is not meshed for a request, but its size limit still holds:
+     * 0.1..0.5 radii in 82 x 40 x 20 take ~58 000 tets (fuzz_request timed out
+     * meshing it in the check) */
+    in = json_pack("{s:i,s:{s:{s:[i,i,i]}},s:s,s:{s:f,s:f,s:i}}", "dim", 3, "domain", "box", "size",
+                   82, 40, 20, "algorithm", "tetfill", "tetfill", "r_min", 0.1, "r_max", 0.5,
+                   "max_tets", 50000);
+    errs = (pk_schema_errors){0};
+    CHECK(pk_process_validate_inputs(p, in, &service, &errs) == 1 &&
+          strstr(errs.items[0].message, "over the limit of 50000"));
+    pk_schema_errors_free(&errs);
+    json_object_set_new(json_object_get(in, "tetfill"), "max_tets", json_integer(100000));
+    errs = (pk_schema_errors){0};
+    CHECK(pk_process_validate_inputs(p, in, &service, &errs) == 0);
+    pk_schema_errors_free(&errs);
+    json_decref(in);
     alarm(0);
 }
 
