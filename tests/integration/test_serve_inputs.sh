@@ -17,6 +17,7 @@ IN="$T/in"
 OUT="$T/outside"
 CASES="dotdot:../outside/secret.msh symlink_out:escape.msh absolute_out:$OUT/secret.msh
 dev_zero:/dev/zero symlink_dev_zero:zero.msh fifo:fifo.msh directory:sub missing:nope.msh"
+EXTRA="fifo_abs:$IN/fifo.msh"
 # every body at once (python starts slowly on a loaded machine)
 python3 -c "
 import json,sys
@@ -27,8 +28,29 @@ h = inputs('homogenize/homogenize-periodic-2d.json'); h['rve'] = {'file': mesh};
 for name, path in [('mesh_path', mesh), ('inside', 'sub/cyl.msh')] + [c.split(':', 1) for c in sys.argv[4:]]:
     i = inputs('tetfill-cylinder.json'); i['domain']['mesh'] = {'file': path}; put(name, i)
 i = inputs('tetfill-cylinder.json'); i['domain']['mesh'] = {'href': 'HREF'}; put('upload', i)
-" "$SRC" "$MESH" "$T" $CASES
+" "$SRC" "$MESH" "$T" $CASES $EXTRA
 
+# burst N BODY_A BODY_B NAME: N requests at once, alternating the bodies; all
+# must be refused (422) and /healthz must answer within 1 s afterwards (no
+# HTTP thread left reading a FIFO or /dev/zero)
+burst() {
+    i=0
+    pids=""
+    while [ $i -lt "$1" ]; do
+        f=$2
+        [ $((i % 2)) -eq 0 ] && f=$3
+        curl -s --max-time 10 -o /dev/null -w '%{http_code}\n' -H 'Content-Type: application/json' \
+            --data-binary "@$f" "$B/processes/pack/execution" >"$T/burst.$4.$i" &
+        pids="$pids $!"
+        i=$((i + 1))
+    done
+    for p in $pids; do wait "$p"; done
+    check "burst_${4}_all_refused" sh -c "test \$(cat '$T'/burst.$4.* | grep -c '^422$') -eq $1"
+    check "healthz_${4}" sh -c "test \"\$(curl -s --max-time 1 -o /dev/null -w '%{http_code}' '$B/healthz')\" = 200"
+}
+
+mkdir -p "$IN/sub" "$OUT"
+mkfifo "$IN/fifo.msh"
 start_daemon closed --workers 0 || { fail serve_starts; exit 1; }
 code=$(post homogenize "$T/rve_path.json" "$T/o1.json")
 check rve_server_path_422 test "$code" = 422
@@ -36,13 +58,13 @@ check rve_server_path_names_field has_error "$T/o1.json" /inputs/rve/file server
 code=$(post pack "$T/mesh_path.json" "$T/o2.json")
 check mesh_server_path_422 test "$code" = 422
 check mesh_server_path_names_field has_error "$T/o2.json" /inputs/domain/mesh/file serverPath
+# the issue's case: /dev/zero and a FIFO as mesh files, without an input directory
+burst 30 "$T/dev_zero.json" "$T/fifo_abs.json" no_input_dir
 
-mkdir -p "$IN/sub" "$OUT"
 cp "$MESH" "$IN/sub/cyl.msh"
 cp "$MESH" "$OUT/secret.msh"
 ln -s "$OUT/secret.msh" "$IN/escape.msh"
 ln -s /dev/zero "$IN/zero.msh"
-mkfifo "$IN/fifo.msh"
 start_daemon open --workers 1 --input-dir "$IN" || { fail serve_starts_input_dir; exit 1; }
 
 code=$(post pack "$T/inside.json" "$T/o3.json")
@@ -68,17 +90,5 @@ done
 check refusal_hides_target sh -c "! grep -q secret '$T/symlink_out.out'"
 
 # 30 hostile requests at once (a FIFO and /dev/zero), then /healthz within 1 s
-i=0
-pids=""
-while [ $i -lt 30 ]; do
-    f="$T/fifo.json"
-    [ $((i % 2)) -eq 0 ] && f="$T/symlink_dev_zero.json"
-    curl -s --max-time 10 -o /dev/null -w '%{http_code}\n' -H 'Content-Type: application/json' \
-        --data-binary "@$f" "$B/processes/pack/execution" >"$T/burst.$i" &
-    pids="$pids $!"
-    i=$((i + 1))
-done
-for p in $pids; do wait "$p"; done
-check burst_all_refused sh -c "test \$(cat '$T'/burst.* | grep -c '^422$') -eq 30"
-check healthz_after_burst sh -c "test \"\$(curl -s --max-time 1 -o /dev/null -w '%{http_code}' '$B/healthz')\" = 200"
+burst 30 "$T/fifo.json" "$T/symlink_dev_zero.json" after_input_dir
 exit 0
