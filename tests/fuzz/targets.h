@@ -13,11 +13,11 @@
  *   h5_rve   an HDF5 file through the RVE reader pk_h5_read_particles; the
  *            reader must leave no HDF5 object open.  libhdf5 itself is not
  *            ours to fix: for forged sizes it asks for blocks of gigabytes
- *            (it handles malloc's NULL; without ASan such a file fails in
- *            0.3 s and 16 MB, under ASan filling the block timed out) and it
- *            leaks a few bytes on some error paths, so FUZZ_SANITIZER_OPTIONS
- *            makes allocations over 512 MB fail and suppresses leaks inside
- *            libhdf5 only. */
+ *            (without ASan such a file fails in 0.3 s and 16 MB, under ASan
+ *            filling the block timed out) and it leaks a few bytes on some
+ *            error paths, so FUZZ_SANITIZER_OPTIONS makes allocations over
+ *            512 MB fail and suppresses leaks inside libhdf5 only.  Files on
+ *            which libhdf5 itself faults are in tests/fuzz/hdf5-known/. */
 #ifndef PK_FUZZ_TARGETS_H
 #define PK_FUZZ_TARGETS_H
 
