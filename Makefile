@@ -115,5 +115,60 @@ run: $(DEPS_OK) $(BUILD)/packd
 check-schemas: $(DEPS_OK)
 	sh tests/integration/test_schemas.sh
 
+# ---- fuzzing: libFuzzer harnesses (tests/fuzz/) built by clang in build-fuzz/
+#   make fuzz        run each harness FUZZ_SECONDS (default 60) from the
+#                    committed corpus; new inputs go to build-fuzz/corpus/,
+#                    crashes to build-fuzz/crash-*
+#   make fuzz-build  only build them (make test does, then runs each for a
+#                    few seconds); skipped with a message when clang's
+#                    fuzzer runtime (libclang-rt-14-dev) is missing
+FUZZ_BUILD   ?= build-fuzz
+FUZZ_CC      ?= clang
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS := request gmsh tetgen h5_rve
+FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+FUZZ_CFLAGS   = $(CSTD) -O1 -g $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -DPACKD_VERSION='"$(VERSION)"' \
+               $(shell pkg-config --cflags $(PKGS) 2>/dev/null) -I/usr/include/suitesparse -Icore -Iapi -I$(FUZZ_BUILD)/gen
+FUZZ_OBJ     := $(CORE_SRC:%.c=$(FUZZ_BUILD)/obj/%.o) $(API_SRC:%.c=$(FUZZ_BUILD)/obj/%.o) \
+               $(FUZZ_BUILD)/obj/gen/schemas_embedded.o
+FUZZ_BIN     := $(FUZZ_TARGETS:%=$(FUZZ_BUILD)/fuzz_%)
+FUZZ_OK      := $(FUZZ_BUILD)/.fuzzer-ok
+
+.PHONY: fuzz fuzz-build
+
+# Does this clang link libFuzzer?  Leaves the stamp only if it does.
+$(FUZZ_OK):
+	@mkdir -p $(@D)
+	@printf 'int LLVMFuzzerTestOneInput(const char *d, unsigned long n) { return 0; }\n' > $(@D)/probe.c
+	@if $(FUZZ_CC) -fsanitize=fuzzer $(@D)/probe.c -o $(@D)/probe 2>/dev/null; then touch $@; \
+	 else echo "fuzz: skipped: $(FUZZ_CC) -fsanitize=fuzzer does not link (apt-get install clang libclang-rt-14-dev)"; fi
+
+$(FUZZ_BUILD)/obj/%.o: %.c $(wildcard core/*.h api/*.h) | $(DEPS_OK)
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -c $< -o $@
+
+$(FUZZ_BUILD)/gen/schemas_embedded.c: $(SCHEMAS) tools/embed-schemas.sh
+	@mkdir -p $(@D)
+	sh tools/embed-schemas.sh $(SCHEMAS) > $@
+
+$(FUZZ_BUILD)/obj/gen/schemas_embedded.o: $(FUZZ_BUILD)/gen/schemas_embedded.c
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -c $< -o $@
+
+$(FUZZ_BUILD)/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/targets.h $(FUZZ_OBJ)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer -o $@ $< $(FUZZ_OBJ) $(EXT_LIBS)
+
+fuzz-build: $(FUZZ_OK)
+	@if [ -f $(FUZZ_OK) ]; then $(MAKE) --no-print-directory $(FUZZ_BIN); fi
+
+fuzz: fuzz-build
+	@[ -f $(FUZZ_OK) ] || exit 0; for t in $(FUZZ_TARGETS); do \
+	    mkdir -p $(FUZZ_BUILD)/corpus/$$t; echo "== fuzz_$$t: $(FUZZ_SECONDS) s"; \
+	    $(FUZZ_BUILD)/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=2048 \
+	        -artifact_prefix=$(FUZZ_BUILD)/crash-$$t- $(FUZZ_BUILD)/corpus/$$t tests/fuzz/corpus/$$t || exit 1; \
+	done
+
+test: fuzz-build
+
 clean:
-	rm -rf build build-san
+	rm -rf build build-san $(FUZZ_BUILD)

@@ -6,7 +6,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+#include "input_open.h"
 
 #ifndef PACKD_VERSION
 #define PACKD_VERSION "0.0.0"
@@ -434,94 +437,142 @@ void pk_h5_abort(pk_h5 *h)
     h5_free(h);
 }
 
+/* Elements of an attribute's or dataset's dataspace; -1 if none. */
+static hssize_t space_points(hid_t space)
+{
+    if (space < 0)
+        return -1;
+    hssize_t n = H5Sget_simple_extent_npoints(space);
+    H5Sclose(space);
+    return n;
+}
+
+/* A dataset's extent when it has `rank` dimensions; -1 otherwise. */
+static int dataset_dims(hid_t d, int rank, hsize_t *dims)
+{
+    hid_t s = d >= 0 ? H5Dget_space(d) : -1;
+    int ok = s >= 0 && H5Sget_simple_extent_ndims(s) == rank &&
+             H5Sget_simple_extent_dims(s, dims, NULL) == rank;
+    if (s >= 0)
+        H5Sclose(s);
+    return ok ? 0 : -1;
+}
+
+/* The box group: dimension, boundary[dim], edges[dim].  Every read is
+ * checked against its buffer first: the file is not trusted. */
+static int read_box(hid_t f, const char *path, pk_box *b, char *err, size_t errlen)
+{
+    hid_t box = H5Gopen2(f, "particles/grains/box", H5P_DEFAULT);
+    if (box < 0) {
+        snprintf(err, errlen, "%s: no /particles/grains/box", path);
+        return -1;
+    }
+    int rc = -1, dim = 0;
+    hid_t a = H5Aopen(box, "dimension", H5P_DEFAULT);
+    if (a < 0 || space_points(H5Aget_space(a)) != 1 || H5Aread(a, H5T_NATIVE_INT, &dim) < 0 ||
+        (dim != 2 && dim != 3)) {
+        snprintf(err, errlen, "%s: bad box dimension", path);
+        goto out;
+    }
+    H5Aclose(a);
+    a = -1;
+    b->dim = dim;
+    char names[PK_MAXDIM][9];
+    hid_t t = string_type(sizeof names[0]);
+    a = H5Aopen(box, "boundary", H5P_DEFAULT);
+    if (a >= 0 && space_points(H5Aget_space(a)) == dim && H5Aread(a, t, names) >= 0)
+        for (int k = 0; k < dim; k++) {
+            names[k][sizeof names[k] - 1] = 0;
+            b->periodic[k] = strcmp(names[k], "periodic") == 0;
+        }
+    H5Tclose(t);
+    hsize_t n;
+    hid_t d = H5Dopen2(box, "edges", H5P_DEFAULT);
+    if (dataset_dims(d, 1, &n) != 0 || n != (hsize_t)dim ||
+        H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, b->L) < 0)
+        snprintf(err, errlen, "%s: bad box edges", path);
+    else
+        rc = 0;
+    if (d >= 0)
+        H5Dclose(d);
+out:
+    if (a >= 0)
+        H5Aclose(a);
+    H5Gclose(box);
+    return rc;
+}
+
+/* Read dataset `name` of extent dims[rank] into buf (native type t). */
+static int read_exact(hid_t f, const char *name, hid_t t, int rank, const hsize_t *want, void *buf)
+{
+    hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
+    hsize_t dims[2];
+    int ok = dataset_dims(d, rank, dims) == 0;
+    for (int k = 0; ok && k < rank; k++)
+        ok = dims[k] == want[k];
+    ok = ok && (want[0] == 0 || H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0);
+    if (d >= 0)
+        H5Dclose(d);
+    return ok ? 0 : -1;
+}
+
 int pk_h5_read_particles(const char *path, pk_box *b, pk_particles *p, char *err, size_t errlen)
 {
     quiet_hdf5();
     memset(b, 0, sizeof *b);
     memset(p, 0, sizeof *p);
-    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    /* Check the file through a descriptor (a regular file, not a FIFO or a
+     * device), then let HDF5 open that very file by its /proc name. */
+    int fd = pk_input_open(path, 0, err, errlen);
+    if (fd < 0)
+        return -1;
+    struct stat st;
+    char fdpath[64];
+    snprintf(fdpath, sizeof fdpath, "/proc/self/fd/%d", fd);
+    hid_t f = fstat(fd, &st) == 0 ? H5Fopen(access(fdpath, R_OK) == 0 ? fdpath : path,
+                                            H5F_ACC_RDONLY, H5P_DEFAULT) : -1;
+    close(fd);
     if (f < 0) {
         snprintf(err, errlen, "cannot open %s as HDF5", path);
         return -1;
     }
-    int rc = -1, dim = 0;
-    hid_t box = H5Gopen2(f, "particles/grains/box", H5P_DEFAULT);
-    if (box < 0) {
-        snprintf(err, errlen, "%s: no /particles/grains/box", path);
+    int rc = -1;
+    if (read_box(f, path, b, err, errlen) != 0)
         goto out;
-    }
-    hid_t a = H5Aopen(box, "dimension", H5P_DEFAULT);
-    if (a < 0 || H5Aread(a, H5T_NATIVE_INT, &dim) < 0 || (dim != 2 && dim != 3)) {
-        snprintf(err, errlen, "%s: bad box dimension", path);
-        if (a >= 0)
-            H5Aclose(a);
-        H5Gclose(box);
-        goto out;
-    }
-    H5Aclose(a);
-    b->dim = dim;
-    {
-        char names[PK_MAXDIM][9];
-        hid_t t = string_type(9);
-        a = H5Aopen(box, "boundary", H5P_DEFAULT);
-        if (a >= 0 && H5Aread(a, t, names) >= 0)
-            for (int k = 0; k < dim; k++)
-                b->periodic[k] = strcmp(names[k], "periodic") == 0;
-        if (a >= 0)
-            H5Aclose(a);
-        H5Tclose(t);
-    }
-    hid_t d = H5Dopen2(box, "edges", H5P_DEFAULT);
-    if (d < 0 || H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, b->L) < 0) {
-        snprintf(err, errlen, "%s: bad box edges", path);
-        if (d >= 0)
-            H5Dclose(d);
-        H5Gclose(box);
-        goto out;
-    }
-    H5Dclose(d);
-    H5Gclose(box);
-
-    d = H5Dopen2(f, "particles/grains/radius", H5P_DEFAULT);
-    hid_t s = d >= 0 ? H5Dget_space(d) : -1;
-    hsize_t n = 0;
-    if (s < 0 || H5Sget_simple_extent_ndims(s) != 1) {
-        snprintf(err, errlen, "%s: no /particles/grains/radius", path);
-        if (s >= 0)
-            H5Sclose(s);
-        if (d >= 0)
-            H5Dclose(d);
-        goto out;
-    }
-    H5Sget_simple_extent_dims(s, &n, NULL);
-    H5Sclose(s);
-    if (pk_particles_init(p, dim, (size_t)n + 1) != 0) {
+    const int dim = b->dim;
+    hsize_t n;
+    hid_t d = H5Dopen2(f, "particles/grains/radius", H5P_DEFAULT);
+    int have = dataset_dims(d, 1, &n) == 0;
+    if (d >= 0)
         H5Dclose(d);
+    if (!have) {
+        snprintf(err, errlen, "%s: no /particles/grains/radius", path);
+        goto out;
+    }
+    /* Each grain takes at least its radius' 8 bytes in a packd file: a
+     * larger count is a forged header, not a packing to allocate for. */
+    if (n > (hsize_t)st.st_size / sizeof(double)) {
+        snprintf(err, errlen, "%s: declares %llu grains, more than its %lld bytes hold", path,
+                 (unsigned long long)n, (long long)st.st_size);
+        goto out;
+    }
+    if (pk_particles_init(p, dim, (size_t)n + 1) != 0) {
         snprintf(err, errlen, "out of memory");
         goto out;
     }
     p->n = (size_t)n;
-    int ok = n == 0 || H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, p->r) >= 0;
-    H5Dclose(d);
     double *pos = malloc(((size_t)n + 1) * (size_t)dim * sizeof *pos);
-    d = H5Dopen2(f, "particles/grains/position", H5P_DEFAULT);
-    ok = ok && pos && d >= 0 &&
-         (n == 0 || H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, pos) >= 0);
-    if (d >= 0)
-        H5Dclose(d);
-    d = H5Dopen2(f, "particles/grains/species", H5P_DEFAULT);
-    ok = ok && d >= 0 &&
-         (n == 0 || H5Dread(d, H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, p->species) >= 0);
-    if (d >= 0)
-        H5Dclose(d);
-    if (ok) {
-        for (size_t i = 0; i < (size_t)n; i++) {
+    hsize_t pdims[2] = {n, (hsize_t)dim};
+    if (pos && read_exact(f, "particles/grains/radius", H5T_NATIVE_DOUBLE, 1, &n, p->r) == 0 &&
+        read_exact(f, "particles/grains/position", H5T_NATIVE_DOUBLE, 2, pdims, pos) == 0 &&
+        read_exact(f, "particles/grains/species", H5T_NATIVE_INT32, 1, &n, p->species) == 0) {
+        for (size_t i = 0; i < (size_t)n; i++)
             for (int k = 0; k < 3; k++)
                 p->x[3 * i + (size_t)k] = k < dim ? pos[i * (size_t)dim + (size_t)k] : 0.0;
-        }
         rc = 0;
     } else {
-        snprintf(err, errlen, "%s: cannot read grain datasets", path);
+        snprintf(err, errlen, "%s: cannot read grain datasets (radius [N], position [N][%d], "
+                 "species [N])", path, dim);
         pk_particles_free(p);
     }
     free(pos);

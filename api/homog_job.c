@@ -279,8 +279,9 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
     return errs->n - before;
 }
 
-void pk_homog_check(json_t *inputs, pk_schema_errors *errs)
+void pk_homog_check(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs)
 {
+    (void)ctx; /* the RVE file is read by the run only */
     pk_homog_job job;
     if (pk_homog_job_from_json(inputs, &job, errs) == 0)
         pk_homog_job_free(&job);

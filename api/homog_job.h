@@ -6,6 +6,7 @@
 #include <jansson.h>
 #include <stddef.h>
 
+#include "check_ctx.h"
 #include "homog_bc.h"
 #include "json_schema.h"
 #include "progress.h"
@@ -52,7 +53,7 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
 void pk_homog_job_free(pk_homog_job *job);
 
 /* process table hooks (see process.h) */
-void pk_homog_check(json_t *inputs, pk_schema_errors *errs);
+void pk_homog_check(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
 int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_monitor *mon,
                  json_t **summary, char *err, size_t errlen);
 

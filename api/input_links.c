@@ -6,6 +6,8 @@
 typedef struct {
     void (*fn)(json_t *, const char *, const char *, void *);
     void *ctx;
+    const char *key;  /* the string member looked for */
+    int alone;        /* 1: only objects with no other member */
     size_t count;
     char ptr[256];
 } walker;
@@ -14,10 +16,10 @@ static void walk(walker *w, json_t *v)
 {
     size_t len = strlen(w->ptr);
     if (json_is_object(v)) {
-        json_t *href = json_object_get(v, "href");
-        if (json_is_string(href) && json_object_size(v) == 1) {
+        json_t *s = json_object_get(v, w->key);
+        if (json_is_string(s) && (!w->alone || json_object_size(v) == 1)) {
             w->count++;
-            w->fn(v, json_string_value(href), w->ptr, w->ctx);
+            w->fn(v, json_string_value(s), w->ptr, w->ctx);
             return;
         }
         const char *key;
@@ -58,7 +60,16 @@ size_t pk_input_links_each(json_t *inputs,
                            void (*fn)(json_t *link, const char *href, const char *pointer, void *ctx),
                            void *ctx)
 {
-    walker w = {.fn = fn, .ctx = ctx};
+    walker w = {.fn = fn, .ctx = ctx, .key = "href", .alone = 1};
+    walk(&w, inputs);
+    return w.count;
+}
+
+size_t pk_input_files_each(json_t *inputs,
+                           void (*fn)(json_t *obj, const char *file, const char *pointer, void *ctx),
+                           void *ctx)
+{
+    walker w = {.fn = fn, .ctx = ctx, .key = "file", .alone = 0};
     walk(&w, inputs);
     return w.count;
 }

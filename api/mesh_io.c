@@ -3,11 +3,14 @@
 #include "json_schema.h"
 
 #include <ctype.h>
+#include <errno.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "input_open.h"
 
 /* ---- a whitespace tokenizer with line numbers ('#' comments for TetGen) */
 typedef struct reader {
@@ -293,6 +296,10 @@ static int msh41_nodes(reader *r, raw_mesh *w, char *err, size_t errlen)
                 return -1;
             }
         }
+        if (dim < 0 || dim > 3) {
+            snprintf(err, errlen, "%s:%ld: entity dimension %lld", r->path, r->line + 1, dim);
+            return -1;
+        }
         int extra = par ? (int)dim : 0;
         for (long long i = 0; i < cnt; i++) {
             double *x = &w->x[3 * (first + (size_t)i)], u;
@@ -329,11 +336,9 @@ static int msh41_elements(reader *r, raw_mesh *w, size_t max_tets, char *err, si
 int pk_mesh_read_msh(const char *path, size_t max_tets, pk_mesh *m, char *err, size_t errlen)
 {
     reader r = {.path = path};
-    r.f = fopen(path, "r");
-    if (!r.f) {
-        snprintf(err, errlen, "%s: cannot open", path);
+    r.f = pk_input_fopen(path, 0, err, errlen);
+    if (!r.f)
         return -1;
-    }
     raw_mesh w = {0};
     int rc = -1, major = 0;
     double version = 0, ftype = 0, dsize = 0;
@@ -344,7 +349,6 @@ int pk_mesh_read_msh(const char *path, size_t max_tets, pk_mesh *m, char *err, s
     if (next_num(&r, &version, err, errlen) || next_num(&r, &ftype, err, errlen) ||
         next_num(&r, &dsize, err, errlen))
         goto out;
-    major = (int)version;
     if (ftype != 0) {
         snprintf(err, errlen, "%s: binary MSH is not supported (save as ASCII)", path);
         goto out;
@@ -353,6 +357,7 @@ int pk_mesh_read_msh(const char *path, size_t max_tets, pk_mesh *m, char *err, s
         snprintf(err, errlen, "%s: MSH version %g is not supported (2.2 or 4.1)", path, version);
         goto out;
     }
+    major = (int)version; /* in range now (a forged 2e11 would not fit an int) */
     if (msh_skip_section(&r, "$MeshFormat", err, errlen))
         goto out;
     int have_nodes = 0, have_elems = 0;
@@ -385,6 +390,9 @@ out:
     return rc;
 }
 
+/* Attributes per TetGen node or tet: far more than any mesh carries. */
+#define MAX_ATTRS 1000
+
 /* TetGen: <base>.node ("n 3 nattr nbm", then "i x y z attrs [bm]") and
  * <base>.ele ("n 4|10 nattr", then "i n1..n4 [...] attrs"); the first index
  * sets the base (0 or 1).  The first tet attribute is the region. */
@@ -399,17 +407,20 @@ int pk_mesh_read_tetgen(const char *path, size_t max_tets, pk_mesh *m, char *err
     int rc = -1;
     reader r = {.hash_comments = 1, .path = fn};
     snprintf(fn, sizeof fn, "%s.node", base);
-    r.f = fopen(fn, "r");
-    if (!r.f) {
-        snprintf(err, errlen, "%s: cannot open", fn);
+    r.f = pk_input_fopen(fn, 0, err, errlen);
+    if (!r.f)
         return -1;
-    }
     long long n, dim, nattr, nbm, idx;
     if (next_int(&r, &n, err, errlen) || next_int(&r, &dim, err, errlen) ||
         next_int(&r, &nattr, err, errlen) || next_int(&r, &nbm, err, errlen))
         goto out;
     if (dim != 3) {
         snprintf(err, errlen, "%s: dimension %lld, expected 3", fn, dim);
+        goto out;
+    }
+    if (nattr < 0 || nattr > MAX_ATTRS || nbm < 0 || nbm > 1) {
+        snprintf(err, errlen, "%s: %lld attributes and %lld boundary markers per node (at most %d "
+                 "and 1)", fn, nattr, nbm, MAX_ATTRS);
         goto out;
     }
     for (long long i = 0; i < n; i++) {
@@ -428,9 +439,8 @@ int pk_mesh_read_tetgen(const char *path, size_t max_tets, pk_mesh *m, char *err
     fclose(r.f);
     snprintf(fn, sizeof fn, "%s.ele", base);
     r.line = 0;
-    r.f = fopen(fn, "r");
+    r.f = pk_input_fopen(fn, 0, err, errlen);
     if (!r.f) {
-        snprintf(err, errlen, "%s: cannot open", fn);
         raw_free(&w);
         return -1;
     }
@@ -438,6 +448,10 @@ int pk_mesh_read_tetgen(const char *path, size_t max_tets, pk_mesh *m, char *err
     if (next_int(&r, &nt, err, errlen) || next_int(&r, &npt, err, errlen) ||
         next_int(&r, &nattr, err, errlen))
         goto out;
+    if (nattr < 0 || nattr > MAX_ATTRS) {
+        snprintf(err, errlen, "%s: %lld attributes per tet (at most %d)", fn, nattr, MAX_ATTRS);
+        goto out;
+    }
     if (npt != 4 && npt != 10) {
         snprintf(err, errlen, "%s: %lld nodes per tet, expected 4 or 10", fn, npt);
         goto out;
@@ -525,21 +539,25 @@ static int ends_with(const char *s, const char *suffix)
 }
 
 /* Gmsh by name (.msh) or by content ($MeshFormat first): uploaded files
- * (the service stores them under their SHA-256) have no extension. */
-static int is_gmsh(const char *file)
+ * (the service stores them under their SHA-256) have no extension.  Looks at
+ * the first 4 KiB only.  1 Gmsh, 2 a file but not Gmsh, 0 no such file (a
+ * TetGen base name), -1 with err when it cannot be read (e.g. not a regular
+ * file). */
+static int is_gmsh(const char *file, char *err, size_t errlen)
 {
     if (ends_with(file, ".msh"))
         return 1;
-    FILE *f = fopen(file, "r");
-    char line[64] = "";
-    int yes = 0;
-    if (f) {
-        while (fgets(line, sizeof line, f) && line[strspn(line, " \t\r\n")] == 0)
-            ;
-        yes = strncmp(line + strspn(line, " \t"), "$MeshFormat", 11) == 0;
-        fclose(f);
-    }
-    return yes;
+    FILE *f = pk_input_fopen(file, 0, err, errlen);
+    if (!f)
+        return errno == ENOENT ? 0 : -1;
+    char head[4096];
+    size_t n = fread(head, 1, sizeof head - 1, f);
+    fclose(f);
+    head[n] = 0;
+    size_t i = 0;
+    while (i < n && isspace((unsigned char)head[i]))
+        i++;
+    return n - i >= 11 && memcmp(head + i, "$MeshFormat", 11) == 0 ? 1 : 2;
 }
 
 int pk_mesh_from_json(json_t *j, size_t max_tets, pk_mesh *m, pk_mesh_report *rep, char *err,
@@ -547,10 +565,16 @@ int pk_mesh_from_json(json_t *j, size_t max_tets, pk_mesh *m, pk_mesh_report *re
 {
     const char *file = json_string_value(json_object_get(j, "file"));
     int rc;
-    if (file)
-        rc = is_gmsh(file) ? pk_mesh_read_msh(file, max_tets, m, err, errlen)
-                                     : pk_mesh_read_tetgen(file, max_tets, m, err, errlen);
-    else {
+    if (file) {
+        int gmsh = is_gmsh(file, err, errlen);
+        rc = gmsh < 0    ? -1
+             : gmsh == 1 ? pk_mesh_read_msh(file, max_tets, m, err, errlen)
+                         : pk_mesh_read_tetgen(file, max_tets, m, err, errlen);
+        if (rc != 0 && gmsh == 2 && !ends_with(file, ".node") && !ends_with(file, ".ele") &&
+            strstr(err, ".node: cannot open")) /* e.g. an upload that is no mesh */
+            snprintf(err, errlen, "%s: neither a Gmsh MSH file (no $MeshFormat at the start) nor "
+                     "the base name of a TetGen .node/.ele pair", file);
+    } else {
         if (max_tets && json_array_size(json_object_get(j, "tets")) > max_tets) {
             snprintf(err, errlen, "the mesh has %zu tets, over the limit of %zu",
                      json_array_size(json_object_get(j, "tets")), max_tets);

@@ -417,11 +417,12 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
     return errs->n - before;
 }
 
-void pk_pack_check(json_t *inputs, pk_schema_errors *errs)
+void pk_pack_check(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs)
 {
     pk_pack_job job;
     if (pk_pack_job_from_json(inputs, &job, errs) != 0)
         return;
+    job.service = ctx->service;
     pk_pack_plan plan;
     pk_pack_plan_make(&job, &plan, errs);
 }

@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "box.h"
+#include "check_ctx.h"
 #include "json_schema.h"
 #include "progress.h"
 #include "psd.h"
@@ -31,6 +32,8 @@ typedef struct pk_pack_job {
     uint64_t seed;
     size_t max_particles;
     double wall_time_s;          /* 0 = none */
+    int service;                 /* 1: checked for a request to the daemon (check_ctx.h): the
+                                  * placer's check opens no file and builds no mesh */
 } pk_pack_job;
 
 /* What the job implies before anything is drawn. */
@@ -53,7 +56,7 @@ size_t pk_pack_job_from_json(json_t *inputs, pk_pack_job *job, pk_schema_errors 
 size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_errors *errs);
 
 /* process table hooks (see process.h) */
-void pk_pack_check(json_t *inputs, pk_schema_errors *errs);
+void pk_pack_check(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
 int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_monitor *mon,
                 json_t **summary, char *err, size_t errlen);
 

@@ -119,7 +119,9 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
         *ptr = "/domain/box";
         *rule = "mesh";
         double h = 8 * 0.5 * (prm->r_min + prm->r_max) / KUHN_MEAN_EDGE; /* ℓ ≈ 8 r̄ */
-        if (pk_mesh_box(&S->mesh, job->box.L, h, max_tets, err, errlen) != 0)
+        /* a request's check only counts the tets: the worker meshes the box */
+        if (job->service ? pk_mesh_box_count(job->box.L, h, max_tets, err, errlen) != 0
+                         : pk_mesh_box(&S->mesh, job->box.L, h, max_tets, err, errlen) != 0)
             return -1;
     }
     prm->eps = opt_num(o, "epsilon", prm->eps);
@@ -146,6 +148,9 @@ static void check_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, pk_s
     tetfill_setup S;
     const char *ptr, *rule;
     char err[512];
+    json_t *mesh = json_object_get(json_object_get(job->inputs, "domain"), "mesh");
+    if (job->service && json_object_get(mesh, "file"))
+        return; /* a request to the daemon: the worker reads and checks the file */
     if (setup(job, &S, &ptr, &rule, err, sizeof err) != 0) {
         pk_schema_errors_add(errs, ptr, rule, "%s", err);
         return;

@@ -41,12 +41,13 @@ const pk_process *pk_process_find(const char *id)
     return NULL;
 }
 
-size_t pk_process_validate_inputs(const pk_process *p, json_t *inputs, pk_schema_errors *errs)
+size_t pk_process_validate_inputs(const pk_process *p, json_t *inputs, const pk_check_ctx *ctx,
+                                  pk_schema_errors *errs)
 {
     size_t before = errs->n;
     pk_schema_validate_embedded(p->inputs_schema, inputs, errs);
     if (errs->n == before && p->check)
-        p->check(inputs, errs);
+        p->check(inputs, ctx, errs);
     return errs->n - before;
 }
 
@@ -64,7 +65,8 @@ static void prefix_inputs(pk_schema_errors *errs, size_t from)
     }
 }
 
-size_t pk_job_validate(json_t *job, const pk_process **proc, pk_schema_errors *errs)
+size_t pk_job_validate(json_t *job, const pk_check_ctx *ctx, const pk_process **proc,
+                       pk_schema_errors *errs)
 {
     size_t before = errs->n;
     *proc = NULL;
@@ -77,7 +79,7 @@ size_t pk_job_validate(json_t *job, const pk_process **proc, pk_schema_errors *e
     }
     size_t mark = errs->n;
     if (pk_input_links_refuse(json_object_get(job, "inputs"), errs) == 0)
-        pk_process_validate_inputs(p, json_object_get(job, "inputs"), errs);
+        pk_process_validate_inputs(p, json_object_get(job, "inputs"), ctx, errs);
     prefix_inputs(errs, mark);
     if (errs->n == before)
         *proc = p;
@@ -111,8 +113,9 @@ int pk_job_run(json_t *job, const char *out_path, pk_monitor *mon, json_t **summ
                pk_schema_errors *errs, char *err, size_t errlen)
 {
     const pk_process *p;
+    const pk_check_ctx local = {.service = 0}; /* the job runs here: its files are read */
     *summary = NULL;
-    if (pk_job_validate(job, &p, errs) != 0) {
+    if (pk_job_validate(job, &local, &p, errs) != 0) {
         snprintf(err, errlen, "invalid job");
         return 1;
     }

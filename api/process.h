@@ -7,6 +7,7 @@
 #include <jansson.h>
 #include <stddef.h>
 
+#include "check_ctx.h"
 #include "json_schema.h"
 #include "progress.h"
 
@@ -17,7 +18,7 @@ typedef struct pk_process {
     const char *inputs_schema;  /* file name in schemas/ */
     /* Semantic checks beyond the schema (cross-field rules, feasibility).
      * Appends errors with JSON pointers relative to the inputs object. */
-    void (*check)(json_t *inputs, pk_schema_errors *errs);
+    void (*check)(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
     /* Run validated inputs, write the result file, return a summary object
      * (new reference) in *summary carrying the verdict (job_verdict.h).
      * 0 whenever a result file and a summary were written, failed verdict
@@ -32,12 +33,15 @@ extern const pk_process *const pk_processes[];
 const pk_process *pk_process_find(const char *id);
 
 /* Validate inputs for a process: schema first, then (only if the schema
- * passed) the semantic checks.  Returns the number of errors appended. */
-size_t pk_process_validate_inputs(const pk_process *p, json_t *inputs, pk_schema_errors *errs);
+ * passed) the semantic checks, in the context ctx (check_ctx.h).  Returns
+ * the number of errors appended. */
+size_t pk_process_validate_inputs(const pk_process *p, json_t *inputs, const pk_check_ctx *ctx,
+                                  pk_schema_errors *errs);
 
 /* A whole job file {"process", "inputs"}: envelope, then inputs.  On success
  * *proc is set.  Pointers in errors are relative to the job file root. */
-size_t pk_job_validate(json_t *job, const pk_process **proc, pk_schema_errors *errs);
+size_t pk_job_validate(json_t *job, const pk_check_ctx *ctx, const pk_process **proc,
+                       pk_schema_errors *errs);
 
 /* Threads of a job's parallel sections (core/par.h), for the jobs run by
  * this process from now on (default 1).  The results are the same bits

@@ -64,5 +64,7 @@ double pk_mesh_tet_volume(const pk_mesh *m, size_t e);
  * diagonal (Kuhn/Freudenthal split: conforming between cubes).  The mesh
  * is checked.  0 or -1. */
 int pk_mesh_box(pk_mesh *m, const double L[3], double h, size_t max_tets, char *err, size_t errlen);
+/* pk_mesh_box's limits without building the mesh (cheap): 0, or -1 with err. */
+int pk_mesh_box_count(const double L[3], double h, size_t max_tets, char *err, size_t errlen);
 
 #endif

@@ -4,9 +4,10 @@
 
 #include "mesh.h"
 
-int pk_mesh_box(pk_mesh *m, const double L[3], double h, size_t max_tets, char *err, size_t errlen)
+/* Cells per axis and the tet count; -1 with err beyond the limits. */
+static int box_cells(const double L[3], double h, size_t max_tets, int64_t n[3], double *tets,
+                     char *err, size_t errlen)
 {
-    int64_t n[3];
     double nt = 6;
     for (int k = 0; k < 3; k++) {
         if (!(L[k] > 0) || !(h > 0)) {
@@ -25,6 +26,23 @@ int pk_mesh_box(pk_mesh *m, const double L[3], double h, size_t max_tets, char *
         snprintf(err, errlen, "box mesh: %.0f tets, over the limit of %zu", nt, max_tets);
         return -1;
     }
+    *tets = nt;
+    return 0;
+}
+
+int pk_mesh_box_count(const double L[3], double h, size_t max_tets, char *err, size_t errlen)
+{
+    int64_t n[3];
+    double nt;
+    return box_cells(L, h, max_tets, n, &nt, err, errlen);
+}
+
+int pk_mesh_box(pk_mesh *m, const double L[3], double h, size_t max_tets, char *err, size_t errlen)
+{
+    int64_t n[3];
+    double nt;
+    if (box_cells(L, h, max_tets, n, &nt, err, errlen) != 0)
+        return -1;
     size_t nn = (size_t)((n[0] + 1) * (n[1] + 1) * (n[2] + 1));
     if (pk_mesh_alloc(m, nn, (size_t)nt) != 0) {
         snprintf(err, errlen, "box mesh: out of memory");

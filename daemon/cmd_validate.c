@@ -17,7 +17,8 @@ int cmd_validate(int argc, char **argv)
     pk_schema_errors errs = {0};
     const pk_process *proc;
     int rc = 0;
-    if (pk_job_validate(job, &proc, &errs) != 0) {
+    const pk_check_ctx local = {.service = 0}; /* the user's own machine: files are read */
+    if (pk_job_validate(job, &local, &proc, &errs) != 0) {
         cli_print_errors(argv[1], &errs);
         rc = 1;
     } else {

@@ -33,6 +33,8 @@ static const struct key {
     {"bind", K_STR, F(bind), 0, 0, "listen address"},
     {"port", K_INT, F(port), 0, 65535, "TCP port (0 = any free port)"},
     {"data", K_STR, F(data), 0, 0, "data directory"},
+    {"input_dir", K_STR, F(input_dir), 0, 0, "directory whose files jobs may name by path (unset: uploads and results only)"},
+    {"input_max_bytes", K_LONG, F(input_max_bytes), 1, 1e13, "largest file a job may name in input_dir"},
     {"workers", K_INT, F(workers), 0, 1024, "concurrent worker processes (0 = accept but run nothing)"},
     {"job_threads", K_INT, F(job_threads), 1, 64, "threads of each job's parallel sections (the results are the same for any)"},
     {"max_body_bytes", K_LONG, F(max_body_bytes), 1024, 1e12, "largest request body"},
@@ -75,6 +77,7 @@ void pk_config_defaults(pk_config *c)
     c->workers = n > 0 ? (int)n : 1;
     c->job_threads = 1; /* the workers take the cores already */
     c->max_body_bytes = 16L << 20;
+    c->input_max_bytes = 1L << 30;
     c->max_particles = 20000000;
     c->max_wall_time_s = 86400;
     c->max_queued = 1000;

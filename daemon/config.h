@@ -17,6 +17,8 @@ typedef struct pk_config {
     char public_url[256];     /* base of absolute links, e.g. https://packd.lab.example; "" = from Host */
     int port;
     char data[1024];          /* data directory: queue.db, jobs/, files/ */
+    char input_dir[1024];     /* "" = requests name no server path; else the directory they may name files in */
+    long input_max_bytes;     /* largest file a request may name in input_dir */
     int workers;              /* concurrent worker processes */
     int job_threads;          /* threads of each job's parallel sections (same results for any) */
     long max_body_bytes;      /* largest request body (POST /files, /execution) */

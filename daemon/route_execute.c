@@ -12,6 +12,7 @@
 #include "input_refs.h"
 #include "http_process_doc.h"
 #include "http_status_info.h"
+#include "input_confine.h"
 #include "log.h"
 #include "sha256.h"
 
@@ -75,12 +76,16 @@ enum MHD_Result route_execute(pk_req *r)
     pk_config cfg = pk_service_config(svc);
     pk_process_apply_caps(p, inputs, cfg.max_particles, cfg.max_wall_time_s);
     pk_schema_errors errs = {0};
-    /* {"href": "[<this service>]/files/…"} and {"href": "[…]/jobs/…/results/result"} → {"file": path} */
+    /* server paths first (refused, or confined to input_dir), then
+     * {"href": "[<this service>]/files/…"} and {"href": "[…]/jobs/…/results/result"}
+     * → {"file": path}; the checks open no file (check_ctx.h): the worker reads them */
     pk_own_links_as_paths(r, inputs);
     char data_abs[PATH_MAX];
     const char *data = realpath(cfg.data, data_abs) ? data_abs : cfg.data;
-    if (pk_resolve_input_refs(inputs, data, svc->q, pk_scope(r), &errs) > 0 ||
-        pk_process_validate_inputs(p, inputs, &errs) > 0) {
+    const pk_check_ctx request = {.service = 1};
+    if (pk_input_files_confine(inputs, cfg.input_dir, cfg.input_max_bytes, &errs) > 0 ||
+        pk_resolve_input_refs(inputs, data, svc->q, pk_scope(r), &errs) > 0 ||
+        pk_process_validate_inputs(p, inputs, &request, &errs) > 0) {
         for (size_t i = 0; i < errs.n; i++) { /* pointers relative to the body */
             char ptr[sizeof errs.items[i].pointer + 8];
             snprintf(ptr, sizeof ptr, "/inputs%s", errs.items[i].pointer);

@@ -8,7 +8,7 @@ if ! command -v dpkg-query >/dev/null 2>&1 || ! command -v apt-get >/dev/null 2>
     echo "  libmicrohttpd jansson sqlite3 openssl(libcrypto) hdf5 (+ h5dump) suitesparse/cholmod openblas (serial) curl python3-jsonschema" >&2
     exit 0
 fi
-PKGS="build-essential pkg-config libmicrohttpd-dev libjansson-dev libsqlite3-dev libssl-dev libhdf5-dev hdf5-tools curl python3 python3-jsonschema libsuitesparse-dev libopenblas0-serial procps libcairo2-dev fonts-dejavu-core"
+PKGS="build-essential pkg-config libmicrohttpd-dev libjansson-dev libsqlite3-dev libssl-dev libhdf5-dev hdf5-tools curl python3 python3-jsonschema libsuitesparse-dev libopenblas0-serial procps libcairo2-dev fonts-dejavu-core clang libclang-rt-14-dev"
 # Optional: what bench/service.sh drives the daemon with (PACKD_BENCH_DEPS=1).
 [ "${PACKD_BENCH_DEPS:-0}" = 1 ] && PKGS="$PKGS wrk sqlite3"
 missing=""

@@ -1,0 +1,12 @@
+/* fuzz_gmsh.c — libFuzzer harness of the 'gmsh' target (targets.h). */
+#include "targets.h"
+
+FUZZ_SANITIZER_OPTIONS
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    fuzz_gmsh(data, size);
+    return 0;
+}
