@@ -1,6 +1,8 @@
 /* picture.c — the picture kinds of a result file (contract in picture.h). */
 #include "picture.h"
 
+#include <cairo.h>
+#include <fontconfig/fontconfig.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -62,4 +64,10 @@ int pk_picture_write_set(const char *h5_path, const char *dir, char *err, size_t
             snprintf(err, errlen, "%s", e);
     }
     return drawn;
+}
+
+void pk_picture_release(void)
+{
+    cairo_debug_reset_static_data();
+    FcFini();
 }

@@ -31,4 +31,8 @@ int pk_picture_write(const char *h5_path, pk_picture_kind kind, const char *out_
 #define PK_PICTURE_SVG_MAX_GRAINS 20000
 int pk_picture_write_set(const char *h5_path, const char *dir, char *err, size_t errlen);
 
+/* Release cairo's and fontconfig's process-wide caches (call once, when no
+ * more pictures follow): a process that drew text ends without leaks. */
+void pk_picture_release(void);
+
 #endif

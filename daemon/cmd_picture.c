@@ -34,7 +34,9 @@ int cmd_picture(int argc, char **argv)
     if (!in || !out || pk_picture_kind_parse(kind_name, &kind) != 0)
         return usage(stderr);
     char err[1024];
-    if (pk_picture_write(in, kind, out, err, sizeof err) != 0) {
+    int rc = pk_picture_write(in, kind, out, err, sizeof err);
+    pk_picture_release();
+    if (rc != 0) {
         fprintf(stderr, "packd picture: %s\n", err);
         return 2;
     }

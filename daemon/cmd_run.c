@@ -159,8 +159,11 @@ int cmd_run(int argc, char **argv)
             else
                 json_object_set_new(summary, "xdmf", json_string(xdmf_path));
         }
-        if (pictures_dir && pk_picture_write_set(out_path, pictures_dir, err, sizeof err) == 0)
-            fprintf(stderr, "packd run: no picture drawn: %s\n", err);
+        if (pictures_dir) {
+            if (pk_picture_write_set(out_path, pictures_dir, err, sizeof err) == 0)
+                fprintf(stderr, "packd run: no picture drawn: %s\n", err);
+            pk_picture_release();
+        }
         json_dumpf(summary, stdout, JSON_INDENT(2) | JSON_REAL_PRECISION(10));
         putchar('\n');
         status = rc == 2 ? 3 : 0;

@@ -15,6 +15,9 @@
 #include "pack_job.h"
 #include "process.h"
 
+/* checks as on the user's own machine (packd run / validate) */
+static const pk_check_ctx local = {0};
+
 /* Base jobs that hold every numeric field of the schema between them. */
 static const char *const bases[] = {
     "{\"dim\":2,\"domain\":{\"box\":{\"size\":[20,20],\"periodic\":[true,false]}},"
@@ -205,7 +208,7 @@ static void test_numeric_fields_walk(void)
         if (!base)
             continue;
         pk_schema_errors errs = {0};
-        CHECK_MSG(pk_process_validate_inputs(pk_process_find("pack"), base, &errs) == 0,
+        CHECK_MSG(pk_process_validate_inputs(pk_process_find("pack"), base, &local, &errs) == 0,
                   "base %zu invalid: %s %s", b, errs.n ? errs.items[0].pointer : "",
                   errs.n ? errs.items[0].message : "");
         pk_schema_errors_free(&errs);
@@ -220,7 +223,7 @@ static void test_numeric_fields_walk(void)
                 instance_leaves(job, "", "", mine, &m, CAP, NULL, NULL, 0);
                 set_leaf(&mine[i], json_real(values[v]));
                 pk_schema_errors e = {0};
-                pk_process_validate_inputs(pk_process_find("pack"), job, &e);
+                pk_process_validate_inputs(pk_process_find("pack"), job, &local, &e);
                 if (e.n) {
                     refusals++;
                     /* the field, one inside it or the object holding it

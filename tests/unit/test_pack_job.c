@@ -11,6 +11,9 @@
 #include "pack_placer.h"
 #include "process.h"
 
+/* checks as on the user's own machine (packd run / validate) */
+static const pk_check_ctx local = {0};
+
 static int plan_from(const char *inputs_json, pk_pack_plan *plan)
 {
     json_error_t e;
@@ -36,7 +39,7 @@ static int refused(const char *inputs_json, const char *ptr, const char *rule)
     if (!in)
         return 0;
     pk_schema_errors errs = {0};
-    pk_process_validate_inputs(pk_process_find("pack"), in, &errs);
+    pk_process_validate_inputs(pk_process_find("pack"), in, &local, &errs);
     int hit = 0;
     for (size_t i = 0; i < errs.n; i++) {
         if (!strcmp(errs.items[i].pointer, ptr) && !strcmp(errs.items[i].rule, rule))
