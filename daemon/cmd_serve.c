@@ -31,6 +31,12 @@ static int usage(FILE *f)
     return f == stderr ? 64 : 0;
 }
 
+void cmd_serve_help(const char *name, FILE *f)
+{
+    (void)name;
+    usage(f);
+}
+
 static int ensure_dir(const char *path)
 {
     return mkdir(path, 0750) == 0 || errno == EEXIST ? 0 : -1;

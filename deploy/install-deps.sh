@@ -8,7 +8,7 @@ if ! command -v dpkg-query >/dev/null 2>&1 || ! command -v apt-get >/dev/null 2>
     echo "  libmicrohttpd jansson sqlite3 hdf5 (+ h5dump) suitesparse/cholmod openblas (serial) curl python3-jsonschema" >&2
     exit 0
 fi
-PKGS="build-essential pkg-config libmicrohttpd-dev libjansson-dev libsqlite3-dev libhdf5-dev hdf5-tools curl python3 python3-jsonschema libsuitesparse-dev libopenblas0-serial procps"
+PKGS="build-essential pkg-config libmicrohttpd-dev libcurl4-openssl-dev libssl-dev libjansson-dev libsqlite3-dev libhdf5-dev hdf5-tools curl python3 python3-jsonschema libsuitesparse-dev libopenblas0-serial procps"
 missing=""
 for p in $PKGS; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
