@@ -20,6 +20,7 @@
 #include "http.h"
 #include "log.h"
 #include "queue.h"
+#include "sd_notify.h"
 #include "supervisor.h"
 
 static int usage(FILE *f)
@@ -134,18 +135,22 @@ int cmd_serve(int argc, char **argv)
     pk_log(PK_LOG_INFO, "listening", "{s:s,s:i,s:s,s:i,s:s,s:i}", "bind", svc.cfg.bind, "port", port,
            "data", svc.cfg.data, "workers", svc.cfg.workers, "version", PACKD_VERSION, "pid",
            (int)getpid());
+    pk_sd_notify("READY=1"); /* Type=notify: systemd starts dependants now */
 
     for (;;) {
         int sig = 0;
         if (sigwait(&set, &sig) != 0)
             continue;
         if (sig == SIGHUP) {
+            pk_sd_notify("RELOADING=1");
             reload(&svc, argc, argv);
+            pk_sd_notify("READY=1");
             continue;
         }
         break;
     }
     pk_config cfg = pk_service_config(&svc);
+    pk_sd_notify("STOPPING=1");
     __atomic_store_n(&svc.draining, 1, __ATOMIC_RELAXED);
     pk_log(PK_LOG_INFO, "stopping: running jobs get the grace period", "{s:f,s:i}", "grace_s",
            cfg.grace_s, "running", pk_supervisor_busy(svc.sup));
