@@ -25,7 +25,8 @@ void pk_reply_free(pk_reply *r);
 /* The body parsed as JSON (new reference), NULL if it is not JSON. */
 json_t *pk_reply_json(const pk_reply *r);
 
-/* One request; path starts with '/' (or is an absolute http(s) URL).  body
+/* One request; path starts with '/' (or is an absolute http(s) URL, used as
+ * it is).  body
  * may be NULL; when set it is sent as application/json.  Returns 0 when an
  * HTTP answer came (any status), -1 on a transport error (r->error). */
 int pk_client_request(const pk_client *c, const char *method, const char *path, const char *body,

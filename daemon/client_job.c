@@ -179,10 +179,27 @@ json_t *pk_client_wait(const pk_client *c, const char *id, int quiet)
 
 /* ------------------------------------------------------------- results */
 
+/* Where to fetch a link from: an absolute href under the server's URL as it
+ * is; another absolute href (a service naming its public URL while the user
+ * reaches it another way) by its path from the server the user chose, so
+ * the token goes nowhere else. */
+static const char *link_path(const pk_client *c, const char *href)
+{
+    size_t n = strlen(c->server);
+    while (n && c->server[n - 1] == '/')
+        n--;
+    const char *p = strstr(href, "://");
+    if (!p || (!strncmp(href, c->server, n) && (href[n] == '/' || !href[n])))
+        return href;
+    p = strchr(p + 3, '/');
+    return p ? p : "/";
+}
+
 /* Download href to out via out.part, verify, rename.  0, or 2. */
 static int download_verified(const pk_client *c, const char *href, const char *out,
                              const char *declared, json_t *info)
 {
+    href = link_path(c, href);
     char part[4200], hex[65], err[400];
     snprintf(part, sizeof part, "%s.part", out);
     pk_reply r;

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """fake_service.py PORTFILE LOGFILE — a stand-in packd service on 127.0.0.1
 for the client's failure paths (test_client.sh): results whose bytes do not
-match their SHA-256, a download cut short, a failed job with a partial file.
+match their SHA-256, a download cut short, a failed job with a partial file,
+a result link naming another host.
 Writes its port to PORTFILE and each request's Authorization header to
 LOGFILE."""
 import hashlib
@@ -36,8 +37,10 @@ class Handler(http.server.BaseHTTPRequestHandler):
                    "detail": "ran out of wall time", "jobID": job, "jobStatus": "failed",
                    "partial_result": {"href": "/jobs/failed/results/result", "sha256": SHA}}
             return self.reply(422, json.dumps(doc).encode(), "application/problem+json")
-        if parts[-1] == "results" and job in ("good", "tampered", "short", "badheader"):
-            doc = {"result": {"href": "/jobs/%s/results/result" % job, "sha256": SHA,
+        if parts[-1] == "results" and job in ("good", "tampered", "short", "badheader", "abs"):
+            # "abs": a public URL the client does not use (a proxy's name)
+            base = "http://public.invalid:9" if job == "abs" else ""
+            doc = {"result": {"href": base + "/jobs/%s/results/result" % job, "sha256": SHA,
                               "size": len(BODY)}, "summary": {"value": {"fake": True}}}
             return self.reply(200, json.dumps(doc).encode())
         if parts[-1] == "result":

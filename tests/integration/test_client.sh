@@ -67,6 +67,8 @@ F="http://127.0.0.1:$(cat "$T/fake.port")"
 PACKD_TOKEN=secret-t "$PACKD" fetch good -o "$T/good.bin" --server "$F" >/dev/null 2>&1
 check fake_good_exit_0 test $? = 0
 check token_sent_as_bearer grep -q '^/jobs/good/results/result Bearer secret-t$' "$T/fake.log"
+"$PACKD" fetch abs -o "$T/abs.bin" --server "$F" --token t2 >/dev/null 2>&1
+check absolute_link_fetched_from_server sh -c "[ -s '$T/abs.bin' ] && grep -q '^/jobs/abs/results/result Bearer t2$' '$T/fake.log'"
 for bad in tampered short badheader; do
     "$PACKD" fetch $bad -o "$T/$bad.bin" --server "$F" --token x >/dev/null 2>"$T/$bad.err"
     check "${bad}_download_exit_2" test $? = 2
