@@ -1,7 +1,8 @@
 /* cmd_backup.c — `packd backup FILE [--data DIR | --config F]`: an online
  * copy of the service's queue database (jobs, events, counters, tokens) with
- * SQLite's backup API, safe while the daemon runs: the copy is taken in steps
- * between the daemon's transactions, written to FILE.tmp, checked with
+ * SQLite's backup API, safe while the daemon runs: the copy is one read
+ * transaction (WAL: the daemon keeps writing meanwhile, the copy is the
+ * snapshot at its start), written to FILE.tmp, checked with
  * PRAGMA integrity_check and renamed to FILE.  Result files (DATA/jobs/) are
  * plain files: copy them with any file tool (docs/operations.md). */
 #include <sqlite3.h>
@@ -33,8 +34,9 @@ static long long scalar(sqlite3 *db, const char *sql)
     return v;
 }
 
-/* Copy src into dst in steps of 256 pages; a step that meets the daemon's
- * write lock waits and retries. */
+/* Copy src into dst in one step: a step restarts when another connection
+ * writes between steps, one step reads a single snapshot.  A busy database
+ * (a checkpoint, a recovery) is waited for and retried. */
 static int copy(sqlite3 *src, sqlite3 *dst, int *pages, char *err, size_t errlen)
 {
     sqlite3_backup *b = sqlite3_backup_init(dst, "main", src, "main");
@@ -43,7 +45,7 @@ static int copy(sqlite3 *src, sqlite3 *dst, int *pages, char *err, size_t errlen
         return -1;
     }
     int rc, waits = 0;
-    while ((rc = sqlite3_backup_step(b, 256)) == SQLITE_OK || rc == SQLITE_BUSY || rc == SQLITE_LOCKED) {
+    while ((rc = sqlite3_backup_step(b, -1)) == SQLITE_OK || rc == SQLITE_BUSY || rc == SQLITE_LOCKED) {
         if (rc != SQLITE_OK) {
             if (++waits > 600) /* 30 s */
                 break;
