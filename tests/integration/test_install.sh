@@ -55,6 +55,15 @@ check backup_exit_0 test $? = 0
 check backup_reports_ok sh -c "grep -q '\"integrity\": \"ok\"' '$T/backup.json' && grep -q '\"jobs\": 1' '$T/backup.json'"
 check backup_integrity_check test "$(python3 -c "import sqlite3,sys; print(sqlite3.connect(sys.argv[1]).execute('PRAGMA integrity_check').fetchone()[0])" "$T/backup.db")" = ok
 check backup_is_one_file test ! -e "$T/backup.db-wal" -a ! -e "$T/backup.db.tmp"
+# and while the daemon writes (three submissions at once)
+pids=""
+for k in 1 2 3; do
+    c -o /dev/null -H 'Content-Type: application/json' --data-binary @"$T/fast.json" "$B/processes/pack/execution" &
+    pids="$pids $!"
+done
+"$P" backup "$T/busy.db" --data "$T/state" >"$T/busy.json"
+check backup_while_writing sh -c "grep -q '\"integrity\": \"ok\"' '$T/busy.json'"
+for p in $pids; do wait "$p"; done
 tar -C "$T/state" -czf "$T/files.tgz" jobs
 "$P" backup "$T/nowhere.db" --data "$T/missing" 2>/dev/null
 check backup_missing_database_fails test $? = 2
