@@ -6,6 +6,12 @@
 #include <time.h>
 #include <unistd.h>
 
+const char *pk_doc_str(const json_t *doc, const char *key)
+{
+    const char *s = json_string_value(json_object_get(doc, key));
+    return s ? s : "";
+}
+
 int pk_client_report(const char *cmd, const pk_reply *r)
 {
     if (r->status == 0) {
@@ -24,7 +30,7 @@ int pk_client_report(const char *cmd, const pk_reply *r)
             const char *ptr = json_string_value(json_object_get(e, "pointer"));
             const char *rule = json_string_value(json_object_get(e, "rule"));
             fprintf(stderr, "  %s: %s%s%s%s\n", ptr && *ptr ? ptr : "/",
-                    json_string_value(json_object_get(e, "message")), rule ? " (rule " : "",
+                    pk_doc_str(e, "message"), rule ? " (rule " : "",
                     rule ? rule : "", rule ? ")" : "");
         }
     } else {
@@ -108,7 +114,7 @@ static int on_event(const char *event, const char *data, const char *id, void *c
         if (json_is_number(fr))
             f->percent = (int)(100 * json_number_value(fr));
         int n = snprintf(f->detail, sizeof f->detail, "%s",
-                         json_string_value(json_object_get(d, "stage")) ?: "");
+                         pk_doc_str(d, "stage"));
         if (json_is_number(json_object_get(d, "phi")) && n < (int)sizeof f->detail)
             n += snprintf(f->detail + n, sizeof f->detail - n, "  phi %.4f",
                           json_number_value(json_object_get(d, "phi")));
@@ -161,7 +167,7 @@ json_t *pk_client_wait(const pk_client *c, const char *id, int quiet)
                 f.percent = (int)json_integer_value(json_object_get(doc, "progress"));
             if (is_final(st)) {
                 snprintf(f.detail, sizeof f.detail, "%s",
-                         json_string_value(json_object_get(doc, "message")) ?: "");
+                         pk_doc_str(doc, "message"));
                 if (changed || f.tty)
                     show(&f, 1);
                 break;
@@ -262,7 +268,8 @@ int pk_client_fetch(const pk_client *c, const char *id, const char *out, json_t 
         if (href && download_verified(c, href, out, json_string_value(json_object_get(part, "sha256")),
                                       info) == 0)
             fprintf(stderr, "packd fetch: partial result of the failed job in %s\n", out);
-        json_object_set(info, "summary", json_object_get(doc, "summary") ?: json_null());
+        if (json_object_get(doc, "summary"))
+            json_object_set(info, "summary", json_object_get(doc, "summary"));
         rc = 3;
     } else {
         rc = pk_client_report("fetch", &r);

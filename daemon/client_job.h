@@ -10,6 +10,9 @@
 
 #include "client_http.h"
 
+/* A string member of a document, "" when absent. */
+const char *pk_doc_str(const json_t *doc, const char *key);
+
 /* Print an answer that is not a success to stderr (a problem document's
  * title, detail and each error's pointer and message; else the raw body)
  * and return its exit status: 2 for no answer or 5xx, 1 otherwise. */

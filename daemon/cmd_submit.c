@@ -77,7 +77,7 @@ int cmd_submit(int argc, char **argv)
             rc = frc;
     } else if (rc == 3) {
         fprintf(stderr, "packd submit: job %s %s: %s\n", jid, st,
-                json_string_value(json_object_get(fin, "message")));
+                pk_doc_str(fin, "message"));
     }
     json_decref(fin);
     json_dumpf(out, stdout, JSON_INDENT(2) | JSON_REAL_PRECISION(10));
