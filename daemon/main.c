@@ -27,11 +27,11 @@ static const struct {
     {"submit", cmd_submit, "submit JOB.json [--server URL] [--token T] [--wait] [-o OUT.h5]\n"
                            "                                                    submit a job to a service (-o: wait, download, verify)",
      pk_client_help},
-    {"jobs", cmd_jobs, "jobs [--server URL] [--status S] [--limit N]     list a service's jobs", pk_client_help},
-    {"cancel", cmd_cancel, "cancel ID [--server URL]                         dismiss a job", pk_client_help},
-    {"fetch", cmd_fetch, "fetch ID -o OUT.h5 [--server URL]               download a result, verify its SHA-256",
+    {"jobs", cmd_jobs, "jobs [--server URL] [--status S]            list a service's jobs", pk_client_help},
+    {"cancel", cmd_cancel, "cancel ID [--server URL]                    dismiss a job", pk_client_help},
+    {"fetch", cmd_fetch, "fetch ID -o OUT.h5 [--server URL]           download a result, verify its SHA-256",
      pk_client_help},
-    {"backup", cmd_backup, "backup FILE [--data DIR | --config F]            online copy of the service's database",
+    {"backup", cmd_backup, "backup FILE [--data DIR | --config F]       online copy of the service's database",
      cmd_backup_help},
 };
 
