@@ -24,7 +24,7 @@ ALIGN   ?= -falign-functions=64
 SAN     ?=
 VERSION := $(shell cat VERSION 2>/dev/null || echo 0.0.0)
 
-PKGS    := hdf5 jansson libmicrohttpd sqlite3 libcurl libcrypto
+PKGS    := hdf5 jansson libmicrohttpd sqlite3 libcrypto cairo libcurl
 DEPS_OK := $(BUILD)/.deps-ok
 
 WARN    := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wno-unused-parameter

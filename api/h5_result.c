@@ -211,6 +211,16 @@ int pk_h5_write_particles(pk_h5 *h, const pk_box *b, const pk_particles *p, cons
     hsize_t d1 = (hsize_t)n;
     rc |= write_dataset(grains, H5P_DEFAULT, "radius", H5T_NATIVE_DOUBLE, 1, &d1, p->r, unit);
     rc |= write_dataset(grains, H5P_DEFAULT, "species", H5T_NATIVE_INT32, 1, &d1, p->species, NULL);
+    /* H5MD's id element (0..N-1): also the Polyvertex connectivity of the XDMF sidecar */
+    int64_t *id = malloc((n ? n : 1) * sizeof *id);
+    if (!id) {
+        H5Gclose(grains);
+        return -1;
+    }
+    for (size_t i = 0; i < n; i++)
+        id[i] = (int64_t)i;
+    rc |= write_dataset(grains, H5P_DEFAULT, "id", H5T_NATIVE_INT64, 1, &d1, id, NULL);
+    free(id);
     H5Gclose(grains);
     return rc ? -1 : 0;
 }

@@ -5,6 +5,7 @@
  *   /particles/grains/position  [N][dim] float64, attr unit
  *   /particles/grains/radius    [N] float64, attr unit      (packd element; H5MD has none)
  *   /particles/grains/species   [N] int32 (size class, 0 = coarsest)
+ *   /particles/grains/id        [N] int64 (H5MD identity 0..N-1)
  *   /parameters                 attrs job (JSON text), process, seed, packd_version
  *   /observables/<name>         scalars, arrays and strings written by the process
  *

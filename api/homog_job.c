@@ -91,8 +91,8 @@ static void plane_of(json_t *load, int *i, int *j)
 static int shear_path(pk_homog_job *job, size_t *cap, json_t *load, int cyclic)
 {
     double lc = num(load, "precompression", 0.01);
-    int pre = (int)num(load, "pre_steps", 10);
-    int steps = (int)num(load, "steps", 1);
+    int pre = (int)pk_json_int_or(load, "pre_steps", 10);
+    int steps = (int)pk_json_int_or(load, "steps", 1);
     int pi, pj;
     plane_of(load, &pi, &pj);
     double F[9];
@@ -147,14 +147,14 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
     json_t *dr = json_object_get(inputs, "relaxation");
     job->tol = num(dr, "tol", 1e-8);
     job->abs_tol = num(dr, "abs_tol", 1e-13);
-    job->max_iter = (size_t)num(dr, "max_iter", 1e6);
-    job->lanczos_steps = (int)num(dr, "lanczos_steps", 40);
-    job->refresh = (size_t)num(dr, "refresh", 200);
+    job->max_iter = (size_t)pk_json_int_or(dr, "max_iter", 1000000);
+    job->lanczos_steps = (int)pk_json_int_or(dr, "lanczos_steps", 40);
+    job->refresh = (size_t)pk_json_int_or(dr, "refresh", 200);
     const char *pred = json_string_value(json_object_get(dr, "predictor"));
     job->affine_predictor = !(pred && !strcmp(pred, "none"));
     const char *solver = json_string_value(json_object_get(dr, "solver"));
     job->newton = solver && !strcmp(solver, "newton");
-    job->newton_max_iter = (size_t)num(dr, "newton_max_iter", 50);
+    job->newton_max_iter = (size_t)pk_json_int_or(dr, "newton_max_iter", 50);
     job->tangent = json_is_true(json_object_get(inputs, "tangent"));
     json_t *out = json_object_get(inputs, "output");
     job->out_micro = json_is_true(json_object_get(out, "micro_state"));
@@ -195,7 +195,7 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
             rc |= push_F(job, &cap, F);
         }
     } else if (type && !strcmp(type, "uniaxial_compression")) {
-        int axis = (int)num(load, "axis", 1) - 1, steps = (int)num(load, "steps", 1);
+        int axis = (int)pk_json_int_or(load, "axis", 1) - 1, steps = (int)pk_json_int_or(load, "steps", 1);
         double lam = num(load, "strain", 0.3);
         if (axis == 2)
             job->fdim = 3;

@@ -1,9 +1,12 @@
+/* http_process_doc.c — OGC process summaries and descriptions from the
+ * process table and its embedded schemas (contract in http_process_doc.h). */
 #include "http_process_doc.h"
 
 #include <stdio.h>
 #include <string.h>
 
 #include "http_status_info.h"
+#include "json_schema.h"
 
 #ifndef PACKD_VERSION
 #define PACKD_VERSION "0.0.0"
@@ -23,6 +26,46 @@ json_t *pk_process_summary(const pk_process *p)
                      "application/json");
 }
 
+/* Add to `into` every definition of `defs` that node refers to as
+ * "#/$defs/<name>", and theirs in turn. */
+static void collect_defs(json_t *node, json_t *defs, json_t *into)
+{
+    if (json_is_array(node)) {
+        size_t i;
+        json_t *e;
+        json_array_foreach(node, i, e) collect_defs(e, defs, into);
+        return;
+    }
+    const char *key;
+    json_t *v;
+    json_object_foreach(node, key, v) {
+        const char *ref = json_string_value(v);
+        if (!strcmp(key, "$ref") && ref && !strncmp(ref, "#/$defs/", 8)) {
+            json_t *def = json_object_get(defs, ref + 8);
+            if (def && !json_object_get(into, ref + 8)) {
+                json_object_set(into, ref + 8, def);
+                collect_defs(def, defs, into);
+            }
+        } else if (json_is_object(v) || json_is_array(v)) {
+            collect_defs(v, defs, into);
+        }
+    }
+}
+
+/* An input's schema that a client can use alone: a copy carrying the $defs
+ * its "#/$defs/…" references need, so they resolve with the input's schema
+ * as the document root. */
+static json_t *standalone_schema(json_t *ps, json_t *defs)
+{
+    json_t *need = json_object();
+    collect_defs(ps, defs, need);
+    json_t *out = json_deep_copy(ps);
+    if (json_object_size(need))
+        json_object_set(out, "$defs", need);
+    json_decref(need);
+    return out;
+}
+
 json_t *pk_process_description(const pk_process *p)
 {
     json_t *d = pk_process_summary(p);
@@ -40,8 +83,8 @@ json_t *pk_process_description(const pk_process *p)
             if (json_is_string(r) && !strcmp(json_string_value(r), name))
                 req = 1;
         }
-        json_t *in = json_pack("{s:s,s:i,s:i,s:O}", "title", name, "minOccurs", req, "maxOccurs", 1,
-                               "schema", ps);
+        json_t *in = json_pack("{s:s,s:i,s:i,s:o}", "title", name, "minOccurs", req, "maxOccurs", 1,
+                               "schema", standalone_schema(ps, json_object_get(schema, "$defs")));
         json_t *desc = json_object_get(ps, "description");
         if (json_is_string(desc))
             json_object_set(in, "description", desc);
@@ -80,7 +123,8 @@ void pk_process_apply_caps(const pk_process *p, json_t *inputs, long max_particl
     if (!json_is_object(limits))
         return; /* the schema will say so */
     json_t *np = json_object_get(limits, "max_particles");
-    if (has_np && (!np || (json_is_integer(np) && json_integer_value(np) > max_particles)))
+    long long np_v; /* 5e7 is an integer too (pk_json_int) */
+    if (has_np && (!np || (pk_json_int(np, &np_v) == 0 && np_v > max_particles)))
         json_object_set_new(limits, "max_particles", json_integer(max_particles));
     json_t *wt = json_object_get(limits, "wall_time_s");
     if (has_wt && (!wt || (json_is_number(wt) && json_number_value(wt) > max_wall_time_s)))

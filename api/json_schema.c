@@ -213,6 +213,27 @@ static int is_integral(const json_t *v)
     return isfinite(d) && floor(d) == d;
 }
 
+int pk_json_int(const json_t *v, long long *out)
+{
+    if (json_is_integer(v)) {
+        *out = (long long)json_integer_value(v);
+        return 0;
+    }
+    if (!is_integral(v))
+        return -1;
+    double d = json_real_value(v);
+    if (fabs(d) > 9007199254740992.0) /* 2^53: beyond it not every integer is exact */
+        return -1;
+    *out = (long long)d;
+    return 0;
+}
+
+long long pk_json_int_or(const json_t *obj, const char *key, long long dflt)
+{
+    long long v;
+    return pk_json_int(json_object_get(obj, key), &v) == 0 ? v : dflt;
+}
+
 /* A non-negative integer keyword value (3 or 3.0). */
 static int get_count(const json_t *v, size_t *out)
 {

@@ -59,6 +59,17 @@ size_t pk_schema_validate_embedded(const char *schema_file, json_t *instance,
 /* The embedded schema parsed once and cached (borrowed reference), or NULL. */
 json_t *pk_schema_get(const char *schema_file);
 
+/* An integer field as JSON Schema defines one ("type": "integer" accepts 500.0
+ * and 1e3): a JSON integer, or a real with an integral value of magnitude
+ * <= 2^53 (exactly representable).  0 with *out set, else -1 (fraction,
+ * out of range, not a number).  Read every integer input through this:
+ * jansson's json_integer_value reads 0 for a real. */
+int pk_json_int(const json_t *v, long long *out);
+
+/* obj[key] through pk_json_int; dflt when absent or not an integer (inputs
+ * that passed their schema always are). */
+long long pk_json_int_or(const json_t *obj, const char *key, long long dflt);
+
 /* Render the errors as a JSON array of {"pointer","rule","message"} (new ref). */
 json_t *pk_schema_errors_json(const pk_schema_errors *e);
 

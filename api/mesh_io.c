@@ -1,5 +1,6 @@
 /* mesh_io.c — read tet meshes: inline JSON, Gmsh MSH 2.2 / 4.1 ASCII, TetGen. */
 #include "mesh_io.h"
+#include "json_schema.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -505,10 +506,14 @@ static int mesh_from_inline(json_t *j, pk_mesh *m, char *err, size_t errlen)
             return -1;
         }
         for (size_t k = 0; k < 4; k++) {
-            json_int_t v = json_integer_value(json_array_get(t, k));
+            long long v = -1; /* 7.0 is node 7 (pk_json_int) */
+            pk_json_int(json_array_get(t, k), &v);
             m->t[4 * e + k] = v >= 0 && v < INT32_MAX ? (int32_t)v : -1;
         }
-        m->region[e] = regions ? (int32_t)json_integer_value(json_array_get(regions, e)) : 0;
+        long long reg = 0;
+        if (regions)
+            pk_json_int(json_array_get(regions, e), &reg);
+        m->region[e] = (int32_t)reg;
     }
     return 0;
 }

@@ -5,10 +5,31 @@
 #include <stdio.h>
 #include <string.h>
 
+/* + 0.0: a -0 in the job reads as +0 (no -0 in results or messages) */
 static double num(json_t *o, const char *key, double dflt)
 {
     json_t *v = json_object_get(o, key);
-    return json_is_number(v) ? json_number_value(v) : dflt;
+    return json_is_number(v) ? json_number_value(v) + 0.0 : dflt;
+}
+
+/* An integer field (pk_json_int: 500.0 is 500); a value that is no exact
+ * integer in [lo, hi] is an error naming the field (the schema's maxima
+ * normally catch it first). */
+static long long int_field(json_t *o, const char *key, const char *ptr, long long lo,
+                           long long hi, long long dflt, pk_schema_errors *errs)
+{
+    json_t *v = json_object_get(o, key);
+    long long x;
+    if (!v)
+        return dflt;
+    if (pk_json_int(v, &x) != 0 || x < lo || x > hi) {
+        char got[32];
+        snprintf(got, sizeof got, "%.17g", json_number_value(v));
+        pk_schema_errors_add(errs, ptr, "integer", "must be an integer in [%lld, %lld] (got %s)", lo,
+                             hi, got);
+        return dflt;
+    }
+    return x;
 }
 
 static int grading_from_json(json_t *g, pk_grading *out, int *default_discrete,
@@ -138,9 +159,7 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
 {
     size_t before = errs->n;
     memset(job, 0, sizeof *job);
-    job->dim = (int)json_integer_value(json_object_get(in, "dim"));
-    if (job->dim != 2 && job->dim != 3)
-        job->dim = (int)num(in, "dim", 3);
+    job->dim = (int)int_field(in, "dim", "/dim", 2, 3, 3, errs);
     const char *unit = json_string_value(json_object_get(in, "unit"));
     snprintf(job->unit, sizeof job->unit, "%s", unit ? unit : "mm");
 
@@ -195,8 +214,7 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
         const char *ref = json_string_value(json_object_get(phi, "refers_to"));
         job->phi_is_mix = ref && strcmp(ref, "mix") == 0;
     }
-    json_t *count = json_object_get(in, "count");
-    job->count = count ? (size_t)json_integer_value(count) : 0;
+    job->count = (size_t)int_field(in, "count", "/count", 1, PK_PACK_MAX_COUNT, 0, errs);
     job->delta_d = num(in, "delta_d", 0);
     const char *algo = json_string_value(json_object_get(in, "algorithm"));
     snprintf(job->algorithm, sizeof job->algorithm, "%s", algo ? algo : "rsa");
@@ -208,13 +226,50 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
                              "algorithm \"%s\" needs a box domain (a mesh needs \"tetfill\")",
                              job->algorithm);
     job->inputs = in;
-    job->seed = json_object_get(in, "seed") ? (uint64_t)json_integer_value(json_object_get(in, "seed")) : 1;
-    job->max_particles = (size_t)num(json_object_get(in, "limits"), "max_particles", 2e7);
+    job->seed = (uint64_t)int_field(in, "seed", "/seed", 0, 9007199254740991LL, 1, errs);
+    job->max_particles = (size_t)int_field(json_object_get(in, "limits"), "max_particles",
+                                           "/limits/max_particles", 1, PK_PACK_MAX_COUNT, 20000000,
+                                           errs);
     job->wall_time_s = num(json_object_get(in, "limits"), "wall_time_s", 0);
     return errs->n - before;
 }
 
 static double class_rep_measure(int dim, double d) { return pk_ball_measure(dim, 0.5 * d); }
+
+/* EDMD growing every diameter until jammed (relative growth) bounds the sizes
+ * only by φ <= 1 (core/edmd.c, spec §3.3d): the largest grain, shell included,
+ * may reach (d_max + Δd)·φ_s^(-1/dim), φ_s the shells' fraction at the target
+ * sizes.  On a periodic axis that must stay below L/2, or a pair could meet
+ * two images of each other (minimum image).  φ_s is bounded below by
+ * φ (1 + Δd/d_max)^dim, so the check errs on the refusing side. */
+static void check_periodic_jamming(const pk_pack_job *job, const pk_pack_plan *plan,
+                                   pk_schema_errors *errs)
+{
+    json_t *o = json_object_get(job->inputs, "edmd");
+    const char *until = json_string_value(json_object_get(o, "until"));
+    const char *growth = json_string_value(json_object_get(o, "growth"));
+    const char *maximize = json_string_value(json_object_get(o, "maximize"));
+    if (strcmp(job->algorithm, "edmd") != 0 || !until || strcmp(until, "jammed") != 0 ||
+        (growth && strcmp(growth, "shell") == 0) || (maximize && strcmp(maximize, "delta_d") == 0))
+        return;
+    const int dim = job->dim;
+    double phi_s = plan->phi_resolved * pow(1 + job->delta_d / plan->d_max, dim);
+    double reach = (plan->d_max + job->delta_d) * pow(fmax(phi_s, 1e-300), -1.0 / dim);
+    for (int k = 0; k < dim; k++) {
+        if (!job->box.periodic[k] || reach < 0.5 * job->box.L[k])
+            continue;
+        char ptr[64];
+        snprintf(ptr, sizeof ptr, "/domain/box/size/%d", k);
+        double need = pow((plan->d_max + job->delta_d) / (0.5 * job->box.L[k]), dim);
+        pk_schema_errors_add(errs, ptr, "periodicJamming",
+                             "until jammed the grains may grow to fill the box: the largest could "
+                             "reach d = %.4g, over half the periodic edge %g (minimum image); needs "
+                             "φ at the target sizes > %.3g (got %.3g): more grains, a walled axis "
+                             "or until: target",
+                             reach, job->box.L[k], need, phi_s);
+        return;
+    }
+}
 
 size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_errors *errs)
 {
@@ -281,8 +336,10 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
         double n1 = pk_grading_expected_count(&plan->resolved, dim, 1.0 / keep, NULL);
         mean_measure = n1 > 0 ? 1.0 / n1 : 0; /* unit resolved measure holds n1 grains */
     }
-    if (!(mean_measure > 0)) {
-        pk_schema_errors_add(errs, "/grading", "grading", "the grading holds no grains above d_min");
+    if (!(mean_measure > 0)) { /* material is left (keep > 0): the count overflowed */
+        pk_schema_errors_add(errs, "/d_min", "maxParticles",
+                             "the grading above d_min = %g holds too many grains to count: raise d_min",
+                             job->d_min);
         return errs->n - before;
     }
     if (job->count) {
@@ -306,7 +363,7 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
 
     if (plan->expected_n > (double)job->max_particles)
         pk_schema_errors_add(errs, job->count ? "/count" : "/phi", "maxParticles",
-                             "the job needs about %.0f grains, over the limit of %zu "
+                             "the job needs about %.4g grains, over the limit of %zu "
                              "(raise limits.max_particles or d_min)",
                              plan->expected_n, job->max_particles);
     if (job->has_phi && !(plan->phi_resolved < 1))
@@ -326,6 +383,27 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
                                  "a walled edge must hold the largest grain plus Δd = %g (got %g)",
                                  need, job->box.L[k]);
     }
+    if (errs->n == before) {
+        /* Grains kept Δd apart carry disjoint shells of diameter d + Δd inside
+         * the box widened by Δd/2 at each wall; their measure is at least
+         * φ (1 + Δd/d_max)^dim of the box: it must stay below 1 (the field
+         * named: Δd when the grains alone fit) */
+        double widened = 1;
+        for (int k = 0; k < dim; k++)
+            widened *= job->box.L[k] / (job->box.L[k] + (job->box.periodic[k] ? 0 : job->delta_d));
+        double phi_shell = plan->phi_resolved * widened * pow(1 + job->delta_d / plan->d_max, dim);
+        if (!(phi_shell < 1)) {
+            const char *ptr = plan->phi_resolved < 1 && job->delta_d > 0 ? "/delta_d"
+                              : job->count && !job->has_phi         ? "/count"
+                                                                    : "/phi/value";
+            pk_schema_errors_add(errs, ptr, "resolvedBelow1",
+                                 "the grains would fill φ = %.4g of the box (%.4g with their gaps "
+                                 "Δd): must be < 1",
+                                 plan->phi_resolved, phi_shell);
+        }
+    }
+    if (errs->n == before)
+        check_periodic_jamming(job, plan, errs);
     const pk_placer *placer = pk_placer_find(job->algorithm);
     if (placer && placer->check && errs->n == before)
         placer->check(job, plan, errs);

@@ -11,6 +11,10 @@
 #include "progress.h"
 #include "psd.h"
 
+/* Largest count / limits.max_particles (the schema's maximum, the daemon's
+ * max_particles cap). */
+#define PK_PACK_MAX_COUNT 1000000000000LL
+
 typedef struct pk_pack_job {
     int dim;
     pk_box box;

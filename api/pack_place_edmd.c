@@ -46,9 +46,9 @@ static void read_params(const pk_pack_job *job, const pk_pack_plan *plan, pk_edm
     json_t *jam = json_object_get(o, "jamming");
     prm->p_max = num(jam, "reduced_pressure", prm->p_max);
     prm->dphi_crit = num(jam, "delta_phi", prm->dphi_crit);
-    prm->dphi_events = (uint64_t)num(jam, "events", 0);
+    prm->dphi_events = (uint64_t)pk_json_int_or(jam, "events", 0);
     json_t *stall = json_object_get(o, "stall");
-    prm->stall_events = (uint64_t)num(stall, "events", (double)prm->stall_events);
+    prm->stall_events = (uint64_t)pk_json_int_or(stall, "events", (long long)prm->stall_events);
     prm->stall_growth = num(stall, "growth", prm->stall_growth);
     json_t *rs = json_object_get(o, "rescale");
     if (json_is_boolean(rs))
@@ -56,7 +56,7 @@ static void read_params(const pk_pack_job *job, const pk_pack_plan *plan, pk_edm
     prm->rescale_tol = num(o, "rescale_tolerance", prm->rescale_tol);
     prm->skin = num(o, "skin", prm->skin);
     prm->equal_masses = strcmp(str(o, "masses", "equal"), "equal") == 0;
-    prm->max_events = (uint64_t)num(o, "max_events", 0);
+    prm->max_events = (uint64_t)pk_json_int_or(o, "max_events", 0);
 }
 
 static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, pk_schema_errors *errs)
@@ -109,8 +109,11 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
         }
         rsa_seconds = rs.seconds;
         if (rs.reason == PK_STOP_CANCELLED || rs.reason == PK_STOP_WALL_TIME) {
+            for (size_t i = 0; i < p->n; i++)
+                p->r[i] *= prm.delta; /* the start's sizes: the grains as they were placed */
             *st = (pk_place_stats){.reason = rs.reason, .placed = rs.placed,
-                                   .requested = sz->n, .seconds = rs.seconds};
+                                   .requested = sz->n, .seconds = rs.seconds,
+                                   .short_delta_d = 1, .audit_delta_d = gap};
             return 0;
         }
         if (rs.placed < sz->n && !delta_default) {
@@ -137,19 +140,21 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     json_t *o = json_object_get(job->inputs, "edmd");
     double w = strcmp(str(o, "wall_gap", "half"), "none") == 0 ? 0.5 * job->delta_d : 0;
     pk_edmd_stats es;
-    if (pk_edmd_run_shell_in_walls(&job->box, w, p, &prm, mon, &es) != 0) {
+    /* the job's wall time covers the RSA start too (each stage restarts the
+     * monitor's clock) */
+    const double wall_limit = mon ? mon->wall_limit_s : 0;
+    if (wall_limit > 0)
+        mon->wall_limit_s = fmax(wall_limit - rsa_seconds, 1e-3);
+    int run_rc = pk_edmd_run_shell_in_walls(&job->box, w, p, &prm, mon, &es);
+    if (wall_limit > 0)
+        mon->wall_limit_s = wall_limit;
+    if (run_rc != 0) {
         snprintf(err, errlen, "EDMD failed (bad parameters, periodic box too small or out of memory)");
         return -1;
     }
-    if (prm.growth == PK_EDMD_GROW_SHELL && es.delta_d < job->delta_d * (1 - 1e-12)) {
-        /* the shell did not reach the job's Δd (jammed, stalled, cancelled):
-         * no result honours the job's minimum gap */
-        snprintf(err, errlen,
-                 "EDMD shell growth stopped (%s) at delta_d = %.6g before reaching %.6g; lower phi or "
-                 "delta_d, or try a smaller edmd.growth_rate",
-                 pk_edmd_criterion_name(es.criterion), es.delta_d, job->delta_d);
-        return -1;
-    }
+    /* the shell short of the job's Δd (jammed, stalled, out of time): the
+     * packing is kept, audited at the Δd reached and says so */
+    const int dd_short = prm.growth == PK_EDMD_GROW_SHELL && es.delta_d < job->delta_d * (1 - 1e-12);
     pk_contact_stats cs;
     /* contact: gap within 1e-6 (r_i + r_j) of Δd — far above round-off,
      * far below any gap left by a run that stopped short of jamming */
@@ -159,7 +164,18 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
         return -1;
     }
     *st = (pk_place_stats){.reason = es.reason, .placed = p->n, .requested = sz->n,
-                           .seconds = es.seconds, .walls_touch = w > 0};
+                           .seconds = es.seconds, .walls_touch = w > 0,
+                           .goal_reached = prm.until == PK_EDMD_UNTIL_JAMMED &&
+                                           es.reason == PK_STOP_JAMMED};
+    if (dd_short) {
+        st->short_delta_d = 1;
+        st->audit_delta_d = es.delta_d;
+        snprintf(st->warning, sizeof st->warning,
+                 "shell growth stopped (%s) at Δd = %.6g, short of the job's delta_d = %.6g: every "
+                 "gap of the result is >= %.6g; lower phi or delta_d, or try a smaller "
+                 "edmd.growth_rate",
+                 pk_edmd_criterion_name(es.criterion), es.delta_d, job->delta_d, es.delta_d);
+    }
     json_t *obs = json_object();
     json_object_set_new(obs, "phi_final", json_real(es.phi));
     json_object_set_new(obs, "phi_shell", json_real(es.phi_sim));

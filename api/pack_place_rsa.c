@@ -9,9 +9,8 @@ static int place_rsa(const pk_pack_job *job, const pk_pack_plan *plan, const pk_
 {
     (void)plan;
     json_t *opt = json_object_get(job->inputs, "rsa");
-    json_t *nf = json_object_get(opt, "max_failed_draws");
     pk_rsa_params prm = {.delta_d = job->delta_d,
-                         .max_failed_draws = nf ? (uint64_t)json_integer_value(nf) : 1000000,
+                         .max_failed_draws = (uint64_t)pk_json_int_or(opt, "max_failed_draws", 1000000),
                          .seed = job->seed};
     pk_rsa_stats rs;
     if (pk_rsa_place(&job->box, sz->d, sz->species, sz->n, &prm, mon, p, &rs) != 0) {

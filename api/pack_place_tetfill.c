@@ -60,7 +60,7 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
     json_t *o = json_object_get(job->inputs, "tetfill");
     json_t *dom = json_object_get(job->inputs, "domain");
     json_t *mesh = json_object_get(dom, "mesh");
-    size_t max_tets = (size_t)opt_num(o, "max_tets", 2e6);
+    size_t max_tets = (size_t)pk_json_int_or(o, "max_tets", 2000000);
     pk_tetfill_params *prm = &S->prm;
     pk_tetfill_defaults(prm);
     *rule = "tetfill";
@@ -103,6 +103,12 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
                      "r_max >= r_min");
             return -1;
         }
+        double lmin = fmin(job->box.L[0], fmin(job->box.L[1], job->box.L[2]));
+        if (!(2 * prm->r_max <= lmin)) {
+            snprintf(err, errlen, "r_max = %g: the largest sphere must fit in the box (2 r_max <= %g)",
+                     prm->r_max, lmin);
+            return -1;
+        }
         *ptr = "/domain/box/periodic";
         *rule = "walledBox";
         for (int k = 0; k < 3; k++)
@@ -117,16 +123,16 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
             return -1;
     }
     prm->eps = opt_num(o, "epsilon", prm->eps);
-    prm->z_min = (int)opt_num(o, "z_min", prm->z_min);
+    prm->z_min = (int)pk_json_int_or(o, "z_min", prm->z_min);
     const char *rule_name = json_string_value(json_object_get(o, "contact_rule"));
     if (rule_name && strcmp(rule_name, "touching") == 0)
         prm->contact_rule = PK_TETFILL_CONTACT_TOUCHING; /* the schema admits tangent|touching */
     prm->vertex_weight = opt_num(o, "vertex_weight", prm->vertex_weight);
     prm->skip_tet_loci = json_is_true(json_object_get(o, "loose"));
     prm->densify = !json_is_false(json_object_get(o, "densify"));
-    prm->neighbours = (int)opt_num(o, "neighbours", prm->neighbours);
-    prm->max_combos = (int)opt_num(o, "max_combos", prm->max_combos);
-    prm->max_passes = (int)opt_num(o, "max_passes", prm->max_passes);
+    prm->neighbours = (int)pk_json_int_or(o, "neighbours", prm->neighbours);
+    prm->max_combos = (int)pk_json_int_or(o, "max_combos", prm->max_combos);
+    prm->max_passes = (int)pk_json_int_or(o, "max_passes", prm->max_passes);
     prm->phi_target = job->has_phi ? job->phi : 0;
     prm->n_target = job->count;
     prm->seed = job->seed;

@@ -12,6 +12,7 @@
 
 #include <jansson.h>
 
+#include "gap_audit.h"
 #include "pack_job.h"
 #include "particles.h"
 #include "psd.h"
@@ -32,6 +33,13 @@ typedef struct pk_place_stats {
     double overlap_tol;   /* overlaps the placer allows by design (0 = hard grains) */
     int walls_touch;      /* 1: Δd between grains only, grains may touch the walls
                            * (edmd "wall_gap": "none", Titscher §6.3); 0: walls ≥ Δd/2 */
+    int goal_reached;     /* 1: the stop reason is what the job asked for (edmd
+                           * "until": "jammed" and jammed), though not PK_STOP_COMPLETE */
+    int short_delta_d;    /* 1: the placer could not reach the job's Δd (edmd shell
+                           * growth): the result is audited at audit_delta_d, the gap
+                           * it guarantees, and the placer's warning says so */
+    double audit_delta_d;
+    char warning[320];    /* a placer's own "stopped short" sentence, or "" */
     /* Bulk datasets too large for obs (e.g. the mesh): written under
      * /observables/<algorithm>/ by write_extra, released by free_extra. */
     void *extra;
@@ -51,6 +59,13 @@ typedef struct pk_placer {
     int (*place)(const pk_pack_job *job, const pk_pack_plan *plan, const pk_sizes *sz,
                  pk_monitor *mon, pk_particles *p, pk_place_stats *st, char *err, size_t errlen);
 } pk_placer;
+
+/* The verdict of a placed, audited packing (api/job_verdict.h): sets
+ * "complete" and adds "warnings" or "failure" to summary.  phi: the solid
+ * fraction reached; delta_d: the gap audited. */
+void pk_pack_verdict(const pk_pack_job *job, const pk_pack_plan *plan, const pk_place_stats *st,
+                     const pk_particles *p, const pk_gap_report *gap, double phi, double delta_d,
+                     json_t *summary);
 
 /* NULL-terminated table. */
 extern const pk_placer *const pk_placers[];

@@ -8,9 +8,16 @@
 #include <stddef.h>
 
 /* Write xdmf_path describing the grains of the result file h5_path; the XML
- * refers to the HDF5 file as `h5_ref` (the name it will have beside the XML,
- * e.g. its base name).  0 on success, -1 with err. */
+ * refers to the HDF5 file as `h5_ref` (e.g. a download's file name, when both
+ * will be saved side by side), or, when h5_ref is NULL, by the relative path
+ * from the XML's folder to h5_path.  The grains are a Polyvertex grid whose
+ * connectivity is /particles/grains/id (inline for files without it).
+ * 0 on success, -1 with err. */
 int pk_xdmf_write(const char *h5_path, const char *h5_ref, const char *xdmf_path, char *err,
                   size_t errlen);
+
+/* The path of h5_path relative to the folder of xdmf_path (both folders must
+ * exist), e.g. "../runs/a.h5".  0 on success. */
+int pk_xdmf_relative_ref(const char *h5_path, const char *xdmf_path, char *out, size_t n);
 
 #endif

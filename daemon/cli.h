@@ -8,6 +8,8 @@ int cmd_run(int argc, char **argv);
 int cmd_validate(int argc, char **argv);
 int cmd_inspect(int argc, char **argv);
 int cmd_serve(int argc, char **argv);
+int cmd_picture(int argc, char **argv);
+int cmd_token(int argc, char **argv);
 /* the client of a packd service (client_args.c: options; exit statuses
  * 0 done, 1 rejected, 2 transport or integrity error, 3 job failed) */
 int cmd_submit(int argc, char **argv);

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "picture.h"
 #include "process.h"
 #include "xdmf.h"
 
@@ -43,7 +44,7 @@ static int print_progress(const pk_progress *p, void *ctx)
 
 int cmd_run(int argc, char **argv)
 {
-    const char *job_path = NULL, *out_path = NULL, *xdmf_path = NULL;
+    const char *job_path = NULL, *out_path = NULL, *xdmf_path = NULL, *pictures_dir = NULL;
     int progress_fd = -1;
     /* the parallel sections' threads (the daemon passes its job_threads):
      * the results are the same for any number.  Default 1: on this 2-core
@@ -55,6 +56,8 @@ int cmd_run(int argc, char **argv)
             out_path = argv[++i];
         else if (!strcmp(argv[i], "--xdmf") && i + 1 < argc)
             xdmf_path = argv[++i];
+        else if (!strcmp(argv[i], "--pictures") && i + 1 < argc)
+            pictures_dir = argv[++i];
         else if (!strcmp(argv[i], "--progress"))
             progress_fd = 2;
         else if (!strcmp(argv[i], "--progress-fd") && i + 1 < argc)
@@ -78,7 +81,7 @@ int cmd_run(int argc, char **argv)
         }
     }
     if (!job_path || !out_path) {
-        fprintf(stderr, "usage: packd run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--progress] "
+        fprintf(stderr, "usage: packd run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--pictures DIR] [--progress] "
                         "[--progress-fd N] [--threads N]\n");
         return 64;
     }
@@ -109,7 +112,7 @@ int cmd_run(int argc, char **argv)
     if (rc == 1) {
         cli_print_errors(job_path, &errs);
         status = 1;
-    } else if (rc != 0) {
+    } else if (rc != 0 && rc != 2) { /* 2: failed, partial file and summary (below) */
         fprintf(stderr, "packd run: %s\n", err);
         status = 2;
     } else {
@@ -117,13 +120,14 @@ int cmd_run(int argc, char **argv)
             fprintf(stderr, "packd run: failed: %s (partial result in %s)\n", err, out_path);
         json_object_set_new(summary, "output", json_string(out_path));
         if (xdmf_path) {
-            /* the XML names the HDF5 file as it sits beside it */
-            const char *base = strrchr(out_path, '/');
-            if (pk_xdmf_write(out_path, base ? base + 1 : out_path, xdmf_path, err, sizeof err) != 0)
+            /* the XML names the HDF5 file by its path relative to the XML */
+            if (pk_xdmf_write(out_path, NULL, xdmf_path, err, sizeof err) != 0)
                 fprintf(stderr, "packd run: %s\n", err);
             else
                 json_object_set_new(summary, "xdmf", json_string(xdmf_path));
         }
+        if (pictures_dir && pk_picture_write_set(out_path, pictures_dir, err, sizeof err) == 0)
+            fprintf(stderr, "packd run: no picture drawn: %s\n", err);
         json_dumpf(summary, stdout, JSON_INDENT(2) | JSON_REAL_PRECISION(10));
         putchar('\n');
         status = rc == 2 ? 3 : 0;

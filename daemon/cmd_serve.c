@@ -15,6 +15,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "auth.h"
 #include "cli.h"
 #include "config.h"
 #include "http.h"
@@ -43,6 +44,19 @@ static int ensure_dir(const char *path)
     return mkdir(path, 0750) == 0 || errno == EEXIST ? 0 : -1;
 }
 
+/* Say plainly whether tokens are required, and why (at start and on reload). */
+static void log_auth(pk_service *svc)
+{
+    pk_config cfg = pk_service_config(svc);
+    const char *why;
+    int on = pk_auth_required(&cfg, &why);
+    pk_log(on ? PK_LOG_INFO : PK_LOG_WARN, on ? "auth is on" : "auth is off", "{s:s,s:s,s:s}", "why", why,
+           "bind", cfg.bind, "trusted_proxy", cfg.trusted_proxy[0] ? cfg.trusted_proxy : "none");
+    if (on && pk_tokens_count(svc->tokens) == 0)
+        pk_log(PK_LOG_WARN, "no tokens yet: every request but the public ones gets 401", "{s:s}", "hint",
+               "packd token add NAME --admin --data DATA");
+}
+
 static void reload(pk_service *svc, int argc, char **argv)
 {
     pk_config next;
@@ -61,6 +75,7 @@ static void reload(pk_service *svc, int argc, char **argv)
     pthread_mutex_unlock(&svc->mu);
     pk_log_set_level(next.log_level);
     pk_supervisor_configure(svc->sup, next.workers, next.max_wall_time_s, next.job_threads);
+    log_auth(svc);
     pk_log(PK_LOG_INFO, "configuration reloaded", "{s:s,s:i,s:s}", "file", next.config_file, "workers",
            next.workers, "log_level", pk_log_level_name(next.log_level));
 }
@@ -107,6 +122,12 @@ int cmd_serve(int argc, char **argv)
         pk_log(PK_LOG_ERROR, "cannot open the queue database", "{s:s}", "error", err);
         return 2;
     }
+    svc.tokens = pk_tokens_open(path, err, sizeof err);
+    if (!svc.tokens) {
+        pk_log(PK_LOG_ERROR, "cannot open the token store", "{s:s}", "error", err);
+        pk_queue_close(svc.q);
+        return 2;
+    }
     int failed = 0, requeued = pk_queue_recover(svc.q, svc.cfg.max_attempts, &failed);
     if (requeued || failed)
         pk_log(PK_LOG_WARN, "recovered jobs of a previous run", "{s:i,s:i}", "requeued", requeued,
@@ -129,12 +150,14 @@ int cmd_serve(int argc, char **argv)
         pk_log(PK_LOG_ERROR, "cannot start", "{s:s}", "error", svc.sup ? err : "supervisor thread");
         pk_supervisor_stop(svc.sup, 0);
         pk_supervisor_free(svc.sup);
+        pk_tokens_close(svc.tokens);
         pk_queue_close(svc.q);
         return 2;
     }
     pk_log(PK_LOG_INFO, "listening", "{s:s,s:i,s:s,s:i,s:s,s:i}", "bind", svc.cfg.bind, "port", port,
            "data", svc.cfg.data, "workers", svc.cfg.workers, "version", PACKD_VERSION, "pid",
            (int)getpid());
+    log_auth(&svc);
     pk_sd_notify("READY=1"); /* Type=notify: systemd starts dependants now */
 
     for (;;) {
@@ -159,6 +182,7 @@ int cmd_serve(int argc, char **argv)
     pk_queue_wake_all(svc.q);
     MHD_stop_daemon(http);
     pk_supervisor_free(svc.sup);
+    pk_tokens_close(svc.tokens);
     pk_queue_close(svc.q);
     close(lock);
     pk_log(PK_LOG_INFO, "stopped", NULL);

@@ -1,5 +1,6 @@
 #include "config.h"
 
+#include <arpa/inet.h>
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -8,7 +9,18 @@
 #include <string.h>
 #include <unistd.h>
 
-typedef enum { K_STR, K_INT, K_LONG, K_DOUBLE, K_LEVEL } key_type;
+typedef enum { K_STR, K_INT, K_LONG, K_DOUBLE, K_LEVEL, K_AUTH, K_ADDR } key_type;
+
+/* Keys whose value is one of some names (stored as the enum's int). */
+static const char *const level_names[] = {"debug", "info", "warn", "error", NULL};
+static const char *const auth_names[] = {"auto", "on", "off", NULL};
+_Static_assert(sizeof(pk_auth_mode) == sizeof(int) && sizeof(pk_log_level) == sizeof(int),
+               "named values are stored as int");
+
+static const char *const *names_of(key_type t)
+{
+    return t == K_LEVEL ? level_names : t == K_AUTH ? auth_names : NULL;
+}
 
 static const struct key {
     const char *name;
@@ -31,14 +43,20 @@ static const struct key {
     {"max_attempts", K_INT, F(max_attempts), 1, 100, "starts of one job before an interrupted job fails"},
     {"grace_s", K_DOUBLE, F(grace_s), 0, 86400, "SIGTERM: time running jobs get to finish"},
     {"log_level", K_LEVEL, F(log_level), 0, 0, "debug | info | warn | error"},
+    {"public_url", K_STR, F(public_url), 0, 0, "base URL of absolute links (reverse proxy); unset: http://<Host header>"},
+    {"auth", K_AUTH, F(auth), 0, 0, "bearer tokens required: auto (unless bind is loopback) | on | off"},
+    {"trusted_proxy", K_ADDR, F(trusted_proxy), 0, 0, "address of the reverse proxy whose X-Packd-Owner is honoured"},
 #undef F
 };
-
-static const char *level_names[] = {"debug", "info", "warn", "error"};
 
 const char *pk_log_level_name(pk_log_level l)
 {
     return l >= PK_LOG_DEBUG && l <= PK_LOG_ERROR ? level_names[l] : "info";
+}
+
+const char *pk_auth_mode_name(pk_auth_mode m)
+{
+    return m >= PK_AUTH_AUTO && m <= PK_AUTH_OFF ? auth_names[m] : "auto";
 }
 
 void pk_config_defaults(pk_config *c)
@@ -84,14 +102,26 @@ int pk_config_set(pk_config *c, const char *key, const char *value, char *err, s
         memcpy(field, value, strlen(value) + 1);
         return 0;
     }
-    if (k->type == K_LEVEL) {
-        for (int l = PK_LOG_DEBUG; l <= PK_LOG_ERROR; l++)
-            if (!strcmp(value, level_names[l])) {
-                c->log_level = (pk_log_level)l;
+    const char *const *names = names_of(k->type);
+    if (names) {
+        for (int i = 0; names[i]; i++)
+            if (!strcmp(value, names[i])) {
+                *(int *)field = i;
                 return 0;
             }
-        snprintf(err, errlen, "%s: '%s' is not debug, info, warn or error", key, value);
+        snprintf(err, errlen, "%s: '%s' is not one of", key, value);
+        for (int i = 0; names[i]; i++)
+            snprintf(err + strlen(err), errlen - strlen(err), " %s", names[i]);
         return -1;
+    }
+    if (k->type == K_ADDR) { /* an IPv4 or IPv6 address, kept as inet_ntop prints it */
+        unsigned char a[16];
+        int fam = strchr(value, ':') ? AF_INET6 : AF_INET;
+        if (inet_pton(fam, value, a) != 1 || !inet_ntop(fam, a, field, (socklen_t)k->size)) {
+            snprintf(err, errlen, "%s: '%s' is not an IP address", key, value);
+            return -1;
+        }
+        return 0;
     }
     char *end;
     errno = 0;
@@ -248,7 +278,9 @@ void pk_config_print_keys(void *file)
         case K_INT: snprintf(def, sizeof def, "%d", *(const int *)field); break;
         case K_LONG: snprintf(def, sizeof def, "%ld", *(const long *)field); break;
         case K_DOUBLE: snprintf(def, sizeof def, "%g", *(const double *)field); break;
-        case K_LEVEL: snprintf(def, sizeof def, "%s", pk_log_level_name(d.log_level)); break;
+        case K_LEVEL:
+        case K_AUTH: snprintf(def, sizeof def, "%s", names_of(k->type)[*(const int *)field]); break;
+        case K_ADDR: snprintf(def, sizeof def, "%s", *field ? field : "none"); break;
         }
         char flag[64];
         size_t j = 0;

@@ -9,9 +9,12 @@
 #include <stddef.h>
 
 typedef enum { PK_LOG_DEBUG, PK_LOG_INFO, PK_LOG_WARN, PK_LOG_ERROR } pk_log_level;
+/* auto: on unless bind is a loopback address */
+typedef enum { PK_AUTH_AUTO, PK_AUTH_ON, PK_AUTH_OFF } pk_auth_mode;
 
 typedef struct pk_config {
     char bind[64];            /* listen address (IPv4 dotted quad) */
+    char public_url[256];     /* base of absolute links, e.g. https://packd.lab.example; "" = from Host */
     int port;
     char data[1024];          /* data directory: queue.db, jobs/, files/ */
     int workers;              /* concurrent worker processes */
@@ -24,6 +27,8 @@ typedef struct pk_config {
     int max_attempts;         /* runs of one job interrupted by daemon deaths before it fails */
     double grace_s;           /* SIGTERM: time running jobs get to finish */
     pk_log_level log_level;
+    pk_auth_mode auth;        /* bearer tokens required (daemon/auth.c) */
+    char trusted_proxy[64];   /* peer whose X-Packd-Owner is honoured; "" = none */
     char config_file[1024];   /* the file read, "" if none (kept for SIGHUP) */
 } pk_config;
 
@@ -44,6 +49,7 @@ int pk_config_load_env(pk_config *c, char *err, size_t errlen);
 int pk_config_from_args(pk_config *c, int argc, char **argv, char *err, size_t errlen);
 
 const char *pk_log_level_name(pk_log_level l);
+const char *pk_auth_mode_name(pk_auth_mode m);
 
 /* Print the keys with their defaults (for --help). */
 void pk_config_print_keys(void *file);

@@ -28,14 +28,20 @@ typedef struct pk_req {
     size_t body_len, body_cap;
     int too_large;
     int first_call_done;
+    char owner[128];           /* who asks (auth.c): token name, proxy's X-Packd-Owner or address */
+    int admin;                 /* sees every owner's jobs and uploads */
 } pk_req;
 
 typedef enum MHD_Result (*pk_handler)(pk_req *r);
+
+/* Who may call a route once auth is on (auth.c). */
+typedef enum { PK_PUBLIC, PK_USER, PK_ADMIN } pk_access;
 
 typedef struct pk_route {
     const char *method;
     const char *pattern;       /* e.g. "/jobs/{*}": a star segment matches any one segment */
     pk_handler handler;
+    pk_access access;
 } pk_route;
 
 extern const pk_route pk_routes[];   /* terminated by {NULL} */
@@ -46,6 +52,13 @@ struct MHD_Daemon *pk_http_start(pk_service *svc, int *port, char *err, size_t e
 
 /* --- replies (each queues the response and counts it for /metrics) --- */
 enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp);
+/* Every "href" of doc that is a path ("/jobs/…") made absolute from the
+ * configured public_url, else the request's Host.  pk_send_json and the
+ * problem senders do it; pk_send makes a path Location header absolute. */
+void pk_absolute_links(pk_req *r, json_t *doc);
+/* The inverse for a request's inputs: links into this service given as
+ * absolute URLs (as its documents give them) become paths again. */
+void pk_own_links_as_paths(pk_req *r, json_t *inputs);
 /* JSON body (stolen); etag may be NULL. */
 enum MHD_Result pk_send_json(pk_req *r, unsigned status, json_t *body, const char *etag);
 /* A response with a JSON body (stolen, indented, ends with a newline). */
@@ -62,7 +75,7 @@ enum MHD_Result pk_send_problem_doc(pk_req *r, unsigned status, json_t *doc, int
 /* Request headers / query arguments (NULL if absent). */
 const char *pk_header(pk_req *r, const char *name);
 const char *pk_query(pk_req *r, const char *name);
-/* Who submits: the X-Packd-Owner header, else the client's IP address. */
+/* Who submits (r->owner, set by pk_authorize before the handler runs). */
 void pk_owner(pk_req *r, char *out, size_t n);
 
 /* Route handlers */

@@ -1,8 +1,6 @@
 /* http_reply.c — the reply helpers of http.h: JSON, problem+json, files
  * (Content-Length, ETag, SHA-256 headers, single byte ranges). */
-#include <arpa/inet.h>
 #include <fcntl.h>
-#include <netinet/in.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,10 +11,91 @@
 #include "log.h"
 #include "sha256.h"
 
+/* The base of absolute links: public_url, else http://<Host> when the Host
+ * header is a plain host[:port], else http://localhost. */
+static void base_url(pk_req *r, char *out, size_t n)
+{
+    pk_config cfg = pk_service_config(r->svc);
+    const char *host = pk_header(r, "Host");
+    if (cfg.public_url[0]) {
+        size_t len = strlen(cfg.public_url);
+        while (len && cfg.public_url[len - 1] == '/')
+            len--;
+        snprintf(out, n, "%.*s", (int)len, cfg.public_url);
+    } else if (host && *host && strlen(host) < 200 &&
+               host[strspn(host, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789.-:[]")] == 0)
+        snprintf(out, n, "http://%s", host);
+    else
+        snprintf(out, n, "http://localhost");
+}
+
+static void absolute_hrefs(json_t *node, const char *base)
+{
+    const char *key;
+    json_t *v;
+    size_t i;
+    if (json_is_array(node))
+        json_array_foreach(node, i, v) absolute_hrefs(v, base);
+    json_object_foreach(node, key, v) {
+        const char *s = json_string_value(v);
+        if (!strcmp(key, "href") && s && s[0] == '/') {
+            char *abs = malloc(strlen(base) + strlen(s) + 1);
+            if (abs) {
+                strcpy(abs, base);
+                strcat(abs, s);
+                json_object_set_new(node, key, json_string(abs));
+                free(abs);
+            }
+        } else if (json_is_object(v) || json_is_array(v)) {
+            absolute_hrefs(v, base);
+        }
+    }
+}
+
+/* hrefs under base back to paths; others stay (and are refused later). */
+static void relative_hrefs(json_t *node, const char *base, size_t bl)
+{
+    const char *key;
+    json_t *v;
+    size_t i;
+    if (json_is_array(node))
+        json_array_foreach(node, i, v) relative_hrefs(v, base, bl);
+    json_object_foreach(node, key, v) {
+        const char *s = json_string_value(v);
+        if (!strcmp(key, "href") && s && !strncmp(s, base, bl) && s[bl] == '/')
+            json_object_set_new(node, key, json_string(s + bl));
+        else if (json_is_object(v) || json_is_array(v))
+            relative_hrefs(v, base, bl);
+    }
+}
+
+void pk_own_links_as_paths(pk_req *r, json_t *inputs)
+{
+    char base[300];
+    base_url(r, base, sizeof base);
+    relative_hrefs(inputs, base, strlen(base));
+}
+
+void pk_absolute_links(pk_req *r, json_t *doc)
+{
+    char base[300];
+    base_url(r, base, sizeof base);
+    absolute_hrefs(doc, base);
+}
+
 enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp)
 {
     if (!resp)
         return MHD_NO;
+    const char *loc = MHD_get_response_header(resp, "Location");
+    if (loc && loc[0] == '/') { /* RFC 9110 allows relative; OGC clients need absolute */
+        char base[300], abs[800], rel[500];
+        base_url(r, base, sizeof base);
+        snprintf(rel, sizeof rel, "%s", loc);
+        snprintf(abs, sizeof abs, "%s%s", base, rel);
+        MHD_del_response_header(resp, "Location", loc);
+        MHD_add_response_header(resp, "Location", abs);
+    }
     if (status < 600)
         __atomic_add_fetch(&r->svc->responses[status], 1, __ATOMIC_RELAXED);
     MHD_add_response_header(resp, "Server", "packd/" PACKD_VERSION);
@@ -49,6 +128,7 @@ struct MHD_Response *pk_json_response(json_t *body, const char *ctype)
 
 enum MHD_Result pk_send_json(pk_req *r, unsigned status, json_t *body, const char *etag)
 {
+    pk_absolute_links(r, body);
     struct MHD_Response *resp = pk_json_response(body, "application/json");
     if (resp && etag)
         MHD_add_response_header(resp, "ETag", etag);
@@ -66,6 +146,7 @@ enum MHD_Result pk_send_text(pk_req *r, unsigned status, const char *ctype, cons
 
 enum MHD_Result pk_send_problem_doc(pk_req *r, unsigned status, json_t *doc, int retry_after)
 {
+    pk_absolute_links(r, doc);
     struct MHD_Response *resp = pk_json_response(doc, "application/problem+json");
     if (resp && retry_after > 0) {
         char ra[32];
@@ -96,18 +177,7 @@ const char *pk_query(pk_req *r, const char *name)
     return MHD_lookup_connection_value(r->conn, MHD_GET_ARGUMENT_KIND, name);
 }
 
-void pk_owner(pk_req *r, char *out, size_t n)
-{
-    const char *h = pk_header(r, "X-Packd-Owner");
-    if (h && *h) {
-        snprintf(out, n, "%s", h);
-        return;
-    }
-    const union MHD_ConnectionInfo *ci = MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
-    snprintf(out, n, "unknown");
-    if (ci && ci->client_addr && ci->client_addr->sa_family == AF_INET)
-        inet_ntop(AF_INET, &((const struct sockaddr_in *)ci->client_addr)->sin_addr, out, (socklen_t)n);
-}
+void pk_owner(pk_req *r, char *out, size_t n) { snprintf(out, n, "%s", r->owner); }
 
 static void base64(const unsigned char *in, size_t n, char *out)
 {

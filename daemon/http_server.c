@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "auth.h"
 #include "http.h"
 #include "log.h"
 
@@ -68,8 +69,10 @@ static enum MHD_Result dispatch(pk_req *r)
     for (const pk_route *rt = pk_routes; rt->method; rt++) {
         if (!match(r, rt->pattern))
             continue;
-        if (!strcmp(rt->method, r->method))
-            return rt->handler(r);
+        if (!strcmp(rt->method, r->method)) {
+            enum MHD_Result refused;
+            return pk_authorize(r, rt->access, &refused) ? rt->handler(r) : refused;
+        }
         if (!strstr(allow, rt->method)) {
             size_t l = strlen(allow);
             snprintf(allow + l, sizeof allow - l, "%s%s", l ? ", " : "", rt->method);

@@ -16,13 +16,13 @@ static int all_hex(const char *s, size_t n)
 }
 
 /* The path a link stands for, or an error message. */
-static int resolve_one(const char *href, const char *data, pk_queue *q, char *path, size_t n,
-                       char *why, size_t wn)
+static int resolve_one(const char *href, const char *data, pk_queue *q, const char *owner,
+                       char *path, size_t n, char *why, size_t wn)
 {
     const char *files = "/files/", *jobs = "/jobs/", *tail = "/results/result";
     if (!strncmp(href, files, strlen(files))) {
         const char *id = href + strlen(files);
-        json_t *f = all_hex(id, 64) ? pk_queue_get_file(q, id) : NULL;
+        json_t *f = all_hex(id, 64) ? pk_queue_get_file(q, id, owner) : NULL;
         if (!f) {
             snprintf(why, wn, "no uploaded file %s (POST /files first)", href);
             return -1;
@@ -43,6 +43,10 @@ static int resolve_one(const char *href, const char *data, pk_queue *q, char *pa
         memcpy(id, href + strlen(jobs), il);
         id[il] = 0;
         json_t *row = pk_queue_get(q, id);
+        if (row && owner && strcmp(json_string_value(json_object_get(row, "owner")), owner) != 0) {
+            json_decref(row); /* another owner's job: as if it did not exist */
+            row = NULL;
+        }
         const char *st = json_string_value(json_object_get(row, "status"));
         if (!row || strcmp(st, "successful") != 0) {
             snprintf(why, wn, "%s: the job %s", href,
@@ -63,6 +67,7 @@ static int resolve_one(const char *href, const char *data, pk_queue *q, char *pa
 typedef struct {
     const char *data;
     pk_queue *q;
+    const char *owner;
     pk_schema_errors *errs;
 } resolve_ctx;
 
@@ -70,7 +75,7 @@ static void resolve_link(json_t *link, const char *href, const char *pointer, vo
 {
     resolve_ctx *c = vctx;
     char path[1400], why[400], ptr[300];
-    if (resolve_one(href, c->data, c->q, path, sizeof path, why, sizeof why)) {
+    if (resolve_one(href, c->data, c->q, c->owner, path, sizeof path, why, sizeof why)) {
         snprintf(ptr, sizeof ptr, "%s/href", pointer);
         pk_schema_errors_add(c->errs, ptr, "href", "%s", why);
         return;
@@ -79,11 +84,11 @@ static void resolve_link(json_t *link, const char *href, const char *pointer, vo
     json_object_set_new(link, "file", json_string(path));
 }
 
-size_t pk_resolve_input_refs(json_t *inputs, const char *data_dir, pk_queue *q,
+size_t pk_resolve_input_refs(json_t *inputs, const char *data_dir, pk_queue *q, const char *owner,
                              pk_schema_errors *errs)
 {
     size_t before = errs->n;
-    resolve_ctx c = {data_dir, q, errs};
+    resolve_ctx c = {data_dir, q, owner, errs};
     pk_input_links_each(inputs, resolve_link, &c);
     return errs->n - before;
 }

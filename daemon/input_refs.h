@@ -13,9 +13,10 @@
 #include "queue.h"
 
 /* Rewrites inputs in place.  Unknown or unusable links become errors
- * (pointer relative to the inputs object, rule "href").  Returns the
- * number of errors appended. */
-size_t pk_resolve_input_refs(json_t *inputs, const char *data_dir, pk_queue *q,
+ * (pointer relative to the inputs object, rule "href"); so do links to
+ * another owner's upload or job when owner is not NULL (NULL: an admin,
+ * any owner's).  Returns the number of errors appended. */
+size_t pk_resolve_input_refs(json_t *inputs, const char *data_dir, pk_queue *q, const char *owner,
                              pk_schema_errors *errs);
 
 #endif

@@ -11,6 +11,8 @@
 #define PACKD_VERSION "0.0.0"
 #endif
 
+static void own_help(const char *name, FILE *f);
+
 static const struct {
     const char *name;
     int (*fn)(int, char **);
@@ -24,6 +26,9 @@ static const struct {
     {"inspect", cmd_inspect, "inspect OUT.h5 [--full]                          print a result file's summary as JSON", NULL},
     {"serve", cmd_serve, "serve [--config F] [--bind A] [--port N] [--data DIR] run the job service",
      cmd_serve_help},
+    {"picture", cmd_picture, "picture OUT.h5 -o FILE.svg|png [--kind packing|grading] draw a result", own_help},
+    {"token", cmd_token, "token add NAME [--admin] | list | revoke NAME [--config F] [--data DIR]\n"
+                         "                                                    the service's bearer tokens", own_help},
     {"submit", cmd_submit, "submit JOB.json [--server URL] [--token T] [--wait] [-o OUT.h5]\n"
                            "                                                    submit a job to a service (-o: wait, download, verify)",
      pk_client_help},
@@ -34,6 +39,16 @@ static const struct {
     {"backup", cmd_backup, "backup FILE [--data DIR | --config F]       online copy of the service's database",
      cmd_backup_help},
 };
+
+/* A command that prints its own --help. */
+static void own_help(const char *name, FILE *f)
+{
+    (void)f;
+    char help[] = "--help", *argv[] = {(char *)name, help, NULL};
+    for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
+        if (!strcmp(commands[i].name, name))
+            commands[i].fn(2, argv);
+}
 
 static int usage(FILE *f)
 {

@@ -34,7 +34,19 @@ static const char *const steps[] = {
     "CREATE TABLE files ("
     "  id TEXT PRIMARY KEY, sha256 TEXT NOT NULL, size INTEGER NOT NULL,"
     "  media_type TEXT NOT NULL, owner TEXT NOT NULL, created REAL NOT NULL);",
-    /* job metrics that outlive the job rows (job_metrics.c): how many jobs
+    /* 1 -> 2: bearer tokens (only their SHA-256 is stored, daemon/tokens.c);
+     * an upload belongs to each owner who sent its bytes: one row per (id, owner) */
+    "CREATE TABLE tokens ("
+    "  name TEXT PRIMARY KEY, sha256 TEXT NOT NULL UNIQUE, admin INTEGER NOT NULL DEFAULT 0,"
+    "  created REAL NOT NULL, last_used REAL);"
+    "CREATE TABLE files_owned ("
+    "  id TEXT NOT NULL, sha256 TEXT NOT NULL, size INTEGER NOT NULL,"
+    "  media_type TEXT NOT NULL, owner TEXT NOT NULL, created REAL NOT NULL,"
+    "  PRIMARY KEY (id, owner));"
+    "INSERT INTO files_owned SELECT id, sha256, size, media_type, owner, created FROM files;"
+    "DROP TABLE files;"
+    "ALTER TABLE files_owned RENAME TO files;",
+    /* 2 -> 3: job metrics that outlive the job rows (job_metrics.c): how many jobs
      * ended per process and final status, and a histogram of their run
      * times; both filled from the jobs already there.  duration_buckets
      * holds the histogram's upper bounds in seconds (9e999 is +Inf). */
@@ -83,8 +95,15 @@ int pk_migrate(sqlite3 *db, char *err, size_t errlen)
     for (; v < pk_schema_version(); v++) {
         char *msg = NULL, sql[64];
         snprintf(sql, sizeof sql, "PRAGMA user_version = %d", v + 1);
-        if (sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, &msg) != SQLITE_OK ||
-            sqlite3_exec(db, steps[v], NULL, NULL, &msg) != SQLITE_OK ||
+        int ok = sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, &msg) == SQLITE_OK;
+        /* Another connection (the daemon, `packd token`) may have migrated meanwhile. */
+        int now = ok ? user_version(db) : v;
+        if (now > v && now <= pk_schema_version()) {
+            sqlite3_exec(db, "COMMIT", NULL, NULL, NULL);
+            v = now - 1;
+            continue;
+        }
+        if (!ok || now != v || sqlite3_exec(db, steps[v], NULL, NULL, &msg) != SQLITE_OK ||
             sqlite3_exec(db, sql, NULL, NULL, &msg) != SQLITE_OK ||
             sqlite3_exec(db, "COMMIT", NULL, NULL, &msg) != SQLITE_OK) {
             snprintf(err, errlen, "migration %d -> %d: %s", v, v + 1, msg ? msg : "?");
@@ -94,4 +113,30 @@ int pk_migrate(sqlite3 *db, char *err, size_t errlen)
         }
     }
     return v;
+}
+
+sqlite3 *pk_db_open(const char *path, char *err, size_t errlen)
+{
+    sqlite3 *db = NULL;
+    if (sqlite3_open_v2(path, &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX,
+                        NULL) != SQLITE_OK) {
+        snprintf(err, errlen, "%s: %s", path, db ? sqlite3_errmsg(db) : "cannot open");
+        sqlite3_close(db);
+        return NULL;
+    }
+    /* WAL: readers never block the writer; FULL: a committed job survives a
+     * power loss too; the busy timeout covers the other connections (the
+     * daemon's queue and token store, `packd token`, the sqlite3 CLI, backups). */
+    sqlite3_busy_timeout(db, 5000);
+    char *msg = NULL;
+    if (sqlite3_exec(db, "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL; PRAGMA foreign_keys=ON;",
+                     NULL, NULL, &msg) != SQLITE_OK ||
+        pk_migrate(db, err, errlen) < 0) {
+        if (msg)
+            snprintf(err, errlen, "%s: %s", path, msg);
+        sqlite3_free(msg);
+        sqlite3_close(db);
+        return NULL;
+    }
+    return db;
 }

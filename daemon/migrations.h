@@ -13,4 +13,8 @@ int pk_migrate(sqlite3 *db, char *err, size_t errlen);
 /* The newest schema version this binary knows. */
 int pk_schema_version(void);
 
+/* Open (create) the queue database with its pragmas and migrate it: every
+ * connection to DATA/queue.db goes through here.  NULL with err. */
+sqlite3 *pk_db_open(const char *path, char *err, size_t errlen);
+
 #endif

@@ -191,25 +191,8 @@ pk_queue *pk_queue_open(const char *path, char *err, size_t errlen)
         snprintf(err, errlen, "out of memory");
         return NULL;
     }
-    if (sqlite3_open_v2(path, &q->db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX,
-                        NULL) != SQLITE_OK) {
-        snprintf(err, errlen, "%s: %s", path, q->db ? sqlite3_errmsg(q->db) : "cannot open");
-        sqlite3_close(q->db);
-        free(q);
-        return NULL;
-    }
-    /* WAL: readers never block the writer; FULL: a committed job survives a
-     * power loss too; the busy timeout covers other connections (sqlite3 CLI,
-     * backups, a second queue handle in tests). */
-    sqlite3_busy_timeout(q->db, 5000);
-    char *msg = NULL;
-    if (sqlite3_exec(q->db, "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL; PRAGMA foreign_keys=ON;",
-                     NULL, NULL, &msg) != SQLITE_OK ||
-        pk_migrate(q->db, err, errlen) < 0) {
-        if (msg)
-            snprintf(err, errlen, "%s: %s", path, msg);
-        sqlite3_free(msg);
-        sqlite3_close(q->db);
+    q->db = pk_db_open(path, err, errlen);
+    if (!q->db) {
         free(q);
         return NULL;
     }
@@ -294,19 +277,20 @@ json_t *pk_queue_get(pk_queue *q, const char *id)
     return r;
 }
 
-json_t *pk_queue_list(pk_queue *q, const char *status, const char *process, int limit, int offset,
-                      int *total)
+json_t *pk_queue_list(pk_queue *q, const char *status, const char *process, const char *owner,
+                      int limit, int offset, int *total)
 {
     pthread_mutex_lock(&q->mu);
-    const char *where = " WHERE (?1 IS NULL OR status=?1) AND (?2 IS NULL OR process=?2)";
+    const char *where = " WHERE (?1 IS NULL OR status=?1) AND (?2 IS NULL OR process=?2)"
+                        " AND (?5 IS NULL OR owner=?5)";
     char sql[512];
     snprintf(sql, sizeof sql, "SELECT count(*) FROM jobs%s", where);
     if (total)
-        *total = (int)scalar(q, prep(q, sql, "ss", status, process));
+        *total = (int)scalar(q, prep(q, sql, "ssiis", status, process, 0, 0, owner));
     snprintf(sql, sizeof sql,
              "SELECT id, process, status, progress, message, created, started, finished, updated, rev"
              " FROM jobs%s ORDER BY seq DESC LIMIT ?3 OFFSET ?4", where);
-    json_t *r = rows(prep(q, sql, "ssii", status, process, limit, offset));
+    json_t *r = rows(prep(q, sql, "ssiis", status, process, limit, offset, owner));
     pthread_mutex_unlock(&q->mu);
     return r;
 }
@@ -569,11 +553,11 @@ int pk_queue_add_file(pk_queue *q, const char *id, const char *sha256, long long
     return n < 0 ? -1 : 0;
 }
 
-json_t *pk_queue_get_file(pk_queue *q, const char *id)
+json_t *pk_queue_get_file(pk_queue *q, const char *id, const char *owner)
 {
     pthread_mutex_lock(&q->mu);
-    json_t *r = one_row(prep(q, "SELECT id, sha256, size, media_type, created FROM files WHERE id=?",
-                             "s", id));
+    json_t *r = one_row(prep(q, "SELECT id, sha256, size, media_type, created FROM files WHERE id=?1"
+                                " AND (?2 IS NULL OR owner=?2) LIMIT 1", "ss", id, owner));
     pthread_mutex_unlock(&q->mu);
     return r;
 }

@@ -41,9 +41,9 @@ int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37]);
 /* The job row, or NULL if unknown. */
 json_t *pk_queue_get(pk_queue *q, const char *id);
 
-/* Newest first; status/process may be NULL (any). */
-json_t *pk_queue_list(pk_queue *q, const char *status, const char *process, int limit, int offset,
-                      int *total);
+/* Newest first; status/process/owner may be NULL (any). */
+json_t *pk_queue_list(pk_queue *q, const char *status, const char *process, const char *owner,
+                      int limit, int offset, int *total);
 
 /* Move the oldest accepted job to running (attempts + 1).  Returns the job
  * row (new ref) or NULL when none waits. */
@@ -93,10 +93,11 @@ void pk_queue_wake_all(pk_queue *q);
  * pk_metrics_read (job_metrics.h)}. */
 json_t *pk_queue_stats(pk_queue *q);
 
-/* Uploaded files. */
+/* Uploaded files: one row per (id, owner) — the bytes are stored once, each
+ * owner who sent them owns the upload.  get_file with owner NULL: any owner's. */
 int pk_queue_add_file(pk_queue *q, const char *id, const char *sha256, long long size,
                       const char *media_type, const char *owner);
-json_t *pk_queue_get_file(pk_queue *q, const char *id);
+json_t *pk_queue_get_file(pk_queue *q, const char *id, const char *owner);
 
 /* A random RFC 4122 version 4 UUID (37 bytes with NUL). */
 void pk_uuid4(char out[37]);

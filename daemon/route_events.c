@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "auth.h"
 #include "http.h"
 #include "queue.h"
 
@@ -112,7 +113,7 @@ static void release(void *cls)
 
 enum MHD_Result route_events(pk_req *r)
 {
-    json_t *row = pk_queue_get(r->svc->q, r->seg[1]);
+    json_t *row = pk_job_visible(r, r->seg[1]);
     if (!row)
         return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
     json_decref(row);

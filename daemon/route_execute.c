@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "auth.h"
 #include "http.h"
 #include "input_refs.h"
 #include "http_process_doc.h"
@@ -19,7 +20,9 @@ static enum MHD_Result reply_job(pk_req *r, const char *id, int replayed)
     json_t *row = pk_queue_get(r->svc->q, id);
     if (!row)
         return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error", "job vanished", NULL, 0);
-    struct MHD_Response *resp = pk_json_response(pk_status_info(row), "application/json");
+    json_t *info = pk_status_info(row);
+    pk_absolute_links(r, info);
+    struct MHD_Response *resp = pk_json_response(info, "application/json");
     json_decref(row);
     char loc[80];
     snprintf(loc, sizeof loc, "/jobs/%s", id);
@@ -72,10 +75,11 @@ enum MHD_Result route_execute(pk_req *r)
     pk_config cfg = pk_service_config(svc);
     pk_process_apply_caps(p, inputs, cfg.max_particles, cfg.max_wall_time_s);
     pk_schema_errors errs = {0};
-    /* {"href": "/files/…"} and {"href": "/jobs/…/results/result"} → {"file": path} */
+    /* {"href": "[<this service>]/files/…"} and {"href": "[…]/jobs/…/results/result"} → {"file": path} */
+    pk_own_links_as_paths(r, inputs);
     char data_abs[PATH_MAX];
     const char *data = realpath(cfg.data, data_abs) ? data_abs : cfg.data;
-    if (pk_resolve_input_refs(inputs, data, svc->q, &errs) > 0 ||
+    if (pk_resolve_input_refs(inputs, data, svc->q, pk_scope(r), &errs) > 0 ||
         pk_process_validate_inputs(p, inputs, &errs) > 0) {
         for (size_t i = 0; i < errs.n; i++) { /* pointers relative to the body */
             char ptr[sizeof errs.items[i].pointer + 8];

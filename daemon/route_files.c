@@ -1,6 +1,6 @@
 /* POST /files (upload a mesh or RVE file) and GET /files/{id}.  Files are
  * content-addressed: the id is the SHA-256 of the bytes, so an upload
- * repeated is stored once. */
+ * repeated is stored once; each owner who sends the bytes owns the upload. */
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "auth.h"
 #include "http.h"
 #include "sha256.h"
 
@@ -66,7 +67,7 @@ enum MHD_Result route_files_post(pk_req *r)
 
 enum MHD_Result route_file_get(pk_req *r)
 {
-    json_t *f = pk_queue_get_file(r->svc->q, r->seg[1]);
+    json_t *f = pk_queue_get_file(r->svc->q, r->seg[1], pk_scope(r));
     if (!f)
         return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-file", "No such file", r->seg[1], NULL, 0);
     pk_config cfg = pk_service_config(r->svc);

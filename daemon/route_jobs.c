@@ -5,6 +5,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "auth.h"
 #include "http.h"
 #include "http_status_info.h"
 #include "log.h"
@@ -29,7 +30,7 @@ enum MHD_Result route_jobs(pk_req *r)
                                "status in accepted|running|successful|failed|dismissed, limit in 1..1000, offset >= 0",
                                NULL, 0);
     int total = 0;
-    json_t *rows = pk_queue_list(r->svc->q, status, process, (int)limit, (int)offset, &total);
+    json_t *rows = pk_queue_list(r->svc->q, status, process, pk_scope(r), (int)limit, (int)offset, &total);
     json_t *jobs = json_array();
     size_t i;
     json_t *row;
@@ -50,7 +51,7 @@ enum MHD_Result route_jobs(pk_req *r)
 
 enum MHD_Result route_job(pk_req *r)
 {
-    json_t *row = pk_queue_get(r->svc->q, r->seg[1]);
+    json_t *row = pk_job_visible(r, r->seg[1]);
     if (!row)
         return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
     char etag[200];
@@ -88,7 +89,9 @@ static void remove_job_files(const char *data, const char *id)
 enum MHD_Result route_job_delete(pk_req *r)
 {
     char was[16];
-    if (pk_queue_dismiss(r->svc->q, r->seg[1], was) != 0)
+    json_t *mine = pk_job_visible(r, r->seg[1]);
+    json_decref(mine);
+    if (!mine || pk_queue_dismiss(r->svc->q, r->seg[1], was) != 0)
         return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
     if (!strcmp(was, "running")) {
         pk_supervisor_wake(r->svc->sup); /* SIGTERM to the worker now */

@@ -1,22 +1,26 @@
-/* routes.c — the one route table of the HTTP API (docs/service.md, schemas/openapi.json). */
+/* routes.c — the one route table of the HTTP API (docs/service.md, schemas/openapi.json).
+ * The last column says who may call a route when auth is on: the service
+ * documents and /healthz are public, /metrics (every owner's counts) needs
+ * an admin token, everything else a token; owners are checked in the
+ * handlers' lookups (auth.c). */
 #include "http.h"
 
 const pk_route pk_routes[] = {
-    {"GET", "/", route_landing},
-    {"GET", "/conformance", route_conformance},
-    {"GET", "/api", route_api},
-    {"GET", "/processes", route_processes},
-    {"GET", "/processes/*", route_process},
-    {"POST", "/processes/*/execution", route_execute},
-    {"GET", "/jobs", route_jobs},
-    {"GET", "/jobs/*", route_job},
-    {"DELETE", "/jobs/*", route_job_delete},
-    {"GET", "/jobs/*/events", route_events},
-    {"GET", "/jobs/*/results", route_results},
-    {"GET", "/jobs/*/results/*", route_result_file},
-    {"POST", "/files", route_files_post},
-    {"GET", "/files/*", route_file_get},
-    {"GET", "/metrics", route_metrics},
-    {"GET", "/healthz", route_healthz},
-    {NULL, NULL, NULL},
+    {"GET", "/", route_landing, PK_PUBLIC},
+    {"GET", "/conformance", route_conformance, PK_PUBLIC},
+    {"GET", "/api", route_api, PK_PUBLIC},
+    {"GET", "/processes", route_processes, PK_USER},
+    {"GET", "/processes/*", route_process, PK_USER},
+    {"POST", "/processes/*/execution", route_execute, PK_USER},
+    {"GET", "/jobs", route_jobs, PK_USER},
+    {"GET", "/jobs/*", route_job, PK_USER},
+    {"DELETE", "/jobs/*", route_job_delete, PK_USER},
+    {"GET", "/jobs/*/events", route_events, PK_USER},
+    {"GET", "/jobs/*/results", route_results, PK_USER},
+    {"GET", "/jobs/*/results/*", route_result_file, PK_USER},
+    {"POST", "/files", route_files_post, PK_USER},
+    {"GET", "/files/*", route_file_get, PK_USER},
+    {"GET", "/metrics", route_metrics, PK_ADMIN},
+    {"GET", "/healthz", route_healthz, PK_PUBLIC},
+    {NULL, NULL, NULL, PK_PUBLIC},
 };

@@ -8,11 +8,13 @@
 #include "config.h"
 #include "queue.h"
 #include "supervisor.h"
+#include "tokens.h"
 
 typedef struct pk_service {
     pthread_mutex_t mu;          /* guards cfg (SIGHUP replaces it) */
     pk_config cfg;
     pk_queue *q;
+    pk_tokens *tokens;           /* bearer tokens (auth.c); its own connection to queue.db */
     pk_supervisor *sup;
     int draining;                /* SIGTERM received: refuse new jobs (atomic) */
     int stopping;                /* streams must end now (atomic) */

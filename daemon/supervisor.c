@@ -165,7 +165,7 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
             dup2(p[1], 3) < 0)
             _exit(125);
         execl(s->exe, "packd", "run", job_path, "-o", out_path, "--progress-fd", "3", "--threads",
-              threads, (char *)NULL);
+              threads, "--pictures", dir, (char *)NULL);
         _exit(127);
     }
     close(p[1]);

@@ -12,7 +12,7 @@
 python3 "$SRC/tests/integration/fake_service.py" "$T/fake.port" "$T/fake.log" &
 DAEMONS="$DAEMONS $!"
 
-for cmd in run validate inspect serve submit jobs cancel fetch backup; do
+for cmd in run validate inspect serve picture token submit jobs cancel fetch backup; do
     check "help_$cmd" sh -c "'$PACKD' $cmd --help >'$T/help.txt' 2>&1 && grep -q 'usage: packd $cmd' '$T/help.txt'"
 done
 

@@ -46,7 +46,7 @@ H=$(member "$T/h.json" jobID)
 check homogenize_by_job_link_accepted grep -q '^HTTP/1.1 201' "$T/h.h"
 check homogenize_by_job_link_successful wait_status "$H" successful 180
 c -o "$T/hres.json" "$B/jobs/$H/results"
-check homogenize_result_document test "$(jget "$T/hres.json" 'd["result"]["href"] == "/jobs/'"$H"'/results/result"')" = True
+check homogenize_result_document test "$(jget "$T/hres.json" 'd["result"]["href"] == "'"$B"'/jobs/'"$H"'/results/result"')" = True
 
 # packd validate: a job file must name files by path
 python3 -c "

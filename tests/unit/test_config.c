@@ -6,6 +6,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "auth.h"
 #include "check.h"
 #include "config.h"
 
@@ -95,6 +96,33 @@ static void test_example_file(void)
     CHECK(!strcmp(c.data, "/var/lib/packd") && c.workers == 4 && c.grace_s == 30);
 }
 
+/* auth = auto|on|off and trusted_proxy; auto is on exactly off loopback. */
+static void test_auth_keys(void)
+{
+    pk_config c;
+    char err[256];
+    pk_config_defaults(&c);
+    CHECK(c.auth == PK_AUTH_AUTO && c.trusted_proxy[0] == 0);
+    CHECK(!pk_auth_required(&c, NULL)); /* 127.0.0.1: the make run default stays open */
+    const char *why = NULL;
+    CHECK(pk_config_set(&c, "bind", "10.1.2.3", err, sizeof err) == 0 && pk_auth_required(&c, &why) && why);
+    CHECK(pk_config_set(&c, "bind", "0.0.0.0", err, sizeof err) == 0 && pk_auth_required(&c, NULL));
+    CHECK(pk_config_set(&c, "bind", "127.8.0.1", err, sizeof err) == 0 && !pk_auth_required(&c, NULL));
+    CHECK(pk_config_set(&c, "bind", "::1", err, sizeof err) == 0 && !pk_auth_required(&c, NULL));
+    CHECK(pk_config_set(&c, "auth", "on", err, sizeof err) == 0 && c.auth == PK_AUTH_ON && pk_auth_required(&c, NULL));
+    CHECK(pk_config_set(&c, "bind", "0.0.0.0", err, sizeof err) == 0);
+    CHECK(pk_config_set(&c, "auth", "off", err, sizeof err) == 0 && !pk_auth_required(&c, NULL));
+    CHECK(pk_config_set(&c, "auth", "yes", err, sizeof err) == -1 && strstr(err, "auto on off"));
+    CHECK(pk_config_set(&c, "trusted_proxy", "10.0.0.7", err, sizeof err) == 0 &&
+          !strcmp(c.trusted_proxy, "10.0.0.7"));
+    CHECK(pk_config_set(&c, "trusted_proxy", "0:0::1", err, sizeof err) == 0 && !strcmp(c.trusted_proxy, "::1"));
+    CHECK(pk_config_set(&c, "trusted_proxy", "proxy.lab", err, sizeof err) == -1);
+    CHECK(pk_config_set(&c, "trusted_proxy", "10.0.0.256", err, sizeof err) == -1);
+    setenv("PACKD_AUTH", "on", 1);
+    CHECK(pk_config_load_env(&c, err, sizeof err) == 0 && c.auth == PK_AUTH_ON);
+    unsetenv("PACKD_AUTH");
+}
+
 int main(void)
 {
     int fd = mkstemp(path);
@@ -106,6 +134,7 @@ int main(void)
     RUN(test_file_errors);
     RUN(test_precedence);
     RUN(test_example_file);
+    RUN(test_auth_keys);
     unlink(path);
     return check_summary();
 }

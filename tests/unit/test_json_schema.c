@@ -582,6 +582,67 @@ static void test_embedded(void)
     pk_schema_errors_free(&e);
 }
 
+/* Every "type": "integer" of every embedded JSON Schema, at any depth, and
+ * every number of a schema that a process reads as an integer has a
+ * "maximum" (issue 21: "count": 1e308 was an integer to the schema and 0 to
+ * the reader); pk_json_int reads integral decimals exactly. */
+static void integer_maxima(json_t *s, const char *name, const char *at, int *n)
+{
+    if (json_is_array(s)) {
+        size_t i;
+        json_t *v;
+        json_array_foreach(s, i, v) integer_maxima(v, name, at, n);
+        return;
+    }
+    if (!json_is_object(s))
+        return;
+    const char *t = json_string_value(json_object_get(s, "type"));
+    if (t && !strcmp(t, "integer")) {
+        (*n)++;
+        CHECK_MSG(json_is_number(json_object_get(s, "maximum")), "%s: integer at %s has no maximum",
+                  name, at);
+    }
+    const char *k;
+    json_t *v;
+    json_object_foreach(s, k, v)
+    {
+        char sub[256];
+        snprintf(sub, sizeof sub, "%s/%s", at, k);
+        integer_maxima(v, name, sub, n);
+    }
+}
+
+static void test_integer_fields(void)
+{
+    int n = 0;
+    for (const pk_embedded_schema *s = pk_embedded_schemas; s->name; s++) {
+        json_t *a = pk_schema_get(s->name);
+        if (json_object_get(a, "$schema"))
+            integer_maxima(a, s->name, "", &n);
+    }
+    CHECK(n >= 20);
+    long long v = -1;
+    json_t *x = J("500.0");
+    CHECK(pk_json_int(x, &v) == 0 && v == 500);
+    json_decref(x);
+    x = J("500");
+    CHECK(pk_json_int(x, &v) == 0 && v == 500);
+    json_decref(x);
+    x = J("-0.0");
+    CHECK(pk_json_int(x, &v) == 0 && v == 0);
+    json_decref(x);
+    const char *bad[] = {"2.5", "1e308", "9007199254740994.0", "\"5\"", "true", "null"};
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        x = J(bad[i]);
+        CHECK_MSG(pk_json_int(x, &v) != 0, "%s read as an integer", bad[i]);
+        json_decref(x);
+    }
+    x = J("{\"a\":7.0,\"b\":7.5}");
+    CHECK(pk_json_int_or(x, "a", 1) == 7 && pk_json_int_or(x, "b", 1) == 1 &&
+          pk_json_int_or(x, "c", 3) == 3);
+    json_decref(x);
+}
+
 int main(void)
 {
     RUN(test_type);
@@ -613,5 +674,6 @@ int main(void)
     RUN(test_max_errors);
     RUN(test_errors_json);
     RUN(test_embedded);
+    RUN(test_integer_fields);
     return check_summary();
 }

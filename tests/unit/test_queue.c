@@ -69,7 +69,7 @@ static void test_submit_limits_and_keys(void)
     CHECK(submit(q, "cid", NULL, NULL, b) == PK_Q_OK);
     CHECK(submit(q, "dan", NULL, NULL, b) == PK_Q_FULL);       /* 5 waiting in all */
     int total = 0;
-    json_t *l = pk_queue_list(q, "accepted", NULL, 2, 0, &total);
+    json_t *l = pk_queue_list(q, "accepted", NULL, NULL, 2, 0, &total);
     CHECK(total == 5 && json_array_size(l) == 2);
     json_decref(l);
     pk_queue_close(q);
@@ -209,7 +209,7 @@ static void test_concurrent_connections(void)
     }
     CHECK(!bad);
     int total = 0;
-    json_decref(pk_queue_list(q1, NULL, NULL, 1, 0, &total));
+    json_decref(pk_queue_list(q1, NULL, NULL, NULL, 1, 0, &total));
     CHECK_MSG(total == 20, "jobs = %d (2 owners x 10 keys)", total);
     CHECK(w[0].claimed + w[1].claimed + w[2].claimed + w[3].claimed == 20);
     pk_queue_close(q1);
