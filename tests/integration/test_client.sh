@@ -79,3 +79,13 @@ check tampered_says_mismatch grep -q 'SHA-256 mismatch' "$T/tampered.err"
 check failed_job_exit_3 test $? = 3
 check failed_job_reason_printed grep -q 'ran out of wall time' "$T/failed.err"
 check failed_job_partial_kept test -s "$T/partial.bin"
+
+# 7. a service with auth on: the token from $PACKD_TOKEN opens it, none gets 401 (exit 1)
+tok=$("$PACKD" token add alice --data "$T/authd" 2>/dev/null)
+printf 'auth = on\nworkers = 1\n' >"$T/auth.conf"
+start_daemon authd --config "$T/auth.conf" || { fail auth_serve_starts; exit 1; }
+PACKD_TOKEN=$tok "$PACKD" submit "$SRC/examples/meier-quartz-2d.json" --server "$B" -q -o "$T/auth.h5" >/dev/null 2>"$T/auth.err"
+check auth_submit_with_token_exit_0 test $? = 0
+"$PACKD" jobs --server "$B" >/dev/null 2>"$T/noauth.err"
+check auth_without_token_exit_1 test $? = 1
+check auth_without_token_says_401 grep -q '401' "$T/noauth.err"
