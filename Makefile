@@ -25,7 +25,7 @@ ALIGN   ?= -falign-functions=64
 SAN     ?=
 VERSION := $(shell cat VERSION 2>/dev/null || echo 0.0.0)
 
-PKGS    := hdf5 jansson libmicrohttpd sqlite3 libcrypto cairo fontconfig
+PKGS    := hdf5 jansson libmicrohttpd sqlite3 libcrypto cairo fontconfig libcurl
 DEPS_OK := $(BUILD)/.deps-ok
 
 WARN    := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wno-unused-parameter
@@ -51,7 +51,7 @@ LIB_OBJ    := $(DAEMON_OBJ) $(API_OBJ) $(CORE_OBJ)
 UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 BENCH_BIN  := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
-.PHONY: all deps test sanitize bench run clean check-schemas
+.PHONY: all deps test sanitize bench run clean check-schemas install
 .SECONDARY:
 
 all: $(DEPS_OK) $(BUILD)/packd $(BENCH_BIN)
@@ -110,6 +110,27 @@ bench: $(DEPS_OK) $(BUILD)/packd $(BENCH_BIN)
 
 run: $(DEPS_OK) $(BUILD)/packd
 	$(BUILD)/packd serve
+
+# make install [PREFIX=/usr/local] [SYSCONFDIR=/etc] [DESTDIR=]: the binary,
+# the systemd unit (paths rewritten to PREFIX and SYSCONFDIR), the example
+# configuration as packd.conf unless one exists, the docs (docs/operations.md)
+# and the example jobs.
+PREFIX     ?= /usr/local
+SYSCONFDIR ?= /etc
+UNITDIR    ?= $(PREFIX)/lib/systemd/system
+DOCDIR     ?= $(PREFIX)/share/doc/packd
+install: $(BUILD)/packd
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(UNITDIR) $(DESTDIR)$(SYSCONFDIR)/packd $(DESTDIR)$(DOCDIR)
+	install -m 0755 $(BUILD)/packd $(DESTDIR)$(PREFIX)/bin/packd
+	sed -e 's|/usr/local/bin/packd|$(PREFIX)/bin/packd|' -e 's|/etc/packd/|$(SYSCONFDIR)/packd/|' \
+	    -e 's|/usr/local/share/doc/packd|$(DOCDIR)|' deploy/packd.service >$(DESTDIR)$(UNITDIR)/packd.service
+	chmod 0644 $(DESTDIR)$(UNITDIR)/packd.service
+	install -m 0644 deploy/packd.conf.example $(DESTDIR)$(SYSCONFDIR)/packd/packd.conf.example
+	[ -e $(DESTDIR)$(SYSCONFDIR)/packd/packd.conf ] || \
+	    install -m 0644 deploy/packd.conf.example $(DESTDIR)$(SYSCONFDIR)/packd/packd.conf
+	install -m 0644 README.md docs/*.md $(DESTDIR)$(DOCDIR)/
+	install -d $(DESTDIR)$(DOCDIR)/examples
+	install -m 0644 examples/*.json $(DESTDIR)$(DOCDIR)/examples/
 
 # Cross-check schemas and examples with an independent validator (python3-jsonschema).
 check-schemas: $(DEPS_OK)

@@ -37,3 +37,11 @@ void cli_print_errors(const char *path, const pk_schema_errors *errs)
                 errs->items[i].pointer[0] ? errs->items[i].pointer : "/", errs->items[i].message,
                 errs->items[i].rule);
 }
+
+int cli_help_requested(int argc, char **argv)
+{
+    for (int i = 1; i < argc && strcmp(argv[i], "--") != 0; i++)
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h"))
+            return 1;
+    return 0;
+}

@@ -21,6 +21,7 @@
 #include "http.h"
 #include "log.h"
 #include "queue.h"
+#include "sd_notify.h"
 #include "supervisor.h"
 
 static int usage(FILE *f)
@@ -30,6 +31,12 @@ static int usage(FILE *f)
                "environment PACKD_<KEY>, flags.  Keys (see deploy/packd.conf.example):\n");
     pk_config_print_keys(f);
     return f == stderr ? 64 : 0;
+}
+
+void cmd_serve_help(const char *name, FILE *f)
+{
+    (void)name;
+    usage(f);
 }
 
 static int ensure_dir(const char *path)
@@ -159,18 +166,22 @@ int cmd_serve(int argc, char **argv)
            "data", svc.cfg.data, "workers", svc.cfg.workers, "version", PACKD_VERSION, "pid",
            (int)getpid());
     log_auth(&svc);
+    pk_sd_notify("READY=1"); /* Type=notify: systemd starts dependants now */
 
     for (;;) {
         int sig = 0;
         if (sigwait(&set, &sig) != 0)
             continue;
         if (sig == SIGHUP) {
+            pk_sd_notify("RELOADING=1");
             reload(&svc, argc, argv);
+            pk_sd_notify("READY=1");
             continue;
         }
         break;
     }
     pk_config cfg = pk_service_config(&svc);
+    pk_sd_notify("STOPPING=1");
     __atomic_store_n(&svc.draining, 1, __ATOMIC_RELAXED);
     pk_log(PK_LOG_INFO, "stopping: running jobs get the grace period", "{s:f,s:i}", "grace_s",
            cfg.grace_s, "running", pk_supervisor_busy(svc.sup));

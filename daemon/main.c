@@ -5,25 +5,50 @@
 #include <string.h>
 
 #include "cli.h"
+#include "client_args.h"
 
 #ifndef PACKD_VERSION
 #define PACKD_VERSION "0.0.0"
 #endif
 
+static void own_help(const char *name, FILE *f);
+
 static const struct {
     const char *name;
     int (*fn)(int, char **);
     const char *usage;
+    void (*help)(const char *name, FILE *f); /* --help; NULL: the usage line */
 } commands[] = {
     {"run", cmd_run, "run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--progress] [--progress-fd N]\n"
-                     "                                                    run a job, write its result"},
-    {"validate", cmd_validate, "validate JOB.json                                 check a job, print its plan or errors"},
-    {"inspect", cmd_inspect, "inspect OUT.h5 [--full]                          print a result file's summary as JSON"},
-    {"serve", cmd_serve, "serve [--config F] [--bind A] [--port N] [--data DIR] run the job service"},
-    {"picture", cmd_picture, "picture OUT.h5 -o FILE.svg|png [--kind packing|grading] draw a result"},
+                     "                                                    run a job, write its result",
+     NULL},
+    {"validate", cmd_validate, "validate JOB.json                                 check a job, print its plan or errors", NULL},
+    {"inspect", cmd_inspect, "inspect OUT.h5 [--full]                          print a result file's summary as JSON", NULL},
+    {"serve", cmd_serve, "serve [--config F] [--bind A] [--port N] [--data DIR] run the job service",
+     cmd_serve_help},
+    {"picture", cmd_picture, "picture OUT.h5 -o FILE.svg|png [--kind packing|grading] draw a result", own_help},
     {"token", cmd_token, "token add NAME [--admin] | list | revoke NAME [--config F] [--data DIR]\n"
-                         "                                                    the service's bearer tokens"},
+                         "                                                    the service's bearer tokens", own_help},
+    {"submit", cmd_submit, "submit JOB.json [--server URL] [--token T] [--wait] [-o OUT.h5]\n"
+                           "                                                    submit a job to a service (-o: wait, download, verify)",
+     pk_client_help},
+    {"jobs", cmd_jobs, "jobs [--server URL] [--status S]            list a service's jobs", pk_client_help},
+    {"cancel", cmd_cancel, "cancel ID [--server URL]                    dismiss a job", pk_client_help},
+    {"fetch", cmd_fetch, "fetch ID -o OUT.h5 [--server URL]           download a result, verify its SHA-256",
+     pk_client_help},
+    {"backup", cmd_backup, "backup FILE [--data DIR | --config F]       online copy of the service's database",
+     cmd_backup_help},
 };
+
+/* A command that prints its own --help. */
+static void own_help(const char *name, FILE *f)
+{
+    (void)f;
+    char help[] = "--help", *argv[] = {(char *)name, help, NULL};
+    for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
+        if (!strcmp(commands[i].name, name))
+            commands[i].fn(2, argv);
+}
 
 static int usage(FILE *f)
 {
@@ -44,9 +69,18 @@ int main(int argc, char **argv)
         printf("packd %s\n", PACKD_VERSION);
         return 0;
     }
-    for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
-        if (!strcmp(argv[1], commands[i].name))
-            return commands[i].fn(argc - 1, argv + 1);
+    for (size_t i = 0; i < sizeof commands / sizeof *commands; i++) {
+        if (strcmp(argv[1], commands[i].name) != 0)
+            continue;
+        if (cli_help_requested(argc - 1, argv + 1)) {
+            if (commands[i].help)
+                commands[i].help(commands[i].name, stdout);
+            else
+                printf("usage: packd %s\n", commands[i].usage);
+            return 0;
+        }
+        return commands[i].fn(argc - 1, argv + 1);
+    }
     fprintf(stderr, "packd: unknown command '%s'\n", argv[1]);
     return usage(stderr);
 }

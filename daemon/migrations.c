@@ -46,6 +46,25 @@ static const char *const steps[] = {
     "INSERT INTO files_owned SELECT id, sha256, size, media_type, owner, created FROM files;"
     "DROP TABLE files;"
     "ALTER TABLE files_owned RENAME TO files;",
+    /* 2 -> 3: job metrics that outlive the job rows (job_metrics.c): how many jobs
+     * ended per process and final status, and a histogram of their run
+     * times; both filled from the jobs already there.  duration_buckets
+     * holds the histogram's upper bounds in seconds (9e999 is +Inf). */
+    "CREATE TABLE job_counts ("
+    "  process TEXT NOT NULL, status TEXT NOT NULL, n INTEGER NOT NULL,"
+    "  PRIMARY KEY (process, status));"
+    "CREATE TABLE duration_buckets (le REAL PRIMARY KEY);"
+    "INSERT INTO duration_buckets VALUES (0.1), (0.5), (1), (2), (5), (10), (30), (60), (120),"
+    "  (300), (600), (1800), (3600), (7200), (21600), (86400), (9e999);"
+    "CREATE TABLE job_durations ("                 /* per bucket, not cumulative */
+    "  process TEXT NOT NULL, le REAL NOT NULL, n INTEGER NOT NULL, secs REAL NOT NULL,"
+    "  PRIMARY KEY (process, le));"
+    "INSERT INTO job_counts(process, status, n) SELECT process, status, count(*) FROM jobs"
+    "  WHERE status IN ('successful', 'failed', 'dismissed') GROUP BY process, status;"
+    "INSERT INTO job_durations(process, le, n, secs)"
+    "  SELECT process, (SELECT min(le) FROM duration_buckets WHERE le >= finished - started) AS b,"
+    "  count(*), sum(finished - started) FROM jobs"
+    "  WHERE started IS NOT NULL AND finished IS NOT NULL GROUP BY process, b;",
 };
 
 int pk_schema_version(void) { return (int)(sizeof steps / sizeof *steps); }

@@ -12,6 +12,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "job_metrics.h"
 #include "migrations.h"
 
 struct pk_queue {
@@ -395,6 +396,7 @@ const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, con
                             size, id));
         if (n == 1) {
             ended = !strcmp(status, "successful") ? "successful" : "failed";
+            pk_metrics_job_ended(q->db, id, ended);
         } else if (run(q, prep(q, "UPDATE jobs SET finished=?, updated=?, worker_pid=NULL, rev=rev+1,"
                                   " message='dismissed; worker stopped' WHERE id=? AND"
                                   " status='dismissed' AND finished IS NULL",
@@ -402,6 +404,8 @@ const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, con
             ended = "unchanged";
             commit(q);
             goto out;
+        } else {
+            pk_metrics_job_ended(q->db, id, "dismissed"); /* its worker stopped */
         }
         add_status_event(q, id);
         /* History stays small: of the progress events only the last is kept. */
@@ -435,6 +439,8 @@ int pk_queue_dismiss(pk_queue *q, const char *id, char was[16])
     else if (strcmp(was, "dismissed") != 0)
         run(q, prep(q, "UPDATE jobs SET status='dismissed', message='dismissed', updated=?,"
                        " finished=coalesce(finished, ?), rev=rev+1 WHERE id=?", "dds", now, now, id));
+    if (!strcmp(was, "accepted")) /* a finished job was counted when it ended */
+        pk_metrics_job_ended(q->db, id, "dismissed");
     add_status_event(q, id);
     commit(q);
     rc = 0;
@@ -469,6 +475,7 @@ int pk_queue_recover(pk_queue *q, int max_attempts, int *failed)
             const char *id = json_string_value(json_object_get(r, "id"));
             if (strcmp(json_string_value(json_object_get(r, "status")), "running") != 0) {
                 run(q, prep(q, "UPDATE jobs SET finished=?, worker_pid=NULL WHERE id=?", "ds", now, id));
+                pk_metrics_job_ended(q->db, id, "dismissed");
                 continue;
             }
             int attempts = (int)json_integer_value(json_object_get(r, "attempts"));
@@ -481,6 +488,7 @@ int pk_queue_recover(pk_queue *q, int max_attempts, int *failed)
                 run(q, prep(q, "UPDATE jobs SET status='failed', worker_pid=NULL, finished=?, updated=?,"
                                " message='interrupted ' || attempts || ' times by daemon restarts; not"
                                " retried', rev=rev+1 WHERE id=?", "dds", now, now, id));
+                pk_metrics_job_ended(q->db, id, "failed");
                 (*failed)++;
             }
             add_status_event(q, id);
@@ -547,11 +555,11 @@ void pk_queue_wake_all(pk_queue *q) { notify(q); }
 json_t *pk_queue_stats(pk_queue *q)
 {
     pthread_mutex_lock(&q->mu);
-    json_t *by = rows(prep(q, "SELECT status, count(*) AS n, count(finished - started) AS timed,"
-                              " coalesce(sum(finished - started), 0.0) AS secs FROM jobs GROUP BY status", NULL));
+    json_t *by = rows(prep(q, "SELECT status, count(*) AS n FROM jobs GROUP BY status", NULL));
     int ok = scalar(q, prep(q, "SELECT count(*) FROM jobs", NULL)) >= 0; /* the database answers */
+    json_t *metrics = pk_metrics_read(q->db);
     pthread_mutex_unlock(&q->mu);
-    json_t *jobs = json_object(), *dur = json_object();
+    json_t *jobs = json_object();
     const char *all[] = {"accepted", "running", "successful", "failed", "dismissed"};
     for (size_t i = 0; i < 5; i++)
         json_object_set_new(jobs, all[i], json_integer(0));
@@ -560,11 +568,11 @@ json_t *pk_queue_stats(pk_queue *q)
     json_array_foreach(by, i, r) {
         const char *st = json_string_value(json_object_get(r, "status"));
         json_object_set(jobs, st, json_object_get(r, "n"));
-        json_object_set_new(dur, st, json_pack("{s:O,s:O}", "count", json_object_get(r, "timed"),
-                                               "sum", json_object_get(r, "secs")));
     }
     json_decref(by);
-    return json_pack("{s:o,s:o,s:b}", "jobs", jobs, "durations", dur, "ok", ok);
+    json_object_set_new(metrics, "jobs", jobs);
+    json_object_set_new(metrics, "ok", json_boolean(ok));
+    return metrics;
 }
 
 int pk_queue_writable(pk_queue *q, char *why, size_t n)

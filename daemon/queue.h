@@ -89,8 +89,9 @@ long long pk_queue_wait_event(pk_queue *q, long long seen, int timeout_ms);
 /* Wake every waiter (shutdown). */
 void pk_queue_wake_all(pk_queue *q);
 
-/* Metrics: {"jobs": {status: n}, "durations": {status: {"count", "sum"}},
- *           "ok": whether the database answered}. */
+/* Metrics: {"jobs": {status: n} (rows now), "ok": whether the database
+ * answered, and the monotonic "finished", "durations", "bounds" of
+ * pk_metrics_read (job_metrics.h)}. */
 json_t *pk_queue_stats(pk_queue *q);
 
 /* 1 when the last write committed; 0 while writes fail (why: the error and

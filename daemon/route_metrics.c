@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "http.h"
+#include "process.h"
 
 typedef struct buf {
     char *p;
@@ -34,6 +35,61 @@ static void put(buf *b, const char *fmt, ...)
     }
 }
 
+/* The processes to label: every known one (so each series exists from the
+ * start, at 0) and any other the database has counted. */
+static json_t *process_names(json_t *st)
+{
+    json_t *names = json_object();
+    for (size_t i = 0; pk_processes[i]; i++)
+        json_object_set_new(names, pk_processes[i]->id, json_true());
+    const char *k;
+    json_t *v;
+    json_object_foreach(json_object_get(st, "finished"), k, v) json_object_set_new(names, k, json_true());
+    json_object_foreach(json_object_get(st, "durations"), k, v) json_object_set_new(names, k, json_true());
+    return names;
+}
+
+/* Counters and the run-time histogram of ended jobs (job_metrics.h): kept
+ * in the database, they never go down when a job is dismissed or the
+ * daemon restarts. */
+static void put_job_counters(buf *b, json_t *st)
+{
+    static const char *const ended[] = {"successful", "failed", "dismissed"};
+    json_t *names = process_names(st), *v;
+    const char *p;
+    put(b, "# HELP packd_jobs_finished_total Jobs that ended, by process and final status"
+           " (a job dismissed after it ended stays counted as it ended).\n"
+           "# TYPE packd_jobs_finished_total counter\n");
+    json_object_foreach(names, p, v) {
+        json_t *counts = json_object_get(json_object_get(st, "finished"), p);
+        for (size_t i = 0; i < sizeof ended / sizeof *ended; i++)
+            put(b, "packd_jobs_finished_total{process=\"%s\",status=\"%s\"} %lld\n", p, ended[i],
+                (long long)json_integer_value(json_object_get(counts, ended[i])));
+    }
+    put(b, "# HELP packd_job_duration_seconds Run time of jobs that ran to an end (started to"
+           " finished), by process.\n# TYPE packd_job_duration_seconds histogram\n");
+    json_t *bounds = json_object_get(st, "bounds");
+    json_object_foreach(names, p, v) {
+        json_t *d = json_object_get(json_object_get(st, "durations"), p);
+        long long cum = 0;
+        size_t i;
+        json_t *le;
+        json_array_foreach(bounds, i, le) {
+            cum += json_integer_value(json_array_get(json_object_get(d, "n"), i));
+            if (json_is_null(le))
+                put(b, "packd_job_duration_seconds_bucket{process=\"%s\",le=\"+Inf\"} %lld\n", p, cum);
+            else
+                put(b, "packd_job_duration_seconds_bucket{process=\"%s\",le=\"%g\"} %lld\n", p,
+                    json_number_value(le), cum);
+        }
+        put(b, "packd_job_duration_seconds_sum{process=\"%s\"} %.6f\n", p,
+            json_number_value(json_object_get(d, "sum")));
+        put(b, "packd_job_duration_seconds_count{process=\"%s\"} %lld\n", p,
+            (long long)json_integer_value(json_object_get(d, "count")));
+    }
+    json_decref(names);
+}
+
 enum MHD_Result route_metrics(pk_req *r)
 {
     pk_service *svc = r->svc;
@@ -54,16 +110,7 @@ enum MHD_Result route_metrics(pk_req *r)
             "packd_workers_busy %d\n", pk_supervisor_busy(svc->sup));
     put(&b, "# HELP packd_workers_max Configured maximum of worker processes.\n"
             "# TYPE packd_workers_max gauge\npackd_workers_max %d\n", pk_supervisor_capacity(svc->sup));
-    put(&b, "# HELP packd_job_duration_seconds Run time of finished jobs (started to finished).\n"
-            "# TYPE packd_job_duration_seconds summary\n");
-    json_object_foreach(json_object_get(st, "durations"), k, v) {
-        if (!strcmp(k, "accepted") || !strcmp(k, "running"))
-            continue;
-        put(&b, "packd_job_duration_seconds_sum{status=\"%s\"} %.3f\n", k,
-            json_number_value(json_object_get(v, "sum")));
-        put(&b, "packd_job_duration_seconds_count{status=\"%s\"} %lld\n", k,
-            (long long)json_integer_value(json_object_get(v, "count")));
-    }
+    put_job_counters(&b, st);
     put(&b, "# HELP packd_http_responses_total HTTP responses by status code.\n"
             "# TYPE packd_http_responses_total counter\n");
     for (int c = 100; c < 600; c++) {

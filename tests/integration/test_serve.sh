@@ -107,7 +107,7 @@ check upload_roundtrip sh -c "cmp -s '$T/mesh.bin' '$T/down.bin' && [ '$(jget "$
 
 # 7. metrics and health
 c "$B/metrics" >"$T/metrics.txt"
-check metrics_prometheus sh -c "grep -q '^packd_jobs{status=\"successful\"} [1-9]' '$T/metrics.txt' && grep -q '^packd_queue_depth ' '$T/metrics.txt' && grep -q '^packd_workers_max 2' '$T/metrics.txt' && grep -q '^packd_job_duration_seconds_count{status=\"successful\"}' '$T/metrics.txt'"
+check metrics_prometheus sh -c "grep -q '^packd_jobs{status=\"successful\"} [1-9]' '$T/metrics.txt' && grep -q '^packd_queue_depth ' '$T/metrics.txt' && grep -q '^packd_workers_max 2' '$T/metrics.txt' && grep -q '^packd_job_duration_seconds_count{process=\"pack\"}' '$T/metrics.txt'"
 check healthz_ready test "$(c -o "$T/h.json" -w '%{http_code}' "$B/healthz")$(jget "$T/h.json" 'd["ready"]')" = 200True
 
 # 8. every error path: status code + application/problem+json + body status

@@ -1,0 +1,71 @@
+/* test_client.c — the client's integrity check: SHA-256 of a file through
+ * OpenSSL EVP (FIPS 180-4 vector "abc") and pk_client_verify against the
+ * results document's digest and the X-Content-SHA256 header; and the client
+ * options' precedence (flag, environment, built-in default). */
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "check.h"
+#include "client_args.h"
+#include "client_http.h"
+
+#define ABC "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+
+static void test_sha256_file(void)
+{
+    char path[] = "/tmp/test_client_XXXXXX", hex[65];
+    int fd = mkstemp(path);
+    CHECK(fd >= 0 && write(fd, "abc", 3) == 3);
+    close(fd);
+    CHECK(pk_client_sha256_file(path, hex) == 0);
+    CHECK_MSG(!strcmp(hex, ABC), "%s", hex);
+    unlink(path);
+    CHECK(pk_client_sha256_file(path, hex) == -1);
+}
+
+static void test_verify(void)
+{
+    char err[300];
+    char other[] = ABC;
+    other[0] = 'c';
+    CHECK(pk_client_verify(ABC, ABC, ABC, err, sizeof err) == 0);
+    CHECK(pk_client_verify(ABC, ABC, "", err, sizeof err) == 0);
+    CHECK(pk_client_verify(ABC, NULL, ABC, err, sizeof err) == 0);
+    CHECK(pk_client_verify(ABC, other, ABC, err, sizeof err) == -1 && strstr(err, "results document"));
+    CHECK(pk_client_verify(ABC, ABC, other, err, sizeof err) == -1 && strstr(err, "X-Content-SHA256"));
+    CHECK(pk_client_verify(ABC, NULL, NULL, err, sizeof err) == -1); /* nothing declared: not verified */
+    CHECK(pk_client_verify("", ABC, ABC, err, sizeof err) == -1);
+}
+
+static void test_option_precedence(void)
+{
+    pk_client_args a;
+    unsetenv("PACKD_SERVER");
+    unsetenv("PACKD_TOKEN");
+    char *v1[] = {"jobs", NULL};
+    CHECK(pk_client_parse(1, v1, &a) == 0);
+    CHECK(!strcmp(a.server, "http://127.0.0.1:8080") && a.token == NULL && !strcmp(a.limit, "20"));
+    setenv("PACKD_SERVER", "http://env:1", 1);
+    setenv("PACKD_TOKEN", "envtok", 1);
+    CHECK(pk_client_parse(1, v1, &a) == 0);
+    CHECK(!strcmp(a.server, "http://env:1") && !strcmp(a.token, "envtok"));
+    char *v2[] = {"submit", "job.json", "--server", "http://flag:2", "--token", "t", "-o", "x.h5", NULL};
+    CHECK(pk_client_parse(8, v2, &a) == 0);
+    CHECK(!strcmp(a.server, "http://flag:2") && !strcmp(a.token, "t") && a.wait == 1 &&
+          !strcmp(a.arg, "job.json"));
+    char *v3[] = {"fetch", "ID", NULL}; /* fetch needs -o */
+    CHECK(pk_client_parse(2, v3, &a) == 64);
+    char *v4[] = {"cancel", "ID", "--wait", NULL}; /* --wait is submit's */
+    CHECK(pk_client_parse(3, v4, &a) == 64);
+    unsetenv("PACKD_SERVER");
+    unsetenv("PACKD_TOKEN");
+}
+
+int main(void)
+{
+    RUN(test_sha256_file);
+    RUN(test_verify);
+    RUN(test_option_precedence);
+    return check_summary();
+}
