@@ -9,18 +9,16 @@
 #                 wrk: PACKD_BENCH_DEPS=1 sh deploy/install-deps.sh)
 #   make run      build and start the daemon with its embedded defaults
 #
-# Source files are found by wildcard: a new core/foo.c or tests/unit/test_foo.c
-# needs no edit here.
+# Source files are found by wildcard: a new core/<method>/foo.c or
+# tests/unit/test_foo.c needs no edit here.  Includes name their file from the
+# tree's root ("core/base/par.h") unless it sits in the same folder; the
+# compiler records which headers each object read (-MMD -MP, build/**/*.d).
 
 BUILD   ?= build
 CC      ?= cc
 OPT     ?= -O2
-# Functions start on a cache line.  The hot loops here are sensitive to where
-# the linker happens to place them: the same dem_contact.o evaluated a 2D pair
-# in 5.1 or 8.4 ns depending on an unrelated object's size, and a 10^4-grain
-# homogenization step with 8-11 % fewer instructions measured slower than the
-# old code in one link and 8-10 % faster in the other (bench/homog, 2026-11-22).
-# Aligned, both links give the fast figures; RSA and EDMD rates are unchanged.
+# Functions start on a cache line: the hot contact loops otherwise run 1.6x
+# slower or faster with where the linker places them (docs/perf/build.md).
 ALIGN   ?= -falign-functions=64
 SAN     ?=
 VERSION := $(shell cat VERSION 2>/dev/null || echo 0.0.0)
@@ -30,16 +28,17 @@ DEPS_OK := $(BUILD)/.deps-ok
 
 WARN    := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wno-unused-parameter
 CSTD    := -std=c17 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
-BASE_CFLAGS := $(CSTD) $(OPT) $(ALIGN) -g $(WARN) $(SAN) -DPACKD_VERSION='"$(VERSION)"'
+BASE_CFLAGS := $(CSTD) $(OPT) $(ALIGN) -g -MMD -MP $(WARN) $(SAN) -DPACKD_VERSION='"$(VERSION)"'
 
-# core/ is plain C17 + libm: compiled without any external include path.
-CORE_CFLAGS := $(BASE_CFLAGS)
-EXT_CFLAGS   = $(BASE_CFLAGS) $(shell pkg-config --cflags $(PKGS) 2>/dev/null) -I/usr/include/suitesparse -Icore -Iapi -I$(BUILD)/gen
+# core/ is plain C17 + libm: compiled with no include path but the tree's root.
+CORE_CFLAGS := $(BASE_CFLAGS) -I.
+EXT_CFLAGS   = $(BASE_CFLAGS) $(shell pkg-config --cflags $(PKGS) 2>/dev/null) -I/usr/include/suitesparse -I. -I$(BUILD)/gen
 EXT_LIBS     = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lcholmod -lgomp -lm -lpthread
 
-CORE_SRC   := $(wildcard core/*.c)
-API_SRC    := $(wildcard api/*.c)
-DAEMON_SRC := $(filter-out daemon/main.c,$(wildcard daemon/*.c))
+tree        = $(shell find $(1) -name '*.c' | sort)
+CORE_SRC   := $(call tree,core)
+API_SRC    := $(call tree,api)
+DAEMON_SRC := $(filter-out daemon/cli/main.c,$(call tree,daemon))
 SCHEMAS    := $(sort $(wildcard schemas/*.json))
 UNIT_SRC   := $(wildcard tests/unit/test_*.c)
 BENCH_SRC  := $(wildcard bench/*.c)
@@ -65,17 +64,17 @@ $(DEPS_OK): deploy/install-deps.sh
 
 deps: $(DEPS_OK)
 
-$(BUILD)/obj/core/%.o: core/%.c $(wildcard core/*.h) | $(DEPS_OK)
+$(BUILD)/obj/core/%.o: core/%.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(CC) $(CORE_CFLAGS) -c $< -o $@
 
-$(BUILD)/obj/api/%.o: api/%.c $(wildcard core/*.h api/*.h) | $(DEPS_OK)
+$(BUILD)/obj/api/%.o: api/%.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(CC) $(EXT_CFLAGS) -c $< -o $@
 
-$(BUILD)/obj/daemon/%.o: daemon/%.c $(wildcard core/*.h api/*.h daemon/*.h) | $(DEPS_OK)
+$(BUILD)/obj/daemon/%.o: daemon/%.c | $(DEPS_OK)
 	@mkdir -p $(@D)
-	$(CC) $(EXT_CFLAGS) -Idaemon -c $< -o $@
+	$(CC) $(EXT_CFLAGS) -c $< -o $@
 
 # The schemas are compiled into the binary so `packd validate` and the daemon
 # serve exactly the files in schemas/, wherever packd is installed.
@@ -85,18 +84,18 @@ $(BUILD)/gen/schemas_embedded.c: $(SCHEMAS) tools/embed-schemas.sh
 
 $(BUILD)/obj/gen/schemas_embedded.o: $(BUILD)/gen/schemas_embedded.c
 	@mkdir -p $(@D)
-	$(CC) $(BASE_CFLAGS) -Iapi -c $< -o $@
+	$(CC) $(BASE_CFLAGS) -I. -c $< -o $@
 
-$(BUILD)/packd: $(BUILD)/obj/daemon/main.o $(LIB_OBJ)
+$(BUILD)/packd: $(BUILD)/obj/daemon/cli/main.o $(LIB_OBJ)
 	$(CC) $(SAN) -o $@ $^ $(EXT_LIBS)
 
-$(BUILD)/tests/%: tests/unit/%.c tests/check.h $(wildcard tests/unit/*.h) $(LIB_OBJ)
+$(BUILD)/tests/%: tests/unit/%.c $(LIB_OBJ)
 	@mkdir -p $(@D)
-	$(CC) $(EXT_CFLAGS) -Idaemon -Itests -o $@ $< $(LIB_OBJ) $(EXT_LIBS)
+	$(CC) $(EXT_CFLAGS) -Itests -o $@ $< $(LIB_OBJ) $(EXT_LIBS)
 
 $(BUILD)/bench/%: bench/%.c $(LIB_OBJ)
 	@mkdir -p $(@D)
-	$(CC) $(EXT_CFLAGS) -Idaemon -o $@ $< $(LIB_OBJ) $(EXT_LIBS)
+	$(CC) $(EXT_CFLAGS) -o $@ $< $(LIB_OBJ) $(EXT_LIBS)
 
 test: $(DEPS_OK) $(BUILD)/packd $(UNIT_BIN) $(BENCH_BIN)
 	@sh tests/run.sh $(BUILD)
@@ -149,7 +148,7 @@ FUZZ_SECONDS ?= 60
 FUZZ_TARGETS := request gmsh tetgen h5_rve
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 FUZZ_CFLAGS   = $(CSTD) -O1 -g $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -DPACKD_VERSION='"$(VERSION)"' \
-               $(shell pkg-config --cflags $(PKGS) 2>/dev/null) -I/usr/include/suitesparse -Icore -Iapi -I$(FUZZ_BUILD)/gen
+               $(shell pkg-config --cflags $(PKGS) 2>/dev/null) -I/usr/include/suitesparse -I. -I$(FUZZ_BUILD)/gen
 FUZZ_OBJ     := $(CORE_SRC:%.c=$(FUZZ_BUILD)/obj/%.o) $(API_SRC:%.c=$(FUZZ_BUILD)/obj/%.o) \
                $(FUZZ_BUILD)/obj/gen/schemas_embedded.o
 FUZZ_BIN     := $(FUZZ_TARGETS:%=$(FUZZ_BUILD)/fuzz_%)
@@ -164,7 +163,7 @@ $(FUZZ_OK):
 	@if $(FUZZ_CC) -fsanitize=fuzzer $(@D)/probe.c -o $(@D)/probe 2>/dev/null; then touch $@; \
 	 else echo "fuzz: skipped: $(FUZZ_CC) -fsanitize=fuzzer does not link (apt-get install clang libclang-rt-14-dev)"; fi
 
-$(FUZZ_BUILD)/obj/%.o: %.c $(wildcard core/*.h api/*.h) | $(DEPS_OK)
+$(FUZZ_BUILD)/obj/%.o: %.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -c $< -o $@
 
@@ -176,7 +175,7 @@ $(FUZZ_BUILD)/obj/gen/schemas_embedded.o: $(FUZZ_BUILD)/gen/schemas_embedded.c
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -c $< -o $@
 
-$(FUZZ_BUILD)/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/targets.h $(FUZZ_OBJ)
+$(FUZZ_BUILD)/fuzz_%: tests/fuzz/fuzz_%.c $(FUZZ_OBJ)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer -o $@ $< $(FUZZ_OBJ) $(EXT_LIBS)
 
 fuzz-build: $(FUZZ_OK)
@@ -193,3 +192,6 @@ test: fuzz-build
 
 clean:
 	rm -rf build build-san $(FUZZ_BUILD)
+
+# The headers each object, test and bench binary read, as the compiler saw them.
+-include $(shell find $(BUILD) $(FUZZ_BUILD) -name '*.d' 2>/dev/null)

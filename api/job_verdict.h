@@ -16,7 +16,7 @@
 
 #include <jansson.h>
 
-#include "h5_result.h"
+#include "api/results/h5_result.h"
 
 /* Append a sentence to summary's "warnings" array. */
 void pk_verdict_warn(json_t *summary, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

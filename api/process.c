@@ -4,10 +4,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "homog_job.h"
-#include "input_links.h"
+#include "api/homog/homog_job.h"
+#include "api/inputs/input_links.h"
 #include "job_verdict.h"
-#include "pack_job.h"
+#include "api/pack/pack_job.h"
 
 static const pk_process pack_process = {
     .id = "pack",

@@ -7,9 +7,9 @@
 #include <jansson.h>
 #include <stddef.h>
 
-#include "check_ctx.h"
-#include "json_schema.h"
-#include "progress.h"
+#include "api/inputs/check_ctx.h"
+#include "api/schemas/json_schema.h"
+#include "core/base/progress.h"
 
 typedef struct pk_process {
     const char *id;             /* "pack" */
@@ -43,7 +43,7 @@ size_t pk_process_validate_inputs(const pk_process *p, json_t *inputs, const pk_
 size_t pk_job_validate(json_t *job, const pk_check_ctx *ctx, const pk_process **proc,
                        pk_schema_errors *errs);
 
-/* Threads of a job's parallel sections (core/par.h), for the jobs run by
+/* Threads of a job's parallel sections (core/base/par.h), for the jobs run by
  * this process from now on (default 1).  The results are the same bits
  * for any number: a deployment setting, not a job input. */
 void pk_job_set_threads(int n);

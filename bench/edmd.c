@@ -28,9 +28,9 @@
 #include <string.h>
 #include <sys/resource.h>
 
-#include "edmd.h"
-#include "process.h"
-#include "rsa.h"
+#include "core/edmd/edmd.h"
+#include "api/process.h"
+#include "core/rsa/rsa.h"
 
 /* Case filter: PACKD_BENCH_CASE=TEXT keeps the cases whose name contains it. */
 static int wanted(const char *name)
@@ -105,7 +105,7 @@ static void run_core(const char *name, int dim, const double *r, size_t n, doubl
             d[i] = 2 * r[i];
         pk_rsa_stats rs;
         prm.start_zero = 0;
-        /* the job's default start (api/pack_place_edmd.c) at rsa_phi */
+        /* the job's default start (api/pack/pack_place_edmd.c) at rsa_phi */
         prm.delta = pk_edmd_start_delta(dim, d, n, 0, pk_box_measure(&b), rsa_phi);
         pk_edmd_start_rsa(&b, d, sp, n, prm.delta, 0, prm.seed, NULL, &p, &rs);
         free(d);

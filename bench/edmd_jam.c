@@ -19,9 +19,9 @@
 #include <string.h>
 #include <sys/resource.h>
 
-#include "edmd.h"
-#include "edmd_contacts.h"
-#include "rsa.h"
+#include "core/edmd/edmd.h"
+#include "core/edmd/edmd_contacts.h"
+#include "core/rsa/rsa.h"
 
 static double cpu_s(void)
 {

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <sys/resource.h>
 
-#include "process.h"
+#include "api/process.h"
 
 static double cpu_s(void)
 {

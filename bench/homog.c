@@ -8,16 +8,16 @@
  *     forces-only pk_dem_eval a DR iteration runs, on the relaxed state)
  *   bench=homog case=contact_{eval,forces}_2d ... ns_per_pair=T threads=2
  *     serial_ns_per_pair=T1 speedup=T1/T (pk_dem_eval and pk_dem_eval_forces
- *     on a 2-thread core/par.h pool against the serial code, best of 9
+ *     on a 2-thread core/base/par.h pool against the serial code, best of 9
  *     alternating rounds; the same bits; parallel_path=0: the list is
  *     below pk_dem_par_min_pairs, both serial)
  *   bench=homog case=periodic_step_newton_2d ... threads=2 seconds=S
  *     serial_seconds=S1 speedup=S1/S same_bits=B (the step again on a 2-thread
  *     pool, pk_homog_opts.par: the attempts speculative on the second thread,
- *     core/homog_speculative.c; B = 1: the same end point, energy, P̄ and
+ *     core/homog/homog_speculative.c; B = 1: the same end point, energy, P̄ and
  *     path statistics — on 0 the fields that differ go to stderr)
  * The step is 0.1 % uniaxial compression at tolerance 1e-8 (the thesis's),
- * solved by the Newton/DR/FIRE hybrid (core/homog_newton.h, CHOLMOD) and by DR
+ * solved by the Newton/DR/FIRE hybrid (core/homog/homog_newton.h, CHOLMOD) and by DR
  * alone from the same committed state; the DR line carries the agreement of
  * P̄ and of the energy (the same local minimum?) and the Newton line the
  * speed-up.  10⁴ grains with PACKD_BENCH_LARGE=1.
@@ -41,12 +41,12 @@
 #include <string.h>
 #include <time.h>
 
-#include "edmd.h"
-#include "homog_tangent.h"
-#include "homog_tensor.h"
-#include "par.h"
-#include "rng.h"
-#include "sparse_cholmod.h"
+#include "core/edmd/edmd.h"
+#include "core/homog/homog_tangent.h"
+#include "core/homog/homog_tensor.h"
+#include "core/base/par.h"
+#include "core/base/rng.h"
+#include "api/solver/sparse_cholmod.h"
 
 /* Case filter: PACKD_BENCH_CASE=TEXT keeps the RVEs whose name contains it. */
 static int wanted(const char *name)
@@ -285,7 +285,7 @@ static double eval_ns(pk_dem_pairs *c, const pk_dem_geom *g, const pk_homog_rve 
     return 1e9 * (pk_wall_seconds() - t0) / ((double)reps * (double)c->n);
 }
 
-/* The evaluation on 2 threads (core/par.h pool in c->par) against the
+/* The evaluation on 2 threads (core/base/par.h pool in c->par) against the
  * serial one, best of ROUNDS alternating rounds each (the machine is
  * shared: ±20 % between single runs), for pk_dem_eval (case
  * contact_eval_2d, the line above's function) and pk_dem_eval_forces (case

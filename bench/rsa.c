@@ -17,7 +17,7 @@
  * seconds wander 2-3x, compare cpu_s old vs new back to back); sys_s and
  * minflt: the placement's system time and page faults (a page's first touch
  * costs ~2 µs here: at 10^6 grains ~15 % of the run); audit_s: the gap audit
- * every job runs on its packing (core/gap_audit.h, horizon r_max as the jobs
+ * every job runs on its packing (core/space/gap_audit.h, horizon r_max as the jobs
  * pass it), timed after the placement, with its ratio to the placement.
  * `rsa mono` runs only the default-path monodisperse cases (1e4, 1e5, 1e6)
  * and the scaling line: a quick re-measurement.
@@ -34,10 +34,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "gap_audit.h"
-#include "pack_job.h"
-#include "process.h"
-#include "rsa.h"
+#include "core/space/gap_audit.h"
+#include "api/pack/pack_job.h"
+#include "api/process.h"
+#include "core/rsa/rsa.h"
 
 enum path { PLAIN, VOXELS, BATCH_PLAIN, BATCHED };
 /* Runs of the default path's cases (medians; ~0.1, 0.4 and 2.5 s in all). */

@@ -10,10 +10,10 @@
 #include <sys/resource.h>
 #include <time.h>
 
-#include "mesh.h"
-#include "mesh_io.h"
-#include "tetfill.h"
-#include "tetfill_stats.h"
+#include "core/mesh/mesh.h"
+#include "api/mesh/mesh_io.h"
+#include "core/tetfill/tetfill.h"
+#include "core/tetfill/tetfill_stats.h"
 
 static double max_rss_mib(void)
 {

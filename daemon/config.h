@@ -35,7 +35,7 @@ typedef struct pk_config {
     double body_timeout_s;    /* a request body must arrive within this time after its headers */
     double checkpoint_interval_s; /* between two checkpoints of a long job (job dir checkpoint.h5) */
     pk_log_level log_level;
-    pk_auth_mode auth;        /* bearer tokens required (daemon/auth.c) */
+    pk_auth_mode auth;        /* bearer tokens required (daemon/http/auth.c) */
     char trusted_proxy[64];   /* peer whose X-Packd-Owner is honoured; "" = none */
     char config_file[1024];   /* the file read, "" if none (kept for SIGHUP) */
 } pk_config;

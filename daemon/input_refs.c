@@ -4,7 +4,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "input_links.h"
+#include "api/inputs/input_links.h"
 #include "supervisor.h"
 
 static int all_hex(const char *s, size_t n)

@@ -9,8 +9,8 @@
 
 #include <jansson.h>
 
-#include "json_schema.h"
-#include "queue.h"
+#include "api/schemas/json_schema.h"
+#include "daemon/store/queue.h"
 
 /* Rewrites inputs in place.  Unknown or unusable links become errors
  * (pointer relative to the inputs object, rule "href"); so do links to

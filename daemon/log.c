@@ -1,6 +1,6 @@
 #include "log.h"
 
-#include "http_time.h"
+#include "api/http/http_time.h"
 
 #include <jansson.h>
 #include <pthread.h>

@@ -6,9 +6,9 @@
 #include <pthread.h>
 
 #include "config.h"
-#include "queue.h"
+#include "daemon/store/queue.h"
 #include "supervisor.h"
-#include "tokens.h"
+#include "daemon/store/tokens.h"
 
 typedef struct pk_service {
     pthread_mutex_t mu;          /* guards cfg (SIGHUP replaces it) */

@@ -15,7 +15,7 @@
 #ifndef PK_SUPERVISOR_H
 #define PK_SUPERVISOR_H
 
-#include "queue.h"
+#include "daemon/store/queue.h"
 
 typedef struct pk_supervisor pk_supervisor;
 

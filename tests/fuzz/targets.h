@@ -30,11 +30,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "h5_result.h"
-#include "http_process_doc.h"
-#include "input_confine.h"
-#include "mesh_io.h"
-#include "process.h"
+#include "api/results/h5_result.h"
+#include "api/http/http_process_doc.h"
+#include "api/inputs/input_confine.h"
+#include "api/mesh/mesh_io.h"
+#include "api/process.h"
 
 static char fuzz_scratch[64];
 

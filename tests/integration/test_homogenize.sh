@@ -180,7 +180,7 @@ rc=$?
 check refuse_friction_with_tangent sh -c "test $rc -eq 1 && printf '%s' '$out' | grep -q '/inputs/tangent'"
 
 # 10. --threads is a deployment setting: a homogenization large enough for the parallel contact
-#     evaluation (core/par.h; >= 4,096 candidate pairs: 2,000 grains have ~7,000) gives the same
+#     evaluation (core/base/par.h; >= 4,096 candidate pairs: 2,000 grains have ~7,000) gives the same
 #     bits with 1 and 2 threads — the whole file but the tangent's timing (h5diff compares exactly
 #     without -d/-p)
 python3 -c "

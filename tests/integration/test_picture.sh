@@ -12,7 +12,7 @@ trap 'rm -rf "$T"' EXIT
 
 "$PACKD" run "$SRC/examples/meier-quartz-2d.json" -o "$T/q.h5" >/dev/null 2>&1
 "$PACKD" picture "$T/q.h5" -o "$T/q.png"
-# box panel: x from 36, y from 54, 720 px wide (api/picture_packing.c); φ = 0.45
+# box panel: x from 36, y from 54, 720 px wide (api/picture/picture_packing.c); φ = 0.45
 fill=$(python3 "$SRC/tests/tools/png_fill.py" "$T/q.png" 37 55 755 773)
 check picture_2d_png_size test "$(echo "$fill" | cut -d' ' -f1-2)" = "792 810"
 # outlines (0.4–0.9 px around 3–17 px disks) add up to ~0.07 of ink

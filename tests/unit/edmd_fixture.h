@@ -5,8 +5,8 @@
 #include <math.h>
 #include <string.h>
 
-#include "box.h"
-#include "particles.h"
+#include "core/space/box.h"
+#include "core/space/particles.h"
 
 /* The periodic cube (square in 2D) in which the grains of p fill phi. */
 static inline pk_box edmd_fixture_periodic_box(const pk_particles *p, double phi)

@@ -9,9 +9,9 @@
 #include <stdbool.h>
 #include <string.h>
 
-#include "box.h"
-#include "particles.h"
-#include "rng.h"
+#include "core/space/box.h"
+#include "core/space/particles.h"
+#include "core/base/rng.h"
 
 /* Box of edges 24, 26, 28 (3D) or 14, 16 (2D) with the given periodicity
  * and 700 (3D) or 300 (2D) grains at uniform positions, radii by the inverse

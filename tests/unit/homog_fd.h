@@ -4,8 +4,8 @@
 #ifndef PK_HOMOG_FD_H
 #define PK_HOMOG_FD_H
 
-#include "homog_tangent.h"
-#include "sparse_cholmod.h"
+#include "core/homog/homog_tangent.h"
+#include "api/solver/sparse_cholmod.h"
 
 /* Largest |FD − Ā| / max|Ā| over the dim² columns of Ā at the fixture's
  * committed state (reached with F0); *asym gets the largest major-symmetry

@@ -8,9 +8,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "homog_bc.h"
-#include "homog_tensor.h"
-#include "rng.h"
+#include "core/homog/homog_bc.h"
+#include "core/homog/homog_tensor.h"
+#include "core/base/rng.h"
 
 static inline pk_homog_opts opts(double rmean)
 {

@@ -7,8 +7,8 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "client_args.h"
-#include "client_http.h"
+#include "daemon/cli/client_args.h"
+#include "daemon/cli/client_http.h"
 
 #define ABC "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
 

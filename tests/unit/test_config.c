@@ -6,9 +6,9 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "auth.h"
+#include "daemon/http/auth.h"
 #include "check.h"
-#include "config.h"
+#include "daemon/config.h"
 
 static char path[] = "/tmp/pk_config_XXXXXX";
 

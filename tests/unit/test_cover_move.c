@@ -12,8 +12,8 @@
 
 #include "check.h"
 #include "grid_fixture.h"
-#include "grid_uniform.h"
-#include "rng.h"
+#include "core/space/grid_uniform.h"
+#include "core/base/rng.h"
 
 static int cmp_i32(const void *a, const void *b)
 {

@@ -5,10 +5,10 @@
 #include <string.h>
 
 #include "check.h"
-#include "dem_contact.h"
-#include "dem_rattler.h"
-#include "homog_tensor.h"
-#include "rng.h"
+#include "core/dem/dem_contact.h"
+#include "core/dem/dem_rattler.h"
+#include "core/homog/homog_tensor.h"
+#include "core/base/rng.h"
 
 static void geom_init(pk_dem_geom *g, int dim, int periodic, double L, const double F[9])
 {

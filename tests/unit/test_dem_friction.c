@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "dem_friction.h"
+#include "core/dem/dem_friction.h"
 #include "homog_fixture.h"
 
 /* After a slip correction Y = f_n tan ρ exactly (spec §5.3 derived check);

@@ -1,10 +1,10 @@
 /* test_dem_kblocks.c — the compact stiffness blocks of the Lanczos estimate
- * (core/dem_kblocks.h) give K·v exactly as pk_dem_kv does (same operations,
+ * (core/dem/dem_kblocks.h) give K·v exactly as pk_dem_kv does (same operations,
  * same order: compared with ==), on jammed periodic packings under a sheared
  * F̄, 2D and 3D, with held grains in the mask and with pair-specific
  * stiffness classes. */
 #include "check.h"
-#include "dem_kblocks.h"
+#include "core/dem/dem_kblocks.h"
 #include "homog_fixture.h"
 
 static void check_kv_equal(int dim, size_t n, double phi, int classes)

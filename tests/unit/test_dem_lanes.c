@@ -1,5 +1,5 @@
 /* test_dem_lanes.c — the AVX2 geometry lanes of the 2D pk_dem_eval
- * (core/dem_contact.c) give the scalar loop's numbers bit for bit: l, |l|,
+ * (core/dem/dem_contact.c) give the scalar loop's numbers bit for bit: l, |l|,
  * ε of every candidate, the contact count, forces, energy and the contact
  * sum S.  Sheared periodic and open boxes, uniform and class-specific
  * stiffness, candidate counts spanning several evaluation blocks with short
@@ -11,9 +11,9 @@
 #include <string.h>
 
 #include "check.h"
-#include "dem_contact.h"
-#include "homog_tensor.h"
-#include "rng.h"
+#include "core/dem/dem_contact.h"
+#include "core/homog/homog_tensor.h"
+#include "core/base/rng.h"
 
 typedef struct outcome {
     size_t nc, n;

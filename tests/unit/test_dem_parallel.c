@@ -1,5 +1,5 @@
 /* test_dem_parallel.c — the parallel contact evaluation (pk_dem_pairs.par,
- * core/dem_contact.c eval_par) gives the serial results bit for bit for 1–4
+ * core/dem/dem_contact.c eval_par) gives the serial results bit for bit for 1–4
  * threads: forces, contact counts, and for pk_dem_eval the pair arrays l,
  * |l|, ε, the energy and S.  Scenes: random 2D periodic (sheared) and open
  * boxes with overlaps, class-specific stiffness, grains moved after the
@@ -14,10 +14,10 @@
 #include <string.h>
 
 #include "check.h"
-#include "dem_contact.h"
-#include "homog_tensor.h"
-#include "par.h"
-#include "rng.h"
+#include "core/dem/dem_contact.h"
+#include "core/homog/homog_tensor.h"
+#include "core/base/par.h"
+#include "core/base/rng.h"
 
 typedef struct outcome {
     size_t nc[4], n, np;

@@ -10,9 +10,9 @@
 #include <time.h>
 
 #include "check.h"
-#include "dem_contact.h"
-#include "dem_rattler.h"
-#include "rng.h"
+#include "core/dem/dem_contact.h"
+#include "core/dem/dem_rattler.h"
+#include "core/base/rng.h"
 
 /* The plain sweep; returns the count, *sweeps the number of sweeps that
  * found a new rattler. */

@@ -6,11 +6,11 @@
 #include <string.h>
 
 #include "check.h"
-#include "edmd.h"
-#include "gap_audit.h"
-#include "rng.h"
+#include "core/edmd/edmd.h"
+#include "core/space/gap_audit.h"
+#include "core/base/rng.h"
 
-/* Independent check (core/gap_audit: its own cell grid, not the engine's
+/* Independent check (core/space/gap_audit: its own cell grid, not the engine's
  * lists): no pair closer than Δd − 1e-9·d_min, no wall clearance below
  * Δd/2 − 1e-9·d_min.  1e-9 relative is the issue's bar; the engine's own
  * round-off is ~1e-15 relative. */

@@ -1,8 +1,8 @@
 /* test_edmd_checkpoint.c — an EDMD run continued from a snapshot
- * (core/edmd_checkpoint.h) is a valid continuation: same grains, no
+ * (core/edmd/edmd_checkpoint.h) is a valid continuation: same grains, no
  * overlaps, the counters and history carried on, the jamming density of an
  * uninterrupted run; the snapshot survives its HDF5 file unchanged
- * (api/edmd_checkpoint_h5.h) and a file of another job is refused. */
+ * (api/pack/edmd_checkpoint_h5.h) and a file of another job is refused. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -10,11 +10,11 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "edmd.h"
-#include "edmd_checkpoint.h"
-#include "edmd_checkpoint_h5.h"
+#include "core/edmd/edmd.h"
+#include "core/edmd/edmd_checkpoint.h"
+#include "api/pack/edmd_checkpoint_h5.h"
 #include "edmd_fixture.h"
-#include "gap_audit.h"
+#include "core/space/gap_audit.h"
 
 #define N 400
 

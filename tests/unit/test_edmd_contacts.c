@@ -1,11 +1,11 @@
 /* test_edmd_contacts.c — contact network of a finished packing
- * (core/edmd_contacts.h): a constructed packing whose contacts and rattlers
+ * (core/edmd/edmd_contacts.h): a constructed packing whose contacts and rattlers
  * are known, the recursive rattler removal, the pressure-based tolerance. */
 #include <math.h>
 #include <string.h>
 
 #include "check.h"
-#include "edmd_contacts.h"
+#include "core/edmd/edmd_contacts.h"
 
 /* 2D, disks of diameter 1 in a large walled box: a hexagon (centre C and
  * ring O0..O5, 12 contacts, C has 6, each Oi 3), X in the notch between O0

@@ -7,9 +7,9 @@
 
 #include "check.h"
 #include "edmd_fixture.h"
-#include "edmd.h"
-#include "edmd_contacts.h"
-#include "gap_audit.h"
+#include "core/edmd/edmd.h"
+#include "core/edmd/edmd_contacts.h"
+#include "core/space/gap_audit.h"
 
 static void check_no_overlap(const pk_box *b, const pk_particles *p)
 {

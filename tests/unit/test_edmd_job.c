@@ -9,8 +9,8 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "edmd_contacts.h"
-#include "process.h"
+#include "core/edmd/edmd_contacts.h"
+#include "api/process.h"
 
 /* 2D periodic, 150 disks d = 1 / 1.4, from zero radii until jammed;
  * extra: more "edmd" members (JSON text, may be empty). */

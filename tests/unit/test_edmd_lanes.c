@@ -1,4 +1,4 @@
-/* test_edmd_lanes.c — the vector neighbour loops of core/edmd_predict.c (AVX2
+/* test_edmd_lanes.c — the vector neighbour loops of core/edmd/edmd_predict.c (AVX2
  * four lanes, AVX-512 eight lanes) give the scalar loop's events bit for
  * bit: the same run through each path ends with identical counts and
  * positions.  Polydisperse 3D (lists of every length, so full and short last
@@ -11,9 +11,9 @@
 #include <string.h>
 
 #include "check.h"
-#include "edmd.h"
+#include "core/edmd/edmd.h"
 #include "edmd_fixture.h"
-#include "edmd_state.h"
+#include "core/edmd/edmd_state.h"
 
 typedef struct outcome {
     pk_edmd_stats st;

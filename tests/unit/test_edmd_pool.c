@@ -1,7 +1,7 @@
-/* test_edmd_pool.c — the pooled neighbour lists (core/edmd_nlist.c: one
+/* test_edmd_pool.c — the pooled neighbour lists (core/edmd/edmd_nlist.c: one
  * block of slots, lists moving to its end when they outgrow their slot, the
  * pool regrown and compacted in grain order) and the Z-order numbering of
- * the start (core/edmd_order.c) over a long run: N = 4096 grains to jamming
+ * the start (core/edmd/edmd_order.c) over a long run: N = 4096 grains to jamming
  * (~2·10^6 events, the pool regrown a dozen times).  Sized for the unit
  * suite: 2D, rate 0.02, ~1.5 s CPU plain. */
 #include <math.h>
@@ -9,8 +9,8 @@
 
 #include "check.h"
 #include "edmd_fixture.h"
-#include "edmd.h"
-#include "gap_audit.h"
+#include "core/edmd/edmd.h"
+#include "core/space/gap_audit.h"
 
 #define N 4096
 

@@ -1,4 +1,4 @@
-/* test_edmd_queue.c — the EDMD event queue (core/edmd_queue.c, a calendar
+/* test_edmd_queue.c — the EDMD event queue (core/edmd/edmd_queue.c, a calendar
  * of time slots): driven as the engine drives it, against a brute-force
  * minimum.  Each step takes the top grain i, checks that its time is the
  * smallest pending one (ties: any grain at that time) and never earlier
@@ -15,8 +15,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "edmd_state.h"
-#include "rng.h"
+#include "core/edmd/edmd_state.h"
+#include "core/base/rng.h"
 
 /* A time ahead of now: log-uniform spacing over six decades, sometimes 0
  * (an event now), sometimes +inf (no event). */

@@ -6,8 +6,8 @@
 
 #include "check.h"
 #include "edmd_fixture.h"
-#include "edmd_state.h"
-#include "gap_audit.h"
+#include "core/edmd/edmd_state.h"
+#include "core/space/gap_audit.h"
 
 /* Two touching unit-mass grains on the x axis (i at 0, j at 1, n = +x),
  * v_i = (0.3, 0.2), v_j = (−0.1, 0.5), radius rates g_i = 0.01, g_j = 0.03:

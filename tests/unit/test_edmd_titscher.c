@@ -6,7 +6,7 @@
  * engine's default walls, which reflect the Δd/2 shell and so keep Δd/2
  * clearance, the shell spheres jam at φ ≈ 0.673–0.680 in the 80 mm box
  * (γ = 0.01 … 0.001): Δd_max = 0.937–0.951 mm over 5 seeds, short of 1 mm.
- * With walls that see the true surface (core/edmd_walls.h) Δd = 1 mm is
+ * With walls that see the true surface (core/edmd/edmd_walls.h) Δd = 1 mm is
  * reached at φ_M = 53.5 % (6 of 6 seeds), at 54 % for 2 of 5, at 54.5 %
  * for 0 of 5 (bench/edmd_titscher.c) — Titscher's Fig. 9: EDMD maximum
  * φ_M = 53.5 % with 90 % success.  Full size here (N ≈ 5130): a smaller
@@ -16,10 +16,10 @@
 #include <string.h>
 
 #include "check.h"
-#include "edmd.h"
-#include "edmd_walls.h"
-#include "gap_audit.h"
-#include "psd.h"
+#include "core/edmd/edmd.h"
+#include "core/edmd/edmd_walls.h"
+#include "core/space/gap_audit.h"
+#include "core/psd/psd.h"
 
 static pk_box walled_cube(double a)
 {

@@ -1,4 +1,4 @@
-/* test_gap_audit.c — core/gap_audit against brute force over all pairs.
+/* test_gap_audit.c — core/space/gap_audit against brute force over all pairs.
  *
  * The audit is what a result file's smallest_gap and pairs_below_delta_d
  * come from, so it is checked here against the plainest possible code (every
@@ -14,9 +14,9 @@
 #include <stdlib.h>
 
 #include "check.h"
-#include "gap_audit.h"
-#include "particles.h"
-#include "rng.h"
+#include "core/space/gap_audit.h"
+#include "core/space/particles.h"
+#include "core/base/rng.h"
 
 static double brute_gap(const pk_box *b, const pk_particles *p, size_t i, size_t j)
 {

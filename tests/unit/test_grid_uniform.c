@@ -1,4 +1,4 @@
-/* test_grid_uniform.c — core/grid_uniform.h (the dense cell levels under
+/* test_grid_uniform.c — core/space/grid_uniform.h (the dense cell levels under
  * EDMD's neighbour lists) against a brute-force pair scan: every query must
  * report exactly the grains within r + r_j by the minimum image, once. */
 #include <math.h>
@@ -7,8 +7,8 @@
 
 #include "check.h"
 #include "grid_fixture.h"
-#include "grid_uniform.h"
-#include "rng.h"
+#include "core/space/grid_uniform.h"
+#include "core/base/rng.h"
 
 typedef struct hits {
     int *seen; /* times each grain was reported */

@@ -1,4 +1,4 @@
-/* test_grid_uniform_wide.c — wide queries of core/grid_uniform.h (boxes of
+/* test_grid_uniform_wide.c — wide queries of core/space/grid_uniform.h (boxes of
  * several cells per axis, as the coarse grains' list rebuilds) against a
  * brute-force scan: every grain within r + r_j of the query point by the
  * minimum image is reported once.  Walled axes hold grains whose centres
@@ -13,8 +13,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "grid_uniform.h"
-#include "rng.h"
+#include "core/space/grid_uniform.h"
+#include "core/base/rng.h"
 
 static int count_hit(size_t j, const double dx[PK_MAXDIM], double dist2, void *ctx)
 {

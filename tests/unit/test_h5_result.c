@@ -6,8 +6,8 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "h5_inspect.h"
-#include "h5_result.h"
+#include "api/results/h5_inspect.h"
+#include "api/results/h5_result.h"
 
 static char dir[] = "/tmp/packd-h5-XXXXXX";
 

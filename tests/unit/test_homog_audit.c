@@ -1,13 +1,13 @@
-/* test_homog_audit.c — the per-step audit of a homogenization (core/homog_audit.h)
- * and the job clock of the wall-time limit (core/progress.h, issue 21 case 1). */
+/* test_homog_audit.c — the per-step audit of a homogenization (core/homog/homog_audit.h)
+ * and the job clock of the wall-time limit (core/base/progress.h, issue 21 case 1). */
 #include "check.h"
 
 #include <math.h>
 #include <string.h>
 
-#include "homog_audit.h"
-#include "homog_tensor.h"
-#include "progress.h"
+#include "core/homog/homog_audit.h"
+#include "core/homog/homog_tensor.h"
+#include "core/base/progress.h"
 
 /* A limit set on a monitor nobody began (as pk_homog_run did): the clock must
  * start with the job, not at the machine's boot — a limit of half the

@@ -1,9 +1,9 @@
 /* test_homog_crawl.c — the crawl rule of the relaxation hook
- * (core/homog_relax.h, pk_dr_hook.crawl; the Newton hybrid calls its next
+ * (core/homog/homog_relax.h, pk_dr_hook.crawl; the Newton hybrid calls its next
  * attempt when DR creeps): pk_relax_iteration_end driven with made-up
  * residual sequences, so the iterations of the calls are known exactly. */
 #include "check.h"
-#include "homog_relax.h"
+#include "core/homog/homog_relax.h"
 
 /* The hook records the iterations it is called at and sets a threshold the
  * sequences never reach (only the crawl rule calls it again). */

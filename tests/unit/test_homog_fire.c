@@ -1,10 +1,10 @@
-/* test_homog_fire.c — FIRE (core/homog_fire.h), the relaxation the Newton
+/* test_homog_fire.c — FIRE (core/homog/homog_fire.h), the relaxation the Newton
  * hybrid switches to after failed attempts: the same minimum as DR on an
  * elastic step in fewer iterations, and the hook / cap contract it shares
- * with DR (core/homog_relax.h), incl. DR's hand-over result. */
+ * with DR (core/homog/homog_relax.h), incl. DR's hand-over result. */
 #include "check.h"
-#include "homog_eigen.h"
-#include "homog_fire.h"
+#include "core/homog/homog_eigen.h"
+#include "core/homog/homog_fire.h"
 #include "homog_fixture.h"
 
 /* Energy, stress sum and free residual at x. */

@@ -1,13 +1,13 @@
 /* test_homog_newton.c — the Newton/DR hybrid equilibrium solver
- * (core/homog_newton.h) on steps with and without plastic events, and the 2D
- * fast path of the contact evaluation (core/dem_contact.c) that every
+ * (core/homog/homog_newton.h) on steps with and without plastic events, and the 2D
+ * fast path of the contact evaluation (core/dem/dem_contact.c) that every
  * relaxation iteration runs. */
 #include "check.h"
-#include "dem_rattler.h"
-#include "homog_eigen.h"
+#include "core/dem/dem_rattler.h"
+#include "core/homog/homog_eigen.h"
 #include "homog_fixture.h"
-#include "homog_stiffness.h"
-#include "sparse_cholmod.h"
+#include "core/homog/homog_stiffness.h"
+#include "api/solver/sparse_cholmod.h"
 
 static void geom_of_rve(const pk_homog_rve *rve, const double F[9], pk_dem_geom *g)
 {
@@ -102,10 +102,10 @@ static void dr_and_hybrid(const pk_homog_rve *rve, double strain, pk_homog_opts 
  * attempt: the case the hybrid exists for — if it no longer happens the RVE
  * no longer tests it); in the third and fourth cases attempts from DR's
  * points fail — given up where Newton's own path climbs into an indefinite
- * block, without a Levenberg–Marquardt shift (core/homog_newton.c SHIFT_*) —
- * and after two failed attempts FIRE (core/homog_fire.h) relaxes on from
+ * block, without a Levenberg–Marquardt shift (core/homog/homog_newton.c SHIFT_*) —
+ * and after two failed attempts FIRE (core/homog/homog_fire.h) relaxes on from
  * DR's point.  (Since DR's λ_min also comes from its own increments
- * (core/homog_relax.c, estimate), the former third case, 400 grains seed 3,
+ * (core/homog/homog_relax.c, estimate), the former third case, 400 grains seed 3,
  * converges at its first attempt; of eleven 200–800-grain cases scanned, the
  * multi-attempt ones all reach FIRE.)  Both solvers must end at an
  * equilibrium (residual ≤ tol·|f⁰|, recomputed here), below the start
@@ -214,7 +214,7 @@ static void test_elastic_step_is_pure_newton(void)
     pk_particles_free(&p);
 }
 
-/* A solver context kept over a load path (api/homog_run.c): elastic steps of
+/* A solver context kept over a load path (api/homog/homog_run.c): elastic steps of
  * a dense RVE keep their contact set, so later factorisations find the
  * pattern of an earlier one and reuse its analysis — and the numbers must be
  * those of fresh analyses (same ordering, same arithmetic: compared with ==,

@@ -7,8 +7,8 @@
  * stored by every evaluation (pk_dem_forces_store = 1), and the pair data
  * at each hook call and on return equal to a fresh pk_dem_eval at x. */
 #include "check.h"
-#include "homog_eigen.h"
-#include "homog_fire.h"
+#include "core/homog/homog_eigen.h"
+#include "core/homog/homog_fire.h"
 #include "homog_fixture.h"
 
 /* The pair data of c equal those of a fresh evaluation at x? */

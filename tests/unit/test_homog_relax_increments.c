@@ -1,5 +1,5 @@
 /* test_homog_relax_increments.c — DR's λ_min from the Rayleigh quotient of
- * its own increments (core/homog_relax.c, estimate): against the plain
+ * its own increments (core/homog/homog_relax.c, estimate): against the plain
  * estimates (Lanczos + the residual's quotient, pk_dr_params.plain_lambda_min)
  * it must end at an equilibrium of the same tolerance, in the same minimum
  * where the step has one near its start, and in fewer iterations where the
@@ -10,7 +10,7 @@
 
 #include "check.h"
 #include "homog_fixture.h"
-#include "homog_relax.h"
+#include "core/homog/homog_relax.h"
 
 /* One compression step from the reference by DR, plain and with the
  * increments: both converge to tol; returns the two step records. */

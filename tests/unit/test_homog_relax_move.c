@@ -1,5 +1,5 @@
 /* test_homog_relax_move.c — the 2D SSE2 move of pk_relax_move
- * (core/homog_relax.c) gives the generic loop's x, v and stale flag bit for
+ * (core/homog/homog_relax.c) gives the generic loop's x, v and stale flag bit for
  * bit: DR's first step (cv = 0) and later steps, FIRE-like coefficients,
  * held grains left untouched, the skin test on both sides of its limit, and
  * NaN/Inf entries passed through alike. */
@@ -8,8 +8,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "homog_relax.h"
-#include "rng.h"
+#include "core/homog/homog_relax.h"
+#include "core/base/rng.h"
 
 typedef struct state {
     double *x, *v;

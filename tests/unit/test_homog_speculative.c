@@ -1,5 +1,5 @@
 /* test_homog_speculative.c — the Newton/DR hybrid with speculative attempts
- * (core/homog_newton.c, hybrid_speculative: a pool of two threads or more)
+ * (core/homog/homog_newton.c, hybrid_speculative: a pool of two threads or more)
  * gives the serial hybrid's step bit for bit: the end point, P̄, the energy
  * and every statistic of the path (DR/FIRE iterations, rebuilds, stop,
  * residuals, factorisations, quasi-Newton steps, attempts, FIRE
@@ -10,8 +10,8 @@
  * the first phase: the relaxation ends alone). */
 #include "check.h"
 #include "homog_fixture.h"
-#include "par.h"
-#include "sparse_cholmod.h"
+#include "core/base/par.h"
+#include "api/solver/sparse_cholmod.h"
 
 typedef struct run {
     pk_homog_state t;

@@ -13,11 +13,11 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "h5_result.h"
-#include "input_confine.h"
-#include "input_open.h"
-#include "mesh_io.h"
-#include "process.h"
+#include "api/results/h5_result.h"
+#include "api/inputs/input_confine.h"
+#include "api/inputs/input_open.h"
+#include "api/mesh/mesh_io.h"
+#include "api/process.h"
 
 static char dir[64];
 

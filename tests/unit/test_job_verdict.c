@@ -7,7 +7,7 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "job_verdict.h"
+#include "api/job_verdict.h"
 
 static char dir[] = "/tmp/packd-verdict-XXXXXX";
 

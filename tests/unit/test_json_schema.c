@@ -1,8 +1,8 @@
-/* test_json_schema.c — the JSON Schema validator (api/json_schema.c) and the
- * embedded schema table (api/schemas_embedded.c). */
+/* test_json_schema.c — the JSON Schema validator (api/schemas/json_schema.c) and the
+ * embedded schema table (api/schemas/schemas_embedded.c). */
 #include "check.h"
-#include "json_schema.h"
-#include "schemas_embedded.h"
+#include "api/schemas/json_schema.h"
+#include "api/schemas/schemas_embedded.h"
 
 #include <pthread.h>
 #include <stdlib.h>

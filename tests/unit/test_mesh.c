@@ -9,10 +9,10 @@
 #include <string.h>
 
 #include "check.h"
-#include "mesh.h"
-#include "mesh_io.h"
-#include "mesh_locate.h"
-#include "rng.h"
+#include "core/mesh/mesh.h"
+#include "api/mesh/mesh_io.h"
+#include "core/mesh/mesh_locate.h"
+#include "core/base/rng.h"
 
 static const char *data(const char *name)
 {

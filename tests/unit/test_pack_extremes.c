@@ -12,8 +12,8 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "pack_job.h"
-#include "process.h"
+#include "api/pack/pack_job.h"
+#include "api/process.h"
 
 /* checks as on the user's own machine (packd run / validate) */
 static const pk_check_ctx local = {0};

@@ -1,4 +1,4 @@
-/* test_par.c — the thread pool of core/par.h: every part t of a job runs
+/* test_par.c — the thread pool of core/base/par.h: every part t of a job runs
  * exactly once per pk_par_run, for many jobs in a row; what the parts wrote
  * (plain stores) is visible when pk_par_run returns and what the caller
  * wrote before is visible to the parts; the workers do take parts;
@@ -13,7 +13,7 @@
 #include <time.h>
 
 #include "check.h"
-#include "par.h"
+#include "core/base/par.h"
 
 #define MAXT 8
 #define WORDS 256

@@ -1,4 +1,4 @@
-/* test_psd.c — grading curve → particle sizes (core/psd.c).
+/* test_psd.c — grading curve → particle sizes (core/psd/psd.c).
  * Reference numbers: ../shared/specs/packing_titscher_jerier_meier.md §1
  * (Titscher & Unger [T], Meier et al. [M], DIN 1045-2). */
 #include <math.h>
@@ -8,8 +8,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "psd.h"
-#include "rng.h"
+#include "core/psd/psd.h"
+#include "core/base/rng.h"
 
 #define PI 3.14159265358979323846
 

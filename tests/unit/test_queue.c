@@ -1,4 +1,4 @@
-/* test_queue.c — daemon/queue.c on a real SQLite file: submission limits,
+/* test_queue.c — daemon/store/queue.c on a real SQLite file: submission limits,
  * idempotency keys, atomic claims, events, dismissal, recovery after a daemon
  * death (bounded attempts), concurrent writers through two connections. */
 #include <pthread.h>
@@ -9,8 +9,8 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "migrations.h"
-#include "queue.h"
+#include "daemon/store/migrations.h"
+#include "daemon/store/queue.h"
 
 static char dir[] = "/tmp/pk_queue_XXXXXX";
 static char db[256];

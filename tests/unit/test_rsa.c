@@ -5,10 +5,10 @@
 #include <string.h>
 
 #include "check.h"
-#include "gap_audit.h"
-#include "grid.h"
-#include "rng.h"
-#include "rsa.h"
+#include "core/space/gap_audit.h"
+#include "core/space/grid.h"
+#include "core/base/rng.h"
+#include "core/rsa/rsa.h"
 
 /* Smallest surface gap over all pairs and smallest wall clearance, O(N²). */
 static void brute_gaps(const pk_box *b, const pk_particles *p, double *min_gap, double *min_wall)

@@ -1,4 +1,4 @@
-/* test_rsa_batch.c — the batched path for runs of equal grains (core/rsa_batch.h)
+/* test_rsa_batch.c — the batched path for runs of equal grains (core/rsa/batch/rsa_batch.h)
  * against plain draws one grain at a time (pk_rsa_params.plain_draws): same
  * seed → the same packing bit for bit (memcmp of positions, radii, species),
  * the same number of draws and the same stop reason, for 2D and 3D, periodic,
@@ -13,9 +13,9 @@
 #include <string.h>
 
 #include "check.h"
-#include "rsa.h"
-#include "rng.h"
-#include "rsa_cells.h"
+#include "core/rsa/rsa.h"
+#include "core/base/rng.h"
+#include "core/rsa/batch/rsa_cells.h"
 
 typedef struct setup {
     pk_box box;

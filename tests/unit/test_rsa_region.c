@@ -1,5 +1,5 @@
-/* test_rsa_region.c — RSA's draws from the open region (core/rsa_region.h),
- * the default of batched runs of equal grains (core/rsa_batch.h).  They give
+/* test_rsa_region.c — RSA's draws from the open region (core/rsa/batch/rsa_region.h),
+ * the default of batched runs of equal grains (core/rsa/batch/rsa_batch.h).  They give
  * another packing per seed than plain draws, so instead of bit identity:
  *   - every mark is exact: each marked fine voxel lies inside one exclusion
  *     ball (brute force over its corners);
@@ -15,10 +15,10 @@
 #include <string.h>
 
 #include "check.h"
-#include "grid.h"
-#include "rng.h"
-#include "rsa.h"
-#include "rsa_region.h"
+#include "core/space/grid.h"
+#include "core/base/rng.h"
+#include "core/rsa/rsa.h"
+#include "core/rsa/batch/rsa_region.h"
 
 /* Cells per axis as rsa_batch.c makes them: the store's (edge >= c) halved. */
 static void region_cells(const pk_box *b, double c, const double *span, int64_t *n)

@@ -1,4 +1,4 @@
-/* test_rsa_voxels.c — the voxel-sampled RSA (core/rsa_voxels.h) against the
+/* test_rsa_voxels.c — the voxel-sampled RSA (core/rsa/rsa_voxels.h) against the
  * plain draw-until-accepted path: same statistics, exact gaps, a clean
  * "saturated" stop, reproducible. */
 #include <math.h>
@@ -6,9 +6,9 @@
 #include <string.h>
 
 #include "check.h"
-#include "rng.h"
-#include "rsa.h"
-#include "rsa_voxels.h"
+#include "core/base/rng.h"
+#include "core/rsa/rsa.h"
+#include "core/rsa/rsa_voxels.h"
 
 #define NBIN 7
 static const double bin_edge[NBIN + 1] = {1.0, 1.05, 1.1, 1.2, 1.35, 1.5, 1.75, 2.0};

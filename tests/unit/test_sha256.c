@@ -1,4 +1,4 @@
-/* test_sha256.c — daemon/sha256.c against the FIPS 180-4 / NIST CAVP example
+/* test_sha256.c — daemon/store/sha256.c against the FIPS 180-4 / NIST CAVP example
  * vectors (exact digests: no tolerance) and split-update equivalence. */
 #include <stdio.h>
 #include <stdlib.h>
@@ -6,7 +6,7 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "sha256.h"
+#include "daemon/store/sha256.h"
 
 static void test_nist_abc(void)
 {

@@ -1,4 +1,4 @@
-/* The solver context of core/sparse.h (api/sparse_cholmod.c): a factor made
+/* The solver context of core/base/sparse.h (api/solver/sparse_cholmod.c): a factor made
  * with the context's reused analysis must be the factor a fresh analysis
  * gives — same ordering, same supernodes, hence the same numbers.  Compared
  * with == (no tolerance): the context may not change the result by a bit. */
@@ -6,8 +6,8 @@
 #include <string.h>
 
 #include "../check.h"
-#include "rng.h"
-#include "sparse_cholmod.h"
+#include "core/base/rng.h"
+#include "api/solver/sparse_cholmod.h"
 
 /* A 2D spring network like Newton's blocks: m×m nodes of 2 DOFs on a
  * periodic grid, each node joined to its right, upper and (when `diag`)

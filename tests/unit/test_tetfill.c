@@ -11,11 +11,11 @@
 #include <string.h>
 
 #include "check.h"
-#include "mesh.h"
-#include "mesh_io.h"
-#include "mesh_locate.h"
-#include "tetfill.h"
-#include "tetfill_stats.h"
+#include "core/mesh/mesh.h"
+#include "api/mesh/mesh_io.h"
+#include "core/mesh/mesh_locate.h"
+#include "core/tetfill/tetfill.h"
+#include "core/tetfill/tetfill_stats.h"
 
 static const char *data(const char *name)
 {

@@ -1,4 +1,4 @@
-/* test_tokens.c — daemon/tokens.c: the token's form, its SHA-256 (FIPS
+/* test_tokens.c — daemon/store/tokens.c: the token's form, its SHA-256 (FIPS
  * 180-2 test vector), the store on a real SQLite file (add, verify, list,
  * revoke, names), uploads owned per (sha256, owner) after the migration, and
  * no token in clear anywhere in the database files. */
@@ -9,8 +9,8 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "queue.h"
-#include "tokens.h"
+#include "daemon/store/queue.h"
+#include "daemon/store/tokens.h"
 
 static char dir[] = "/tmp/pk_tokens_XXXXXX";
 static char db[256];

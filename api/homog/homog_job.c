@@ -1,0 +1,288 @@
+/* homog_job.c — parse and check 'homogenize' inputs; build the F̄ path. */
+#include "homog_job.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/homog/homog_tensor.h"
+
+void pk_homog_job_free(pk_homog_job *job)
+{
+    free(job->F);
+    job->F = NULL;
+    job->nstep = 0;
+    free(job->E_n_species);
+    job->E_n_species = NULL;
+    job->n_species = 0;
+}
+
+/* contact.E_n_species: square and symmetric (E_n,ij = E_n,ji: one contact,
+ * one spring); the schema checks the entries are positive numbers. */
+static void species_stiffness(json_t *m, pk_homog_job *job, pk_schema_errors *errs)
+{
+    size_t n = json_array_size(m);
+    if (!n)
+        return;
+    job->E_n_species = malloc(n * n * sizeof *job->E_n_species);
+    if (!job->E_n_species) {
+        pk_schema_errors_add(errs, "/contact/E_n_species", "memory", "out of memory");
+        return;
+    }
+    job->n_species = n;
+    for (size_t a = 0; a < n; a++) {
+        json_t *row = json_array_get(m, a);
+        if (json_array_size(row) != n) {
+            char ptr[64];
+            snprintf(ptr, sizeof ptr, "/contact/E_n_species/%zu", a);
+            pk_schema_errors_add(errs, ptr, "semantic",
+                                 "row %zu has %zu entries: the matrix must be %zu × %zu", a,
+                                 json_array_size(row), n, n);
+            return;
+        }
+        for (size_t b = 0; b < n; b++)
+            job->E_n_species[a * n + b] = json_number_value(json_array_get(row, b));
+    }
+    for (size_t a = 0; a < n; a++)
+        for (size_t b = a + 1; b < n; b++)
+            if (job->E_n_species[a * n + b] != job->E_n_species[b * n + a]) {
+                char ptr[64];
+                snprintf(ptr, sizeof ptr, "/contact/E_n_species/%zu/%zu", a, b);
+                pk_schema_errors_add(errs, ptr, "semantic",
+                                     "E_n_species must be symmetric: [%zu][%zu] = %g but [%zu][%zu] = %g",
+                                     a, b, job->E_n_species[a * n + b], b, a,
+                                     job->E_n_species[b * n + a]);
+                return;
+            }
+}
+
+static double num(json_t *o, const char *key, double dflt)
+{
+    json_t *v = json_object_get(o, key);
+    return json_is_number(v) ? json_number_value(v) : dflt;
+}
+
+static int push_F(pk_homog_job *job, size_t *cap, const double F[9])
+{
+    if (job->nstep == *cap) {
+        size_t c = *cap ? 2 * *cap : 64;
+        double *n = realloc(job->F, c * 9 * sizeof *n);
+        if (!n)
+            return -1;
+        job->F = n;
+        *cap = c;
+    }
+    memcpy(&job->F[9 * job->nstep++], F, 9 * sizeof *F);
+    return 0;
+}
+
+/* "12" → (0, 1) */
+static void plane_of(json_t *load, int *i, int *j)
+{
+    const char *s = json_string_value(json_object_get(load, "plane"));
+    if (!s || strlen(s) != 2)
+        s = "12";
+    *i = s[0] - '1';
+    *j = s[1] - '1';
+}
+
+/* (1 − λc)1 ramped over pre_steps, then the shear history λs(t) (steps). */
+static int shear_path(pk_homog_job *job, size_t *cap, json_t *load, int cyclic)
+{
+    double lc = num(load, "precompression", 0.01);
+    int pre = (int)pk_json_int_or(load, "pre_steps", 10);
+    int steps = (int)pk_json_int_or(load, "steps", 1);
+    int pi, pj;
+    plane_of(load, &pi, &pj);
+    double F[9];
+    for (int k = 1; k <= pre; k++) {
+        pk_m3_identity(F);
+        for (int a = 0; a < 3; a++)
+            F[4 * a] = 1 - lc * k / pre;
+        if (push_F(job, cap, F))
+            return -1;
+    }
+    double amp = cyclic ? num(load, "amplitude", 0.5) : num(load, "shear", 1);
+    for (int k = 1; k <= steps; k++) {
+        double t = (double)k / steps, ls;
+        if (!cyclic)
+            ls = amp * t;
+        else if (t <= 0.25) /* 0 → a → −a → 0, piecewise linear */
+            ls = 4 * amp * t;
+        else if (t <= 0.75)
+            ls = amp * (1 - 4 * (t - 0.25));
+        else
+            ls = -amp + 4 * amp * (t - 0.75);
+        pk_m3_identity(F);
+        for (int a = 0; a < 3; a++)
+            F[4 * a] = 1 - lc;
+        F[3 * pi + pj] += ls;
+        if (push_F(job, cap, F))
+            return -1;
+    }
+    return 0;
+}
+
+size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_errors *errs)
+{
+    size_t before = errs->n;
+    memset(job, 0, sizeof *job);
+    json_t *rve = json_object_get(inputs, "rve");
+    snprintf(job->rve_file, sizeof job->rve_file, "%s",
+             json_string_value(json_object_get(rve, "file")) ? json_string_value(json_object_get(rve, "file")) : "");
+    const char *bc = json_string_value(json_object_get(inputs, "boundary_condition"));
+    job->bc = bc && !strcmp(bc, "taylor") ? PK_BC_TAYLOR
+              : bc && !strcmp(bc, "restricted_taylor") ? PK_BC_RESTRICTED_TAYLOR
+                                                     : PK_BC_PERIODIC;
+    job->E_n = num(json_object_get(inputs, "contact"), "E_n", 1);
+    species_stiffness(json_object_get(json_object_get(inputs, "contact"), "E_n_species"), job, errs);
+    json_t *fr = json_object_get(inputs, "friction");
+    job->friction = json_is_object(fr);
+    if (job->friction) {
+        job->fric.E_t = num(fr, "E_t", job->E_n);
+        job->fric.tan_rho = tan(num(fr, "rho_deg", 0) * M_PI / 180);
+        job->fric.h = num(fr, "h", 0);
+    }
+    json_t *dr = json_object_get(inputs, "relaxation");
+    job->tol = num(dr, "tol", 1e-8);
+    job->abs_tol = num(dr, "abs_tol", 1e-13);
+    job->max_iter = (size_t)pk_json_int_or(dr, "max_iter", 1000000);
+    job->lanczos_steps = (int)pk_json_int_or(dr, "lanczos_steps", 40);
+    job->refresh = (size_t)pk_json_int_or(dr, "refresh", 200);
+    const char *pred = json_string_value(json_object_get(dr, "predictor"));
+    job->affine_predictor = !(pred && !strcmp(pred, "none"));
+    const char *solver = json_string_value(json_object_get(dr, "solver"));
+    job->newton = solver && !strcmp(solver, "newton");
+    job->newton_max_iter = (size_t)pk_json_int_or(dr, "newton_max_iter", 50);
+    job->tangent = json_is_true(json_object_get(inputs, "tangent"));
+    json_t *out = json_object_get(inputs, "output");
+    job->out_micro = json_is_true(json_object_get(out, "micro_state"));
+    job->out_contacts = json_is_true(json_object_get(out, "contacts"));
+    json_t *ini = json_object_get(inputs, "initial_state");
+    const char *pol = json_string_value(json_object_get(ini, "policy"));
+    job->radius_factor = 1;
+    if (pol && !strcmp(pol, "radius_inflation"))
+        job->radius_factor = 1 + num(ini, "value", 0);
+    if (pol && !strcmp(pol, "precompress"))
+        job->precompress = num(ini, "value", 0);
+    job->wall_time_s = num(json_object_get(inputs, "limits"), "wall_time_s", 0);
+
+    json_t *load = json_object_get(inputs, "load");
+    const char *type = json_string_value(json_object_get(load, "type"));
+    size_t cap = 0;
+    int rc = 0;
+    if (type && !strcmp(type, "list")) {
+        json_t *list = json_object_get(load, "F"), *row;
+        size_t k;
+        json_array_foreach(list, k, row) {
+            size_t m = json_array_size(row);
+            char ptr[64];
+            snprintf(ptr, sizeof ptr, "/load/F/%zu", k);
+            if (m != 4 && m != 9) {
+                pk_schema_errors_add(errs, ptr, "semantic", "F̄ needs 4 (2D) or 9 (3D) numbers, got %zu", m);
+                continue;
+            }
+            int d = m == 4 ? 2 : 3;
+            if (job->fdim && job->fdim != d)
+                pk_schema_errors_add(errs, ptr, "semantic", "all F̄ of a path must have the same dimension");
+            job->fdim = d;
+            double F[9];
+            pk_m3_identity(F);
+            for (int a = 0; a < d; a++)
+                for (int b = 0; b < d; b++)
+                    F[3 * a + b] = json_number_value(json_array_get(row, (size_t)(a * d + b)));
+            rc |= push_F(job, &cap, F);
+        }
+    } else if (type && !strcmp(type, "uniaxial_compression")) {
+        int axis = (int)pk_json_int_or(load, "axis", 1) - 1, steps = (int)pk_json_int_or(load, "steps", 1);
+        double lam = num(load, "strain", 0.3);
+        if (axis == 2)
+            job->fdim = 3;
+        for (int k = 1; k <= steps; k++) {
+            double F[9];
+            pk_m3_identity(F);
+            F[4 * axis] = 1 - lam * k / steps;
+            rc |= push_F(job, &cap, F);
+        }
+    } else {
+        int cyc = type && !strcmp(type, "cyclic_shear");
+        int pi, pj;
+        plane_of(load, &pi, &pj);
+        if (pi == pj)
+            pk_schema_errors_add(errs, "/load/plane", "semantic", "a shear plane needs two different axes");
+        if (pi == 2 || pj == 2)
+            job->fdim = 3;
+        rc |= shear_path(job, &cap, load, cyc);
+    }
+    if (rc) {
+        pk_schema_errors_add(errs, "/load", "memory", "out of memory for the load path");
+    }
+    if (job->friction && job->tangent)
+        pk_schema_errors_add(errs, "/tangent", "semantic",
+                             "no tangent with friction: the consistent tangent of the return map is not "
+                             "implemented (ch. 7 derives none); use finite differences of the stress");
+    if (job->friction && job->newton)
+        pk_schema_errors_add(errs, "/relaxation/solver", "semantic",
+                             "friction needs solver \"dr\" (Newton has no frictional stiffness)");
+    if (job->friction && job->fdim == 3)
+        pk_schema_errors_add(errs, "/friction", "semantic", "friction is 2D only (Meier 2009 ch. 7)");
+    if (job->friction && pk_fric_law_active(&job->fric) && job->bc != PK_BC_TAYLOR)
+        pk_schema_errors_add(errs, "/friction", "semantic",
+                             "friction with rho_deg > 0 or h > 0 needs boundary_condition taylor "
+                             "(Meier 2009 §7.4): under %s sliding contacts make the relaxation "
+                             "diverge (their forces are not the gradient of the energy it "
+                             "minimises); use taylor or drop friction",
+                             pk_homog_bc_name(job->bc));
+    /* every step (on top of the pre-compression): finite, det F̄ > 0, the
+     * principal stretches within bounds (PK_HOMOG_MIN_STRETCH, spec H13) */
+    double F0[9];
+    pk_m3_identity(F0);
+    for (int a = 0; a < 3; a++)
+        F0[4 * a] = 1 - job->precompress;
+    for (size_t k = 0; k < job->nstep && errs->n - before < 20; k++) {
+        double F[9];
+        pk_m3_mul(&job->F[9 * k], F0, F);
+        int d3 = job->fdim == 3 ? 3 : 2, finite = 1;
+        double fro = 0;
+        for (int a = 0; a < d3; a++)
+            for (int b = 0; b < d3; b++) {
+                finite &= isfinite(F[3 * a + b]) != 0;
+                fro += F[3 * a + b] * F[3 * a + b];
+            }
+        double d = pk_m3_det(F), smin = pk_m3_sigma_min(F, d3);
+        char ptr[64];
+        if (type && !strcmp(type, "list"))
+            snprintf(ptr, sizeof ptr, "/load/F/%zu", k);
+        else
+            snprintf(ptr, sizeof ptr, "/load");
+        const char *pre = job->precompress > 0 ? " (with the pre-compression)" : "";
+        if (!finite || !isfinite(fro))
+            pk_schema_errors_add(errs, ptr, "semantic", "F̄ of step %zu%s is not finite", k, pre);
+        else if (!(d > 0))
+            pk_schema_errors_add(errs, ptr, "semantic",
+                                 "det F̄ of step %zu%s is %g: must be > 0 (no inversion or collapse "
+                                 "of the cell)", k, pre, d);
+        else if (!(smin >= PK_HOMOG_MIN_STRETCH))
+            pk_schema_errors_add(errs, ptr, "semantic",
+                                 "F̄ of step %zu%s has a principal stretch %.4g (det F̄ %.4g): each "
+                                 "must be >= %g; below, touching grains overlap by more than a "
+                                 "radius (the contact law needs ε ≪ r)", k, pre, smin, d,
+                                 PK_HOMOG_MIN_STRETCH);
+        else if (!(sqrt(fro) <= PK_HOMOG_MAX_STRETCH))
+            pk_schema_errors_add(errs, ptr, "semantic",
+                                 "|F̄| of step %zu%s is %.4g: must be <= %g (every contact is open "
+                                 "long before)", k, pre, sqrt(fro), PK_HOMOG_MAX_STRETCH);
+    }
+    if (errs->n != before)
+        pk_homog_job_free(job);
+    return errs->n - before;
+}
+
+void pk_homog_check(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs)
+{
+    (void)ctx; /* the RVE file is read by the run only */
+    pk_homog_job job;
+    if (pk_homog_job_from_json(inputs, &job, errs) == 0)
+        pk_homog_job_free(&job);
+}

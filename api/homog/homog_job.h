@@ -1,0 +1,60 @@
+/* homog_job.h — the 'homogenize' process: JSON inputs → job struct and load
+ * path (schemas/homogenize.inputs.schema.json), semantic checks, run. */
+#ifndef PK_HOMOG_JOB_H
+#define PK_HOMOG_JOB_H
+
+#include <jansson.h>
+#include <stddef.h>
+
+#include "api/inputs/check_ctx.h"
+#include "core/homog/homog_bc.h"
+#include "api/schemas/json_schema.h"
+#include "core/base/progress.h"
+
+/* Every load step's F̄ (with the pre-compression): det F̄ > 0 and every
+ * principal stretch (singular value) >= PK_HOMOG_MIN_STRETCH — at 0.5 an
+ * affinely moved touching pair of equal grains has ε = r, the overlap bound
+ * of the audit (homog_audit.h): beyond it a centre enters its neighbour and
+ * the linear contact law (ε ≪ r, spec H3/H13) has lost its meaning.  |F̄|
+ * (Frobenius) <= PK_HOMOG_MAX_STRETCH: every contact is open long before,
+ * and F̄X, J̄V stay far from overflow. */
+#define PK_HOMOG_MIN_STRETCH 0.5
+#define PK_HOMOG_MAX_STRETCH 100.0
+
+typedef struct pk_homog_job {
+    char rve_file[1024];
+    pk_homog_bc bc;
+    double E_n;
+    double *E_n_species;       /* [n_species²] row-major, NULL = uniform E_n */
+    size_t n_species;
+    int friction;              /* "friction" given */
+    pk_fric_law fric;          /* E_t, tan ρ, h (E_t defaults to E_n) */
+    double tol, abs_tol;
+    size_t max_iter;
+    int lanczos_steps;
+    size_t refresh;
+    int affine_predictor;
+    int newton;                /* relaxation.solver = newton */
+    size_t newton_max_iter;
+    int tangent;
+    int out_micro, out_contacts;
+    double radius_factor;      /* initial_state radius_inflation */
+    double precompress;        /* initial_state precompress λ₀ */
+    double wall_time_s;
+    size_t nstep;
+    int fdim;                  /* 2 or 3: dimension the load path is written for (0 = any) */
+    double *F;                 /* [nstep][9] row-major, 3D-embedded */
+} pk_homog_job;
+
+/* Inputs (schema-valid) → job; semantic errors appended with pointers
+ * relative to the inputs object.  Returns their number (job->F is freed on
+ * error). */
+size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_errors *errs);
+void pk_homog_job_free(pk_homog_job *job);
+
+/* process table hooks (see process.h) */
+void pk_homog_check(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
+int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_monitor *mon,
+                 json_t **summary, char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,307 @@
+/* pack_place_edmd.c — the 'edmd' placer: core/edmd/edmd (Lubachevsky–Stillinger
+ * growth) with the job's "edmd" options; start from zero radii (Meier) or
+ * from RSA at δ·d (Titscher/Kansal, core/rsa/rsa); walls keep Δd/2 clearance or,
+ * with "wall_gap": "none", only the true grains inside (core/edmd/edmd_walls.h). */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "core/edmd/edmd.h"
+#include "edmd_checkpoint_h5.h"
+#include "core/edmd/edmd_contacts.h"
+#include "core/edmd/edmd_walls.h"
+#include "pack_placer.h"
+#include "api/process.h"
+
+static double num(json_t *o, const char *key, double def)
+{
+    json_t *v = json_object_get(o, key);
+    return json_is_number(v) ? json_number_value(v) : def;
+}
+
+static const char *str(json_t *o, const char *key, const char *def)
+{
+    json_t *v = json_object_get(o, key);
+    return json_is_string(v) ? json_string_value(v) : def;
+}
+
+/* Options → parameters (schema-valid input assumed). */
+static void read_params(const pk_pack_job *job, const pk_pack_plan *plan, pk_edmd_params *prm)
+{
+    json_t *o = json_object_get(job->inputs, "edmd");
+    pk_edmd_params_default(prm);
+    prm->seed = job->seed;
+    prm->delta_d = job->delta_d;
+    int maximize = strcmp(str(o, "maximize", "none"), "delta_d") == 0;
+    prm->growth = maximize || strcmp(str(o, "growth", "relative"), "shell") == 0
+                      ? PK_EDMD_GROW_SHELL
+                      : PK_EDMD_GROW_RELATIVE;
+    prm->until = maximize || strcmp(str(o, "until", "target"), "jammed") == 0 ? PK_EDMD_UNTIL_JAMMED
+                                                                             : PK_EDMD_UNTIL_TARGET;
+    prm->start_zero = strcmp(str(o, "start", "rsa"), "zero") == 0;
+    /* NAN: the default δ, chosen by place_edmd from the drawn sizes
+     * (pk_edmd_start_delta) */
+    prm->delta = prm->growth == PK_EDMD_GROW_SHELL ? 1.0 : num(o, "delta", NAN);
+    if (prm->growth == PK_EDMD_GROW_RELATIVE && job->has_phi)
+        prm->phi_target = plan->phi_resolved;
+    prm->growth_rate = num(o, "growth_rate", prm->growth_rate);
+    json_t *jam = json_object_get(o, "jamming");
+    prm->p_max = num(jam, "reduced_pressure", prm->p_max);
+    prm->dphi_crit = num(jam, "delta_phi", prm->dphi_crit);
+    prm->jam_rate_factor = num(jam, "rate_factor", prm->jam_rate_factor);
+    prm->dphi_events = (uint64_t)pk_json_int_or(jam, "events", 0);
+    json_t *stall = json_object_get(o, "stall");
+    prm->stall_events = (uint64_t)pk_json_int_or(stall, "events", (long long)prm->stall_events);
+    prm->stall_growth = num(stall, "growth", prm->stall_growth);
+    const char *rule = str(o, "collision_rule", "elastic");
+    prm->rule = strcmp(rule, "meier") == 0  ? PK_EDMD_RULE_MEIER
+                : strcmp(rule, "lift") == 0 ? PK_EDMD_RULE_LIFT
+                                            : PK_EDMD_RULE_ELASTIC;
+    json_t *rs = json_object_get(o, "rescale");
+    if (json_is_boolean(rs))
+        prm->rescale = json_is_true(rs);
+    prm->rescale_tol = num(o, "rescale_tolerance", prm->rescale_tol);
+    prm->skin = num(o, "skin", prm->skin);
+    prm->equal_masses = strcmp(str(o, "masses", "equal"), "equal") == 0;
+    prm->max_events = (uint64_t)pk_json_int_or(o, "max_events", 0);
+}
+
+static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, pk_schema_errors *errs)
+{
+    json_t *o = json_object_get(job->inputs, "edmd");
+    pk_edmd_params prm;
+    read_params(job, plan, &prm);
+    if (prm.growth == PK_EDMD_GROW_SHELL && json_object_get(o, "start") && prm.start_zero)
+        pk_schema_errors_add(errs, "/edmd/start", "consistent",
+                             "shell growth starts from an RSA configuration (start: rsa)");
+    if (prm.growth == PK_EDMD_GROW_SHELL && prm.until == PK_EDMD_UNTIL_TARGET && !(job->delta_d > 0))
+        pk_schema_errors_add(errs, "/delta_d", "consistent",
+                             "shell growth to a target needs delta_d > 0 (or maximize: delta_d)");
+    if (strcmp(str(o, "wall_gap", "half"), "none") == 0 && !(job->delta_d > 0))
+        pk_schema_errors_add(errs, "/edmd/wall_gap", "consistent",
+                             "wall_gap none lets the shell reach delta_d/2 into the walls: needs delta_d > 0");
+    if (prm.rule == PK_EDMD_RULE_MEIER && !prm.equal_masses)
+        pk_schema_errors_add(errs, "/edmd/collision_rule", "consistent",
+                             "Meier's Eq. (9) is an equal-mass rule: use masses: equal");
+    /* the periodic edge > 2 (d_max + Δd) rule is the plan's (pack_job.c) */
+}
+
+/* The job's checkpoint file (pk_job_checkpoint): saved by the run, loaded
+ * to resume. */
+typedef struct ckpt_file {
+    const char *path, *digest;
+    char err[300];
+} ckpt_file;
+
+static int save_ckpt(const pk_edmd_snapshot *snap, void *ctx)
+{
+    ckpt_file *f = ctx;
+    return pk_edmd_ckpt_save(f->path, f->digest, snap, f->err, sizeof f->err);
+}
+
+static json_t *doubles(const double *a, size_t n)
+{
+    json_t *arr = json_array();
+    for (size_t i = 0; i < n; i++)
+        json_array_append_new(arr, json_real(a[i]));
+    return arr;
+}
+
+static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk_sizes *sz,
+                      pk_monitor *mon, pk_particles *p, pk_place_stats *st, char *err,
+                      size_t errlen)
+{
+    pk_edmd_params prm;
+    read_params(job, plan, &prm);
+    /* the default δ: RSA at φ = PK_EDMD_START_PHI (core/edmd/edmd.h); should RSA
+     * still fall short (it does not below its saturation), the run starts
+     * from zero radii instead — a given δ is the user's: it fails */
+    const int delta_default = isnan(prm.delta);
+    if (delta_default)
+        prm.delta = pk_edmd_start_delta(job->box.dim, sz->d, sz->n, job->delta_d,
+                                        pk_box_measure(&job->box), PK_EDMD_START_PHI);
+    const int rsa_start = !prm.start_zero && prm.delta > 0;
+    double rsa_seconds = 0;
+    if (rsa_start) {
+        pk_rsa_stats rs;
+        double gap = prm.growth == PK_EDMD_GROW_SHELL ? 0.0 : job->delta_d;
+        if (pk_edmd_start_rsa(&job->box, sz->d, sz->species, sz->n, prm.delta, gap, job->seed, mon,
+                              p, &rs) != 0) {
+            snprintf(err, errlen, "RSA start configuration failed");
+            return -1;
+        }
+        rsa_seconds = rs.seconds;
+        if (rs.reason == PK_STOP_CANCELLED || rs.reason == PK_STOP_WALL_TIME) {
+            for (size_t i = 0; i < p->n; i++)
+                p->r[i] *= prm.delta; /* the start's sizes: the grains as they were placed */
+            *st = (pk_place_stats){.reason = rs.reason, .placed = rs.placed,
+                                   .requested = sz->n, .seconds = rs.seconds,
+                                   .short_delta_d = 1, .audit_delta_d = gap};
+            return 0;
+        }
+        if (rs.placed < sz->n && !delta_default) {
+            snprintf(err, errlen,
+                     "RSA start placed only %zu of %zu grains at delta = %g: lower edmd.delta or use "
+                     "start: zero",
+                     rs.placed, sz->n, prm.delta);
+            return -1;
+        }
+        if (rs.placed < sz->n)
+            p->n = 0; /* the default start fell short: from zero radii */
+    }
+    prm.start_zero = p->n == 0; /* (shell growth: δ = 1 is given, never zero) */
+    if (prm.start_zero) {
+        double x[3] = {0, 0, 0};
+        for (size_t i = 0; i < sz->n; i++)
+            if (pk_particles_push(p, x, 0.5 * sz->d[i], sz->species[i]) == (size_t)-1) {
+                snprintf(err, errlen, "out of memory for %zu grains", sz->n);
+                return -1;
+            }
+    }
+    /* "wall_gap": "none" (Titscher §6.3: Δd between grains only): the shell
+     * may reach Δd/2 of the job into the walls */
+    json_t *o = json_object_get(job->inputs, "edmd");
+    double w = strcmp(str(o, "wall_gap", "half"), "none") == 0 ? 0.5 * job->delta_d : 0;
+    ckpt_file cf = {0};
+    pk_edmd_checkpoint ck = {0};
+    pk_edmd_snapshot snap = {0};
+    cf.path = pk_job_checkpoint(&cf.digest, &ck.interval_s);
+    int loaded = 1;
+    if (cf.path) {
+        ck.save = save_ckpt;
+        ck.ctx = &cf;
+        loaded = pk_edmd_ckpt_load(cf.path, cf.digest, &snap, cf.err, sizeof cf.err);
+        if (loaded == 0)
+            ck.resume = &snap;
+        prm.checkpoint = &ck;
+    }
+    pk_edmd_stats es;
+    /* the monitor's wall limit counts from the job's start (pk_monitor_start),
+     * so it covers the RSA start too */
+    int run_rc = pk_edmd_run_shell_in_walls(&job->box, w, p, &prm, mon, &es);
+    if (run_rc != 0 && ck.resume && !ck.resumed) { /* a snapshot that does not fit: from the start */
+        snprintf(cf.err, sizeof cf.err, "checkpoint %s does not fit this job; started anew", cf.path);
+        loaded = -1;
+        ck.resume = NULL;
+        run_rc = pk_edmd_run_shell_in_walls(&job->box, w, p, &prm, mon, &es);
+    }
+    pk_edmd_snapshot_free(&snap);
+    if (run_rc != 0) {
+        snprintf(err, errlen, "EDMD failed (bad parameters, periodic box too small or out of memory)");
+        return -1;
+    }
+    /* a run that reached its end needs no checkpoint; a stopped one (cancel,
+     * wall time) keeps it for the next attempt */
+    if (cf.path && (es.reason == PK_STOP_COMPLETE || es.reason == PK_STOP_JAMMED ||
+                    es.reason == PK_STOP_STALLED))
+        remove(cf.path);
+    /* the shell short of the job's Δd (jammed, stalled, out of time): the
+     * packing is kept, audited at the Δd reached and says so */
+    const int dd_short = prm.growth == PK_EDMD_GROW_SHELL && es.delta_d < job->delta_d * (1 - 1e-12);
+    pk_contact_stats cs;
+    /* contact: gap within tol·(r_i + r_j) of Δd, tol from the final
+     * reduced pressure (pk_contact_tolerance) */
+    double ctol = pk_contact_tolerance(job->box.dim, es.pressure);
+    if (pk_contact_stats_compute(&job->box, p, es.delta_d, ctol, &cs) != 0) {
+        snprintf(err, errlen, "out of memory in the contact analysis");
+        return -1;
+    }
+    *st = (pk_place_stats){.reason = es.reason, .placed = p->n, .requested = sz->n,
+                           .seconds = es.seconds, .walls_touch = w > 0};
+    if (prm.until == PK_EDMD_UNTIL_JAMMED) {
+        /* "jammed" when the pressure test held, or the Δφ test the job
+         * chose; a stall below the pressure target, or max_events, is said */
+        int jam_ok = es.criterion == PK_EDMD_CRIT_PRESSURE ||
+                     es.criterion == PK_EDMD_CRIT_DELTA_PHI ||
+                     (es.criterion == PK_EDMD_CRIT_STALL && es.pressure >= prm.p_max);
+        if (!jam_ok && (es.criterion == PK_EDMD_CRIT_STALL ||
+                        es.criterion == PK_EDMD_CRIT_MAX_EVENTS))
+            snprintf(st->warning, sizeof st->warning,
+                     "EDMD stopped on %s at reduced pressure %.3g, below "
+                     "jamming.reduced_pressure %.3g: the packing (phi %.6f) is not proven jammed",
+                     pk_edmd_criterion_name(es.criterion), es.pressure, prm.p_max, es.phi);
+        int periodic = 1; /* (contacts with walls are not counted: walled boxes are exempt) */
+        for (int k = 0; k < job->box.dim; k++)
+            periodic &= job->box.periodic[k];
+        if (jam_ok && periodic && p->n > 1 && cs.rattlers == p->n) {
+            /* caged fines can carry the pressure with no rigid backbone (3D
+             * diameters 1–16 at one rate γ = 0.03: p 10^12, every grain a
+             * rattler; with rate_factor 0.1 an isostatic backbone) */
+            jam_ok = 0;
+            snprintf(st->warning, sizeof st->warning,
+                     "EDMD reached reduced pressure %.3g but no grain has dim + 1 contacts at "
+                     "tolerance %.3g (no rigid backbone, phi %.6f): lower growth_rate or "
+                     "jamming.rate_factor", es.pressure, ctol, es.phi);
+        }
+        st->goal_reached = jam_ok && es.reason == PK_STOP_JAMMED;
+    }
+    if (dd_short) {
+        st->short_delta_d = 1;
+        st->audit_delta_d = es.delta_d;
+        snprintf(st->warning, sizeof st->warning,
+                 "shell growth stopped (%s) at Δd = %.6g, short of the job's delta_d = %.6g: every "
+                 "gap of the result is >= %.6g; lower phi or delta_d, or try a smaller "
+                 "edmd.growth_rate",
+                 pk_edmd_criterion_name(es.criterion), es.delta_d, job->delta_d, es.delta_d);
+    }
+    json_t *obs = json_object();
+    json_object_set_new(obs, "phi_final", json_real(es.phi));
+    json_object_set_new(obs, "phi_shell", json_real(es.phi_sim));
+    json_object_set_new(obs, "reduced_pressure", json_real(es.pressure));
+    if (prm.until == PK_EDMD_UNTIL_JAMMED) {
+        json_object_set_new(obs, "reduced_pressure_target", json_real(prm.p_max));
+        json_object_set_new(obs, "jammed", json_boolean(st->goal_reached));
+    }
+    json_object_set_new(obs, "collision_rule",
+                        json_string(prm.rule == PK_EDMD_RULE_MEIER  ? "meier"
+                                    : prm.rule == PK_EDMD_RULE_LIFT ? "lift"
+                                                                    : "elastic"));
+    json_object_set_new(obs, "kinetic_energy_ratio", json_real(es.kinetic_ratio));
+    if (isfinite(es.phi_jam_estimate))
+        json_object_set_new(obs, "phi_jamming_estimate", json_real(es.phi_jam_estimate));
+    json_object_set_new(obs, "termination_criterion", json_string(pk_edmd_criterion_name(es.criterion)));
+    json_object_set_new(obs, "delta_d_reached", json_real(es.delta_d));
+    json_object_set_new(obs, "wall_gap_guaranteed", json_real(fmax(0.5 * es.delta_d - w, 0)));
+    json_object_set_new(obs, "start", json_string(prm.start_zero ? "zero" : "rsa"));
+    if (!prm.start_zero) {
+        json_object_set_new(obs, "start_delta", json_real(prm.delta));
+        json_object_set_new(obs, "start_seconds", json_real(rsa_seconds));
+    }
+    json_object_set_new(obs, "time_simulated", json_real(es.t_stop));
+    if (cf.path) {
+        json_object_set_new(obs, "resumed", json_boolean(ck.resumed));
+        if (ck.resumed) {
+            json_object_set_new(obs, "resumed_from_events", json_integer((json_int_t)ck.resumed_events));
+            json_object_set_new(obs, "resumed_from_time", json_real(ck.resumed_time));
+        }
+        json_object_set_new(obs, "checkpoints_saved", json_integer(ck.saved));
+        if (ck.save_failures || loaded < 0)
+            json_object_set_new(obs, "checkpoint_error", json_string(cf.err));
+    }
+    if (isfinite(es.t_end))
+        json_object_set_new(obs, "time_end", json_real(es.t_end));
+    json_object_set_new(obs, "events", json_integer((json_int_t)es.events));
+    json_object_set_new(obs, "events_pair", json_integer((json_int_t)es.pair));
+    json_object_set_new(obs, "events_wall", json_integer((json_int_t)es.wall));
+    json_object_set_new(obs, "events_neighbour_list", json_integer((json_int_t)es.nlist));
+    json_object_set_new(obs, "events_invalidated", json_integer((json_int_t)es.invalid));
+    json_object_set_new(obs, "rescales", json_integer((json_int_t)es.rescales));
+    json_object_set_new(obs, "overlaps_predicted", json_integer((json_int_t)es.overlaps));
+    json_object_set_new(obs, "collisions_per_second",
+                        json_real(es.seconds > 0 ? (double)es.pair / es.seconds : 0));
+    json_object_set_new(obs, "contacts", json_integer((json_int_t)cs.contacts));
+    json_object_set_new(obs, "mean_contact_number", json_real(cs.mean_contacts));
+    json_object_set_new(obs, "rattlers", json_integer((json_int_t)cs.rattlers));
+    json_object_set_new(obs, "rattler_fraction", json_real(cs.rattler_fraction));
+    json_object_set_new(obs, "contact_tolerance", json_real(ctol));
+    json_t *h = json_object();
+    json_object_set_new(h, "events", doubles(es.hist_events, es.nhist));
+    json_object_set_new(h, "time", doubles(es.hist_t, es.nhist));
+    json_object_set_new(h, "phi", doubles(es.hist_phi, es.nhist));
+    json_object_set_new(h, "reduced_pressure", doubles(es.hist_p, es.nhist));
+    json_object_set_new(obs, "history", h);
+    st->obs = obs;
+    return 0;
+}
+
+const pk_placer pk_placer_edmd = {.name = "edmd", .check = check_edmd, .place = place_edmd};

@@ -1,0 +1,309 @@
+/* pack_place_tetfill.c — the 'tetfill' placer: Jerier's mesh filling
+ * (core/tetfill/tetfill.h) of "domain": {"mesh": ...} or of a walled box (meshed by
+ * core/mesh/mesh_box.c), with the job's "tetfill" options.  Sizes come from the
+ * filler itself (only the radius range is prescribed): no grading. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "api/results/h5_result.h"
+#include "api/mesh/mesh_io.h"
+#include "pack_placer.h"
+#include "core/tetfill/tetfill.h"
+#include "core/tetfill/tetfill_stats.h"
+
+/* Kuhn cubes of edge h have mean unique-edge length (3 + 3√2 + √3)/7 · h. */
+#define KUHN_MEAN_EDGE 1.2820
+
+typedef struct tetfill_setup {
+    pk_mesh mesh;
+    pk_mesh_report rep;
+    double origin[3];          /* mesh frame = particle frame + origin */
+    pk_tetfill_params prm;
+} tetfill_setup;
+
+static double opt_num(json_t *o, const char *k, double dflt)
+{
+    json_t *v = json_object_get(o, k);
+    return json_is_number(v) ? json_number_value(v) : dflt;
+}
+
+/* Radii from r_min / r_max / ratio; ratio alone uses Jerier's mesh rule
+ * r̄ = ℓ_mean / 8 (spec §4.1): r_min = 2 r̄/(R+1), r_max = 2 r̄ − r_min. */
+static int radii(json_t *o, double edge_mean, double *rmin, double *rmax)
+{
+    double a = opt_num(o, "r_min", 0), b = opt_num(o, "r_max", 0), R = opt_num(o, "ratio", 0);
+    if (a > 0 && b > 0) {
+        *rmin = a;
+        *rmax = b;
+    } else if (R > 0 && a > 0) {
+        *rmin = a;
+        *rmax = R * a;
+    } else if (R > 0 && b > 0) {
+        *rmin = b / R;
+        *rmax = b;
+    } else if (R > 0 && edge_mean > 0) {
+        double rbar = edge_mean / 8;
+        *rmin = 2 * rbar / (R + 1);
+        *rmax = 2 * rbar - *rmin;
+    } else
+        return -1;
+    return *rmax >= *rmin ? 0 : -1;
+}
+
+/* Build the mesh and the parameters.  0, or -1 with a pointer and message. */
+static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, const char **rule,
+                 char *err, size_t errlen)
+{
+    memset(S, 0, sizeof *S);
+    json_t *o = json_object_get(job->inputs, "tetfill");
+    json_t *dom = json_object_get(job->inputs, "domain");
+    json_t *mesh = json_object_get(dom, "mesh");
+    size_t max_tets = (size_t)pk_json_int_or(o, "max_tets", 2000000);
+    pk_tetfill_params *prm = &S->prm;
+    pk_tetfill_defaults(prm);
+    *rule = "tetfill";
+    if (job->dim != 3) {
+        *ptr = "/dim";
+        snprintf(err, errlen, "tetfill fills 3D domains (dim = 3)");
+        return -1;
+    }
+    if (mesh) {
+        *ptr = "/domain/mesh";
+        *rule = "mesh";
+        if (pk_mesh_from_json(mesh, max_tets, &S->mesh, &S->rep, err, errlen) != 0)
+            return -1;
+        memcpy(S->origin, S->mesh.lo, sizeof S->origin);
+        pk_mesh_translate(&S->mesh, S->origin);
+        *rule = "radii";
+        *ptr = "/tetfill";
+        if (radii(o, S->mesh.edge_mean, &prm->r_min, &prm->r_max) != 0) {
+            snprintf(err, errlen, "give r_min and r_max, or the ratio R (with r_min, r_max, or "
+                     "alone: r̄ = mean edge / 8), with r_max >= r_min");
+            pk_mesh_free(&S->mesh);
+            return -1;
+        }
+        /* Jerier's size rule ℓ ≈ 8 r̄: far off it, the direct spheres either
+         * leave holes no sphere of the range can close or swallow each other */
+        double ratio = S->mesh.edge_mean / (0.5 * (prm->r_min + prm->r_max));
+        if (ratio < 4 || ratio > 16) {
+            *rule = "meshScale";
+            snprintf(err, errlen, "the mesh's mean edge (%.4g) is %.3g mean radii; Jerier's method "
+                     "needs about 8 (between 4 and 16): remesh, or give the ratio R alone",
+                     S->mesh.edge_mean, ratio);
+            pk_mesh_free(&S->mesh);
+            return -1;
+        }
+    } else {
+        *ptr = "/tetfill";
+        *rule = "radii";
+        if (radii(o, 0, &prm->r_min, &prm->r_max) != 0) {
+            snprintf(err, errlen, "a box domain needs r_min or r_max (with r_max or ratio), "
+                     "r_max >= r_min");
+            return -1;
+        }
+        double lmin = fmin(job->box.L[0], fmin(job->box.L[1], job->box.L[2]));
+        if (!(2 * prm->r_max <= lmin)) {
+            snprintf(err, errlen, "r_max = %g: the largest sphere must fit in the box (2 r_max <= %g)",
+                     prm->r_max, lmin);
+            return -1;
+        }
+        *ptr = "/domain/box/periodic";
+        *rule = "walledBox";
+        for (int k = 0; k < 3; k++)
+            if (job->box.periodic[k]) {
+                snprintf(err, errlen, "tetfill fills walled boxes (axis %d is periodic)", k);
+                return -1;
+            }
+        *ptr = "/domain/box";
+        *rule = "mesh";
+        double h = 8 * 0.5 * (prm->r_min + prm->r_max) / KUHN_MEAN_EDGE; /* ℓ ≈ 8 r̄ */
+        /* a request's check only counts the tets: the worker meshes the box */
+        if (job->service ? pk_mesh_box_count(job->box.L, h, max_tets, err, errlen) != 0
+                         : pk_mesh_box(&S->mesh, job->box.L, h, max_tets, err, errlen) != 0)
+            return -1;
+    }
+    prm->eps = opt_num(o, "epsilon", prm->eps);
+    prm->z_min = (int)pk_json_int_or(o, "z_min", prm->z_min);
+    const char *rule_name = json_string_value(json_object_get(o, "contact_rule"));
+    if (rule_name && strcmp(rule_name, "touching") == 0)
+        prm->contact_rule = PK_TETFILL_CONTACT_TOUCHING; /* the schema admits tangent|touching */
+    prm->vertex_weight = opt_num(o, "vertex_weight", prm->vertex_weight);
+    prm->skip_tet_loci = json_is_true(json_object_get(o, "loose"));
+    prm->densify = !json_is_false(json_object_get(o, "densify"));
+    prm->neighbours = (int)pk_json_int_or(o, "neighbours", prm->neighbours);
+    prm->max_combos = (int)pk_json_int_or(o, "max_combos", prm->max_combos);
+    prm->max_passes = (int)pk_json_int_or(o, "max_passes", prm->max_passes);
+    prm->phi_target = job->has_phi ? job->phi : 0;
+    prm->n_target = job->count;
+    prm->seed = job->seed;
+    prm->max_spheres = job->max_particles;
+    return 0;
+}
+
+static void check_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, pk_schema_errors *errs)
+{
+    (void)plan;
+    tetfill_setup S;
+    const char *ptr, *rule;
+    char err[512];
+    json_t *mesh = json_object_get(json_object_get(job->inputs, "domain"), "mesh");
+    if (job->service && json_object_get(mesh, "file"))
+        return; /* a request to the daemon: the worker reads and checks the file */
+    if (setup(job, &S, &ptr, &rule, err, sizeof err) != 0) {
+        pk_schema_errors_add(errs, ptr, rule, "%s", err);
+        return;
+    }
+    pk_mesh_free(&S.mesh);
+}
+
+static json_t *ints_json(const int64_t *v, size_t n)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; i < n; i++)
+        json_array_append_new(a, json_integer((json_int_t)v[i]));
+    return a;
+}
+
+static json_t *reals_json(const double *v, size_t n)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; i < n; i++)
+        json_array_append_new(a, json_real(v[i]));
+    return a;
+}
+
+static json_t *observables(const tetfill_setup *S, const pk_tetfill_stats *ts,
+                           const pk_tetfill_measures *ms)
+{
+    const pk_tetfill_params *prm = &S->prm;
+    const pk_mesh *m = &S->mesh;
+    json_t *o = json_object();
+    json_object_set_new(o, "r_min", json_real(prm->r_min));
+    json_object_set_new(o, "r_max", json_real(prm->r_max));
+    json_object_set_new(o, "ratio", json_real(prm->r_max / prm->r_min));
+    json_object_set_new(o, "epsilon", json_real(prm->eps));
+    json_object_set_new(o, "overlap_bound", json_real(prm->eps * prm->r_min));
+    json_object_set_new(o, "z_min", json_integer(prm->z_min));
+    json_object_set_new(o, "count_direct", json_integer((json_int_t)ts->n_direct));
+    json_object_set_new(o, "count_trimmed", json_integer((json_int_t)ts->n_trimmed));
+    json_object_set_new(o, "count_geometric", json_integer((json_int_t)ts->n_geometric));
+    json_object_set_new(o, "phi_geometric", json_real(ts->phi_geometric));
+    json_object_set_new(o, "coordination_geometric", json_real(ts->geometric.z));
+    json_object_set_new(o, "coordination_tangent_geometric", json_real(ts->geometric.z_tangent));
+    json_object_set_new(o, "coordination_touching_geometric",
+                        json_real(ts->geometric.z_touching));
+    json_object_set_new(o, "densify_passes", json_integer(ts->passes));
+    json_object_set_new(o, "loci", json_integer((json_int_t)ts->loci));
+    json_object_set_new(o, "solves", json_integer((json_int_t)ts->solves));
+    json_object_set_new(o, "singular_quadruples", json_integer((json_int_t)ts->singular));
+    json_object_set_new(o, "accepted_four", json_integer((json_int_t)ts->accepted));
+    json_object_set_new(o, "accepted_three", json_integer((json_int_t)ts->accepted_three));
+    json_object_set_new(o, "seconds_geometric", json_real(ts->seconds_geometric));
+    json_object_set_new(o, "overlap_max_relative", json_real(ms->overlap_max));
+    json_object_set_new(o, "overlap_mean_relative", json_real(ms->overlap_mean));
+    json_object_set_new(o, "pairs_overlapping", json_integer((json_int_t)ms->pairs_overlapping));
+    json_object_set_new(o, "pairs_over_bound", json_integer((json_int_t)ms->pairs_over_bound));
+    json_object_set_new(o, "contacts", json_integer((json_int_t)ms->contacts));
+    json_object_set_new(o, "coordination_mean", json_real(ms->z_mean));
+    json_object_set_new(o, "coordination_tangent", json_real(ms->z_tangent));
+    json_object_set_new(o, "coordination_touching", json_real(ms->z_touching));
+    json_object_set_new(o, "coordination_histogram", ints_json(ms->z_hist, PK_TETFILL_ZHIST));
+    json_object_set_new(o, "fabric", reals_json(ms->fabric, 9));
+    json_object_set_new(o, "fabric_eigenvalues", reals_json(ms->fabric_eig, 3));
+    json_object_set_new(o, "phi", json_real(ms->phi));
+    json_object_set_new(o, "region_ids", ints_json(ms->region_id, ms->nregion));
+    json_object_set_new(o, "region_phi", reals_json(ms->region_phi, ms->nregion));
+    json_object_set_new(o, "spheres_per_tet_mean", json_real(ms->spheres_per_tet_mean));
+    json_object_set_new(o, "spheres_per_tet_histogram", ints_json(ms->t_hist, PK_TETFILL_THIST));
+    json_object_set_new(o, "centres_outside_mesh", json_integer((json_int_t)ms->outside));
+    json_object_set_new(o, "min_boundary_clearance_relative",
+                        json_real(isfinite(ms->min_wall_clearance) ? ms->min_wall_clearance : -1));
+    json_object_set_new(o, "mesh_nodes_count", json_integer((json_int_t)m->nnode));
+    json_object_set_new(o, "mesh_tets_count", json_integer((json_int_t)m->ntet));
+    json_object_set_new(o, "mesh_boundary_faces", json_integer((json_int_t)m->nbface));
+    json_object_set_new(o, "mesh_volume", json_real(m->volume));
+    json_object_set_new(o, "mesh_edge_mean", json_real(m->edge_mean));
+    json_object_set_new(o, "mesh_reoriented", json_integer((json_int_t)S->rep.reoriented));
+    json_object_set_new(o, "mesh_slivers", json_integer((json_int_t)S->rep.slivers));
+    json_object_set_new(o, "mesh_first_sliver",
+                        json_integer(S->rep.slivers ? (json_int_t)S->rep.first_sliver : -1));
+    json_object_set_new(o, "mesh_origin", reals_json(S->origin, 3));
+    return o;
+}
+
+/* The mesh itself, in the particles' frame: mesh_nodes [3·nnode],
+ * mesh_tets [4·ntet] (0-based), mesh_regions [ntet]. */
+static int write_mesh(pk_h5 *h, const char *prefix, void *extra)
+{
+    const pk_mesh *m = &((tetfill_setup *)extra)->mesh;
+    char name[128];
+    int64_t *t = malloc(4 * m->ntet * sizeof *t);
+    if (!t)
+        return -1;
+    int rc = 0;
+    snprintf(name, sizeof name, "%s/mesh_nodes", prefix);
+    rc |= pk_h5_obs_doubles(h, name, m->x, 3 * m->nnode, NULL);
+    for (size_t i = 0; i < 4 * m->ntet; i++)
+        t[i] = m->t[i];
+    snprintf(name, sizeof name, "%s/mesh_tets", prefix);
+    rc |= pk_h5_obs_ints(h, name, t, 4 * m->ntet);
+    for (size_t i = 0; i < m->ntet; i++)
+        t[i] = m->region[i];
+    snprintf(name, sizeof name, "%s/mesh_regions", prefix);
+    rc |= pk_h5_obs_ints(h, name, t, m->ntet);
+    free(t);
+    return rc;
+}
+
+static void free_setup(void *extra)
+{
+    tetfill_setup *S = extra;
+    pk_mesh_free(&S->mesh);
+    free(S);
+}
+
+static int place_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, const pk_sizes *sz,
+                         pk_monitor *mon, pk_particles *p, pk_place_stats *st, char *err,
+                         size_t errlen)
+{
+    (void)plan;
+    (void)sz;
+    tetfill_setup *S = malloc(sizeof *S);
+    const char *ptr, *rule;
+    if (!S) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    if (setup(job, S, &ptr, &rule, err, errlen) != 0) {
+        free(S);
+        return -1;
+    }
+    pk_tetfill_stats ts;
+    if (pk_tetfill(&S->mesh, &S->prm, mon, p, &ts) != 0) {
+        snprintf(err, errlen, "tet filling failed (%s)", pk_stop_reason_name(ts.reason));
+        free_setup(S);
+        return -1;
+    }
+    pk_tetfill_measures ms;
+    if (pk_tetfill_measure(&S->mesh, p, S->prm.r_min, S->prm.eps, &ms) != 0) {
+        snprintf(err, errlen, "out of memory measuring the packing");
+        free_setup(S);
+        return -1;
+    }
+    *st = (pk_place_stats){.reason = ts.reason, .placed = p->n, .requested = job->count,
+                           .seconds = ts.seconds, .has_domain = 1,
+                           .domain_measure = S->mesh.volume,
+                           .overlap_tol = S->prm.eps * S->prm.r_min, .extra = S,
+                           .write_extra = write_mesh, .free_extra = free_setup};
+    st->domain_box.dim = 3;
+    for (int k = 0; k < 3; k++)
+        st->domain_box.L[k] = S->mesh.hi[k];
+    st->obs = observables(S, &ts, &ms);
+    pk_tetfill_measures_free(&ms);
+    return 0;
+}
+
+const pk_placer pk_placer_tetfill = {
+    .name = "tetfill", .own_sizes = 1, .check = check_tetfill, .place = place_tetfill};

@@ -1,0 +1,76 @@
+/* pack_placer.h — the placement algorithms of the 'pack' process.
+ *
+ * The pack process draws sizes (core/psd/psd), hands them to one placer, audits
+ * the result and writes the file.  A placer is one row in pk_placers[]
+ * (api/pack/pack_placers.c) plus one file api/pack_place_<name>.c: it reads its
+ * own parameter object from the inputs (e.g. "edmd": {...}), runs its core/
+ * algorithm and reports common statistics plus any algorithm-specific
+ * observables as a JSON object, which the writer stores under
+ * /observables/<name>/ (numbers, integers, strings, arrays of numbers). */
+#ifndef PK_PACK_PLACER_H
+#define PK_PACK_PLACER_H
+
+#include <jansson.h>
+
+#include "core/space/gap_audit.h"
+#include "pack_job.h"
+#include "core/space/particles.h"
+#include "core/psd/psd.h"
+#include "core/rsa/rsa.h"
+
+struct pk_h5;
+
+typedef struct pk_place_stats {
+    pk_stop_reason reason;
+    size_t placed, requested;
+    double seconds;
+    json_t *obs;          /* algorithm-specific observables (new reference) or NULL */
+    /* Placers that fill their own domain (tetfill: a mesh) report it here:
+     * the box written to the file and audited, and its true measure. */
+    int has_domain;
+    pk_box domain_box;
+    double domain_measure;
+    double overlap_tol;   /* overlaps the placer allows by design (0 = hard grains) */
+    int walls_touch;      /* 1: Δd between grains only, grains may touch the walls
+                           * (edmd "wall_gap": "none", Titscher §6.3); 0: walls ≥ Δd/2 */
+    int goal_reached;     /* 1: the stop reason is what the job asked for (edmd
+                           * "until": "jammed" and jammed at its own test: the reduced
+                           * pressure, or the Δφ test the job chose), though not
+                           * PK_STOP_COMPLETE */
+    int short_delta_d;    /* 1: the placer could not reach the job's Δd (edmd shell
+                           * growth): the result is audited at audit_delta_d, the gap
+                           * it guarantees, and the placer's warning says so */
+    double audit_delta_d;
+    char warning[512];    /* a placer's own "stopped short" sentence, or "" */
+    /* Bulk datasets too large for obs (e.g. the mesh): written under
+     * /observables/<algorithm>/ by write_extra, released by free_extra. */
+    void *extra;
+    int (*write_extra)(struct pk_h5 *h, const char *prefix, void *extra);
+    void (*free_extra)(void *extra);
+} pk_place_stats;
+
+typedef struct pk_placer {
+    const char *name;     /* the "algorithm" value */
+    int own_sizes;        /* 1 = the placer makes its own sizes: no grading, no size draw */
+    /* Semantic checks of the placer's own inputs (schema already passed);
+     * may be NULL. */
+    void (*check)(const pk_pack_job *job, const pk_pack_plan *plan, pk_schema_errors *errs);
+    /* Place the grains (diameters sz->d, descending) into job->box, appending
+     * to p (initialised, dim = job->dim).  0 when the run ended cleanly for
+     * whatever reason (st->reason), -1 on failure with err. */
+    int (*place)(const pk_pack_job *job, const pk_pack_plan *plan, const pk_sizes *sz,
+                 pk_monitor *mon, pk_particles *p, pk_place_stats *st, char *err, size_t errlen);
+} pk_placer;
+
+/* The verdict of a placed, audited packing (api/job_verdict.h): sets
+ * "complete" and adds "warnings" or "failure" to summary.  phi: the solid
+ * fraction reached; delta_d: the gap audited. */
+void pk_pack_verdict(const pk_pack_job *job, const pk_pack_plan *plan, const pk_place_stats *st,
+                     const pk_particles *p, const pk_gap_report *gap, double phi, double delta_d,
+                     json_t *summary);
+
+/* NULL-terminated table. */
+extern const pk_placer *const pk_placers[];
+const pk_placer *pk_placer_find(const char *name);
+
+#endif

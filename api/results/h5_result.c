@@ -1,0 +1,582 @@
+#include "h5_result.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <hdf5.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "api/inputs/input_open.h"
+
+#ifndef PACKD_VERSION
+#define PACKD_VERSION "0.0.0"
+#endif
+
+struct pk_h5 {
+    hid_t file;
+    hid_t obs;            /* /observables */
+    hid_t lcpl;           /* link creation: intermediate groups */
+    int fd;               /* the temporary file, written at commit */
+    char *path, *tmp;
+};
+
+static void quiet_hdf5(void)
+{
+    /* Errors are reported through return codes and our own messages. */
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+}
+
+static hid_t string_type(size_t len)
+{
+    hid_t t = H5Tcopy(H5T_C_S1);
+    H5Tset_size(t, len ? len : 1);
+    H5Tset_strpad(t, H5T_STR_NULLTERM);
+    H5Tset_cset(t, H5T_CSET_UTF8);
+    return t;
+}
+
+static int attr_string(hid_t obj, const char *name, const char *v)
+{
+    hid_t t = string_type(strlen(v) + 1), s = H5Screate(H5S_SCALAR);
+    hid_t a = H5Acreate2(obj, name, t, s, H5P_DEFAULT, H5P_DEFAULT);
+    herr_t rc = a < 0 ? -1 : H5Awrite(a, t, v);
+    if (a >= 0)
+        H5Aclose(a);
+    H5Sclose(s);
+    H5Tclose(t);
+    return rc < 0 ? -1 : 0;
+}
+
+static int attr_ints(hid_t obj, const char *name, const int *v, hsize_t n, int scalar)
+{
+    hid_t s = scalar ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &n, NULL);
+    hid_t a = H5Acreate2(obj, name, H5T_NATIVE_INT, s, H5P_DEFAULT, H5P_DEFAULT);
+    herr_t rc = a < 0 ? -1 : H5Awrite(a, H5T_NATIVE_INT, v);
+    if (a >= 0)
+        H5Aclose(a);
+    H5Sclose(s);
+    return rc < 0 ? -1 : 0;
+}
+
+static int attr_u64(hid_t obj, const char *name, uint64_t v)
+{
+    hid_t s = H5Screate(H5S_SCALAR);
+    hid_t a = H5Acreate2(obj, name, H5T_NATIVE_UINT64, s, H5P_DEFAULT, H5P_DEFAULT);
+    herr_t rc = a < 0 ? -1 : H5Awrite(a, H5T_NATIVE_UINT64, &v);
+    if (a >= 0)
+        H5Aclose(a);
+    H5Sclose(s);
+    return rc < 0 ? -1 : 0;
+}
+
+/* Dataset creation without timestamps, so equal inputs give equal bytes. */
+static hid_t dcpl_untimed(void)
+{
+    hid_t p = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_obj_track_times(p, 0);
+    return p;
+}
+
+static hid_t gcpl_untimed(void)
+{
+    hid_t p = H5Pcreate(H5P_GROUP_CREATE);
+    H5Pset_obj_track_times(p, 0);
+    return p;
+}
+
+static hid_t make_group(hid_t parent, const char *name, hid_t lcpl)
+{
+    hid_t g = gcpl_untimed();
+    hid_t id = H5Gcreate2(parent, name, lcpl, g, H5P_DEFAULT);
+    H5Pclose(g);
+    return id;
+}
+
+/* Write an n-d dataset of `type` at parent/name; optional unit attribute. */
+static int write_dataset(hid_t parent, hid_t lcpl, const char *name, hid_t type, int rank,
+                         const hsize_t *dims, const void *data, const char *unit)
+{
+    hid_t s = rank == 0 ? H5Screate(H5S_SCALAR) : H5Screate_simple(rank, dims, NULL);
+    hid_t p = dcpl_untimed();
+    hid_t d = H5Dcreate2(parent, name, type, s, lcpl, p, H5P_DEFAULT);
+    herr_t rc = -1;
+    if (d >= 0) {
+        hsize_t total = 1;
+        for (int k = 0; k < rank; k++)
+            total *= dims[k];
+        rc = total ? H5Dwrite(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) : 0;
+        if (rc >= 0 && unit)
+            rc = attr_string(d, "unit", unit);
+        H5Dclose(d);
+    }
+    H5Pclose(p);
+    H5Sclose(s);
+    return rc < 0 ? -1 : 0;
+}
+
+pk_h5 *pk_h5_create(const char *path, char *err, size_t errlen)
+{
+    quiet_hdf5();
+    pk_h5 *h = calloc(1, sizeof *h);
+    if (!h) {
+        snprintf(err, errlen, "out of memory");
+        return NULL;
+    }
+    size_t n = strlen(path) + 32;
+    h->path = strdup(path);
+    h->tmp = malloc(n);
+    if (!h->path || !h->tmp) {
+        free(h->path);
+        free(h->tmp);
+        free(h);
+        snprintf(err, errlen, "out of memory");
+        return NULL;
+    }
+    snprintf(h->tmp, n, "%s.tmp.%ld", path, (long)getpid());
+    unlink(h->tmp);
+    /* The file is built in memory (HDF5's core driver, no backing store) and
+     * written out by pk_h5_commit with plain write(2): a full disk is then an
+     * errno of ours, and HDF5 never holds a file it failed to flush (its exit
+     * handler would close it again and crash).  The temporary file is created
+     * now so a directory that cannot take it fails before the work. */
+    h->fd = open(h->tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0640);
+    if (h->fd < 0) {
+        snprintf(err, errlen, "cannot create %s: %s", h->tmp, strerror(errno));
+        free(h->path);
+        free(h->tmp);
+        free(h);
+        return NULL;
+    }
+    hid_t fcpl = H5Pcreate(H5P_FILE_CREATE), fapl = H5Pcreate(H5P_FILE_ACCESS);
+    H5Pset_fapl_core(fapl, (size_t)1 << 20, 0);
+    h->file = H5Fcreate(h->tmp, H5F_ACC_TRUNC, fcpl, fapl);
+    H5Pclose(fcpl);
+    H5Pclose(fapl);
+    if (h->file < 0) {
+        snprintf(err, errlen, "cannot create %s in memory", h->tmp);
+        close(h->fd);
+        unlink(h->tmp);
+        free(h->path);
+        free(h->tmp);
+        free(h);
+        return NULL;
+    }
+    h->lcpl = H5Pcreate(H5P_LINK_CREATE);
+    H5Pset_create_intermediate_group(h->lcpl, 1);
+    H5Pset_char_encoding(h->lcpl, H5T_CSET_UTF8);
+
+    /* /h5md: version, author, creator (H5MD 1.1 §"H5MD metadata"). */
+    hid_t md = make_group(h->file, "h5md", H5P_DEFAULT);
+    int ver[2] = {1, 1};
+    attr_ints(md, "version", ver, 2, 0);
+    hid_t au = make_group(md, "author", H5P_DEFAULT);
+    attr_string(au, "name", "packd user");
+    H5Gclose(au);
+    hid_t cr = make_group(md, "creator", H5P_DEFAULT);
+    attr_string(cr, "name", "packd");
+    attr_string(cr, "version", PACKD_VERSION);
+    H5Gclose(cr);
+    H5Gclose(md);
+    h->obs = make_group(h->file, "observables", H5P_DEFAULT);
+    if (h->obs < 0) {
+        snprintf(err, errlen, "cannot write %s", h->tmp);
+        pk_h5_abort(h);
+        return NULL;
+    }
+    return h;
+}
+
+int pk_h5_write_particles(pk_h5 *h, const pk_box *b, const pk_particles *p, const char *unit)
+{
+    const int dim = b->dim;
+    hid_t grains = make_group(h->file, "particles/grains", h->lcpl);
+    if (grains < 0)
+        return -1;
+    int rc = 0;
+    hid_t box = make_group(grains, "box", H5P_DEFAULT);
+    rc |= attr_ints(box, "dimension", &dim, 1, 1);
+    {
+        /* boundary: fixed-length string array, "periodic" or "none" per axis */
+        char names[PK_MAXDIM][9];
+        for (int k = 0; k < dim; k++)
+            snprintf(names[k], sizeof names[k], "%s", b->periodic[k] ? "periodic" : "none");
+        hid_t t = string_type(9);
+        hsize_t n = (hsize_t)dim;
+        hid_t s = H5Screate_simple(1, &n, NULL);
+        hid_t a = H5Acreate2(box, "boundary", t, s, H5P_DEFAULT, H5P_DEFAULT);
+        rc |= (a < 0 || H5Awrite(a, t, names) < 0) ? -1 : 0;
+        if (a >= 0)
+            H5Aclose(a);
+        H5Sclose(s);
+        H5Tclose(t);
+    }
+    hsize_t nd = (hsize_t)dim;
+    rc |= write_dataset(box, H5P_DEFAULT, "edges", H5T_NATIVE_DOUBLE, 1, &nd, b->L, unit);
+    H5Gclose(box);
+
+    size_t n = p->n;
+    double *pos = malloc((n ? n : 1) * (size_t)dim * sizeof *pos);
+    if (!pos) {
+        H5Gclose(grains);
+        return -1;
+    }
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < dim; k++)
+            pos[i * (size_t)dim + (size_t)k] = p->x[3 * i + (size_t)k];
+    hsize_t d2[2] = {(hsize_t)n, (hsize_t)dim};
+    rc |= write_dataset(grains, H5P_DEFAULT, "position", H5T_NATIVE_DOUBLE, 2, d2, pos, unit);
+    free(pos);
+    hsize_t d1 = (hsize_t)n;
+    rc |= write_dataset(grains, H5P_DEFAULT, "radius", H5T_NATIVE_DOUBLE, 1, &d1, p->r, unit);
+    rc |= write_dataset(grains, H5P_DEFAULT, "species", H5T_NATIVE_INT32, 1, &d1, p->species, NULL);
+    /* H5MD's id element (0..N-1): also the Polyvertex connectivity of the XDMF sidecar */
+    int64_t *id = malloc((n ? n : 1) * sizeof *id);
+    if (!id) {
+        H5Gclose(grains);
+        return -1;
+    }
+    for (size_t i = 0; i < n; i++)
+        id[i] = (int64_t)i;
+    rc |= write_dataset(grains, H5P_DEFAULT, "id", H5T_NATIVE_INT64, 1, &d1, id, NULL);
+    free(id);
+    H5Gclose(grains);
+    return rc ? -1 : 0;
+}
+
+int pk_h5_write_parameters(pk_h5 *h, const char *process, const char *job_json, uint64_t seed)
+{
+    hid_t g = make_group(h->file, "parameters", H5P_DEFAULT);
+    if (g < 0)
+        return -1;
+    int rc = attr_string(g, "process", process);
+    rc |= attr_string(g, "packd_version", PACKD_VERSION);
+    rc |= attr_u64(g, "seed", seed);
+    /* The job as given, as a dataset: attributes are limited to 64 KiB and a
+     * job may carry an inline mesh. */
+    hid_t t = string_type(strlen(job_json) + 1);
+    rc |= write_dataset(g, H5P_DEFAULT, "job", t, 0, NULL, job_json, NULL);
+    H5Tclose(t);
+    H5Gclose(g);
+    return rc ? -1 : 0;
+}
+
+int pk_h5_obs_double(pk_h5 *h, const char *name, double v, const char *unit)
+{
+    return write_dataset(h->obs, h->lcpl, name, H5T_NATIVE_DOUBLE, 0, NULL, &v, unit);
+}
+
+int pk_h5_obs_int(pk_h5 *h, const char *name, int64_t v)
+{
+    return write_dataset(h->obs, h->lcpl, name, H5T_NATIVE_INT64, 0, NULL, &v, NULL);
+}
+
+int pk_h5_obs_string(pk_h5 *h, const char *name, const char *v)
+{
+    hid_t t = string_type(strlen(v) + 1);
+    int rc = write_dataset(h->obs, h->lcpl, name, t, 0, NULL, v, NULL);
+    H5Tclose(t);
+    return rc;
+}
+
+int pk_h5_obs_doubles(pk_h5 *h, const char *name, const double *v, size_t n, const char *unit)
+{
+    hsize_t d = (hsize_t)n;
+    return write_dataset(h->obs, h->lcpl, name, H5T_NATIVE_DOUBLE, 1, &d, v, unit);
+}
+
+int pk_h5_obs_ints(pk_h5 *h, const char *name, const int64_t *v, size_t n)
+{
+    hsize_t d = (hsize_t)n;
+    return write_dataset(h->obs, h->lcpl, name, H5T_NATIVE_INT64, 1, &d, v, NULL);
+}
+
+int pk_h5_obs_json(pk_h5 *h, const char *prefix, json_t *obj)
+{
+    const char *key;
+    json_t *v;
+    int rc = 0;
+    json_object_foreach(obj, key, v)
+    {
+        char name[256];
+        snprintf(name, sizeof name, "%s/%s", prefix, key);
+        if (json_is_integer(v))
+            rc |= pk_h5_obs_int(h, name, (int64_t)json_integer_value(v));
+        else if (json_is_real(v))
+            rc |= pk_h5_obs_double(h, name, json_real_value(v), NULL);
+        else if (json_is_boolean(v))
+            rc |= pk_h5_obs_int(h, name, json_is_true(v));
+        else if (json_is_string(v))
+            rc |= pk_h5_obs_string(h, name, json_string_value(v));
+        else if (json_is_object(v))
+            rc |= pk_h5_obs_json(h, name, v);
+        else if (json_is_array(v)) {
+            size_t n = json_array_size(v), i;
+            int all_int = 1, all_num = 1;
+            json_t *e;
+            json_array_foreach(v, i, e)
+            {
+                all_int &= json_is_integer(e);
+                all_num &= json_is_number(e);
+            }
+            if (!all_num)
+                continue;
+            if (all_int) {
+                int64_t *a = malloc((n ? n : 1) * sizeof *a);
+                if (!a)
+                    return -1;
+                json_array_foreach(v, i, e) a[i] = (int64_t)json_integer_value(e);
+                rc |= pk_h5_obs_ints(h, name, a, n);
+                free(a);
+            } else {
+                double *a = malloc((n ? n : 1) * sizeof *a);
+                if (!a)
+                    return -1;
+                json_array_foreach(v, i, e) a[i] = json_number_value(e);
+                rc |= pk_h5_obs_doubles(h, name, a, n, NULL);
+                free(a);
+            }
+        }
+    }
+    return rc ? -1 : 0;
+}
+
+static void h5_free(pk_h5 *h)
+{
+    free(h->path);
+    free(h->tmp);
+    free(h);
+}
+
+static void h5_close_all(pk_h5 *h)
+{
+    if (h->obs >= 0)
+        H5Gclose(h->obs);
+    H5Pclose(h->lcpl);
+    H5Fclose(h->file);
+}
+
+/* All of buf to fd: 0, or -1 with errno. */
+static int write_all(int fd, const unsigned char *buf, size_t n)
+{
+    while (n > 0) {
+        ssize_t w = write(fd, buf, n);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0) {
+            if (w == 0)
+                errno = EIO;
+            return -1;
+        }
+        buf += w;
+        n -= (size_t)w;
+    }
+    return 0;
+}
+
+int pk_h5_commit(pk_h5 *h, char *err, size_t errlen)
+{
+    unsigned char *img = NULL;
+    ssize_t n = H5Fflush(h->file, H5F_SCOPE_GLOBAL) < 0 ? -1 : H5Fget_file_image(h->file, NULL, 0);
+    if (n > 0 && (img = malloc((size_t)n)) != NULL &&
+        H5Fget_file_image(h->file, img, (size_t)n) != n) {
+        free(img);
+        img = NULL;
+    }
+    h5_close_all(h);
+    int rc = -1, saved = ENOMEM;
+    if (img) {
+        rc = write_all(h->fd, img, (size_t)n) != 0 || fsync(h->fd) != 0 ? -1 : 0;
+        saved = errno;
+    }
+    free(img);
+    if (close(h->fd) != 0 && rc == 0) {
+        rc = -1;
+        saved = errno;
+    }
+    if (rc == 0 && rename(h->tmp, h->path) != 0) {
+        rc = -1;
+        saved = errno;
+    }
+    if (rc != 0) {
+        snprintf(err, errlen, "cannot write %s: %s", h->path, strerror(saved));
+        unlink(h->tmp);
+        h5_free(h);
+        errno = saved;
+        return -1;
+    }
+    /* make the rename itself durable */
+    char *dir = strdup(h->path);
+    if (dir) {
+        char *slash = strrchr(dir, '/');
+        const char *d = ".";
+        if (slash) {
+            *slash = 0;
+            d = *dir ? dir : "/";
+        }
+        int dfd = open(d, O_RDONLY | O_DIRECTORY);
+        if (dfd >= 0) {
+            fsync(dfd);
+            close(dfd);
+        }
+        free(dir);
+    }
+    h5_free(h);
+    return 0;
+}
+
+void pk_h5_abort(pk_h5 *h)
+{
+    if (!h)
+        return;
+    h5_close_all(h);
+    close(h->fd);
+    unlink(h->tmp);
+    h5_free(h);
+}
+
+/* Elements of an attribute's or dataset's dataspace; -1 if none. */
+static hssize_t space_points(hid_t space)
+{
+    if (space < 0)
+        return -1;
+    hssize_t n = H5Sget_simple_extent_npoints(space);
+    H5Sclose(space);
+    return n;
+}
+
+/* A dataset's extent when it has `rank` dimensions; -1 otherwise. */
+static int dataset_dims(hid_t d, int rank, hsize_t *dims)
+{
+    hid_t s = d >= 0 ? H5Dget_space(d) : -1;
+    int ok = s >= 0 && H5Sget_simple_extent_ndims(s) == rank &&
+             H5Sget_simple_extent_dims(s, dims, NULL) == rank;
+    if (s >= 0)
+        H5Sclose(s);
+    return ok ? 0 : -1;
+}
+
+/* The box group: dimension, boundary[dim], edges[dim].  Every read is
+ * checked against its buffer first: the file is not trusted. */
+static int read_box(hid_t f, const char *path, pk_box *b, char *err, size_t errlen)
+{
+    hid_t box = H5Gopen2(f, "particles/grains/box", H5P_DEFAULT);
+    if (box < 0) {
+        snprintf(err, errlen, "%s: no /particles/grains/box", path);
+        return -1;
+    }
+    int rc = -1, dim = 0;
+    hid_t a = H5Aopen(box, "dimension", H5P_DEFAULT);
+    if (a < 0 || space_points(H5Aget_space(a)) != 1 || H5Aread(a, H5T_NATIVE_INT, &dim) < 0 ||
+        (dim != 2 && dim != 3)) {
+        snprintf(err, errlen, "%s: bad box dimension", path);
+        goto out;
+    }
+    H5Aclose(a);
+    a = -1;
+    b->dim = dim;
+    char names[PK_MAXDIM][9];
+    hid_t t = string_type(sizeof names[0]);
+    a = H5Aopen(box, "boundary", H5P_DEFAULT);
+    if (a >= 0 && space_points(H5Aget_space(a)) == dim && H5Aread(a, t, names) >= 0)
+        for (int k = 0; k < dim; k++) {
+            names[k][sizeof names[k] - 1] = 0;
+            b->periodic[k] = strcmp(names[k], "periodic") == 0;
+        }
+    H5Tclose(t);
+    hsize_t n;
+    hid_t d = H5Dopen2(box, "edges", H5P_DEFAULT);
+    if (dataset_dims(d, 1, &n) != 0 || n != (hsize_t)dim ||
+        H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, b->L) < 0)
+        snprintf(err, errlen, "%s: bad box edges", path);
+    else
+        rc = 0;
+    if (d >= 0)
+        H5Dclose(d);
+out:
+    if (a >= 0)
+        H5Aclose(a);
+    H5Gclose(box);
+    return rc;
+}
+
+/* Read dataset `name` of extent dims[rank] into buf (native type t). */
+static int read_exact(hid_t f, const char *name, hid_t t, int rank, const hsize_t *want, void *buf)
+{
+    hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
+    hsize_t dims[2];
+    int ok = dataset_dims(d, rank, dims) == 0;
+    for (int k = 0; ok && k < rank; k++)
+        ok = dims[k] == want[k];
+    ok = ok && (want[0] == 0 || H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0);
+    if (d >= 0)
+        H5Dclose(d);
+    return ok ? 0 : -1;
+}
+
+int pk_h5_read_particles(const char *path, pk_box *b, pk_particles *p, char *err, size_t errlen)
+{
+    quiet_hdf5();
+    memset(b, 0, sizeof *b);
+    memset(p, 0, sizeof *p);
+    /* Check the file through a descriptor (a regular file, not a FIFO or a
+     * device), then let HDF5 open that very file by its /proc name. */
+    int fd = pk_input_open(path, 0, err, errlen);
+    if (fd < 0)
+        return -1;
+    struct stat st;
+    char fdpath[64];
+    snprintf(fdpath, sizeof fdpath, "/proc/self/fd/%d", fd);
+    hid_t f = fstat(fd, &st) == 0 ? H5Fopen(access(fdpath, R_OK) == 0 ? fdpath : path,
+                                            H5F_ACC_RDONLY, H5P_DEFAULT) : -1;
+    close(fd);
+    if (f < 0) {
+        snprintf(err, errlen, "cannot open %s as HDF5", path);
+        return -1;
+    }
+    int rc = -1;
+    if (read_box(f, path, b, err, errlen) != 0)
+        goto out;
+    const int dim = b->dim;
+    hsize_t n;
+    hid_t d = H5Dopen2(f, "particles/grains/radius", H5P_DEFAULT);
+    int have = dataset_dims(d, 1, &n) == 0;
+    if (d >= 0)
+        H5Dclose(d);
+    if (!have) {
+        snprintf(err, errlen, "%s: no /particles/grains/radius", path);
+        goto out;
+    }
+    /* Each grain takes at least its radius' 8 bytes in a packd file: a
+     * larger count is a forged header, not a packing to allocate for. */
+    if (n > (hsize_t)st.st_size / sizeof(double)) {
+        snprintf(err, errlen, "%s: declares %llu grains, more than its %lld bytes hold", path,
+                 (unsigned long long)n, (long long)st.st_size);
+        goto out;
+    }
+    if (pk_particles_init(p, dim, (size_t)n + 1) != 0) {
+        snprintf(err, errlen, "out of memory");
+        goto out;
+    }
+    p->n = (size_t)n;
+    double *pos = malloc(((size_t)n + 1) * (size_t)dim * sizeof *pos);
+    hsize_t pdims[2] = {n, (hsize_t)dim};
+    if (pos && read_exact(f, "particles/grains/radius", H5T_NATIVE_DOUBLE, 1, &n, p->r) == 0 &&
+        read_exact(f, "particles/grains/position", H5T_NATIVE_DOUBLE, 2, pdims, pos) == 0 &&
+        read_exact(f, "particles/grains/species", H5T_NATIVE_INT32, 1, &n, p->species) == 0) {
+        for (size_t i = 0; i < (size_t)n; i++)
+            for (int k = 0; k < 3; k++)
+                p->x[3 * i + (size_t)k] = k < dim ? pos[i * (size_t)dim + (size_t)k] : 0.0;
+        rc = 0;
+    } else {
+        snprintf(err, errlen, "%s: cannot read grain datasets (radius [N], position [N][%d], "
+                 "species [N])", path, dim);
+        pk_particles_free(p);
+    }
+    free(pos);
+out:
+    H5Fclose(f);
+    return rc;
+}

@@ -1,0 +1,58 @@
+/* h5_result.h — packd result files, layout after H5MD 1.1 (docs/result-format.md).
+ *
+ *   /h5md                       version = [1,1]; /h5md/author, /h5md/creator (name, version)
+ *   /particles/grains/box       attrs dimension, boundary[dim] ("periodic"|"none"); dataset edges[dim]
+ *   /particles/grains/position  [N][dim] float64, attr unit
+ *   /particles/grains/radius    [N] float64, attr unit      (packd element; H5MD has none)
+ *   /particles/grains/species   [N] int32 (size class, 0 = coarsest)
+ *   /particles/grains/id        [N] int64 (H5MD identity 0..N-1)
+ *   /parameters                 attrs job (JSON text), process, seed, packd_version
+ *   /observables/<name>         scalars, arrays and strings written by the process
+ *
+ * A file is built in memory (HDF5's core driver), written by pk_h5_commit()
+ * under a temporary name in the same directory with write(2), fsync'd and
+ * renamed into place, so a reader never sees a half file, a crash leaves at
+ * most a *.tmp.* file behind, and a full disk is an errno in the message
+ * ("No space left on device") with the temporary file removed. */
+#ifndef PK_H5_RESULT_H
+#define PK_H5_RESULT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/space/box.h"
+#include "core/space/particles.h"
+
+typedef struct pk_h5 pk_h5;
+
+/* Creates "<path>.tmp.<pid>".  NULL on failure with a message in err. */
+pk_h5 *pk_h5_create(const char *path, char *err, size_t errlen);
+
+int pk_h5_write_particles(pk_h5 *h, const pk_box *b, const pk_particles *p, const char *unit);
+int pk_h5_write_parameters(pk_h5 *h, const char *process, const char *job_json, uint64_t seed);
+
+/* Observables under /observables (name may contain '/' for sub-groups,
+ * e.g. "grading/target_passing"); unit may be NULL (dimensionless). */
+int pk_h5_obs_double(pk_h5 *h, const char *name, double v, const char *unit);
+int pk_h5_obs_int(pk_h5 *h, const char *name, int64_t v);
+int pk_h5_obs_string(pk_h5 *h, const char *name, const char *v);
+int pk_h5_obs_doubles(pk_h5 *h, const char *name, const double *v, size_t n, const char *unit);
+int pk_h5_obs_ints(pk_h5 *h, const char *name, const int64_t *v, size_t n);
+
+/* Every member of a JSON object as observables under prefix ("rsa" →
+ * /observables/rsa/<key>): reals → float64, integers → int64, strings,
+ * booleans → int64 0/1, arrays of numbers → 1-d arrays, objects → sub-groups.
+ * Other values are skipped.  0 on success. */
+#include <jansson.h>
+int pk_h5_obs_json(pk_h5 *h, const char *prefix, json_t *obj);
+
+/* Close, fsync and rename into place.  Frees h.  0 on success. */
+int pk_h5_commit(pk_h5 *h, char *err, size_t errlen);
+/* Close and remove the temporary file.  Frees h. */
+void pk_h5_abort(pk_h5 *h);
+
+/* Read the grains back (tests, `packd inspect`, homogenization input).
+ * `p` is initialised here.  0 on success. */
+int pk_h5_read_particles(const char *path, pk_box *b, pk_particles *p, char *err, size_t errlen);
+
+#endif

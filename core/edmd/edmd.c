@@ -1,0 +1,728 @@
+/* edmd.c — the EDMD growth-packing driver (spec §3; issue 3).
+ *
+ * Time unit: the time a grain at the rms speed per axis (u = mean target
+ * diameter d̄ per unit time) needs to cross d̄.  Relative growth: every
+ * diameter is d_i·s(t) with s' = γ (Meier: s(0) = 0; Titscher §6.2: s(0) = δ,
+ * t_end = (1 − δ)/γ, Eq. 30).  Shell growth: true radii fixed, the shell
+ * grows at γ·d̄/2 (Titscher §6.3: t_end = Δd/(2γ_a), Eq. 31; §6.4: until
+ * jammed, Δd_max = 2 h(t_stop)). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "edmd_checkpoint.h"
+#include "edmd_state.h"
+#include "core/base/rng.h"
+
+/* Skins shrink as SKIN_P0/p above that reduced pressure, to SKIN_MIN of the
+ * base skin at most (mono 3D N = 2000 to jamming: −9 % instructions). */
+#define SKIN_P0 100.0
+#define SKIN_MIN 0.1
+/* Skin factor of the grains below the mean radius (see setup). */
+#define SKIN_FINE 2.5
+/* Round 5, dropped: skins ×2 or ×3 in the dilute phase of a zero start
+ * (scale min(S, SKIN_P0/p) instead of min(1, ...), where 43 % of the
+ * Fuller-like run's CPU time and 75 % of its 2.0M list rebuilds fall before
+ * φ = 0.42): rebuilds 2.0M → 1.1M, but each query 5.0k → 12k instructions
+ * (wider spheres, wider level cells) and 27 → 34 lanes per prediction:
+ * 8740 → 9470 (×2) and 9200 (×3) instructions per collision.  Coarse
+ * grains' skins ×0.5 (coarse lists 27 → 22.5 lanes per prediction):
+ * +18 % list rebuilds, more instructions to φ = 0.70. */
+/* Round 7 account, Fuller-like 1–16 N = 10^4 to jamming (bench/edmd;
+ * callgrind, 4-lane path: 26.65G instructions, 8497 per collision).
+ * Events 5.90M: 3.14M collisions, 2.00M list rebuilds (by octave of the
+ * grain's d: 1–2 1.17M, 2–4 0.66M, 4–8 0.14M, 8–16 0.025M), 0.76M invalid
+ * (0.72M took the runner-up, 0.044M re-predicted), no walls.  Predictions
+ * 13.4G: d 8–16 3.12M (3.09M after a collision) × 54.7 neighbours (29 of
+ * d 1–2), 2810 instructions each = 8.8G, a third of the run; 4–8 1.62M ×
+ * 19.0, 1320; 2–4 1.54M × 6.9, 740; 1–2 2.06M × 5.9, 665.  Rebuilds 9.1G
+ * (queries 6.4G, re-filing 1.8G): 3230 instructions each for d 1–2, 4320
+ * for 2–4, 13.0k for 4–8, 24.0k for 8–16.  Heap 1.86G, collision rule
+ * 0.97G.  Masses are equal by default (pk_edmd_params.equal_masses), so a
+ * fine turns a coarse grain as much as any grain does: nothing a coarse
+ * grain predicted survives its collision, and an exact change cannot skip
+ * those 171M neighbour tests; fewer of them needs other skins (other
+ * events).  Kept: cover moves (grid_cover.c: −1.5 % instructions, the
+ * same events); dropped: culled rows in wide queries (grid_uniform.c), a
+ * reload-free heap step (edmd_queue.c).
+ * Seventh session: the base skin (pk_edmd_params.skin, 0.6) at 0.45 gives
+ * the Fuller-like case 8.4–8.8e5 collisions per CPU s against 6.2–6.3e5
+ * (0.8: 6.3–6.8e5), but only because that run makes 5.10M collisions
+ * instead of 3.14M before the jamming test stops it (φ 0.7129 / 0.7108):
+ * the jammed packing takes 5.8–6.1 s instead of 5.0 — slower for the
+ * user, kept at 0.6.  From an RSA start at φ = 0.30 (bench/edmd …_rsa030,
+ * Titscher/Kansal) the same case makes 1.08–1.13e6 collisions per CPU s
+ * and jams in 3.5 s (the dilute phase, where rebuilds outnumber
+ * collisions, is skipped). */
+/* From this many grains on (arrays beyond the caches) the grains are
+ * renumbered along a Z-order curve every RESORT_WINDOWS·N events: they
+ * diffuse away from their start order and each prediction then misses the
+ * cache once per neighbour (N = 10^6 from zero radii to φ = 0.55: 460 →
+ * 339 s CPU, peak memory 395 → 522 MB; lists and events are rebuilt there,
+ * as at the start; from 4096 grains instead: mono 3D N = 10^4 to jamming
+ * 1.17e6 → 1.11e6 collisions per CPU second with edmd_prefetch_list). */
+#define RESORT_MIN_N 32768
+#define RESORT_WINDOWS 10
+
+/* The clock is re-based every REBASE_WINDOWS·N events: a grain has a few
+ * events in that window, so |v·t| stays a few flights (a re-base touches
+ * every grain: ~2 % of the instructions when done every N events, mono 3D
+ * to jamming; a longer window loses precision near contact — N = 8 in a
+ * walled cube then jams short of π/6 more often). */
+#define REBASE_WINDOWS 4
+
+/* Reduced pressure past which a run to jamming grows at
+ * pk_edmd_params.jam_rate_factor of its rate (the structure is arrested
+ * near p ~ 10^2–10^3). */
+#define JAM_SLOW_P 1e3
+
+static void state_free(edmd_state *s)
+{
+    edmd_nlist_free(s);
+    free(s->k);
+    free(s->m);
+    free(s->ev);
+    free(s->ncoll);
+    edmd_queue_free(s);
+    free(s->skin);
+    free(s->rref);
+    free(s->ncoll_nl);
+}
+
+static int state_alloc(edmd_state *s, size_t n)
+{
+    size_t c = n ? n : 1;
+    s->k = aligned_alloc(64, c * sizeof *s->k); /* sizeof = 64: a multiple of the alignment */
+    if (s->k)
+        memset(s->k, 0, c * sizeof *s->k);
+    s->m = calloc(c, sizeof *s->m);
+    s->ev = aligned_alloc(32, c * sizeof *s->ev); /* sizeof = 32 */
+    s->ncoll = calloc(c, sizeof *s->ncoll);
+    const int queue = edmd_queue_alloc(s, c);
+    s->skin = calloc(c, sizeof *s->skin);
+    s->rref = calloc(c, sizeof *s->rref);
+    s->ncoll_nl = calloc(c, sizeof *s->ncoll_nl);
+    s->nl = calloc(c, sizeof *s->nl);
+    s->nl_mark = calloc(c, sizeof *s->nl_mark);
+    if (!s->k || !s->m || !s->ev || !s->ncoll || queue != 0 || !s->skin || !s->rref ||
+        !s->ncoll_nl || !s->nl || !s->nl_mark)
+        return -1;
+    return pk_particles_init(&s->bs, s->dim, c);
+}
+
+/* True radius R_i(t) = ρ_i(t) − h(t), clamped at 0. */
+static inline double true_radius(const edmd_state *s, size_t i, double t)
+{
+    return fmax(edmd_rho(s, i, t) - (s->h0 + s->h1 * t), 0);
+}
+
+/* pk_ball_measure's expression, inlined (the same operations, the same
+ * sums): φ is summed over all grains every window of N events, and the two
+ * calls per grain (measure, fmax) were 2.1 % of the instructions, mono 3D
+ * N = 10^4 to jamming (now 1.0 %). */
+static inline double ball_measure(int dim, double r)
+{
+    return dim == 2 ? M_PI * r * r : 4.0 / 3.0 * M_PI * r * r * r;
+}
+
+static double phi_true(const edmd_state *s, double t)
+{
+    const double h = s->h0 + s->h1 * t;
+    double sum = 0;
+    for (size_t i = 0; i < s->n; i++) {
+        const double r = edmd_rho(s, i, t) - h; /* true_radius */
+        sum += ball_measure(s->dim, r > 0 ? r : 0);
+    }
+    return sum / pk_box_measure(&s->box);
+}
+
+static double phi_sim(const edmd_state *s, double t)
+{
+    double sum = 0;
+    for (size_t i = 0; i < s->n; i++)
+        sum += ball_measure(s->dim, edmd_rho(s, i, t));
+    return sum / pk_box_measure(&s->box);
+}
+
+/* Smallest t >= 0 with φ_true(t) >= phi (φ_true is non-decreasing). */
+static double time_of_phi(const edmd_state *s, double phi)
+{
+    double lo = 0, hi = 1;
+    while (phi_true(s, hi) < phi && hi < 1e300)
+        hi *= 2;
+    for (int it = 0; it < 200 && hi - lo > 1e-15 * hi; it++) {
+        double mid = 0.5 * (lo + hi);
+        if (phi_true(s, mid) >= phi)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    return hi;
+}
+
+static int all_periodic(const edmd_state *s)
+{
+    for (int k = 0; k < s->dim; k++)
+        if (!s->box.periodic[k])
+            return 0;
+    return 1;
+}
+
+static double kinetic(const edmd_state *s)
+{
+    double K = 0;
+    for (size_t i = 0; i < s->n; i++)
+        for (int k = 0; k < s->dim; k++)
+            K += 0.5 * s->m[i] * s->k[i].v[k] * s->k[i].v[k];
+    return K;
+}
+
+/* In a fully periodic box the centre of mass is at rest (Meier's Eq. 3.9
+ * does not conserve momentum for unequal rates; spec §3.5). */
+static void remove_drift(edmd_state *s)
+{
+    if (!all_periodic(s))
+        return;
+    double P[3] = {0, 0, 0}, M = 0;
+    for (size_t i = 0; i < s->n; i++) {
+        M += s->m[i];
+        for (int k = 0; k < s->dim; k++)
+            P[k] += s->m[i] * s->k[i].v[k];
+    }
+    for (size_t i = 0; i < s->n; i++)
+        for (int k = 0; k < s->dim; k++)
+            s->k[i].v[k] -= P[k] / M;
+}
+
+static void predict_all(edmd_state *s)
+{
+    for (size_t i = 0; i < s->n; i++)
+        edmd_predict(s, i);
+    edmd_queue_init(s);
+}
+
+/* The criterion of a monitor stop (pk_monitor_tick: 1 cancelled, 2 wall limit). */
+static pk_edmd_criterion monitor_criterion(int m)
+{
+    return m == 2 ? PK_EDMD_CRIT_WALL_TIME : PK_EDMD_CRIT_CANCEL;
+}
+
+/* All lists and events anew (after a skin change or a renumbering): 0, -1
+ * out of memory, 1 when the monitor stopped the run during the list build
+ * (*crit set): the run must end, its positions are still exact. */
+static int rebuild_all(edmd_state *s, pk_edmd_criterion *crit)
+{
+    int rc = edmd_nlist_build_all(s);
+    if (rc == 0)
+        predict_all(s);
+    else if (rc > 0)
+        *crit = monitor_criterion(s->stop);
+    return rc;
+}
+
+/* Synchronise everyone and move the time origin to now (spec §6: |t| stays
+ * small against Δt).  Predictions are shifted, not recomputed. */
+static void rebase(edmd_state *s)
+{
+    double T = s->t;
+    for (size_t i = 0; i < s->n; i++) {
+        edmd_kin *k = &s->k[i];
+        edmd_pos(s, i, k->p);
+        edmd_wrap_near(s, k->p);
+        k->a += k->g * T;
+    }
+    s->h0 += s->h1 * T;
+    s->t = 0;
+    edmd_queue_shift(s, T); /* (the queue is rebuilt about the new clock) */
+}
+
+/* Kinetic-energy rescaling: every trajectory changes, so all predictions are
+ * redone (spec §3.5).  p holds the positions now while the velocities change. */
+static void rescale(edmd_state *s, double K0)
+{
+    for (size_t i = 0; i < s->n; i++)
+        edmd_pos(s, i, s->k[i].p);
+    remove_drift(s);
+    double K = kinetic(s);
+    double lam = K > 0 ? sqrt(K0 / K) : 1;
+    for (size_t i = 0; i < s->n; i++) {
+        double x[3] = {s->k[i].p[0], s->k[i].p[1], s->k[i].p[2]};
+        for (int k = 0; k < 3; k++)
+            s->k[i].v[k] *= lam;
+        edmd_pin(s, i, x);
+    }
+    s->K = kinetic(s);
+    for (size_t i = 0; i < s->n; i++)
+        s->ncoll[i]++;
+    predict_all(s);
+}
+
+/* Multiply every growth rate (and the shell's) by f from now on, radii
+ * continuous; every prediction is redone (the pair quadratics change). */
+static void scale_growth(edmd_state *s, double f)
+{
+    const double t = s->t;
+    for (size_t i = 0; i < s->n; i++) {
+        edmd_kin *k = &s->k[i];
+        const double g = k->g * f;
+        k->a += (k->g - g) * t;
+        k->g = g;
+        s->ncoll[i]++;
+    }
+    const double h1 = s->h1 * f;
+    s->h0 += (s->h1 - h1) * t;
+    s->h1 = h1;
+    predict_all(s);
+}
+
+static void hist_push(pk_edmd_stats *st, uint64_t *stride, uint64_t ev, double t, double phi,
+                      double p)
+{
+    if (st->nhist == PK_EDMD_HIST_MAX) { /* keep every other point, double the stride */
+        size_t k = 0;
+        for (size_t q = 0; q < st->nhist; q += 2, k++) {
+            st->hist_events[k] = st->hist_events[q];
+            st->hist_t[k] = st->hist_t[q];
+            st->hist_phi[k] = st->hist_phi[q];
+            st->hist_p[k] = st->hist_p[q];
+        }
+        st->nhist = k;
+        *stride *= 2;
+    }
+    st->hist_events[st->nhist] = (double)ev;
+    st->hist_t[st->nhist] = t;
+    st->hist_phi[st->nhist] = phi;
+    st->hist_p[st->nhist] = p;
+    st->nhist++;
+}
+
+/* Set rates, masses, velocities, positions (zero start), skins.  Returns the
+ * stop time (INFINITY when growing until jammed) or NAN on bad input. */
+static double setup(edmd_state *s, const pk_particles *p, const pk_edmd_params *prm,
+                    pk_edmd_stats *st)
+{
+    const size_t n = s->n;
+    const int dim = s->dim;
+    double dbar = 0, rmax = 0;
+    for (size_t i = 0; i < n; i++) {
+        dbar += 2 * p->r[i] / (double)n;
+        rmax = fmax(rmax, p->r[i]);
+    }
+    if (!(dbar > 0) || !(prm->growth_rate > 0))
+        return NAN;
+    const double gam = prm->growth_rate, h = 0.5 * prm->delta_d;
+    double t_end;
+    if (prm->growth == PK_EDMD_GROW_RELATIVE) {
+        double s0 = prm->start_zero ? 0 : prm->delta;
+        if (!(s0 >= 0 && s0 < 1))
+            return NAN;
+        t_end = (1 - s0) / gam;
+        for (size_t i = 0; i < n; i++) {
+            if (prm->start_zero) { /* ρ = (r + h)·γt: the shell scales with the grain */
+                s->k[i].a = 0;
+                s->k[i].g = (p->r[i] + h) * gam;
+            } else {
+                s->k[i].a = s0 * p->r[i] + h;
+                s->k[i].g = p->r[i] * gam;
+            }
+        }
+        s->h0 = h;
+        s->h1 = 0;
+    } else {
+        if (prm->start_zero)
+            return NAN;
+        double ga = 0.5 * gam * dbar;
+        for (size_t i = 0; i < n; i++) {
+            s->k[i].a = p->r[i];
+            s->k[i].g = ga;
+        }
+        s->h0 = 0;
+        s->h1 = ga;
+        t_end = h / ga;
+    }
+    st->t_end = t_end;
+    double t_stop = t_end;
+    if (prm->until == PK_EDMD_UNTIL_JAMMED)
+        t_stop = INFINITY;
+    else if (prm->growth == PK_EDMD_GROW_RELATIVE && prm->phi_target > 0)
+        t_stop = time_of_phi(s, prm->phi_target);
+
+    /* masses (normalised to mean 1) and equipartition velocities */
+    double msum = 0;
+    for (size_t i = 0; i < n; i++) {
+        s->m[i] = prm->equal_masses ? 1.0 : pow(p->r[i] / rmax, dim);
+        if (!(s->m[i] > 0))
+            s->m[i] = 1e-300;
+        msum += s->m[i];
+    }
+    pk_rng rng;
+    pk_rng_seed(&rng, prm->seed, 2);
+    for (size_t i = 0; i < n; i++) {
+        s->m[i] *= (double)n / msum;
+        double sc = dbar / sqrt(s->m[i]);
+        for (int k = 0; k < dim; k++)
+            s->k[i].v[k] = sc * pk_rng_normal(&rng);
+    }
+    remove_drift(s);
+    for (size_t i = 0; i < n; i++) { /* wrapped into [0, L) */
+        for (int k = 0; k < 3; k++)
+            s->k[i].p[k] = k >= dim ? 0 : p->x[3 * i + k];
+        pk_box_wrap(&s->box, s->k[i].p); /* t = 0: p is the position */
+    }
+    /* skins: a fraction of the radius at the reference time, at most twice
+     * the mean (coarse grains would list hundreds of fines); grains below the
+     * mean get SKIN_FINE·(2ρ̄ − r), up to SKIN_FINE·2ρ̄ for the finest: fines
+     * fly as fast as the coarse and rattle in their pores, so with a small
+     * skin they rebuild all the time (a rebuild is a multi-level cell query),
+     * while their lists (few grains of their size) stay short (Fuller-like
+     * case, N = 2000: list events 1.55 → 1.19 per collision with 2ρ̄ − r;
+     * N = 10^4 to jamming: 16.1k → 13.0k instructions per collision with
+     * SKIN_FINE = 2.5 instead of 1) */
+    double t_ref = isfinite(t_end) ? t_end : 0;
+    double rho_mean = 0, rho_max = 0;
+    for (size_t i = 0; i < n; i++) {
+        double r = edmd_rho(s, i, t_ref);
+        rho_mean += r / (double)n;
+        rho_max = fmax(rho_max, r);
+    }
+    double Lper = INFINITY;
+    for (int k = 0; k < dim; k++)
+        if (s->box.periodic[k])
+            Lper = fmin(Lper, s->box.L[k]);
+    /* periodic images: a pair must have one image within reach (spec §3.3d) */
+    double grow_max = 1; /* growing until jammed: bound the sizes by φ <= 1 (spec §3.3d) */
+    if (prm->until == PK_EDMD_UNTIL_JAMMED && prm->growth == PK_EDMD_GROW_RELATIVE)
+        grow_max = pow(1 / fmax(phi_sim(s, t_ref), 1e-300), 1.0 / dim);
+    double room = 0.25 * Lper - rho_max * grow_max;
+    if (!(room > 0))
+        return NAN;
+    for (size_t i = 0; i < n; i++) {
+        double r = edmd_rho(s, i, t_ref);
+        s->rref[i] = r;
+        const double base = fmin(fmax(r, 2 * rho_mean - r), 2 * rho_mean);
+        const int fine = r < rho_mean * (1 - 1e-9); /* equal grains: r = ρ̄ to round-off */
+        s->skin[i] = prm->skin * (fine ? SKIN_FINE * (2 * rho_mean - r) : base);
+        if (0.5 * s->skin[i] > room)
+            s->skin[i] = 2 * room;
+    }
+    double vmax_g = 0;
+    for (size_t i = 0; i < n; i++)
+        vmax_g = fmax(vmax_g, s->k[i].g);
+    s->eps_v = 1e-9 * fmax(dbar, 2 * vmax_g);
+    return t_stop;
+}
+
+int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_monitor *mon,
+                pk_edmd_stats *st)
+{
+    memset(st, 0, sizeof *st);
+    st->reason = PK_STOP_ERROR;
+    st->criterion = PK_EDMD_CRIT_ERROR;
+    if (!b || !p || !prm || p->dim != b->dim || p->n == 0 || p->n > INT32_MAX)
+        return -1;
+    double w0 = pk_wall_seconds();
+    edmd_state S;
+    memset(&S, 0, sizeof S);
+    edmd_state *s = &S;
+    pk_particles q = {0};
+    size_t *perm = NULL;
+    s->box = *b;
+    s->dim = b->dim;
+    for (int k = 0; k < 3; k++) {
+        s->Lp[k] = k < b->dim && b->periodic[k] ? b->L[k] : 0;
+        s->inv_Lp[k] = s->Lp[k] > 0 ? 1 / s->Lp[k] : 0;
+        if (k < b->dim && !b->periodic[k])
+            s->walled = 1;
+    }
+    s->n = p->n;
+    s->rule = prm->rule;
+    int rc = -1;
+    if (state_alloc(s, s->n) != 0)
+        goto out;
+    /* zero start: uniform positions (stream 3); then the engine works on a
+     * copy q in Z-order (perm[k] = grain of p at engine index k) */
+    if (prm->start_zero) {
+        pk_rng rng;
+        pk_rng_seed(&rng, prm->seed, 3);
+        for (size_t i = 0; i < p->n; i++)
+            for (int k = 0; k < 3; k++)
+                p->x[3 * i + k] = k < b->dim ? pk_rng_range(&rng, 0, b->L[k]) : 0;
+    }
+    double hcell = 0;
+    for (size_t i = 0; i < p->n; i++)
+        hcell += 2 * p->r[i] / (double)p->n;
+    perm = malloc(p->n * sizeof *perm);
+    /* a resumed run takes the engine order of its snapshot */
+    pk_edmd_checkpoint *ckpt = prm->checkpoint;
+    const int resume = ckpt && ckpt->resume;
+    if (!perm || pk_particles_init(&q, p->dim, p->n) != 0 ||
+        (resume ? edmd_checkpoint_perm(ckpt->resume, p->n, p->dim, perm)
+                : edmd_spatial_order(b, p->x, p->n, hcell > 0 ? hcell : 1, perm)) != 0)
+        goto out;
+    for (size_t k = 0; k < p->n; k++)
+        pk_particles_push(&q, &p->x[3 * perm[k]], p->r[perm[k]], p->species[perm[k]]);
+    double t_stop = setup(s, &q, prm, st);
+    if (isnan(t_stop))
+        goto out;
+    s->skin_scale = 1;
+    edmd_ckpt_loop L = {.hist_stride = 1, .fraction = -1};
+    if (resume)
+        edmd_checkpoint_restore(s, st, &L, ckpt);
+    double skin_built = s->skin_scale;
+    if (edmd_nlist_build_all(s) != 0)
+        goto out;
+    s->K = kinetic(s);
+    const double K0 = resume ? L.K0 : s->K;
+    const double K_hi = K0 * (1 + prm->rescale_tol), K_lo = K0 / (1 + prm->rescale_tol);
+    predict_all(s);
+
+    const uint64_t c_win = prm->dphi_events ? prm->dphi_events : (uint64_t)s->n;
+    /* stall window: at least one event per grain (Titscher: 1000 events) */
+    uint64_t stall_win = prm->stall_events ? prm->stall_events : 1000;
+    if (stall_win < (uint64_t)s->n)
+        stall_win = (uint64_t)s->n;
+    double gam_now = resume ? L.growth_rate : prm->growth_rate;
+    int slowed = (resume && L.slowed) || !(prm->jam_rate_factor > 0 && prm->jam_rate_factor < 1);
+    const int stall_auto = isnan(prm->stall_growth);
+    uint64_t next_check = st->events + c_win, hist_stride = L.hist_stride, hist_count = L.hist_count;
+    uint64_t stall_ev = st->events;
+    uint64_t last_rebase = st->events, rebase_win = REBASE_WINDOWS * (uint64_t)s->n;
+    const uint64_t resort_win = s->n >= RESORT_MIN_N ? RESORT_WINDOWS * (uint64_t)s->n : 0;
+    uint64_t next_resort = st->events + resort_win;
+    double t_base = L.t_base;    /* absolute time of the re-based origin t = 0 */
+    double stall_acc = 0, phi_prev = phi_sim(s, 0), pressure = L.pressure;
+    pk_progress pr = {.stage = "edmd", .fraction = L.fraction, .phi = phi_true(s, 0), .eta_s = -1};
+    char msg[160];
+    pk_monitor_begin(mon);
+    s->mon = mon; /* ticked inside the full list builds from here on */
+    s->pr = &pr;
+    if (!resume)
+        hist_push(st, &hist_stride, 0, 0, pr.phi, 0);
+    pk_edmd_criterion crit = PK_EDMD_CRIT_NONE;
+
+    for (;;) {
+        size_t i = edmd_queue_top(s);
+        edmd_event *e = &s->ev[i];
+        double te = e->t;
+        if (te >= t_stop - t_base) {
+            double tt = fmax(t_stop - t_base, s->t);
+            s->kint += s->K * (tt - s->t);
+            s->t = tt;
+            crit = PK_EDMD_CRIT_TARGET;
+            break;
+        }
+        if (!(te < INFINITY)) {
+            crit = PK_EDMD_CRIT_STALL; /* nothing will ever happen (no growth, no motion) */
+            break;
+        }
+        s->kint += s->K * (te - s->t);
+        stall_acc += te - s->t;
+        s->t = te;
+        st->events++;
+        const int32_t w = e->with;
+        if (w >= 0) {
+            size_t j = (size_t)w;
+            if (e->stamp != s->ncoll[j]) { /* partner changed course since */
+                st->invalid++;
+                if (e->t2 < INFINITY) { /* the runner-up, predicted with i's flight */
+                    *e = (edmd_event){e->t2, INFINITY, e->with2, EDMD_EV_NONE, e->stamp2, 0};
+                    st->second++;
+                } else {
+                    edmd_predict(s, i);
+                }
+                edmd_queue_update(s, i);
+            } else {
+                /* both predictions below read the neighbours' records:
+                 * start all those loads now (edmd_prefetch_list) */
+                edmd_prefetch_list(s, i);
+                edmd_prefetch_list(s, j);
+                s->virial += edmd_collide_pair(s, i, j);
+                s->ncoll[i]++;
+                s->ncoll[j]++;
+                st->pair++;
+                edmd_predict(s, i);
+                edmd_queue_update(s, i);
+                edmd_predict(s, j);
+                edmd_queue_update(s, j);
+            }
+        } else if (w == EDMD_EV_NLIST) {
+            if (edmd_nlist_rebuild(s, i) != 0)
+                goto out;
+            st->nlist++;
+            edmd_predict(s, i);
+            edmd_queue_update(s, i);
+        } else if (w <= EDMD_EV_WALL0) {
+            edmd_collide_wall(s, i, EDMD_EV_WALL0 - w);
+            s->ncoll[i]++;
+            st->wall++;
+            edmd_predict(s, i);
+            edmd_queue_update(s, i);
+        } else {
+            edmd_predict(s, i);
+            edmd_queue_update(s, i);
+        }
+        if (prm->rescale && (s->K > K_hi || s->K < K_lo)) {
+            rescale(s, K0);
+            st->rescales++;
+        }
+        if (st->events - stall_ev >= stall_win) {
+            /* the default: 10^-12, and until jammed below a hundredth of
+             * what a packing at the window's pressure p grows (~γ/p per
+             * window), so the stall never preempts the pressure test */
+            double stall_growth = prm->stall_growth;
+            if (stall_auto)
+                stall_growth = prm->until == PK_EDMD_UNTIL_JAMMED
+                                   ? fmin(1e-12, 1e-2 * gam_now / fmax(pressure, 1))
+                                   : 1e-12;
+            if (stall_acc * gam_now < stall_growth) {
+                crit = PK_EDMD_CRIT_STALL;
+                break;
+            }
+            stall_ev = st->events;
+            stall_acc = 0;
+        }
+        if (prm->max_events && st->events >= prm->max_events) {
+            crit = PK_EDMD_CRIT_MAX_EVENTS;
+            break;
+        }
+        if ((st->events & 1023) == 0) {
+            pr.done = (size_t)st->events;
+            if (isfinite(t_stop)) {
+                pr.fraction = fmin(1, (t_base + s->t) / t_stop);
+                pr.eta_s = pr.fraction > 0 ? (pk_wall_seconds() - w0) * (1 - pr.fraction) / pr.fraction : -1;
+            } else { /* until jammed: the reduced pressure on its way to p_max, on a log scale */
+                double f = pressure > 1 && prm->p_max > 1 ? log(pressure) / log(prm->p_max) : 0;
+                if (prm->max_events)
+                    f = fmax(f, (double)st->events / (double)prm->max_events);
+                pr.fraction = fmax(pr.fraction, fmin(f, 0.99));
+            }
+            snprintf(msg, sizeof msg, "events=%llu collisions=%llu reduced_pressure=%.4g",
+                     (unsigned long long)st->events, (unsigned long long)st->pair, pressure);
+            pr.message = msg;
+            int m = pk_monitor_tick(mon, &pr, 0);
+            if (m) {
+                crit = monitor_criterion(m);
+                break;
+            }
+        }
+        if (st->events >= next_check) {
+            next_check = st->events + c_win;
+            double phi = phi_true(s, s->t);
+            double phis = phi_sim(s, s->t); /* grows in both modes (shell: φ_true is fixed) */
+            pressure = s->kint > 0 ? 1 + s->virial / (2 * s->kint) : 0;
+            s->virial = s->kint = 0;
+            pr.phi = phi;
+            if (++hist_count % hist_stride == 0)
+                hist_push(st, &hist_stride, st->events, t_base + s->t, phi, pressure);
+            if (prm->until == PK_EDMD_UNTIL_JAMMED) {
+                if (pressure >= prm->p_max) {
+                    crit = PK_EDMD_CRIT_PRESSURE;
+                    break;
+                }
+                /* Meier Eq. 3.11; only in a dense state (p > 10^3): from zero
+                 * radii φ ∝ t^d barely moves over the first windows */
+                if (prm->dphi_crit > 0 && pressure > 1e3 && phis - phi_prev < prm->dphi_crit) {
+                    crit = PK_EDMD_CRIT_DELTA_PHI;
+                    break;
+                }
+            }
+            /* near jamming the grains rattle in cages of width ~ d/p: shrink
+             * the skins with the pressure (shorter lists, fewer pair
+             * predictions; the lists stay exact for any skin), and rebuild
+             * all lists when they have halved since the last full build */
+            s->skin_scale = pressure > SKIN_P0 ? fmax(SKIN_P0 / pressure, SKIN_MIN) : 1;
+            if (s->skin_scale < 0.5 * skin_built) {
+                skin_built = s->skin_scale;
+                int rb = rebuild_all(s, &crit);
+                if (rb < 0)
+                    goto out;
+                if (rb > 0)
+                    break;
+            }
+            phi_prev = phis;
+            /* past the structural arrest the growth slows (Lubachevsky–
+             * Stillinger, Skoge et al. 2006): at a fast rate the pressure
+             * reaches 10^12 on a hypostatic network the growth drives
+             * (3D mono N = 500, γ = 0.02: z = 5.59 on 7 % rattlers), at a
+             * tenth of it the backbone is isostatic (z = 5.95, 2.4 %) */
+            if (prm->until == PK_EDMD_UNTIL_JAMMED && !slowed && pressure > JAM_SLOW_P) {
+                scale_growth(s, prm->jam_rate_factor);
+                gam_now *= prm->jam_rate_factor;
+                slowed = 1;
+                st->growth_changes++;
+            }
+            if (edmd_checkpoint_due(ckpt)) { /* re-based first: the snapshot starts at t = 0 */
+                t_base += s->t;
+                rebase(s);
+                st->rebases++;
+                last_rebase = st->events;
+                edmd_ckpt_loop now = {t_base, K0, pressure, pr.fraction, hist_stride, hist_count,
+                                      gam_now, slowed};
+                edmd_checkpoint_take(s, perm, st, &now, ckpt);
+            }
+        }
+        if (st->events - last_rebase >= rebase_win) {
+            /* positions are p + v·t: keep |v·t| small */
+            t_base += s->t;
+            rebase(s);
+            st->rebases++;
+            last_rebase = st->events;
+        }
+        if (resort_win && st->events >= next_resort) {
+            next_resort = st->events + resort_win;
+            if (edmd_reorder(s, perm, hcell > 0 ? hcell : 1) != 0)
+                goto out;
+            st->resorts++;
+            int rb = rebuild_all(s, &crit);
+            if (rb < 0)
+                goto out;
+            if (rb > 0)
+                break;
+        }
+    }
+    /* final state */
+    if (s->kint > 0)
+        pressure = 1 + s->virial / (2 * s->kint);
+    for (size_t i = 0; i < s->n; i++) {
+        double *x = &p->x[3 * perm[i]], xi[3];
+        edmd_pos(s, i, xi);
+        for (int k = 0; k < 3; k++)
+            x[k] = k < s->dim ? xi[k] : 0;
+        pk_box_wrap(b, x);
+        for (int k = 0; k < s->dim; k++) /* walled axes: keep round-off inside */
+            if (!b->periodic[k])
+                x[k] = fmin(fmax(x[k], 0), b->L[k]);
+        p->r[perm[i]] = true_radius(s, i, s->t);
+    }
+    st->criterion = crit;
+    switch (crit) {
+    case PK_EDMD_CRIT_TARGET: st->reason = PK_STOP_COMPLETE; break;
+    case PK_EDMD_CRIT_PRESSURE:
+    case PK_EDMD_CRIT_DELTA_PHI: st->reason = PK_STOP_JAMMED; break;
+    case PK_EDMD_CRIT_STALL: /* growing until jammed, a stall is the jam (Titscher §6.4) */
+        st->reason = prm->until == PK_EDMD_UNTIL_JAMMED ? PK_STOP_JAMMED : PK_STOP_STALLED;
+        break;
+    case PK_EDMD_CRIT_MAX_EVENTS: st->reason = PK_STOP_STALLED; break;
+    case PK_EDMD_CRIT_CANCEL: st->reason = PK_STOP_CANCELLED; break;
+    case PK_EDMD_CRIT_WALL_TIME: st->reason = PK_STOP_WALL_TIME; break;
+    default: st->reason = PK_STOP_ERROR; break;
+    }
+    st->phi = phi_true(s, s->t);
+    st->phi_sim = phi_sim(s, s->t);
+    st->pressure = pressure;
+    st->phi_jam_estimate = pressure > s->dim ? st->phi / (1 - s->dim / pressure) : NAN;
+    st->delta_d = 2 * (s->h0 + s->h1 * s->t);
+    st->t_stop = t_base + s->t;
+    st->overlaps = s->n_overlap;
+    st->max_overlap_rel = s->max_overlap_rel;
+    st->kinetic_ratio = K0 > 0 ? kinetic(s) / K0 : NAN;
+    hist_push(st, &hist_stride, st->events, t_base + s->t, st->phi, pressure);
+    rc = 0;
+out:
+    st->seconds = pk_wall_seconds() - w0;
+    state_free(s);
+    pk_particles_free(&q);
+    free(perm);
+    return rc;
+}

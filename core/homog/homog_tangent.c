@@ -1,0 +1,136 @@
+#include "homog_tangent.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/dem/dem_contact.h"
+#include "core/dem/dem_rattler.h"
+#include "homog_stiffness.h"
+#include "homog_tensor.h"
+#include "core/base/progress.h"
+
+int pk_homog_tangent(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homog_state *s,
+                     const pk_sparse_solver *solver, double A[81], pk_tangent_info *info)
+{
+    const int dim = rve->dim;
+    const size_t n = rve->n;
+    const double E = o->E_n;
+    double t0 = pk_wall_seconds();
+    memset(info, 0, sizeof *info);
+    if (o->friction) /* no frictional tangent (none derived in ch. 7); see -3 */
+        return -3;
+    pk_dem_geom g = {.dim = dim, .periodic = rve->periodic};
+    memcpy(g.L, rve->L, sizeof g.L);
+    if (!(pk_dem_geom_set_F(&g, s->F) > 0))
+        return -1;
+    pk_dem_pairs c = {0};
+    pk_homog_pairs_setup(&c, rve, o);
+    int rc = pk_dem_pairs_build(&c, &g, s->x, rve->r, n, o->dr.skin);
+    if (rc != 0)
+        return rc;
+    pk_dem_eval(&c, &g, s->x, rve->r, n, E, NULL, NULL, NULL);
+    uint8_t *is_free = malloc(n ? n : 1), *rat = malloc(n ? n : 1);
+    int32_t *dof = malloc((n ? n : 1) * sizeof *dof);
+    double *Bm = NULL, *Y = NULL;
+    pk_sparse_sym K = {0};
+    pk_sparse_factor *fac = NULL;
+    if (!is_free || !rat || !dof) {
+        rc = -1;
+        goto done;
+    }
+    for (size_t i = 0; i < n; i++)
+        is_free[i] = !rve->fixed[i];
+    if (pk_dem_rattlers(&c, dim, n, is_free, rat) == (size_t)-1) {
+        rc = -1;
+        goto done;
+    }
+    size_t nd = 0;
+    for (size_t i = 0; i < n; i++)
+        dof[i] = is_free[i] && !rat[i] ? (int32_t)(dim * nd++) : -1;
+    nd *= (size_t)dim;
+    K.n = nd;
+    info->free_dofs = nd;
+    const int m = dim * dim;
+    Bm = calloc((nd ? nd : 1) * (size_t)m, sizeof *Bm); /* column-major nd × m */
+    Y = calloc((nd ? nd : 1) * (size_t)m, sizeof *Y);
+    if (!Bm || !Y) {
+        rc = -1;
+        goto done;
+    }
+    double AFF[81] = {0};
+    for (size_t p = 0; p < c.n; p++) {
+        if (!(c.eps[p] >= 0) || !(c.len[p] > 0))
+            continue;
+        size_t i = (size_t)c.i[p], j = (size_t)c.j[p];
+        if (rat[i] || rat[j])
+            continue; /* jammed contacts only (4.35) */
+        info->jammed_contacts++;
+        const double *l = &c.l[3 * p];
+        double H[9], q[3], G[3];
+        pk_homog_pair_hessian(pk_dem_pair_E(&c, p, E), c.len[p], c.eps[p], l, H);
+        /* G = F⁻¹(l − x_j[free] + x_i[free]) */
+        for (int a = 0; a < 3; a++)
+            q[a] = l[a] - (is_free[j] ? s->x[3 * j + a] : 0) + (is_free[i] ? s->x[3 * i + a] : 0);
+        pk_m3_vec(g.Finv, q, G);
+        for (int a = 0; a < dim; a++)
+            for (int b = 0; b < dim; b++)
+                for (int cc = 0; cc < dim; cc++)
+                    for (int d = 0; d < dim; d++)
+                        AFF[(3 * a + b) * 9 + 3 * cc + d] += H[3 * a + cc] * G[b] * G[d];
+        /* K_II blocks; B rows ±H G */
+        int32_t di = dof[i], dj = dof[j];
+        if (pk_homog_add_pair_K(&K, dim, di, dj, H) != 0)
+            rc = -1;
+        for (int al = 0; al < dim; al++)
+            for (int ga = 0; ga < dim; ga++)
+                for (int de = 0; de < dim; de++) {
+                    double v = H[3 * ga + al] * G[de];
+                    int col = ga * dim + de;
+                    if (dj >= 0)
+                        Bm[(size_t)col * nd + (size_t)(dj + al)] += v;
+                    if (di >= 0)
+                        Bm[(size_t)col * nd + (size_t)(di + al)] -= v;
+                }
+        if (rc != 0)
+            goto done;
+    }
+    if (nd > 0) {
+        fac = solver->factor(&K, &info->block);
+        if (info->block.status == PK_SPARSE_FAILED) {
+            rc = -1;
+            goto done;
+        }
+        if (info->block.status != PK_SPARSE_OK) {
+            rc = 1;
+            goto done;
+        }
+        if (solver->solve(fac, (size_t)m, Bm, Y) != 0) {
+            rc = -1;
+            goto done;
+        }
+    }
+    memset(A, 0, 81 * sizeof *A);
+    for (int a = 0; a < dim; a++)
+        for (int b = 0; b < dim; b++)
+            for (int cc = 0; cc < dim; cc++)
+                for (int d = 0; d < dim; d++) {
+                    int I = a * dim + b, J = cc * dim + d;
+                    double s2 = 0; /* (Bᵀ K⁻¹ B)_IJ */
+                    for (size_t k = 0; k < nd; k++)
+                        s2 += Bm[(size_t)I * nd + k] * Y[(size_t)J * nd + k];
+                    A[(3 * a + b) * 9 + 3 * cc + d] = (AFF[(3 * a + b) * 9 + 3 * cc + d] - s2) / rve->V;
+                }
+done:
+    if (fac)
+        solver->release(fac);
+    pk_sparse_sym_free(&K);
+    pk_dem_pairs_free(&c);
+    free(is_free);
+    free(rat);
+    free(dof);
+    free(Bm);
+    free(Y);
+    info->seconds = pk_wall_seconds() - t0;
+    return rc;
+}

@@ -1,0 +1,270 @@
+#include "rsa.h"
+
+#include <math.h>
+
+#include "core/space/grid.h"
+#include "core/base/rng.h"
+#include "core/rsa/batch/rsa_batch.h"
+#include "rsa_voxels.h"
+
+/* Draws come from a voxel set (rsa_voxels.h) built for a run of sizes
+ * r in [r_build / SEGMENT_RATIO, r_build]; it is rebuilt when the sizes fall
+ * below.  Larger ratios mean fewer rebuilds but weaker covers. */
+#define SEGMENT_RATIO 1.25
+/* A set is built only if it stays O(grains): voxels <= this many per grain of
+ * its segment (plus a constant).  Otherwise (e.g. a few fine grains in a box
+ * 1000× their size) the plain draws are used. */
+#define VOXELS_PER_GRAIN 16
+#define VOXELS_FREE 65536
+
+/* Marking covered sub-voxels costs more than it saves while most draws
+ * succeed: it starts once a window of WINDOW placements took more than
+ * COVER_AFTER draws per grain, or one grain failed COVER_AFTER_FAILS times. */
+#define WINDOW 256
+#define COVER_AFTER 6
+#define COVER_AFTER_FAILS 4096
+
+typedef struct segment {
+    pk_rsa_vox vox;
+    int on;
+    int covering;        /* placed grains mark their exclusion zones */
+    int unstored;        /* a segment grain went to the grid instead of a voxel */
+    size_t first;        /* grains first.. (in `out`) are stored in vox, not yet in the grid */
+    double retry_below;  /* no new build is tried while r >= retry_below */
+    uint64_t win_draws, win_placed;
+} segment;
+
+/* Every grain placed so far marks its exclusion zone: the grains of earlier
+ * segments, then this segment's in voxel order (neighbouring marks share
+ * cache lines).  Marks are optional for correctness (a bit left set only
+ * costs a draw), so a cancel request may cut this short. */
+static void start_covering(segment *sg, const pk_particles *out, pk_monitor *mon,
+                           pk_progress *pg)
+{
+    sg->covering = 1;
+    size_t upto = sg->unstored ? out->n : sg->first;
+    for (size_t j = 0; j < upto; j++) {
+        pk_rsa_vox_cover(&sg->vox, &out->x[3 * j], out->r[j]);
+        if ((j & 0xfff) == 0xfff && pk_monitor_tick(mon, pg, 0))
+            return;
+    }
+    if (!sg->unstored)
+        for (uint64_t v = 0; v < sg->vox.nvox; v++) {
+            if (sg->vox.cell[v].x[0] != INFINITY)
+                pk_rsa_vox_cover(&sg->vox, sg->vox.cell[v].x, sg->vox.cell[v].r);
+            if ((v & 0xffff) == 0xffff && pk_monitor_tick(mon, pg, 0))
+                return;
+        }
+}
+
+/* Build the voxel set for grain i onwards (all bits set; the placed grains
+ * mark their zones once start_covering runs). */
+static void begin_segment(segment *sg, const pk_box *b, const double *diameters, size_t i,
+                          size_t n, double gap, const pk_particles *out)
+{
+    double r = 0.5 * diameters[i];
+    double r_valid = fmax(0.5 * diameters[n - 1], r / SEGMENT_RATIO);
+    size_t count = 0;
+    while (i + count < n && 0.5 * diameters[i + count] >= r_valid)
+        count++;
+    sg->retry_below = r_valid;
+    uint64_t nv = pk_rsa_vox_count(b, r_valid, r, gap);
+    if (nv == 0 || nv > (uint64_t)VOXELS_PER_GRAIN * count + VOXELS_FREE)
+        return;
+    if (pk_rsa_vox_init(&sg->vox, b, r_valid, r, gap) != 0)
+        return; /* out of memory for the set: plain draws still work */
+    sg->first = out->n;
+    sg->on = 1;
+    sg->covering = sg->unstored = 0;
+    sg->win_draws = sg->win_placed = 0;
+}
+
+/* Hand the segment's grains to the grid (the one neighbour structure). */
+static int end_segment(segment *sg, pk_grid *grid, const pk_particles *out)
+{
+    int rc = 0;
+    for (size_t j = sg->first; j < out->n; j++)
+        rc |= pk_grid_insert(grid, out, j);
+    pk_rsa_vox_free(&sg->vox);
+    sg->on = 0;
+    return rc;
+}
+
+int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *species, size_t n,
+                 const pk_rsa_params *prm, pk_monitor *mon, pk_particles *out,
+                 pk_rsa_stats *st)
+{
+    pk_rsa_stats local = {0};
+    if (!st)
+        st = &local;
+    *st = (pk_rsa_stats){.reason = PK_STOP_ERROR, .requested = n};
+    if (!b || !prm || !out || out->dim != b->dim || (n && (!diameters || !species)))
+        return -1;
+    if (!(prm->delta_d >= 0) || prm->max_failed_draws == 0)
+        return -1;
+    for (size_t i = 0; i < n; i++)
+        if (!(diameters[i] > 0) || (i && diameters[i] > diameters[i - 1]))
+            return -1; /* sizes must be positive and sorted largest first */
+
+    double t0 = pk_wall_seconds();
+    st->reason = PK_STOP_COMPLETE;
+    if (n == 0)
+        return 0;
+    if (pk_particles_reserve(out, out->n + n) != 0)
+        return -1;
+
+    const double gap = prm->delta_d;
+    pk_grid grid;
+    if (pk_grid_init(&grid, b, 0.5 * diameters[n - 1], 0.5 * diameters[0], gap, out->n + n) != 0)
+        return -1;
+    for (size_t j = 0; j < out->n; j++) /* grains already present stay obstacles */
+        pk_grid_insert(&grid, out, j);
+
+    pk_rng rng;
+    pk_rng_seed(&rng, prm->seed, 1);
+    pk_monitor_begin(mon);
+    double box_measure = pk_box_measure(b);
+    double solid = pk_particles_solid_measure(out);
+    pk_progress pg = {.stage = "rsa", .total = n, .eta_s = -1};
+
+    segment sg = {.on = 0, .retry_below = prm->plain_draws ? 0 : INFINITY};
+    const size_t min_run = prm->batch_min_run ? prm->batch_min_run : PK_RSA_BATCH_MIN_RUN;
+    size_t no_batch_below = prm->plain_draws || prm->no_batch ? SIZE_MAX : 0;
+    for (size_t i = 0; i < n; i++) {
+        double r = 0.5 * diameters[i];
+        /* Draw range per axis: walls keep the grain Δd/2 away (spec §2.1). */
+        double lo[PK_MAXDIM] = {0, 0, 0}, span[PK_MAXDIM] = {0, 0, 0};
+        int fits = 1;
+        for (int k = 0; k < b->dim; k++) {
+            if (b->periodic[k]) {
+                lo[k] = 0;
+                span[k] = b->L[k];
+            } else {
+                lo[k] = r + 0.5 * gap;
+                span[k] = b->L[k] - 2 * lo[k];
+                if (span[k] < 0)
+                    fits = 0;
+            }
+        }
+        if (!fits) {
+            st->reason = PK_STOP_NO_ROOM;
+            break;
+        }
+        size_t run = 1;
+        while (i >= no_batch_below && i + run < n && diameters[i + run] == diameters[i])
+            run++;
+        if (i >= no_batch_below && run >= min_run &&
+            pk_rsa_batch_usable(b, r, gap, lo, span, run)) {
+            if (sg.on && end_segment(&sg, &grid, out) != 0) {
+                st->reason = PK_STOP_ERROR;
+                break;
+            }
+            size_t first = out->n;
+            pk_stop_reason why = pk_rsa_batch_run(b, r, &species[i], run, lo, span, prm, &grid,
+                                                  &rng, mon, &pg, box_measure, &solid, out, st);
+            for (size_t j = first; why == PK_STOP_COMPLETE && i + run < n && j < out->n; j++)
+                if (pk_grid_insert(&grid, out, j) != 0)
+                    why = PK_STOP_ERROR; /* later (smaller) grains see the run's grains */
+            if (why != PK_STOP_COMPLETE) {
+                st->reason = why;
+                break;
+            }
+            i += run - 1;
+            continue;
+        }
+        if (i >= no_batch_below)
+            no_batch_below = i + run; /* the rest of this run goes one at a time too */
+        if (sg.on && r < sg.vox.r_valid && end_segment(&sg, &grid, out) != 0) {
+            st->reason = PK_STOP_ERROR;
+            break;
+        }
+        if (!sg.on && r < sg.retry_below)
+            begin_segment(&sg, b, diameters, i, n, gap, out);
+        uint64_t failed = 0, vid = 0;
+        double x[PK_MAXDIM] = {0, 0, 0};
+        int saturated = 0;
+        for (;;) {
+            int ok;
+            if (sg.on) {
+                int rc = pk_rsa_vox_draw(&sg.vox, &rng, x, &vid);
+                if (rc < 0) {
+                    saturated = 1;
+                    break;
+                }
+                st->draws++;
+                ok = rc == 0; /* rc 1: in a sub-voxel known to be covered */
+                /* a grain larger than r_valid has a narrower range on walled axes */
+                for (int k = 0; ok && k < b->dim; k++)
+                    if (!b->periodic[k] && (x[k] < lo[k] || x[k] > lo[k] + span[k]))
+                        ok = 0;
+                ok = ok && !pk_rsa_vox_overlaps(&sg.vox, x, r) &&
+                     !pk_grid_overlaps(&grid, out, x, r);
+            } else {
+                for (int k = 0; k < b->dim; k++)
+                    x[k] = lo[k] + span[k] * pk_rng_uniform(&rng);
+                st->draws++;
+                ok = !pk_grid_overlaps(&grid, out, x, r);
+            }
+            if (ok)
+                break;
+            if (++failed >= prm->max_failed_draws)
+                break;
+            if (failed == COVER_AFTER_FAILS && sg.on && !sg.covering)
+                start_covering(&sg, out, mon, &pg);
+            if ((failed & 0xffff) == 0 && pk_monitor_tick(mon, &pg, 0))
+                break;
+        }
+        if (saturated) {
+            st->reason = PK_STOP_SATURATED;
+            break;
+        }
+        if (failed >= prm->max_failed_draws) {
+            st->reason = PK_STOP_MAX_FAILED_DRAWS;
+            break;
+        }
+        if (mon && mon->cancelled) {
+            st->reason = mon->cancelled == 2 ? PK_STOP_WALL_TIME : PK_STOP_CANCELLED;
+            break;
+        }
+        size_t j = pk_particles_push(out, x, r, species[i]);
+        int stored = 0;
+        if (j != (size_t)-1 && sg.on) {
+            /* the grid check stays exact for a grain the voxels could not take */
+            stored = pk_rsa_vox_store(&sg.vox, vid, x, r) == 0;
+            sg.unstored |= !stored;
+            if (sg.covering) {
+                pk_rsa_vox_cover(&sg.vox, x, r);
+            } else if (sg.win_draws += failed + 1, ++sg.win_placed == WINDOW) {
+                if (sg.win_draws > COVER_AFTER * WINDOW)
+                    start_covering(&sg, out, mon, &pg);
+                sg.win_draws = sg.win_placed = 0;
+            }
+        }
+        if (j == (size_t)-1 || (!stored && pk_grid_insert(&grid, out, j) != 0)) {
+            st->reason = PK_STOP_ERROR;
+            break;
+        }
+        st->placed++;
+        solid += pk_ball_measure(b->dim, r);
+        if ((i & 0x3ff) == 0) {
+            pg.done = st->placed;
+            pg.fraction = (double)st->placed / (double)n;
+            pg.phi = solid / box_measure;
+            int c = pk_monitor_tick(mon, &pg, 0);
+            if (c) {
+                st->reason = c == 2 ? PK_STOP_WALL_TIME : PK_STOP_CANCELLED;
+                break;
+            }
+        }
+    }
+    pg.done = st->placed;
+    pg.fraction = (double)st->placed / (double)n;
+    pg.phi = solid / box_measure;
+    if (mon && !mon->cancelled)
+        pk_monitor_tick(mon, &pg, 1);
+    if (sg.on && end_segment(&sg, &grid, out) != 0)
+        st->reason = PK_STOP_ERROR;
+    pk_grid_free(&grid);
+    st->seconds = pk_wall_seconds() - t0;
+    return st->reason == PK_STOP_ERROR ? -1 : 0;
+}

@@ -1,0 +1,331 @@
+/* http_server.c — libmicrohttpd set-up, request bodies (with the size limit
+ * and the media type of JSON routes) and dispatch through the route table:
+ * unknown path 404, known path with another method 405 + Allow.
+ *
+ * Connections are served by http_threads epoll event loops (MHD's thread
+ * pool), never a thread per connection: a slow or idle client costs a
+ * socket and its buffer, bounded by max_connections, max_connections_per_ip
+ * and idle_timeout_s.  Handlers therefore must not block: they do short
+ * SQLite transactions and bounded work (bodies are at most max_body_bytes,
+ * files go out as fd responses); SSE streams park (http_park.h). */
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/resource.h>
+
+#include "auth.h"
+#include "http.h"
+#include "http_park.h"
+#include "daemon/log.h"
+
+pk_config pk_service_config(pk_service *s)
+{
+    pthread_mutex_lock(&s->mu);
+    pk_config c = s->cfg;
+    pthread_mutex_unlock(&s->mu);
+    return c;
+}
+
+/* The next path segment at or after p: its start, and its length in *n
+ * (0 at the end of the path).  Runs of '/' count as one separator. */
+static const char *next_segment(const char *p, size_t *n)
+{
+    while (*p == '/')
+        p++;
+    *n = strcspn(p, "/");
+    return p;
+}
+
+/* Split the path into segments; -1 if too many/long or it contains "..". */
+static int split_path(pk_req *r, const char *url)
+{
+    r->nseg = 0;
+    size_t n;
+    for (const char *p = next_segment(url, &n); n; p = next_segment(p + n, &n)) {
+        if (r->nseg == PK_MAX_SEGMENTS || n >= sizeof r->seg[0])
+            return -1;
+        memcpy(r->seg[r->nseg], p, n);
+        r->seg[r->nseg][n] = 0;
+        if (!strcmp(r->seg[r->nseg], "..") || !strcmp(r->seg[r->nseg], "."))
+            return -1;
+        r->nseg++;
+    }
+    return 0;
+}
+
+static int match(const pk_req *r, const char *pattern)
+{
+    int i = 0;
+    size_t n;
+    for (const char *p = next_segment(pattern, &n); n; p = next_segment(p + n, &n)) {
+        if (i >= r->nseg)
+            return 0;
+        if (!(n == 1 && *p == '*') && (strlen(r->seg[i]) != n || strncmp(r->seg[i], p, n) != 0))
+            return 0;
+        i++;
+    }
+    return i == r->nseg;
+}
+
+static enum MHD_Result dispatch(pk_req *r)
+{
+    if (split_path(r, r->url) != 0)
+        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such resource", NULL, 0);
+    char allow[128] = "";
+    for (const pk_route *rt = pk_routes; rt->method; rt++) {
+        if (!match(r, rt->pattern))
+            continue;
+        if (!strcmp(rt->method, r->method)) {
+            enum MHD_Result refused;
+            return pk_authorize(r, rt->access, &refused) ? rt->handler(r) : refused;
+        }
+        if (!strstr(allow, rt->method)) {
+            size_t l = strlen(allow);
+            snprintf(allow + l, sizeof allow - l, "%s%s", l ? ", " : "", rt->method);
+            if (!strcmp(rt->method, "GET") && !strstr(allow, "HEAD")) {
+                l = strlen(allow);
+                snprintf(allow + l, sizeof allow - l, ", HEAD");
+            }
+        }
+    }
+    if (!allow[0])
+        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such resource", NULL, 0);
+    char detail[200];
+    snprintf(detail, sizeof detail, "%s is not allowed here; allowed: %s", r->method, allow);
+    struct MHD_Response *resp = pk_json_response(
+        pk_problem(405, PK_PROBLEM_GENERIC, "Method Not Allowed", detail), "application/problem+json");
+    MHD_add_response_header(resp, "Allow", allow);
+    return pk_send(r, 405, resp);
+}
+
+/* Routes whose body is a JSON document: anything else is refused with 415
+ * before the body is read (a web page can post text/plain or form bodies
+ * across origins without a preflight; it cannot post application/json). */
+static const char *const json_body_routes[] = {"/processes/*/execution", NULL};
+
+static int wants_json_body(pk_req *r)
+{
+    if (strcmp(r->method, "POST") != 0 || split_path(r, r->url) != 0)
+        return 0;
+    for (const char *const *p = json_body_routes; *p; p++)
+        if (match(r, *p))
+            return 1;
+    return 0;
+}
+
+/* "application/json", any case, optionally followed by parameters
+ * (";charset=utf-8"). */
+static int is_json_media_type(const char *ct)
+{
+    static const char want[] = "application/json";
+    if (!ct)
+        return 0;
+    ct += strspn(ct, " \t");
+    if (strncasecmp(ct, want, sizeof want - 1) != 0)
+        return 0;
+    ct += sizeof want - 1;
+    ct += strspn(ct, " \t");
+    return *ct == 0 || *ct == ';';
+}
+
+/* The route of a request with a body (POST), or NULL. */
+static const pk_route *body_route(pk_req *r)
+{
+    if (strcmp(r->method, "POST") != 0 || split_path(r, r->url) != 0)
+        return NULL;
+    for (const pk_route *rt = pk_routes; rt->method; rt++)
+        if (!strcmp(rt->method, r->method) && match(r, rt->pattern))
+            return rt;
+    return NULL;
+}
+
+/* First call of a request (headers complete): answers that need no body —
+ * a request that may not call its route is refused before its body is read. */
+static enum MHD_Result on_headers(pk_req *r)
+{
+    pk_config cfg = pk_service_config(r->svc);
+    const pk_route *rt = body_route(r);
+    enum MHD_Result refused;
+    if (rt && !pk_authorize(r, rt->access, &refused)) {
+        r->answered = 1;
+        return refused;
+    }
+    if (wants_json_body(r) && !is_json_media_type(pk_header(r, "Content-Type"))) {
+        r->answered = 1;
+        return pk_send_problem(r, 415, PK_PROBLEM_GENERIC, "Unsupported Media Type",
+                               "this route takes a JSON body: Content-Type must be application/json"
+                               " (a charset parameter is allowed)",
+                               NULL, 0);
+    }
+    const char *cl = pk_header(r, "Content-Length");
+    if (cl && strtoll(cl, NULL, 10) > cfg.max_body_bytes) {
+        r->answered = 1;
+        char d[128];
+        snprintf(d, sizeof d, "the body exceeds max_body_bytes = %ld", cfg.max_body_bytes);
+        return pk_send_problem(r, 413, PK_PROBLEM_GENERIC, "Content Too Large", d, NULL, 0);
+    }
+    return MHD_YES;
+}
+
+/* A chunk of the body: kept unless over max_body_bytes; MHD_NO (the
+ * connection is closed) once the body takes longer than body_timeout_s. */
+static enum MHD_Result on_body(pk_req *r, const char *upload, size_t n)
+{
+    pk_config cfg = pk_service_config(r->svc);
+    if (pk_queue_now() - r->started > cfg.body_timeout_s) {
+        pk_log(PK_LOG_WARN, "request body too slow; connection closed", "{s:s,s:s,s:f}", "method",
+               r->method, "url", r->url, "body_timeout_s", cfg.body_timeout_s);
+        return MHD_NO;
+    }
+    if (r->answered || r->too_large)
+        return MHD_YES;
+    if ((long)(r->body_len + n) > cfg.max_body_bytes) {
+        r->too_large = 1;
+        free(r->body);
+        r->body = NULL;
+        r->body_len = r->body_cap = 0;
+        return MHD_YES;
+    }
+    if (r->body_len + n + 1 > r->body_cap) {
+        size_t cap = (r->body_len + n + 1) * 2;
+        char *nb = realloc(r->body, cap);
+        if (!nb)
+            return MHD_NO;
+        r->body = nb;
+        r->body_cap = cap;
+    }
+    memcpy(r->body + r->body_len, upload, n);
+    r->body_len += n;
+    r->body[r->body_len] = 0;
+    return MHD_YES;
+}
+
+static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const char *url,
+                                  const char *method, const char *version, const char *upload,
+                                  size_t *upload_size, void **con_cls)
+{
+    pk_service *svc = cls;
+    pk_req *r = *con_cls;
+    (void)version;
+    if (!r) {
+        r = calloc(1, sizeof *r);
+        if (!r)
+            return MHD_NO;
+        r->conn = conn;
+        r->svc = svc;
+        r->url = url;
+        r->method = !strcmp(method, "HEAD") ? "GET" : method;
+        r->started = pk_queue_now();
+        *con_cls = r;
+        return on_headers(r);
+    }
+    if (*upload_size) {
+        enum MHD_Result rc = on_body(r, upload, *upload_size);
+        *upload_size = 0;
+        return rc;
+    }
+    if (r->answered)
+        return MHD_YES;
+    if (r->too_large) {
+        pk_config cfg = pk_service_config(svc);
+        char d[128];
+        snprintf(d, sizeof d, "the body exceeds max_body_bytes = %ld", cfg.max_body_bytes);
+        return pk_send_problem(r, 413, PK_PROBLEM_GENERIC, "Content Too Large", d, NULL, 0);
+    }
+    return dispatch(r);
+}
+
+static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
+                         enum MHD_RequestTerminationCode toe)
+{
+    pk_req *r = *con_cls;
+    if (r) {
+        free(r->body);
+        free(r);
+    }
+    *con_cls = NULL;
+}
+
+static void mhd_log(void *cls, const char *fmt, va_list ap)
+{
+    char msg[512];
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    msg[strcspn(msg, "\n")] = 0;
+    pk_log(PK_LOG_WARN, "http", "{s:s}", "detail", msg);
+}
+
+/* Every connection is a file descriptor: lift the soft limit to the hard one,
+ * and keep max_connections below it with room for the database, the
+ * workers' pipes and MHD's own descriptors. */
+static unsigned connection_limit(const pk_config *cfg)
+{
+    struct rlimit rl;
+    unsigned want = (unsigned)cfg->max_connections;
+    if (getrlimit(RLIMIT_NOFILE, &rl) != 0)
+        return want;
+    if (rl.rlim_cur < rl.rlim_max) {
+        rlim_t was = rl.rlim_cur;
+        rl.rlim_cur = rl.rlim_max;
+        if (setrlimit(RLIMIT_NOFILE, &rl) != 0)
+            rl.rlim_cur = was;
+    }
+    rlim_t reserve = 64 + 4 * (rlim_t)cfg->workers + 8 * (rlim_t)cfg->http_threads;
+    rlim_t fit = rl.rlim_cur > 2 * reserve ? rl.rlim_cur - reserve : rl.rlim_cur / 2;
+    if (rl.rlim_cur != RLIM_INFINITY && want > fit) {
+        pk_log(PK_LOG_WARN, "max_connections lowered to fit the open-files limit", "{s:i,s:I,s:I}",
+               "max_connections", cfg->max_connections, "nofile", (json_int_t)rl.rlim_cur, "used",
+               (json_int_t)fit);
+        want = (unsigned)fit;
+    }
+    return want;
+}
+
+struct MHD_Daemon *pk_http_start(pk_service *svc, int *port, char *err, size_t errlen)
+{
+    pk_config cfg = pk_service_config(svc);
+    struct sockaddr_in addr;
+    memset(&addr, 0, sizeof addr);
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons((uint16_t)cfg.port);
+    if (inet_pton(AF_INET, cfg.bind, &addr.sin_addr) != 1) {
+        snprintf(err, errlen, "bind: '%s' is not an IPv4 address", cfg.bind);
+        return NULL;
+    }
+    if (pk_park_start(svc) != 0) {
+        snprintf(err, errlen, "cannot start the stream waker thread");
+        return NULL;
+    }
+    unsigned limit = connection_limit(&cfg);
+    struct MHD_Daemon *d = MHD_start_daemon(
+        MHD_USE_EPOLL_INTERNAL_THREAD | MHD_ALLOW_SUSPEND_RESUME | MHD_USE_ERROR_LOG,
+        (uint16_t)cfg.port, NULL, NULL, on_request, svc,
+        MHD_OPTION_EXTERNAL_LOGGER, mhd_log, NULL,
+        MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr,
+        MHD_OPTION_NOTIFY_COMPLETED, on_completed, NULL,
+        MHD_OPTION_THREAD_POOL_SIZE, (unsigned)cfg.http_threads,
+        MHD_OPTION_CONNECTION_LIMIT, limit,
+        MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)cfg.max_connections_per_ip,
+        MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg.idle_timeout_s,
+        MHD_OPTION_END);
+    if (!d) {
+        pk_park_stop();
+        snprintf(err, errlen, "cannot listen on %s:%d (in use or not permitted)", cfg.bind, cfg.port);
+        return NULL;
+    }
+    const union MHD_DaemonInfo *info = MHD_get_daemon_info(d, MHD_DAEMON_INFO_BIND_PORT);
+    *port = info ? info->port : cfg.port;
+    pk_log(PK_LOG_INFO, "http", "{s:i,s:i,s:i,s:i}", "threads", cfg.http_threads, "max_connections",
+           (int)limit, "max_connections_per_ip", cfg.max_connections_per_ip, "idle_timeout_s",
+           cfg.idle_timeout_s);
+    return d;
+}
+
+void pk_http_stop(struct MHD_Daemon *d)
+{
+    pk_park_stop(); /* resumes every parked stream: MHD must not stop with suspended ones */
+    MHD_stop_daemon(d);
+}

@@ -1,0 +1,51 @@
+/* GET /, /conformance, /api — what the service is and which standards it follows. */
+#include <string.h>
+
+#include "http.h"
+#include "api/schemas/schemas_embedded.h"
+
+static json_t *mklink(const char *href, const char *rel, const char *type, const char *title)
+{
+    return json_pack("{s:s,s:s,s:s,s:s}", "href", href, "rel", rel, "type", type, "title", title);
+}
+
+enum MHD_Result route_landing(pk_req *r)
+{
+    json_t *links = json_array();
+    json_array_append_new(links, mklink("/", "self", "application/json", "this document"));
+    json_array_append_new(links, mklink("/api", "service-desc", "application/vnd.oai.openapi+json;version=3.0",
+                                      "the API definition (OpenAPI 3.0)"));
+    json_array_append_new(links, mklink("/conformance", "http://www.opengis.net/def/rel/ogc/1.0/conformance",
+                                      "application/json", "conformance classes implemented"));
+    json_array_append_new(links, mklink("/processes", "http://www.opengis.net/def/rel/ogc/1.0/processes",
+                                      "application/json", "processes"));
+    json_array_append_new(links, mklink("/jobs", "http://www.opengis.net/def/rel/ogc/1.0/job-list",
+                                      "application/json", "jobs"));
+    return pk_send_json(r, 200,
+                        json_pack("{s:s,s:s,s:s,s:o}", "title", "packd job service", "description",
+                                  "Dense random packings of grains from grading curves (OGC API - Processes)",
+                                  "version", PACKD_VERSION, "links", links),
+                        NULL);
+}
+
+enum MHD_Result route_conformance(pk_req *r)
+{
+    const char *base = "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/";
+    const char *classes[] = {"core", "json", "oas30", "job-list", "dismiss", "ogc-process-description"};
+    json_t *a = json_array();
+    for (size_t i = 0; i < sizeof classes / sizeof *classes; i++) {
+        char uri[160];
+        snprintf(uri, sizeof uri, "%s%s", base, classes[i]);
+        json_array_append_new(a, json_string(uri));
+    }
+    return pk_send_json(r, 200, json_pack("{s:o}", "conformsTo", a), NULL);
+}
+
+enum MHD_Result route_api(pk_req *r)
+{
+    const char *doc = pk_schema_text("openapi.json"); /* schemas/openapi.json, served as is */
+    if (!doc)
+        return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error",
+                               "openapi.json is not compiled in", NULL, 0);
+    return pk_send_text(r, 200, "application/vnd.oai.openapi+json;version=3.0", doc);
+}
