@@ -8,6 +8,7 @@
 #   make bench    build and run the benchmarks in bench/ (bench/service.sh wants
 #                 wrk: PACKD_BENCH_DEPS=1 sh deploy/install-deps.sh)
 #   make run      build and start the daemon with its embedded defaults
+#   make format   apply .clang-format to every C file (clang-format 14)
 #
 # Source files are found by wildcard: a new core/<method>/foo.c or
 # tests/unit/test_foo.c needs no edit here.  Includes name their file from the
@@ -50,7 +51,7 @@ LIB_OBJ    := $(DAEMON_OBJ) $(API_OBJ) $(CORE_OBJ)
 UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 BENCH_BIN  := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
-.PHONY: all deps test sanitize bench run clean check-schemas install
+.PHONY: all deps test sanitize bench run clean check-schemas install format
 .SECONDARY:
 
 all: $(DEPS_OK) $(BUILD)/packd $(BENCH_BIN)
@@ -130,6 +131,11 @@ install: $(BUILD)/packd
 	install -m 0644 README.md docs/*.md $(DESTDIR)$(DOCDIR)/
 	install -d $(DESTDIR)$(DOCDIR)/examples
 	install -m 0644 examples/*.json $(DESTDIR)$(DOCDIR)/examples/
+
+# Apply the house style (.clang-format) to every C file of the tree.
+format:
+	@command -v clang-format >/dev/null || { echo "format: apt-get install clang-format"; exit 1; }
+	git ls-files '*.c' '*.h' | xargs clang-format -i
 
 # Cross-check schemas and examples with an independent validator (python3-jsonschema).
 check-schemas: $(DEPS_OK)
