@@ -1,3 +1,5 @@
+/* gap_audit.c — the exact, independent gap check of a finished packing.
+ * Contract: core/space/gap_audit.h. */
 #include "gap_audit.h"
 
 #include <math.h>
