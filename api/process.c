@@ -1,3 +1,5 @@
+/* process.c — the one table of processes packd offers (pack, homogenize).
+ * Contract: api/process.h. */
 #include "process.h"
 
 #include <stdio.h>

@@ -1,3 +1,5 @@
+/* config.c — the daemon's configuration: one key table, defaults, file, env, flags.
+ * Contract: daemon/config.h. */
 #include "config.h"
 
 #include <arpa/inet.h>

@@ -1,3 +1,5 @@
+/* input_refs.c — file inputs by link ({"href"}) resolved to server paths.
+ * Contract: daemon/input_refs.h. */
 #include "input_refs.h"
 
 #include <stdio.h>

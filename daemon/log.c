@@ -1,3 +1,5 @@
+/* log.c — the daemon's JSON-lines logs on stderr.
+ * Contract: daemon/log.h. */
 #include "log.h"
 
 #include "api/http/http_time.h"

@@ -1,3 +1,5 @@
+/* sd_notify.c — systemd readiness and status datagrams without libsystemd.
+ * Contract: daemon/sd_notify.h. */
 #include "sd_notify.h"
 
 #include <stddef.h>

@@ -1,3 +1,5 @@
+/* supervisor.c — the worker processes: claim jobs, fork/exec `packd run`, reap.
+ * Contract: daemon/supervisor.h. */
 #include "supervisor.h"
 
 #include <dirent.h>

@@ -1,3 +1,5 @@
+/* homog_record.c — per-step observables of a 'homogenize' run as JSON arrays.
+ * Contract: api/homog/homog_record.h. */
 #include "homog_record.h"
 
 #include <float.h>

@@ -1,3 +1,5 @@
+/* http_problem.c — RFC 7807 problem+json bodies (OGC API – Processes types).
+ * Contract: api/http/http_problem.h. */
 #include "http_problem.h"
 
 json_t *pk_problem(int status, const char *type, const char *title, const char *detail)

@@ -1,3 +1,5 @@
+/* http_status_info.c — OGC statusInfo and results documents from a job row.
+ * Contract: api/http/http_status_info.h. */
 #include "http_status_info.h"
 
 #include <stdio.h>

@@ -1,3 +1,5 @@
+/* http_time.c — RFC 3339 UTC timestamps of the HTTP API and the logs.
+ * Contract: api/http/http_time.h. */
 #include "http_time.h"
 
 #include <stdio.h>

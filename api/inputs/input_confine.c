@@ -1,3 +1,5 @@
+/* input_confine.c — server paths a request may name ({"file": ...}) kept
+ * inside the input directory.  Contract: api/inputs/input_confine.h. */
 #include "input_confine.h"
 
 #include <errno.h>

@@ -1,3 +1,5 @@
+/* input_links.c — the walker over file inputs given by link ({"href": ...}).
+ * Contract: api/inputs/input_links.h. */
 #include "input_links.h"
 
 #include <stdio.h>

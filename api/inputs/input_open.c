@@ -1,3 +1,5 @@
+/* input_open.c — open a job's input file without trusting it (regular files
+ * only, size-limited).  Contract: api/inputs/input_open.h. */
 #include "input_open.h"
 
 #include <errno.h>

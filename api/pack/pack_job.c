@@ -1,3 +1,5 @@
+/* pack_job.c — the 'pack' process: JSON inputs to the job struct, plan, run.
+ * Contract: api/pack/pack_job.h. */
 #include "pack_job.h"
 #include "pack_placer.h"
 

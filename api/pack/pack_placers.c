@@ -1,3 +1,5 @@
+/* pack_placers.c — the table of placers (rsa, edmd, tetfill) of 'pack'.
+ * Contract: api/pack/pack_placer.h. */
 #include <string.h>
 
 #include "pack_placer.h"

@@ -1,3 +1,5 @@
+/* h5_inspect.c — a JSON view of a result file (`packd inspect`, results document).
+ * Contract: api/results/h5_inspect.h. */
 #include "h5_inspect.h"
 
 #include <hdf5.h>

@@ -1,3 +1,5 @@
+/* h5_result.c — the H5MD 1.1 result file writer (docs/result-format.md).
+ * Contract: api/results/h5_result.h. */
 #include "h5_result.h"
 
 #include <errno.h>

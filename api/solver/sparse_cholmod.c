@@ -1,3 +1,5 @@
+/* sparse_cholmod.c — core/base/sparse.h's solver with SuiteSparse CHOLMOD:
+ * supernodal LLᵀ, simplicial LDLᵀ for the inertia.  Contract: sparse_cholmod.h. */
 #include "sparse_cholmod.h"
 
 #include <cholmod.h>
@@ -10,12 +12,12 @@
  * up to 4 threads (num_threads clauses) — small ones on packd's blocks, so a
  * team costs more to start, and its threads more in spinning (libgomp spins
  * before it sleeps, on the cores the relaxation and the speculative attempts
- * use), than it gives.  Measured (seventh session, near-jamming 10⁴ bench
- * step, seed 6; OMP_THREAD_LIMIT=1 against none): 1.73–1.78 s against
- * 2.32–2.55 s, serial.  So every entry point makes the calling thread's
- * parallel regions inactive (max-active-levels 0: a team of one; the ICV is
- * per thread, so each thread that calls in sets its own — a few ns).  The
- * numbers do not change (the same operations, in one thread). */
+ * use), than it gives (near-jamming 10⁴ bench/homog step: −25..−30 % time
+ * with a team of one; docs/perf/sparse.md).  So every entry point makes the
+ * calling thread's parallel regions inactive (max-active-levels 0: a team
+ * of one; the ICV is per thread, so each thread that calls in sets its own
+ * — a few ns).  The numbers do not change (the same operations, in one
+ * thread). */
 static void serial_regions(void)
 {
     omp_set_max_active_levels(0);
@@ -82,23 +84,10 @@ static int supernodal_pivots(const cholmod_factor *L, double *d)
 /* Analyse and factorise S in the given mode; 0 when CHOLMOD ran (the factor
  * may still stop early: L->minor < n).
  * factor and factor_pd analyse (AMD) afresh; factor_pd_ctx reuses its
- * context's analysis when the pattern repeats (factorize_supernodal).
- * Measured (round 10): within one relaxation the contact pattern never
- * repeated — 0 of 23 factorisations of the near-jamming 10⁴ steps seeds 6
- * and 8 (nnz 121,179–121,401, analysis 9–11 ms against 33–50 ms numeric),
- * 0 of 18 in the 10³ bench (RVE relaxations and steps); the reuse pays
- * where a context spans steps whose contact set does not change (elastic
- * load steps).  Measured and dropped (round 7, Newton
- * blocks of the near-jamming 10⁴ step, 2·10⁴ DOFs, ~1.2·10⁵ entries): AMD
- * analysis 0.011–0.018 s against 0.041–0.057 s numeric (1.9–2.0e8 flops);
- * reusing one block's ordering for the next contact pattern doubles the
- * flops (3.9e8 with AMD's, 2.6e8 with METIS's: a new contact across a
- * separator fills it); one symbolic analysis per candidate-pair pattern
- * (non-contacts as explicit zeros) needs 3.3e8 flops with AMD, 1.8e8 with
- * METIS but 0.06–0.08 s to order, and the pair list changes at every attempt
- * (10 analyses for 18 factorisations); METIS on the contact pattern: 1.3e8
- * flops, −0.004–0.017 s numeric for +0.04–0.05 s analysis; coarser
- * supernodes (nrelax ×2–×8) no faster. */
+ * context's analysis when the pattern repeats (factorize_supernodal): that
+ * pays where a context spans steps whose contact set does not change
+ * (elastic load steps); within one relaxation the pattern changes.  Other
+ * orderings and analyses measured against AMD: docs/perf/sparse.md. */
 static int factorize_mode(pk_sparse_factor *f, cholmod_sparse *S, int mode)
 {
     f->c.supernodal = mode;
@@ -149,7 +138,7 @@ static int analyse_into(pk_sparse_ctx *ctx, cholmod_sparse *S)
 /* The supernodal LLᵀ of S, analysed afresh (ctx NULL) or with ctx's
  * analysis — the same AMD ordering and supernodes as a fresh analysis of
  * the same pattern (cholmod_analyze reads the pattern only), hence the same
- * numbers; the analysis was ~25 % of a factorisation (round 9). */
+ * numbers (the analysis is ~25 % of a factorisation). */
 static int factorize_supernodal(pk_sparse_ctx *ctx, pk_sparse_factor *f, cholmod_sparse *S,
                                 pk_sparse_info *info)
 {
@@ -168,7 +157,7 @@ static int factorize_supernodal(pk_sparse_ctx *ctx, pk_sparse_factor *f, cholmod
 }
 
 /* Supernodal LLᵀ first: BLAS-3 on dense column blocks, 2.5× faster than the
- * simplicial LDLᵀ on the 2·10⁴-DOF 2D blocks of issue 6 (bench/homog, with
+ * simplicial LDLᵀ on the 2·10⁴-DOF 2D Newton blocks (bench/homog, with
  * OpenBLAS).  It stops at the first non-positive pivot, so a block that is
  * not positive definite is factorised again as simplicial LDLᵀ, whose D
  * gives the full inertia that the tangent reports — unless `pd_only`

@@ -1,3 +1,5 @@
+/* par.c — the persistent thread pool of the relaxations' parallel sections.
+ * Contract: core/base/par.h. */
 #include "par.h"
 
 void pk_par_range(size_t n, int t, int nt, size_t align, size_t *lo, size_t *hi)

@@ -1,3 +1,5 @@
+/* progress.c — the wall clock and the monitor that rate-limits progress
+ * callbacks and notices cancellation.  Contract: core/base/progress.h. */
 #include "progress.h"
 
 #include <time.h>

@@ -1,3 +1,5 @@
+/* rng.c — xoshiro256** seeded through splitmix64, one stream per purpose.
+ * Contract: core/base/rng.h. */
 #include "rng.h"
 
 #include <math.h>

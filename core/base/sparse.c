@@ -1,3 +1,5 @@
+/* sparse.c — the symmetric triplet matrix core/ assembles for the sparse
+ * solver api/ provides.  Contract: core/base/sparse.h. */
 #include "sparse.h"
 
 #include <stdlib.h>

@@ -1,11 +1,15 @@
-/* edmd.c — the EDMD growth-packing driver (spec §3; issue 3).
+/* edmd.c — the EDMD growth-packing driver: set-up, event loop, stop criteria.
+ * Contract: core/edmd/edmd.h; folder guide core/edmd/README.md (spec §3).
  *
  * Time unit: the time a grain at the rms speed per axis (u = mean target
  * diameter d̄ per unit time) needs to cross d̄.  Relative growth: every
- * diameter is d_i·s(t) with s' = γ (Meier: s(0) = 0; Titscher §6.2: s(0) = δ,
- * t_end = (1 − δ)/γ, Eq. 30).  Shell growth: true radii fixed, the shell
- * grows at γ·d̄/2 (Titscher §6.3: t_end = Δd/(2γ_a), Eq. 31; §6.4: until
- * jammed, Δd_max = 2 h(t_stop)). */
+ * diameter is d_i·s(t) with s' = γ, so γ is relative to the FINAL (target)
+ * diameter: d_i' = γ·d_i (Meier: s(0) = 0; Titscher §6.2: s(0) = δ,
+ * t_end = (1 − δ)/γ).  Titscher's Eq. 30, t_end = (1 − δ)/(δ γ_T), takes
+ * the rate relative to the INITIAL diameter d_0 = δ d (d' = γ_T d_0): the
+ * same end time with γ = δ γ_T.  Shell growth: true radii fixed, the shell
+ * grows at γ_a = γ·d̄/2 (Titscher §6.3: t_end = Δd/(2γ_a), Eq. 31; §6.4:
+ * until jammed, Δd_max = 2 h(t_stop)). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,61 +19,23 @@
 #include "edmd_state.h"
 #include "core/base/rng.h"
 
-/* Skins shrink as SKIN_P0/p above that reduced pressure, to SKIN_MIN of the
- * base skin at most (mono 3D N = 2000 to jamming: −9 % instructions). */
+/* Near jamming the skins shrink as SKIN_P0/p above that reduced pressure,
+ * to SKIN_MIN of the base skin at most (mono 3D N = 2000 to jamming: −9 %
+ * instructions against fixed skins; docs/perf/edmd.md). */
 #define SKIN_P0 100.0
 #define SKIN_MIN 0.1
-/* Skin factor of the grains below the mean radius (see setup). */
+/* Skin factor of the grains below the mean radius (see setup; Fuller-like
+ * 1–16 N = 10^4 to jamming: 13.0k instructions per collision, 16.1k at 1). */
 #define SKIN_FINE 2.5
-/* Round 5, dropped: skins ×2 or ×3 in the dilute phase of a zero start
- * (scale min(S, SKIN_P0/p) instead of min(1, ...), where 43 % of the
- * Fuller-like run's CPU time and 75 % of its 2.0M list rebuilds fall before
- * φ = 0.42): rebuilds 2.0M → 1.1M, but each query 5.0k → 12k instructions
- * (wider spheres, wider level cells) and 27 → 34 lanes per prediction:
- * 8740 → 9470 (×2) and 9200 (×3) instructions per collision.  Coarse
- * grains' skins ×0.5 (coarse lists 27 → 22.5 lanes per prediction):
- * +18 % list rebuilds, more instructions to φ = 0.70. */
-/* Round 7 account, Fuller-like 1–16 N = 10^4 to jamming (bench/edmd;
- * callgrind, 4-lane path: 26.65G instructions, 8497 per collision).
- * Events 5.90M: 3.14M collisions, 2.00M list rebuilds (by octave of the
- * grain's d: 1–2 1.17M, 2–4 0.66M, 4–8 0.14M, 8–16 0.025M), 0.76M invalid
- * (0.72M took the runner-up, 0.044M re-predicted), no walls.  Predictions
- * 13.4G: d 8–16 3.12M (3.09M after a collision) × 54.7 neighbours (29 of
- * d 1–2), 2810 instructions each = 8.8G, a third of the run; 4–8 1.62M ×
- * 19.0, 1320; 2–4 1.54M × 6.9, 740; 1–2 2.06M × 5.9, 665.  Rebuilds 9.1G
- * (queries 6.4G, re-filing 1.8G): 3230 instructions each for d 1–2, 4320
- * for 2–4, 13.0k for 4–8, 24.0k for 8–16.  Heap 1.86G, collision rule
- * 0.97G.  Masses are equal by default (pk_edmd_params.equal_masses), so a
- * fine turns a coarse grain as much as any grain does: nothing a coarse
- * grain predicted survives its collision, and an exact change cannot skip
- * those 171M neighbour tests; fewer of them needs other skins (other
- * events).  Kept: cover moves (grid_cover.c: −1.5 % instructions, the
- * same events); dropped: culled rows in wide queries (grid_uniform.c), a
- * reload-free heap step (edmd_queue.c).
- * Seventh session: the base skin (pk_edmd_params.skin, 0.6) at 0.45 gives
- * the Fuller-like case 8.4–8.8e5 collisions per CPU s against 6.2–6.3e5
- * (0.8: 6.3–6.8e5), but only because that run makes 5.10M collisions
- * instead of 3.14M before the jamming test stops it (φ 0.7129 / 0.7108):
- * the jammed packing takes 5.8–6.1 s instead of 5.0 — slower for the
- * user, kept at 0.6.  From an RSA start at φ = 0.30 (bench/edmd …_rsa030,
- * Titscher/Kansal) the same case makes 1.08–1.13e6 collisions per CPU s
- * and jams in 3.5 s (the dilute phase, where rebuilds outnumber
- * collisions, is skipped). */
-/* From this many grains on (arrays beyond the caches) the grains are
- * renumbered along a Z-order curve every RESORT_WINDOWS·N events: they
- * diffuse away from their start order and each prediction then misses the
- * cache once per neighbour (N = 10^6 from zero radii to φ = 0.55: 460 →
- * 339 s CPU, peak memory 395 → 522 MB; lists and events are rebuilt there,
- * as at the start; from 4096 grains instead: mono 3D N = 10^4 to jamming
- * 1.17e6 → 1.11e6 collisions per CPU second with edmd_prefetch_list). */
+/* From RESORT_MIN_N grains on (arrays beyond the caches) the grains are
+ * renumbered along a Z-order curve every RESORT_WINDOWS·N events, as they
+ * diffuse from their start order (N = 10^6 to φ = 0.55: −26 % CPU time). */
 #define RESORT_MIN_N 32768
 #define RESORT_WINDOWS 10
 
-/* The clock is re-based every REBASE_WINDOWS·N events: a grain has a few
- * events in that window, so |v·t| stays a few flights (a re-base touches
- * every grain: ~2 % of the instructions when done every N events, mono 3D
- * to jamming; a longer window loses precision near contact — N = 8 in a
- * walled cube then jams short of π/6 more often). */
+/* The clock is re-based every REBASE_WINDOWS·N events, so |v·t| stays a few
+ * flights (a re-base touches every grain; a longer window loses precision
+ * near contact: N = 8 in a walled cube then jams short of π/6 more often). */
 #define REBASE_WINDOWS 4
 
 /* Reduced pressure past which a run to jamming grows at
@@ -118,9 +84,7 @@ static inline double true_radius(const edmd_state *s, size_t i, double t)
 }
 
 /* pk_ball_measure's expression, inlined (the same operations, the same
- * sums): φ is summed over all grains every window of N events, and the two
- * calls per grain (measure, fmax) were 2.1 % of the instructions, mono 3D
- * N = 10^4 to jamming (now 1.0 %). */
+ * sums): φ is summed over all grains every window of N events. */
 static inline double ball_measure(int dim, double r)
 {
     return dim == 2 ? M_PI * r * r : 4.0 / 3.0 * M_PI * r * r * r;
@@ -375,10 +339,8 @@ static double setup(edmd_state *s, const pk_particles *p, const pk_edmd_params *
      * mean get SKIN_FINE·(2ρ̄ − r), up to SKIN_FINE·2ρ̄ for the finest: fines
      * fly as fast as the coarse and rattle in their pores, so with a small
      * skin they rebuild all the time (a rebuild is a multi-level cell query),
-     * while their lists (few grains of their size) stay short (Fuller-like
-     * case, N = 2000: list events 1.55 → 1.19 per collision with 2ρ̄ − r;
-     * N = 10^4 to jamming: 16.1k → 13.0k instructions per collision with
-     * SKIN_FINE = 2.5 instead of 1) */
+     * while their lists (few grains of their size) stay short
+     * (docs/perf/edmd.md, SKIN_FINE) */
     double t_ref = isfinite(t_end) ? t_end : 0;
     double rho_mean = 0, rho_max = 0;
     for (size_t i = 0; i < n; i++) {

@@ -28,7 +28,9 @@
 #include "core/rsa/rsa.h"
 
 typedef enum pk_edmd_growth {
-    PK_EDMD_GROW_RELATIVE = 0, /* d_i(t) = d_i·s(t), s' = γ: size ratios exact (Meier, Titscher §6.2) */
+    /* d_i(t) = d_i·s(t), s' = γ, d_i the FINAL diameter: size ratios exact (Meier,
+     * Titscher §6.2; Titscher's γ of Eq. 30 is relative to δ·d_i, i.e. ours/δ) */
+    PK_EDMD_GROW_RELATIVE = 0,
     PK_EDMD_GROW_SHELL         /* true radii fixed, the Δd/2 shell grows at γ·d̄/2 (Titscher §6.3/6.4) */
 } pk_edmd_growth;
 

@@ -1,4 +1,5 @@
 /* edmd_collide.c — growth-aware collision rules (spec §3.4; pk_edmd_rule).
+ * Contract: edmd_collide_pair / edmd_collide_wall in core/edmd/edmd_state.h.
  *
  * Titscher's elastic rule (Eq. 27) alone leaves a growing pair approaching
  * whenever its separation speed w < G = g_i + g_j.  The default rule

@@ -1,4 +1,5 @@
-/* edmd_contacts.c — contacts, rattlers and mean contact number at the end. */
+/* edmd_contacts.c — contacts, rattlers and mean contact number at the end.
+ * Contract: core/edmd/edmd_contacts.h. */
 #include "edmd_contacts.h"
 
 #include <math.h>

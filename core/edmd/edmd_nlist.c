@@ -1,4 +1,5 @@
 /* edmd_nlist.c — Donev-style neighbour lists for growing grains (spec §3.3c).
+ * Contract: the edmd_nlist_* declarations in core/edmd/edmd_state.h.
  *
  * At its build time particle i gets a bounding sphere (centre c_i = x_i,
  * radius σ_i = ρ_i + s_i/2); j is in i's list iff the bounding spheres
@@ -227,9 +228,9 @@ static int visit_rebuild(size_t j, const double dx[PK_MAXDIM], double dist2, voi
 }
 
 /* i's list anew; the lists stay symmetric by touching only the lists of
- * the neighbours i gains or loses (mono 3D N = 10^4 to φ = 0.6: the drop
- * loop over all old neighbours was a fifth of the L2 misses).  i's old list
- * stays in its slot until the new one (built in nl_new) replaces it. */
+ * the neighbours i gains or loses (not every old neighbour's: L2 misses).
+ * i's old list stays in its slot until the new one (built in nl_new)
+ * replaces it. */
 int edmd_nlist_rebuild(edmd_state *s, size_t i)
 {
     if (s->nl_tag > UINT32_MAX - 2) { /* tags used up: clear the marks */

@@ -1,6 +1,7 @@
 /* edmd_order.c — memory order of the grains: sorted along a Morton (Z-order)
  * curve of cells about one mean diameter wide, so that neighbours in space
- * are neighbours in the engine's arrays (fewer cache misses per event). */
+ * are neighbours in the engine's arrays (fewer cache misses per event).
+ * Contract: edmd_spatial_order / edmd_reorder in core/edmd/edmd_state.h. */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>

@@ -1,5 +1,7 @@
 /* edmd_predict.c — event times: pair collisions (spec §3.3a, cancellation-free
- * roots), walls (§3.3b), leaving the neighbour-list bounding sphere (§3.3c). */
+ * roots), walls (§3.3b), leaving the neighbour-list bounding sphere (§3.3c).
+ * Contract: core/edmd/edmd.h (pk_edmd_pair_time, pk_edmd_exit_time) and the
+ * edmd_predict declarations in core/edmd/edmd_state.h. */
 #include <math.h>
 
 #include "edmd_state.h"
@@ -91,7 +93,7 @@ double edmd_wall_time(const edmd_state *s, size_t i, int *code)
 }
 
 /* Prefetch distance in a neighbour list: the grains' records are scattered
- * (mono 3D N = 4000 to jamming: about −10 % run time at 3, none at 1). */
+ * (mono 3D N = 4000 to jamming: about −10 % run time; docs/perf/edmd.md). */
 #define PREFETCH_AHEAD 4
 
 /* edmd_prefetch_list: lists up to this long whole; longer lists (coarse
@@ -213,10 +215,8 @@ static inline void lane_offers(edmd_state *s, pred *pr, const int32_t *ix, unsig
  * so the results are bit-identical to the scalar code.  The common root (gap
  * open, approaching, A >= 0: C/(−B + √D), as pair_root) is taken in the
  * lanes; touching, overlapping or A < 0 lanes go to pair_take.  A short last
- * group repeats its first neighbour in the empty lanes and masks them.
- * Lanes not dismissed (to a root or pair_take), to jamming at N = 10^4:
- * mono 31 % of 8.8 neighbours per prediction, Fuller-like 1–16 9 % of 27
- * (the share of record loads a cheaper pre-test could not avoid). */
+ * group repeats its first neighbour in the empty lanes and masks them
+ * (lanes passed on, per run: docs/perf/edmd.md). */
 __attribute__((target("avx2"))) static void pair_lanes4(edmd_state *s, pred *pr, const self *c,
                                                         const int32_t *nb, uint32_t nq)
 {
@@ -240,9 +240,6 @@ __attribute__((target("avx2"))) static void pair_lanes4(edmd_state *s, pred *pr,
         int32_t tail[4];
         int lanes = 0xf;
         if (q + 4 > nq) {
-            /* round 5: the 1–2 neighbours of a short last group through
-             * pair_one instead (scalar, a call each): same events, mono 3D
-             * N = 10^4 to jamming −0.3 % instructions; dropped */
             const uint32_t left = nq - q; /* 1..3 */
             lanes = (1 << left) - 1;
             tail[0] = tail[3] = nb[q];    /* nb[q + l] for l < left, else nb[q] */
@@ -250,14 +247,8 @@ __attribute__((target("avx2"))) static void pair_lanes4(edmd_state *s, pred *pr,
             tail[2] = nb[q + 2 * (left > 2)];
             ix = tail;
         } else if (q + PREFETCH_AHEAD + 3 < nq) {
-            /* unrolled (gcc kept 4-step loops of 7 instructions here and
-             * for the tail above): same events, Fuller-like 1–16 N = 10^4 to
-             * jamming 9033 → 8740 instructions per collision, mono 10^4
-             * jammed 3693 → 3625; CPU time unchanged within the noise.
-             * Round 4's split of that Fuller case: predictions 48 % (the
-             * coarsest octave, d 8–16, has 53 neighbours per prediction and
-             * 78 % of the lane tests), rebuild queries 33 % (2.0M, 5040
-             * instructions each), heap 6 % */
+            /* unrolled (gcc keeps a 4-step loop of 7 instructions
+             * otherwise): −3 % instructions per collision, same events */
             const int32_t *pf = nb + q + PREFETCH_AHEAD;
             __builtin_prefetch(&K[pf[0]]);
             __builtin_prefetch(&K[pf[1]]);
@@ -311,17 +302,9 @@ __attribute__((target("avx2"))) static void pair_lanes4(edmd_state *s, pred *pr,
  * the pre-filter of eight lanes: it may pass more lanes than the 4-lane
  * loop, but each offer is tested against the current pr->second, in list
  * order.
- * Zen 4 (512-bit operations double-pumped), predictions timed alone at a
- * state of the run, ns per prediction 8-lane/4-lane: lists of 33+ 0.75-0.80,
- * 13-32 0.87, 7-8 0.90-0.98, 5-6 1.04-1.09 (one 8-lane group costs more
- * than 4 + 1..2): hence LANES8_MIN.  Weighted by the predictions' list
- * lengths of whole runs to jamming at N = 10^4, prediction time −14 % for
- * Fuller-like 1–16 (≈ −2.5 % of the run), mono ≈ −1 % of the run; whole
- * runs against the 4-lane HEAD, 3 alternating pairs, CPU s: mono 7.12 →
- * 6.81, Fuller-like 5.12 → 4.77 (noise ±10 %); same events.  Valgrind hides
- * AVX-512 (this loop never runs under callgrind) and there are no hardware
- * counters here: no instruction counts.  Eight gathers instead of the loads
- * and the transpose: no better within the noise of whole runs. */
+ * LANES8_MIN: below 7 neighbours one 8-lane group costs more than a 4-lane
+ * group and 1–2 scalar ones (ns per prediction 8-lane/4-lane: 33+ 0.75–0.80,
+ * 5–6 1.04–1.09; docs/perf/edmd.md). */
 #define LANES8_MIN 7
 __attribute__((target("avx512f"))) static uint32_t pair_lanes8(edmd_state *s, pred *pr,
                                                                const self *c,
@@ -437,16 +420,11 @@ int edmd_lanes8_available(void)
 
 /* Issued at a collision for both grains before the first prediction, so j's
  * neighbours load while i's are processed (a list of ~9 is too short for
- * the loop's PREFETCH_AHEAD).  Same events; mono 3D N = 10^4 to jamming:
- * −5..−8 % CPU on a quiet machine, −15..−20 % when the L3 is shared with
- * other jobs, +4 % instructions; Fuller-like 1–16: unchanged (±2 %, the
- * run is not memory-bound there).  Prefetching the partner's event/heap
- * slot, the root's children's events, or each neighbour found by a list
- * rebuild gave nothing beyond this. */
+ * the loop's PREFETCH_AHEAD).  Same events; mono 3D N = 10^4 to jamming
+ * −5..−8 % CPU (docs/perf/edmd.md). */
 void edmd_prefetch_list(const edmd_state *s, size_t i)
 {
-    /* four a step (gcc keeps the 7-instruction loop): same events, mono 3D
-     * N = 10^4 to jamming 68 → 61 instructions a call, two per collision */
+    /* four a step (gcc keeps a 7-instruction loop otherwise) */
     const edmd_kin *K = s->k;
     const int32_t *nb = s->nl_pool + s->nl[i].off;
     const uint32_t nq = s->nl[i].n <= PREFETCH_LIST_MAX ? s->nl[i].n : PREFETCH_AHEAD;
@@ -479,8 +457,8 @@ void edmd_predict(edmd_state *s, size_t i)
 
     /* leaving the bounding sphere */
     {
-        /* pk_min_image3 written out on the copies in c (same operations;
-         * the loop through s was 39 instructions a prediction) */
+        /* pk_min_image3 written out on the copies in c (same operations,
+         * no loop through s) */
         const double *bx = &s->bs.x[3 * i], M = MIN_IMAGE_M;
         double q[3] = {c.x[0] - bx[0], c.x[1] - bx[1], c.x[2] - bx[2]}; /* 0 beyond dim */
         q[0] -= c.L[0] * ((q[0] * c.iL[0] + M) - M);

@@ -1,31 +1,21 @@
 /* edmd_queue.c — the event queue: each grain's one pending event in a
  * calendar of time slots (Paul 2007, J. Comput. Phys. 221, 615: O(1) per
- * event).  slot(t) = floor((t − T0)/w), with w sized at each (re)build so a
- * slot holds about PER_SLOT events.  The current slot's events sit in a small
+ * event).  Contract: the edmd_queue_* declarations in core/edmd/edmd_state.h.
+ *
+ * slot(t) = floor((t − T0)/w), with w sized at each (re)build so a slot
+ * holds about PER_SLOT events.  The current slot's events sit in a small
  * 4-ary heap; the events of the next slots, up to lap_end, in unsorted
  * doubly linked bucket lists (bucket = slot mod nb, one list per slot in the
  * window); later ones in an overflow list, sorted into the buckets when a lap
  * of nb slots starts.  Exact order: slot() is monotone in t (a subtraction
  * and a product by a positive constant, rounded, then floor), so a grain in
- * a later slot never has an earlier time than one in the heap.
+ * a later slot never has an earlier time than one in the heap.  Ties between
+ * equal times come out in an order of their own (each order is exact).
  *
- * Why: the 4-ary heap of all N events (one sift from the root per event,
- * two at a collision) was a quarter of the CPU time of mono 3D N = 10^4 to
- * jamming — each of its ~7 levels waits on a line and a chain of compares;
- * here an event costs a small heap's pop and a list insert.  Measured
- * (medians of 6 alternating runs, the same events): mono N = 10^4 to
- * φ = 0.60 from zero radii 0.824 → 0.725 CPU s, from the RSA start 0.426 →
- * 0.378; N = 10^5 to φ = 0.55 from the RSA start 5.73/6.12 → 5.35/5.48 s;
- * a Fuller-like 1–16 job to φ = 0.62 unchanged (its time is in the
- * predictions and list rebuilds).  PER_SLOT 2 or 8 instead of 4: within
- * 3 %.  An 8-ary heap of separate keys (eight children a line) instead:
- * no faster than the 4-ary one.  The grains' slot, links, place and heap
- * node in one 24-byte record instead of five arrays: no faster.  Mono
- * N = 10^6 to φ = 0.55 from the RSA start: 104.7 → 82.5 CPU s (one run
- * each, the same 48.7M events): the full heap's 10 levels missed the
- * caches.  Ties between equal times may come out
- * in another order than the full heap's (each order is exact), so runs
- * to jamming make other events than before. */
+ * Why: a heap of all N events makes every event wait on ~log4 N cache lines
+ * and a chain of compares (a quarter of the CPU time of mono 3D N = 10^4 to
+ * jamming); here an event costs a small heap's pop and a list insert
+ * (docs/perf/edmd.md). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -36,7 +26,7 @@ enum { ARITY = 4 };
 enum { Q_HEAP = -1, Q_OVER = -2 };
 #define SLOT_INF ((int64_t)1 << 62) /* infinite (or absurd) times */
 /* Events per slot aimed at: fewer empty slots to skip against a larger heap
- * per slot. */
+ * per slot (2 or 8: within 3 %, docs/perf/edmd.md). */
 #define PER_SLOT 4.0
 #define SAMPLE_MAX 1024
 

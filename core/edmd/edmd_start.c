@@ -1,5 +1,6 @@
 /* edmd_start.c — EDMD parameters' defaults, criterion names and the RSA start
- * configuration at reduced size δ·d (Titscher §6.2, Kansal). */
+ * configuration at reduced size δ·d (Titscher §6.2, Kansal).
+ * Contract: core/edmd/edmd.h. */
 #include <math.h>
 #include <stdlib.h>
 

@@ -1,4 +1,5 @@
-/* edmd_state.h — the EDMD engine's internal state, shared by core/edmd/edmd*.c.
+/* edmd_state.h — the EDMD engine's internal state, shared by core/edmd/edmd*.c
+ * (not part of the public contract, core/edmd/edmd.h).
  * Each grain's flight is one 64-byte record (one cache line: a prediction
  * reads one line per neighbour): position at time t is p + v·t — p is the
  * position extrapolated back to the re-based origin t = 0, so no per-grain
@@ -31,10 +32,8 @@ _Static_assert(sizeof(edmd_event) == 32, "two events per cache line");
  * pool (CSR with slack), n of it used.  A full build lays the slots out in
  * grain order, so a prediction streams its list and the next grain's list
  * is in the next lines; a list that outgrows its slot moves to the pool's
- * end (edmd_nlist.c).  Against one malloc block per list: same events,
- * mono 3D N = 10^4 to φ = 0.6 −0.7 % instructions, L1/L2 misses within
- * 0.3 % (cachegrind, 1 MB L2) — the misses are the partners' records, not
- * the lists — and no per-list malloc header or power-of-two capacity. */
+ * end (edmd_nlist.c).  No per-list malloc header or power-of-two capacity
+ * (measurements: docs/perf/edmd.md). */
 typedef struct edmd_nlist {
     uint32_t off, n, cap;
 } edmd_nlist;
@@ -175,8 +174,7 @@ static inline void edmd_pin(edmd_state *s, size_t i, const double x[3])
 static inline void edmd_sync_pos(edmd_state *s, size_t i, double x[3])
 {
     /* one test for the common case (every axis inside), bitwise & without
-     * branches; same results (mono 3D N = 10^4 to jamming: the collisions'
-     * syncs 1.67G → 1.47G instructions, the predictions' unchanged) */
+     * branches; same results as the per-axis loop (docs/perf/edmd.md) */
     edmd_kin *k = &s->k[i];
     const double t = s->t;
     const double x0 = k->p[0] + k->v[0] * t, x1 = k->p[1] + k->v[1] * t,

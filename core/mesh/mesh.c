@@ -1,3 +1,5 @@
+/* mesh.c — a linear tet mesh: allocation, checks (orientation, conformity,
+ * manifold boundary), boundary faces, volumes.  Contract: core/mesh/mesh.h. */
 #include "mesh.h"
 
 #include <math.h>

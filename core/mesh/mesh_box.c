@@ -1,4 +1,5 @@
-/* mesh_box.c — a box domain as a tet mesh (so a box can be filled by tetfill). */
+/* mesh_box.c — a box domain as a tet mesh (so a box can be filled by tetfill).
+ * Contract: pk_mesh_box / pk_mesh_box_count in core/mesh/mesh.h. */
 #include <math.h>
 #include <stdio.h>
 

@@ -1,3 +1,5 @@
+/* mesh_edges.c — the unique edges of a tet mesh and their lengths.
+ * Contract: core/mesh/mesh_edges.h. */
 #include "mesh_edges.h"
 
 #include <math.h>

@@ -1,3 +1,5 @@
+/* mesh_locate.c — point-in-mesh and distance to the mesh boundary through
+ * two core/space/grid.h grids.  Contract: core/mesh/mesh_locate.h. */
 #include "mesh_locate.h"
 
 #include <math.h>

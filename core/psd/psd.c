@@ -1,5 +1,5 @@
-/* psd.c — grading (sieve) curves → particle sizes.  See psd.h and
- * ../shared/specs/packing_titscher_jerier_meier.md §1.
+/* psd.c — grading (sieve) curves → particle sizes (Titscher §2–3, Algorithm 1).
+ * Contract: core/psd/psd.h; folder guide core/psd/README.md.
  *
  * One in-class law for everything: the mass CDF inside a class is ∝ d^β on
  * [a, b] (β = 0: ln d, Titscher Eq. 2).  With grain measure c·d^dim the

@@ -1,3 +1,5 @@
+/* box.c — the rectangular domain: measure, minimum image, wrapping, ball
+ * measure.  Contract: core/space/box.h. */
 #include "box.h"
 
 #include <math.h>

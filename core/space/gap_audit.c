@@ -1,3 +1,5 @@
+/* gap_audit.c — the exact, independent gap check of a finished packing.
+ * Contract: core/space/gap_audit.h. */
 #include "gap_audit.h"
 
 #include <math.h>
@@ -11,19 +13,15 @@
  * gap < h is then within one cell of the finer grain's cell in the coarser
  * grain's level grid (d < r_i + r_j + h <= e_L), so each grain scans the 3^dim
  * cells around it in its own level and in every coarser one: O(N) work per
- * level, whatever the size ratio.  (A sort-and-sweep along x before scanned
- * N·(2 r_max + horizon)/L_x grains per grain: 33 s for 534 000 equal spheres
- * in a walled box against 0.7 s of placement, 197 s for 335 000 grains of a
- * Fuller curve 0.5-16 mm against 0.7 s, over 11 minutes (not waited for)
- * for 10^6 disks of a 2D Fuller curve 1:1000 against 1.9 s; now 0.12 s,
- * 0.28 s and 0.53 s, the same figures.  10^6 spheres at φ = 0.30: 0.27 s.)
+ * level, whatever the size ratio (10^6 disks of a 2D Fuller curve 1:1000:
+ * 0.53 s; a sort-and-sweep along x is quadratic there, docs/perf/space.md).
  *
  * The horizon grows: pairs_below needs h >= required; the smallest gap of a
  * packing is usually far below r_max (the caller's horizon), so the first
  * pass looks at h = max(required, r_min/4) and only a pass that meets no pair
  * at all is repeated with 4h, up to the caller's horizon.  The smallest gap
  * over pairs closer than h is then the smallest over pairs closer than the
- * horizon, as before. */
+ * horizon. */
 
 #define MAX_LEVELS 40
 
@@ -78,9 +76,9 @@ static uint64_t cell_index(const level_grid *G, const int64_t *c)
 
 /* The grains in (level, cell) order: keys base_l + cell (32 bits: at most
  * 4 cells per grain and level), an LSD radix sort of 11 bits a pass, then each
- * level's CSR and its centres and radii gathered in that order.  (A counting
- * sort straight into the cells wrote to random places of 40 MB at 10^6 grains:
- * two thirds of the audit's time.) */
+ * level's CSR and its centres and radii gathered in that order (a counting
+ * sort straight into the cells writes to random places of 40 MB at 10^6
+ * grains). */
 static int fill_by_cell(audit *A)
 {
     const pk_box *b = A->b;

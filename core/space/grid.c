@@ -1,3 +1,5 @@
+/* grid.c — the hashed multi-level cell grid: O(1) neighbour queries for any
+ * size ratio, memory O(N).  Contract: core/space/grid.h. */
 #include "grid.h"
 
 #include <math.h>
@@ -231,8 +233,7 @@ static inline int scan(const pk_grid *g, const pk_particles *p, const double *x,
             }
         }
         /* a wrapped cell coordinate: the division only off [0, n) (two of
-         * them per cell were most of a 2D query's time: a DEM pair-list
-         * build 4.1 → 3.5 ms at 10⁴ grains, the same cells in the same order) */
+         * them per cell are most of a 2D query's time; docs/perf/space.md) */
 #define WRAPPED(c_, k_)                                                                        \
     (wrap[k_] && ((c_) < 0 || (c_) >= lv->ncell[k_])                                          \
          ? (((c_) % lv->ncell[k_]) + lv->ncell[k_]) % lv->ncell[k_]                             \

@@ -1,4 +1,5 @@
-/* grid_cover.c — the cover of a pk_ugrid's coarse levels (grid_uniform.h). */
+/* grid_cover.c — the cover of a pk_ugrid's coarse levels (grid_uniform.h).
+ * Contract: core/space/grid_cover.h. */
 #include "grid_cover.h"
 
 #include <math.h>
@@ -106,8 +107,7 @@ static void cover_drop(pk_ugrid_cover *cell, int32_t j)
  * (AXIS_WHOLE: the axis whole); the ball's cells are those with
  * !(e2₁ + e2₂ > R²) and !(e2₀ + (e2₁ + e2₂) > R²), R² returned (Rm², Rm
  * = R with the margin).  Tabulated first so that a cell costs a sum and a
- * compare: the first version (modulo and slab distance per cell) made
- * coarse re-inserts 8k instructions each. */
+ * compare, not a modulo and a slab distance. */
 static double ball_axes(const pk_ugrid *g, const double c[PK_MAXDIM], double R, int64_t *off_all,
                         double *e2_all, int64_t cnt[PK_MAXDIM], int64_t first[PK_MAXDIM])
 {
@@ -246,16 +246,12 @@ static int walk_union(pk_ugrid *g, const int64_t *off, const double *e2o, double
  * union of the two balls' boxes, and only the cells of one ball and not
  * the other change (a coarse grain's list rebuild moves its ball by a
  * fraction of a cell: ~5 of its ~32 cells change).  Remove + add when an
- * axis is taken whole, across a periodic seam, or to or from cov_big.
- * Round 7, Fuller-like 1–16 N = 10^4 to jamming: cover re-filing 1.40G →
- * 0.96G instructions (0.27M moves; the run 26.65G → 26.26G, −1.5 %; two
- * walks with a lookup of the other ball per cell: 1.09G).  In the cells of
- * both balls j keeps its place (remove + add moved it to the cell's end),
- * so a query may meet the grains in another order and a list hold its
- * neighbours in another order: that run and mono 3D N = 10^4 to jamming
- * end bit-identical (events, φ, pressure, every position and radius); an
- * exact tie between two candidates of one prediction could resolve
- * otherwise (the earlier in the list wins). */
+ * axis is taken whole, across a periodic seam, or to or from cov_big
+ * (Fuller-like 1–16 N = 10^4 to jamming: −1.5 % instructions of the run,
+ * docs/perf/space.md).  In the cells of both balls j keeps its place, so a
+ * query may meet the grains in another order than after a remove + add; an
+ * exact tie between two candidates of one EDMD prediction could then
+ * resolve otherwise (the earlier in the list wins). */
 int pk_ugrid_cover_move(pk_ugrid *g, size_t j, const double x[PK_MAXDIM], double r)
 {
     double *b = &g->cov_ball[4 * j];

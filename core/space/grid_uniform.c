@@ -1,4 +1,5 @@
-/* grid_uniform.c — levels of dense cell lists (see grid_uniform.h). */
+/* grid_uniform.c — levels of dense cell lists for often rebuilt neighbour
+ * searches (EDMD's lists).  Contract: core/space/grid_uniform.h. */
 #include "grid_uniform.h"
 
 #include <math.h>
@@ -198,27 +199,9 @@ static inline int scan_cells(const qctx *q, const int32_t *row, int32_t a, int32
     return 0;
 }
 
-/* One level: every cell of the box [x − reach, x + reach].  Tried on the
- * Fuller-like 1–16 case (N = 10^4 to jamming, 8.9k instructions per
- * collision; a rebuild query tests ~80 grains for ~7 found): skipping the
- * rows and row ends outside the reach sphere — 64 grains tested (the
- * coarse level worst: 32 for 1.2 found) but 10.1k instructions per
- * collision; that plus cells of edge r_hi instead of 2 r_hi — half the
- * grains, 3.8x the cells, 10.3k; a packed (x, y, z, r) copy per grain —
- * same CPU time, and on mono 10^4 D1 misses −12 % but 1 MB-L2 misses +9 %.
- * None kept.  Round 4 (same case, 5040 instructions per rebuild query):
- * cells of edge r_hi on all but the finest level — 5500 (more cells
- * visited than grains saved); a |Δx| < reach pre-test before the y, z
- * terms — ±0.  Dropped too.  Round 5: the fines' queries (1.74M of 2.03M)
- * spent 26 cells and 48 tests for 2.4 grains found in the two coarse
- * levels; the cover (grid_uniform.h) reads one cell with ~7 grains instead:
- * same run (first 5.5M events, identical events), queries 10.2G → 6.4G
- * instructions, inserts 0.34G → 1.56G (coarse balls walked), total 26.3G →
- * 23.5G.  Round 7: rows and row ends beyond the reach skipped only in boxes
- * of 4+ cells along y or z (the coarse grains' queries, 0.31M calls, 13
- * rows each; visits identical, bit-identical run): the whole run 26.40G →
- * 26.87G instructions — few rows are culled, and gcc's second inlined copy
- * of scan_cells came out slower.  Dropped. */
+/* One level: every cell of the box [x − reach, x + reach] (the variants
+ * tried against it — culled rows, finer cells, packed copies — are in
+ * docs/perf/space.md). */
 static int query_level(const pk_ugrid *g, const pk_ugrid_level *lv, const pk_particles *p,
                        const double x[PK_MAXDIM], double r, pk_grid_visit fn, void *ctx)
 {

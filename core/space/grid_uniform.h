@@ -10,7 +10,7 @@
  * beyond that), so memory stays O(N).  Same visitor contract as
  * pk_grid_query (the order of the visits is not part of it).
  *
- * Cover (round 5): with many small grains and few big ones (Fuller-like
+ * Cover: with many small grains and few big ones (Fuller-like
  * gradings) the small grains' queries spent most of their time in the
  * coarse levels — a box of big cells with few grains, ~50 tests for ~2
  * found.  The levels coarser than the most populated one are therefore also

@@ -1,3 +1,5 @@
+/* particles.c — the shared particle array (positions, radii, species).
+ * Contract: core/space/particles.h. */
 #include "particles.h"
 
 #include <stdlib.h>

@@ -1,3 +1,5 @@
+/* tetfill.c — Jerier et al. (2010) geometric filling of a tet mesh with
+ * spheres, steps 2–7b.  Contract: core/tetfill/tetfill.h. */
 #include "tetfill.h"
 
 #include <math.h>

@@ -1,3 +1,5 @@
+/* tetfill_stats.c — characterisation of a filled mesh (Jerier §3.1:
+ * coordination Eq. 15, fabric Eq. 17).  Contract: core/tetfill/tetfill_stats.h. */
 #include "tetfill_stats.h"
 
 #include <math.h>

@@ -1,3 +1,5 @@
+/* cli_util.c — helpers shared by the commands: JSON files, schema errors, --help.
+ * Contract: daemon/cli/cli.h. */
 #include <stdio.h>
 #include <string.h>
 

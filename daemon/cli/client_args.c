@@ -1,3 +1,5 @@
+/* client_args.c — the one option table of the client commands (flag, env, default).
+ * Contract: daemon/cli/client_args.h. */
 #include "client_args.h"
 
 #include <stddef.h>

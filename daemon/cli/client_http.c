@@ -1,3 +1,5 @@
+/* client_http.c — the client's HTTP over libcurl: JSON, hashed downloads, SSE.
+ * Contract: daemon/cli/client_http.h. */
 #include "client_http.h"
 
 #include <curl/curl.h>

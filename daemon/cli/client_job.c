@@ -1,3 +1,5 @@
+/* client_job.c — what the client commands do with one job (problem, events, result).
+ * Contract: daemon/cli/client_job.h. */
 #include "client_job.h"
 
 #include <stdio.h>

@@ -1,3 +1,5 @@
+/* cmd_inspect.c — `packd inspect OUT.h5 [--full]`: a result file as JSON.
+ * Contract: daemon/cli/cli.h; the view is api/results/h5_inspect.h's. */
 #include <stdio.h>
 #include <string.h>
 

@@ -1,3 +1,5 @@
+/* cmd_run.c — `packd run JOB.json -o OUT.h5`: one job in this process (batch use
+ * and the daemon's workers).  Contract: daemon/cli/cli.h; processes in api/process.h. */
 #include <errno.h>
 #include <signal.h>
 #include <stdio.h>

@@ -1,3 +1,5 @@
+/* cmd_validate.c — `packd validate JOB.json`: the schema and semantic checks
+ * without running.  Contract: daemon/cli/cli.h. */
 #include <stdio.h>
 #include <string.h>
 

@@ -1,3 +1,5 @@
+/* auth.c — bearer-token authorisation and owner scoping of every request.
+ * Contract: daemon/http/auth.h. */
 #include "auth.h"
 
 #include <arpa/inet.h>

@@ -1,3 +1,5 @@
+/* http_park.c — parked SSE connections and the one waker thread.
+ * Contract: daemon/http/http_park.h. */
 #include "http_park.h"
 
 #include <pthread.h>

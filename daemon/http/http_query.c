@@ -1,4 +1,5 @@
-/* Integer query parameters with a range: the one parser of every route. */
+/* http_query.c — integer query parameters with a range: the one parser of
+ * every route.  Contract: pk_query_int in daemon/http/http.h. */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,3 +1,5 @@
+/* job_metrics.c — counters of ended jobs that never go down (Prometheus).
+ * Contract: daemon/store/job_metrics.h. */
 #include "job_metrics.h"
 
 #include <math.h>

@@ -1,3 +1,5 @@
+/* queue.c — the durable SQLite job queue (jobs, inputs, states, events).
+ * Contract: daemon/store/queue.h. */
 #include "queue.h"
 
 #include <errno.h>

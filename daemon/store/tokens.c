@@ -1,3 +1,5 @@
+/* tokens.c — bearer tokens of the job service (hashed, made, listed, revoked).
+ * Contract: daemon/store/tokens.h. */
 #include "tokens.h"
 
 #include <openssl/evp.h>
