@@ -9,7 +9,11 @@
  * frame, l = F̄·minimg(F̄⁻¹(x_j − x_i)), i.e. the lattice vectors are F̄L
  * (spec §2.5.4 "equivalent simpler form").  Candidate pairs (a Verlet list
  * with a skin) come from the shared pk_grid built on reference coordinates;
- * each keeps the lattice image it had at the build (pk_dem_pairs.sh). */
+ * each keeps the lattice image it had at the build (pk_dem_pairs.sh).
+ *
+ * Implemented by dem_pairs.c (geometry, candidate list, images), dem_eval.c
+ * (the evaluation: dem_eval_loops.c serial and in lanes, dem_eval_par.c
+ * threaded) and dem_kv.c (K·v, Gershgorin bound); core/dem/README.md. */
 #ifndef PK_DEM_CONTACT_H
 #define PK_DEM_CONTACT_H
 
@@ -68,7 +72,7 @@ typedef struct pk_dem_pairs {
      * between the pool's threads (lists of pk_dem_par_min_pairs candidates
      * or more, in pk_dem_pairs_build's order), and give the serial results
      * bit for bit — f, the count, l, |l|, ε, energy, S — for any number of
-     * threads (dem_contact.c, eval_par).  The fields below are its own: */
+     * threads (dem_eval_par.c).  The fields below are its own: */
     pk_par *par;
     double *fa;          /* [n][dim] force on i of each candidate, 0 when not in contact */
     int32_t *ord;        /* per part P of the grains, its grains k with candidates
@@ -117,11 +121,7 @@ size_t pk_dem_eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const
  * periodic AVX2 path keeps each block's geometry in L1 buffers instead of
  * writing ~40 B per candidate to the pair arrays): the relaxation
  * iterations' evaluation.  Call pk_dem_eval at x before reading them (the
- * values are a function of x: the same bits as if they had been stored).
- * Measured (round 11, before eval_2d_loop was inlined per call): the 40 B
- * per candidate not written, 2–9 % less time than pk_dem_eval on 10⁴
- * random grains (noisy machine); the relaxation's figures at
- * core/homog/homog_relax.c (relax). */
+ * values are a function of x: the same bits as if they had been stored). */
 size_t pk_dem_eval_forces(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
                           size_t np, double E, double *f);
 /* 1: pk_dem_eval_forces stores the geometry as pk_dem_eval does (tests:

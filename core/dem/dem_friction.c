@@ -1,3 +1,5 @@
+/* dem_friction.c — 2D inter-particle friction (Meier 2009 ch. 7, Table 7.1):
+ * return map, forces and couples, history; contract: dem_friction.h. */
 #include "dem_friction.h"
 
 #include <math.h>

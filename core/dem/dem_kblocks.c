@@ -1,3 +1,5 @@
+/* dem_kblocks.c — the contact stiffness as a compact block list for repeated
+ * K·v on one mask; contract: dem_kblocks.h. */
 #include "dem_kblocks.h"
 
 #include <stdlib.h>
@@ -71,14 +73,8 @@ static inline void kv_loop(const pk_dem_kblocks *kb, const int dim, const double
     }
 }
 
-/* kv_loop for dim = 2 written out (the compiler kept the axis loops).
- * Dropped (round 12, both bit for bit; 10⁴ grains, 14,000 blocks, CPU time
- * per block): the arithmetic of four blocks in AVX2 lanes, the sums added
- * into out afterwards in block order (−20 % instructions: the bench step's
- * K·v 1.83 → 1.46·10⁹, seed 7) but 2.6 → 3.7 ns (the lanes' results stored
- * and reloaded per block); out_i of a run of equal i kept in registers
- * (the same additions in order) 2.6 → 3.2 ns (runs of ~1.4 blocks: the
- * run test mispredicts); l stored as [3][n] instead of [n][3]: no change. */
+/* kv_loop for dim = 2 written out (the compiler kept the axis loops); the
+ * variants tried are in docs/perf/dem.md (kv_2d). */
 static void kv_2d(const pk_dem_kblocks *kb, const double *v, double *out)
 {
     for (size_t p = 0; p < kb->n; p++) {

@@ -1,5 +1,5 @@
 /* test_dem_images.c — the periodic image of each candidate pair is fixed at
- * the list's build (pk_dem_pairs.sh, core/dem/dem_contact.c): pk_dem_eval must
+ * the list's build (pk_dem_pairs.sh, core/dem/dem_pairs.c): pk_dem_eval must
  * still give the contacts and forces of the minimum image at the positions
  * and F̄ it is given —
  *   - after F̄ changed on the same list, grains not moved (the images are

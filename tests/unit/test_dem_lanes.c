@@ -1,5 +1,5 @@
 /* test_dem_lanes.c — the AVX2 geometry lanes of the 2D pk_dem_eval
- * (core/dem/dem_contact.c) give the scalar loop's numbers bit for bit: l, |l|,
+ * (core/dem/dem_eval_loops.c) give the scalar loop's numbers bit for bit: l, |l|,
  * ε of every candidate, the contact count, forces, energy and the contact
  * sum S.  Sheared periodic and open boxes, uniform and class-specific
  * stiffness, candidate counts spanning several evaluation blocks with short

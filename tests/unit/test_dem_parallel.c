@@ -1,5 +1,5 @@
 /* test_dem_parallel.c — the parallel contact evaluation (pk_dem_pairs.par,
- * core/dem/dem_contact.c eval_par) gives the serial results bit for bit for 1–4
+ * core/dem/dem_eval_par.c) gives the serial results bit for bit for 1–4
  * threads: forces, contact counts, and for pk_dem_eval the pair arrays l,
  * |l|, ε, the energy and S.  Scenes: random 2D periodic (sheared) and open
  * boxes with overlaps, class-specific stiffness, grains moved after the
