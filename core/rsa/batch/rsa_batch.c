@@ -67,8 +67,9 @@
 #define REGION_STEPS_MIN 6
 #define REGION_GRAINS_PER_ENTRY 128.0
 
-int pk_rsa_batch_usable(const pk_box *b, double r, double gap, const double *lo,
-                        const double *span, size_t m)
+/* 1 if a cell store for grains of radius r over this draw range serves the
+ * box and stays O(m) for a run of m grains; decided without drawing. */
+static int usable(const pk_box *b, double r, double gap, const double *span, size_t m)
 {
     uint64_t nc = pk_rsa_cells_count(b, r, gap, span);
     return nc > 0 && nc <= (uint64_t)CELLS_PER_GRAIN * m + CELLS_FREE;
@@ -609,12 +610,20 @@ static inline size_t draw_of(const scratch *w, int region, size_t a)
     return region ? w->ord[a] : a;
 }
 
-pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *species, size_t m,
-                                const double *lo, const double *span, const pk_rsa_params *prm,
-                                const pk_grid *grid, pk_rng *rng, pk_monitor *mon,
-                                pk_progress *pg, double box_measure, double *solid,
-                                pk_particles *out, pk_rsa_stats *st)
+/* The run in batches of attempts (README.md, steps 1-4). */
+static pk_stop_reason run_batches(const pk_rsa_batch_env *e, double r, const int32_t *species,
+                                  size_t m, const double *lo, const double *span)
 {
+    const pk_box *b = e->b;
+    const pk_rsa_params *prm = e->prm;
+    const pk_grid *grid = e->grid;
+    pk_rng *rng = e->rng;
+    pk_monitor *mon = e->mon;
+    pk_progress *pg = e->pg;
+    const double box_measure = e->box_measure;
+    double *solid = e->solid;
+    pk_particles *out = e->out;
+    pk_rsa_stats *st = e->st;
     pk_rsa_cells C;
     if (pk_rsa_cells_init(&C, b, r, prm->delta_d, lo, span) != 0)
         return PK_STOP_ERROR;
@@ -636,7 +645,7 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
     const size_t first = out->n;
     pk_rsa_region reg;
     memset(&reg, 0, sizeof reg);
-    int region = 0, region_allowed = !prm->batch_plain_draws;
+    int region = 0, region_allowed = prm->draws == PK_RSA_DRAWS_OPEN;
     uint64_t stale_since = 0; /* draws in fully covered cells since the last compaction */
 
     pk_stop_reason reason = PK_STOP_COMPLETE;
@@ -654,7 +663,7 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
             reason = PK_STOP_SATURATED; /* every fine voxel lies in an exclusion ball */
             break;
         }
-        size_t B = prm->batch_attempts;
+        size_t B = prm->test.batch_attempts;
         if (!B) {
             double want = SURVIVORS / p_surv, finish = 2.0 * (double)(m - placed) / p_acc;
             want = want < finish ? want : finish;
@@ -803,4 +812,16 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
     free(map);
     pk_rsa_cells_free(&C);
     return reason;
+}
+
+int pk_rsa_batch_place(const pk_rsa_batch_env *e, double r, const int32_t *species, size_t m,
+                       const double *lo, const double *span, pk_stop_reason *why)
+{
+    const uint32_t min_run = e->prm->test.batch_min_run;
+    if (m < (min_run ? min_run : PK_RSA_BATCH_MIN_RUN) ||
+        !usable(e->b, r, e->prm->delta_d, span, m))
+        return 0;
+    *why = e->enter && e->enter(e->ctx) != 0 ? PK_STOP_ERROR
+                                              : run_batches(e, r, species, m, lo, span);
+    return 1;
 }
