@@ -5,9 +5,10 @@
  * The monodisperse cases without suffix take the default path (batched runs of
  * equal grains, rsa_batch.h, drawing from the open region once most draws
  * fail, rsa_region.h); *_batch_plain the batched path with plain draws all
- * along (batch_plain_draws: the packing of plain draws, bit for bit); *_plain
- * runs the reference (one uniform draw at a time, pk_rsa_params.plain_draws)
- * and *_voxels the per-grain voxel-pruned path (no_batch) for the ratios;
+ * along (draws = plain: the packing of plain draws, bit for bit); *_plain
+ * runs the reference (draws = plain, test.one_at_a_time: one uniform draw at a
+ * time) and *_voxels the per-grain voxel-pruned path (draws = open,
+ * test.one_at_a_time) for the ratios;
  * 1e6 plain and voxels are left out (a minute / 20 s).  Each run is a child
  * process of its own (fresh memory, as a job's worker), each default-path
  * case runs several times (reps=; 9, 5, 3 at 10^4, 10^5, 10^6) and its line
@@ -100,8 +101,9 @@ static double mono_once(const char *name, int dim, size_t n, double phi, enum pa
     pk_particles p;
     pk_particles_init(&p, dim, n);
     pk_rsa_params prm = {.delta_d = 0, .max_failed_draws = 1000000, .seed = 1,
-                         .plain_draws = path == PLAIN, .no_batch = path == VOXELS,
-                         .batch_plain_draws = path == BATCH_PLAIN};
+                         .draws = path == PLAIN || path == BATCH_PLAIN ? PK_RSA_DRAWS_PLAIN
+                                                                       : PK_RSA_DRAWS_OPEN,
+                         .test.one_at_a_time = path == PLAIN || path == VOXELS};
     pk_rsa_stats st;
     struct rusage ru0, ru;
     getrusage(RUSAGE_SELF, &ru0);

@@ -1,5 +1,6 @@
 /* pack_place_rsa.c — the 'rsa' placer: core/rsa/rsa with the job's "rsa" options. */
 #include <stdio.h>
+#include <string.h>
 
 #include "pack_placer.h"
 
@@ -9,9 +10,12 @@ static int place_rsa(const pk_pack_job *job, const pk_pack_plan *plan, const pk_
 {
     (void)plan;
     json_t *opt = json_object_get(job->inputs, "rsa");
+    const char *draws = json_string_value(json_object_get(opt, "draws")); /* "open" | "plain" */
     pk_rsa_params prm = {.delta_d = job->delta_d,
                          .max_failed_draws = (uint64_t)pk_json_int_or(opt, "max_failed_draws", 1000000),
-                         .seed = job->seed};
+                         .seed = job->seed,
+                         .draws = draws && strcmp(draws, "plain") == 0 ? PK_RSA_DRAWS_PLAIN
+                                                                       : PK_RSA_DRAWS_OPEN};
     pk_rsa_stats rs;
     if (pk_rsa_place(&job->box, sz->d, sz->species, sz->n, &prm, mon, p, &rs) != 0) {
         snprintf(err, errlen, "RSA placement failed (%s)", pk_stop_reason_name(rs.reason));

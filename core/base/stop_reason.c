@@ -1,4 +1,6 @@
-#include "core/rsa/rsa.h"
+/* stop_reason.c — the stable machine names of the reasons a placement run ends.
+ * Contract: core/base/stop_reason.h. */
+#include "stop_reason.h"
 
 const char *pk_stop_reason_name(pk_stop_reason r)
 {

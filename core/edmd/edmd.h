@@ -25,7 +25,8 @@
 #include "core/space/box.h"
 #include "core/space/particles.h"
 #include "core/base/progress.h"
-#include "core/rsa/rsa.h"
+#include "core/base/stop_reason.h"
+#include "core/rsa/rsa.h" /* pk_rsa_stats of the RSA start */
 
 typedef enum pk_edmd_growth {
     /* d_i(t) = d_i·s(t), s' = γ, d_i the FINAL diameter: size ratios exact (Meier,

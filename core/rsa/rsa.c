@@ -1,3 +1,5 @@
+/* rsa.c — random sequential addition, one grain at a time or, for runs of equal
+ * grains, through the batched path.  Contract: core/rsa/rsa.h, core/rsa/README.md. */
 #include "rsa.h"
 
 #include <math.h>
@@ -90,6 +92,20 @@ static int end_segment(segment *sg, pk_grid *grid, const pk_particles *out)
     return rc;
 }
 
+/* A batched run's entry hook (pk_rsa_batch_env.enter): the grid must hold
+ * every grain placed so far. */
+typedef struct segment_exit {
+    segment *sg;
+    pk_grid *grid;
+    const pk_particles *out;
+} segment_exit;
+
+static int leave_segment(void *ctx)
+{
+    segment_exit *x = ctx;
+    return x->sg->on ? end_segment(x->sg, x->grid, x->out) : 0;
+}
+
 int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *species, size_t n,
                  const pk_rsa_params *prm, pk_monitor *mon, pk_particles *out,
                  pk_rsa_stats *st)
@@ -127,9 +143,12 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
     double solid = pk_particles_solid_measure(out);
     pk_progress pg = {.stage = "rsa", .total = n, .eta_s = -1};
 
-    segment sg = {.on = 0, .retry_below = prm->plain_draws ? 0 : INFINITY};
-    const size_t min_run = prm->batch_min_run ? prm->batch_min_run : PK_RSA_BATCH_MIN_RUN;
-    size_t no_batch_below = prm->plain_draws || prm->no_batch ? SIZE_MAX : 0;
+    segment sg = {.on = 0, .retry_below = prm->draws == PK_RSA_DRAWS_PLAIN ? 0 : INFINITY};
+    size_t no_batch_below = prm->test.one_at_a_time ? SIZE_MAX : 0;
+    segment_exit flush = {&sg, &grid, out};
+    const pk_rsa_batch_env env = {.b = b, .prm = prm, .grid = &grid, .rng = &rng, .mon = mon,
+                                  .pg = &pg, .box_measure = box_measure, .solid = &solid,
+                                  .out = out, .st = st, .enter = leave_segment, .ctx = &flush};
     for (size_t i = 0; i < n; i++) {
         double r = 0.5 * diameters[i];
         /* Draw range per axis: walls keep the grain Δd/2 away (spec §2.1). */
@@ -153,15 +172,9 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
         size_t run = 1;
         while (i >= no_batch_below && i + run < n && diameters[i + run] == diameters[i])
             run++;
-        if (i >= no_batch_below && run >= min_run &&
-            pk_rsa_batch_usable(b, r, gap, lo, span, run)) {
-            if (sg.on && end_segment(&sg, &grid, out) != 0) {
-                st->reason = PK_STOP_ERROR;
-                break;
-            }
-            size_t first = out->n;
-            pk_stop_reason why = pk_rsa_batch_run(b, r, &species[i], run, lo, span, prm, &grid,
-                                                  &rng, mon, &pg, box_measure, &solid, out, st);
+        size_t first = out->n;
+        pk_stop_reason why;
+        if (i >= no_batch_below && pk_rsa_batch_place(&env, r, &species[i], run, lo, span, &why)) {
             for (size_t j = first; why == PK_STOP_COMPLETE && i + run < n && j < out->n; j++)
                 if (pk_grid_insert(&grid, out, j) != 0)
                     why = PK_STOP_ERROR; /* later (smaller) grains see the run's grains */

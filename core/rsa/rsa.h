@@ -9,9 +9,7 @@
  * from the voxels not yet covered (rsa_voxels.h) and none is left, the box is
  * provably full for the next grain: the run stops as PK_STOP_SATURATED.
  * Long runs of equal diameters (monodisperse jobs, discrete size classes) are
- * placed in batches of attempts (rsa_batch.h) with cache-friendly tests; late
- * in such a run the draws come from the space not yet known to be excluded
- * (rsa_region.h). */
+ * placed in batches of attempts (batch/rsa_batch.h, batch/README.md). */
 #ifndef PK_RSA_H
 #define PK_RSA_H
 
@@ -21,41 +19,32 @@
 #include "core/space/box.h"
 #include "core/space/particles.h"
 #include "core/base/progress.h"
+#include "core/base/stop_reason.h"
 
-typedef enum pk_stop_reason {
-    PK_STOP_COMPLETE = 0,        /* every grain placed / target reached */
-    PK_STOP_MAX_FAILED_DRAWS,    /* N^F consecutive failures for one grain */
-    PK_STOP_NO_ROOM,             /* a grain does not fit into the box at all */
-    PK_STOP_CANCELLED,           /* cancel flag or callback */
-    PK_STOP_WALL_TIME,           /* wall-clock limit */
-    PK_STOP_JAMMED,              /* (EDMD) jamming criterion met */
-    PK_STOP_STALLED,             /* (EDMD) no progress */
-    PK_STOP_ERROR,               /* out of memory or invalid input */
-    PK_STOP_SATURATED            /* no free space is left for the next grain */
-} pk_stop_reason;
-
-/* Stable machine name ("complete", "max_failed_draws", ...). */
-const char *pk_stop_reason_name(pk_stop_reason r);
+/* Where a draw comes from.  Both place each grain uniformly over the space
+ * still open to it (the law of Titscher's draw-until-accepted loop); they
+ * differ in how many draws a grain costs, hence in what a given N^F reaches,
+ * and in the packing a seed gives. */
+typedef enum pk_rsa_draws {
+    PK_RSA_DRAWS_OPEN = 0,       /* "open" (default): late in a run, draws come from the
+                                    space not yet known to be excluded (rsa_voxels.h; runs
+                                    of equal grains: batch/README.md); a run whose open
+                                    space is used up stops as PK_STOP_SATURATED */
+    PK_RSA_DRAWS_PLAIN           /* "plain": uniform over the whole draw range all along,
+                                    Titscher's loop draw for draw (runs of equal grains
+                                    are batched with the same outcome bit for bit) */
+} pk_rsa_draws;
 
 typedef struct pk_rsa_params {
     double delta_d;              /* minimum surface gap Δd (>= 0) */
     uint64_t max_failed_draws;   /* N^F (e.g. 1e6) */
     uint64_t seed;               /* positions use stream 1 of this seed */
-    int plain_draws;             /* 1: uniform draws over the whole range only (the
-                                    reference path of the tests); 0: draws from the
-                                    voxels not yet covered where that pays (same
-                                    statistics, see rsa_voxels.h) */
-    int no_batch;                /* 1: runs of equal diameters also go one grain at a
-                                    time; 0 (default, with plain_draws = 0): runs of at
-                                    least batch_min_run equal grains take the batched
-                                    path (rsa_batch.h), bit-identical to plain draws */
-    int batch_plain_draws;       /* 1: the batched path draws as plain_draws does all
-                                    along (bit-identical to it: the tests' reference);
-                                    0 (default): once most draws fail, it draws from the
-                                    space not yet known excluded (rsa_region.h; same
-                                    statistics, fewer draws, another packing per seed) */
-    uint32_t batch_attempts;     /* attempts per batch; 0 = adaptive (tests fix it) */
-    uint32_t batch_min_run;      /* 0 = PK_RSA_BATCH_MIN_RUN */
+    pk_rsa_draws draws;
+    struct {                     /* test and bench overrides; all 0 in jobs */
+        int one_at_a_time;       /* 1: runs of equal grains are not batched either */
+        uint32_t batch_attempts; /* attempts per batch; 0 = adaptive */
+        uint32_t batch_min_run;  /* shortest run batched; 0 = PK_RSA_BATCH_MIN_RUN */
+    } test;
 } pk_rsa_params;
 
 typedef struct pk_rsa_stats {

@@ -1,3 +1,5 @@
+/* rsa_voxels.c — the voxel set of space not yet known to be covered, for the
+ * one-grain-at-a-time path.  Contract: rsa_voxels.h. */
 #include "rsa_voxels.h"
 
 #include <math.h>

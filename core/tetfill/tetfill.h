@@ -54,7 +54,7 @@
 #include "core/mesh/mesh.h"
 #include "core/space/particles.h"
 #include "core/base/progress.h"
-#include "core/rsa/rsa.h"
+#include "core/base/stop_reason.h"
 #include "tetfill_stats.h"
 
 /* What counts as a contact in the z_min test of a candidate.

@@ -1,11 +1,11 @@
-/* test_rsa_batch.c — the batched path for runs of equal grains (core/rsa/batch/rsa_batch.h)
- * against plain draws one grain at a time (pk_rsa_params.plain_draws): same
+/* test_rsa_batch.c — the batched path for runs of equal grains (core/rsa/batch/README.md)
+ * against plain draws one grain at a time (draws = plain, test.one_at_a_time): same
  * seed → the same packing bit for bit (memcmp of positions, radii, species),
  * the same number of draws and the same stop reason, for 2D and 3D, periodic,
  * walled and mixed axes, with Δd, with grains already present, with several
  * size classes in a row (the rng must be rewound exactly after each run),
  * across batch sizes from 1 attempt to adaptive.  The batched runs here keep
- * plain draws all along (pk_rsa_params.batch_plain_draws); the default, which
+ * plain draws all along (draws = plain); the default (draws = open), which
  * later draws from the open region only, is compared with the plain path
  * statistically in test_rsa_region.c. */
 #include <math.h>
@@ -37,9 +37,10 @@ static void place(const setup *u, size_t batch, uint32_t min_run, pk_particles *
     for (size_t k = 0; k < u->nfixed; k++)
         pk_particles_push(p, u->fixed[k], u->fixed[k][3], 9);
     pk_rsa_params prm = {.delta_d = u->delta_d, .max_failed_draws = u->max_failed, .seed = 21,
-                         .plain_draws = batch == 0, .batch_plain_draws = 1,
-                         .batch_attempts = batch == SIZE_MAX ? 0 : (uint32_t)batch,
-                         .batch_min_run = min_run};
+                         .draws = PK_RSA_DRAWS_PLAIN,
+                         .test = {.one_at_a_time = batch == 0,
+                                  .batch_attempts = batch == SIZE_MAX ? 0 : (uint32_t)batch,
+                                  .batch_min_run = min_run}};
     CHECK(pk_rsa_place(&u->box, u->d, u->sp, u->n, &prm, NULL, p, st) == 0);
 }
 

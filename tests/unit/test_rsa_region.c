@@ -246,7 +246,7 @@ static void freeze(frozen *F, int dim, size_t n, double phi, double gap)
         d[i] = 1.0;
     pk_particles_init(&F->p, dim, n);
     pk_rsa_params prm = {.delta_d = gap, .max_failed_draws = 1000000, .seed = 77,
-                         .plain_draws = 1};
+                         .draws = PK_RSA_DRAWS_PLAIN};
     pk_rsa_stats st;
     CHECK(pk_rsa_place(&F->box, d, sp, n, &prm, NULL, &F->p, &st) == 0 && st.placed == n);
     free(d);
@@ -386,7 +386,7 @@ static void mono_run(int dim, size_t n, double phi, uint64_t seed, int plain, pk
         d[i] = 1.0;
     pk_particles_init(p, dim, n);
     pk_rsa_params prm = {.delta_d = 0, .max_failed_draws = 1000000, .seed = seed,
-                         .plain_draws = plain};
+                         .draws = plain ? PK_RSA_DRAWS_PLAIN : PK_RSA_DRAWS_OPEN};
     CHECK(pk_rsa_place(b, d, sp, n, &prm, NULL, p, st) == 0);
     free(d);
     free(sp);

@@ -36,10 +36,11 @@ static void mono_run(int dim, size_t n, double phi, uint64_t seed, int plain, pk
     for (size_t i = 0; i < n; i++)
         d[i] = 1.0;
     pk_particles_init(p, dim, n);
-    /* no_batch: equal grains would otherwise take the batched path (which
+    /* one at a time: equal grains would otherwise take the batched path (which
      * equals the plain one bit for bit, test_rsa_batch.c) and skip the voxels */
     pk_rsa_params prm = {.delta_d = 0, .max_failed_draws = 1000000, .seed = seed,
-                         .plain_draws = plain, .no_batch = 1};
+                         .draws = plain ? PK_RSA_DRAWS_PLAIN : PK_RSA_DRAWS_OPEN,
+                         .test.one_at_a_time = 1};
     CHECK(pk_rsa_place(b, d, sp, n, &prm, NULL, p, st) == 0);
     free(d);
     free(sp);
@@ -122,7 +123,7 @@ static void test_saturated_stop(void)
     /* the plain path cannot know: it stops after N_F failures */
     pk_particles_free(&p);
     pk_particles_init(&p, 2, 2);
-    prm.plain_draws = 1;
+    prm.draws = PK_RSA_DRAWS_PLAIN;
     prm.max_failed_draws = 20000;
     CHECK(pk_rsa_place(&b, d, sp, 2, &prm, NULL, &p, &st) == 0);
     CHECK(st.reason == PK_STOP_MAX_FAILED_DRAWS && st.placed == 1);
@@ -180,7 +181,8 @@ static void test_fast_respects_present_grains(void)
     int32_t *sp = calloc(n, sizeof *sp);
     for (size_t i = 0; i < n; i++)
         d[i] = 0.5;
-    pk_rsa_params prm = {.delta_d = 0.02, .max_failed_draws = 100000, .seed = 8, .no_batch = 1};
+    pk_rsa_params prm = {.delta_d = 0.02, .max_failed_draws = 100000, .seed = 8,
+                         .test.one_at_a_time = 1};
     pk_rsa_stats st;
     CHECK(pk_rsa_place(&b, d, sp, n, &prm, NULL, &p, &st) == 0);
     CHECK(p.n == 4 + st.placed && st.placed > 1000);

@@ -1,3 +1,5 @@
+/* rsa_batch.c — batched RSA for runs of equal grains: draw, filter against the
+ * cell store, walk in attempt order, store.  Contract: rsa_batch.h, README.md. */
 #include "rsa_batch.h"
 #include "core/base/rng.h"
 
@@ -7,29 +9,17 @@
 #include "rsa_cells.h"
 #include "rsa_region.h"
 
-/* Batch size: B = SURVIVORS / (survivors per draw of the last batch), at
- * least B_MIN draws, at most B_MAX (bounded memory: 5 bytes of scratch per
- * region draw, ~130 per attempt — region draws rejected at once make no
- * attempt).  Small batches win: a batch's scratch (~300 KB at 512 survivors)
- * stays in the per-core cache, and each batch's grains are marked before the
- * next batch draws (fewer draws into space just closed).  Survivors per batch
- * against the rate (medians of 4 alternating runs, 3D φ = 0.30, M/s at
- * 10^4 / 10^5 / 10^6 grains; draws per grain at 10^6):
- *   32 768: 0.78 / 0.94 / 1.13 (15.59)    512: 1.20 / 1.21 / 1.19 (15.31)
- *    8 192: 0.89 / 0.99 / 1.15 (15.39)    256: 1.22 / 1.24 / 1.17 (15.27)
- *    1 024: 1.17 / 1.10 / 1.18 (15.29)    128: 1.33 / 1.23 / 1.16 (15.30)
- * (32 768 until the tenth session: meant to share cache lines between the
- * cell-ordered tests of a batch, which at 10^6 grains are too sparse to share
- * them anyway.)  B_MIN 1024 or 2048 instead of 4096: 10^6 no faster. */
+/* The tuned constants below: what each was measured against, docs/perf/rsa.md. */
+/* Batch size: B = SURVIVORS / (survivors per draw of the last batch) draws,
+ * between B_MIN and B_MAX: a batch's scratch stays in the per-core cache
+ * (docs/perf/rsa.md: mono3d_phi030_1e4..1e6, 1.19 M/s at 10^6). */
 #define B_MIN 4096
-/* Prefetch distance of the region draws' mark look-up (draws; the draw
- * arrays have this much slack: no bound tests in the look-up loop).  128
- * instead of 64 with batches of 512 survivors: 10^6 grains 1.42 -> 1.45-1.46
- * M/s in two series of 5 alternating runs (the list entry read for the mark's
- * prefetch was the pick's stall, perf); 192 and 256 no better. */
-#define PICK_AHEAD 128
 #define B_MAX ((size_t)1 << 20)
 #define SURVIVORS 512.0
+/* Prefetch distance of the region draws' list and mark look-ups (draws; the
+ * draw arrays have this much slack: no bound tests in the look-up loop;
+ * mono3d_phi030_1e6: +2 % over 64). */
+#define PICK_AHEAD 128
 /* Counting sort of attempts by cell: at most this many buckets (contiguous
  * ranges of cell indices), so the scatter writes few streams. */
 #define MAX_BUCKETS 4096
@@ -37,38 +27,33 @@
  * a huge box keep the per-grain path). */
 #define CELLS_PER_GRAIN 64
 #define CELLS_FREE 65536
-/* Draws come from the open region (rsa_region.h) once a batch accepted fewer
- * than this fraction of its draws and at least REGION_MIN_LEFT grains remain:
- * from there on plain draws are mostly wasted (φ ≈ 0.2 of 0.3 for equal
- * spheres), marking exclusion balls pays. */
+/* Draws come from the open region once a batch accepted fewer than this
+ * fraction of its draws and at least REGION_MIN_LEFT grains remain (equal
+ * spheres: from φ ≈ 0.2 on). */
 #define REGION_SWITCH_ACC 0.2
-/* Cost of a draw into a fully covered cell over a list entry's in a compaction. */
-#define STALE_PER_PASS 16
 #define REGION_MIN_LEFT 256
+/* Compact the open list once the draws into fully covered cells since the
+ * last compaction cost about one pass over it (a stale draw ≈ this many list
+ * entries; 10^6 grains: three compactions, 15.6 draws per grain). */
+#define STALE_PER_PASS 16
 /* Region cells per store cell and axis: edge ≈ c/2, fine voxels ≈ c/8 in 3D
- * (c/16 in 2D).  Halving the edge again (or 16 steps of the mark table) saved
- * fewer draws than the marks cost more (callgrind, 3D φ = 0.30).  At most
- * REGION_CELLS_PER_GRAIN region cells per grain of the run (12 bytes each). */
+ * (c/16 in 2D); at most REGION_CELLS_PER_GRAIN region cells per grain of the
+ * run (12 bytes each). */
 #define REGION_SPLIT 2
 #define REGION_CELLS_PER_GRAIN 64
 /* Obstacles of other sizes (grains placed before the run) are marked only
  * while their exclusion radius is at most this many contact distances (the
  * cost grows with its square; unmarked obstacles only cost draws). */
 #define REGION_MAX_OBSTACLE 3.0
-/* Steps of the mark table per axis (rsa_region.h): finer steps mark more of
- * each exclusion ball (delta 0.054 c at 8 steps, 0.027 c at 16: 20 % fewer
- * exact tests at φ = 0.30), but the table's steps³ entries cost ~40 000
- * instructions each to make, so steps = cbrt(m / 128) for a run of m grains,
- * between 6 and 16.  Against 8 steps, 3D φ = 0.30: 10^4 grains (6 steps) -4 %
- * instructions, 10^5 (9) ±0, 10^6 (16) -7 % instructions and -5 % last-level
- * misses (callgrind, cachegrind); 16 steps at 10^5 +8 %, 4 steps at 10^5
- * +17 %.  Wall clock at 10^6: no difference beyond the noise (the table, then
- * 4.6 MB, outgrows the L2 cache, marks take longer, draws less). */
+/* Steps of the mark table per axis: cbrt(m / REGION_GRAINS_PER_ENTRY) for a
+ * run of m grains, at least REGION_STEPS_MIN, at most PK_RSA_REGION_MAX_STEPS
+ * (finer steps mark more, but each entry costs ~40 000 instructions). */
 #define REGION_STEPS_MIN 6
 #define REGION_GRAINS_PER_ENTRY 128.0
 
-int pk_rsa_batch_usable(const pk_box *b, double r, double gap, const double *lo,
-                        const double *span, size_t m)
+/* 1 if a cell store for grains of radius r over this draw range serves the
+ * box and stays O(m) for a run of m grains; decided without drawing. */
+static int usable(const pk_box *b, double r, double gap, const double *span, size_t m)
 {
     uint64_t nc = pk_rsa_cells_count(b, r, gap, span);
     return nc > 0 && nc <= (uint64_t)CELLS_PER_GRAIN * m + CELLS_FREE;
@@ -131,10 +116,9 @@ static void scratch_free(scratch *w)
 }
 
 /* Scratch holds nothing from one batch to the next, so a larger block
- * replaces the old one without a copy (free, then malloc: the heap can hand
- * back pages just freed).  realloc copied each array at each of the plain
- * phase's ~15 steps of growth: 13 000 of 66 000 page faults at 10^6 grains.
- * NULL and *fail set when out of memory (scratch_free still works). */
+ * replaces the old one without realloc's copy (free, then malloc: the heap
+ * can hand back pages just freed).  NULL and *fail set when out of memory
+ * (scratch_free still works). */
 static void *renew(void *p, size_t bytes, int *fail)
 {
     free(p);
@@ -244,8 +228,8 @@ static int batch_hits(const pk_rsa_cells *C, const scratch *w, const uint8_t *ma
     return 0;
 }
 
-/* Prefetch distance of step 4's marks (accepted grains; -6 % time at 10^6
- * grains, mean of 6 runs — the pick's prefetch above is the large part). */
+/* Prefetch distance of the marks of step 4 and region_start (grains;
+ * mono3d_phi030_1e6: -6 % time). */
 #define MARK_AHEAD 4
 /* Marks in flight: grain q + MARK_AHEAD is located (once: the prefetch and
  * the mark share its spot) and its words fetched while grain q is marked. */
@@ -258,169 +242,20 @@ static inline void mark_ahead(pk_rsa_region *reg, pk_rsa_region_spot *ring, size
     *s = pk_rsa_region_locate(reg, x);
     pk_rsa_region_prefetch(reg, *s);
 }
-/* Prefetch distance of the centres read by region_start's marks (grains):
- * the centres come in cell order from the store, so each one is a miss in the
- * particle array; with it and the mark's rows fetched ahead region_start took
- * ~30 % less time at 10^6 grains, the run 9-11 % less CPU (same marks, same
- * packing).
- * Round 4 also measured, and dropped (10^6 grains, 3D φ = 0.30, CPU time,
- * alternating runs against the kept version):
- *  - marks in blocks of 2×2×2 cells (a 64-byte line each): a mark's lines
- *    37 -> 27, its last-level misses -15 %, but +11 % instructions (block
- *    index arithmetic in the pick, the point and the prefetch): no faster;
- *  - draws from slots weighted by class (a cell with o open fine voxels gets
- *    2^ceil(log2 o) slots, classes rebuilt at compaction, draw = the s-th open
- *    fine voxel): draws per grain 19 -> 8-14, but the rebuilds (two passes,
- *    new pages) cost more: +25 % CPU;
- *  - the same draws from 64 slots with a bound of the cell's open count in
- *    the list entry (the marks' word read only under the bound): -40 % of
- *    those reads, but +6-15 % CPU (the select and an unpredictable branch);
- *  - table marks without the outer cells (|d| = 2: 9 rows instead of 25):
- *    +11 % draws, slower; without words of fewer than 4-12 marked bits:
- *    +1-4 % draws, no faster;
- *  - compacting the list 2-8 times as often, the region switch at a batch
- *    acceptance of 0.12-0.4 instead of 0.2, mark-table steps 4 or 8 at 10^6:
- *    within the noise or slower;
- *  - transparent huge pages for the 290 MB (74 000 page faults, 0.14-0.18 s
- *    of system time): faults -86 %, system time x3-4 on this machine.
- * Round 5 (the memory a 10^6 run touches: 70 000 pages — marks 111 MB,
- * store 58 MB, list 39 MB, particles 36 MB, scratch ~30 MB) measured, and
- * dropped:
- *  - region draws picked through a ring of 2 x 4096 entries a chunk ahead of
- *    their look-ups, keeping only the draws not rejected at once (9.4 MB of
- *    pick arrays -> 1.5 MB, -3 350 faults, same packings): wall and CPU time
- *    unchanged within the noise (4 alternating pairs) — not worth its code;
- *  - the list as a bitmap with ranks and samples (3.5 MB instead of 39 MB,
- *    -8 000 faults, same packings): the select costs ~65 instructions a draw
- *    and a chain of dependent misses: CPU x1.7-2;
- *  - no list until the first compaction (draws from all cells; -17 MB,
- *    -4 700 faults): draws per grain 19.0 -> 23.3, CPU within the noise;
- *  - region cells of the store's edge (REGION_SPLIT 1: -100 MB, -20 000
- *    faults, -0.06 s system): draws per grain 34.7, CPU +15-20 %;
- *  - the marks' block pre-faulted (mmap MAP_POPULATE): the same faults and
- *    system time — the kernel's cost is per page, not per trap.
- *  - transparent huge pages for every malloc (sixth session; this kernel has
- *    THP on madvise: GLIBC_TUNABLES=glibc.malloc.hugetlb=1): 1,836-2,147
- *    faults instead of 70,066, but 0.62-0.74 s of system time (zeroing and
- *    compacting 2 MB pages) against 0.12-0.15 s: 0.63-0.71 against
- *    1.08-1.09 M placements per s (three alternating pairs).  The same
- *    session, quiet machine, no code change: 1.10-1.17 M per s in 5 of 5.
- * Round 6: where a 10^6 run's time goes (3D φ = 0.30, rdtsc per phase, best
- * of 3 on a quiet machine, 2.47 Gcycles): plain draws 16 %; region_start 20 %
- * (its marks 16 %, a third of that the 27 000 first touches of the marks'
- * array, the first compaction 3 %); region draws' pick 20 % (draws 3 %, list
- * and mark look-ups 16 %); point, sort, filter 21 % (the filter 14 %); step 3
- * 5 %; step 4's inserts and marks 18 %; later compactions < 1 % (there is one:
- * the list shrinks 9.7 -> 4.6 M cells).  A page's first touch costs ~2 µs on
- * this machine and unmapping ~0.1 ms per MB: ~0.18 s of the run for its
- * 290 MB.  Kept: marks located once (pk_rsa_region_locate: the prefetch and
- * the mark share the spot) and no bound tests in the pick's look-up loop:
- * -3 % instructions, the same simulated misses (cachegrind), the same
- * packings; wall and CPU time within the noise (5 alternating pairs at a
- * load of 4-5).  Measured and dropped (same packings unless said):
- *  - prefetching only the lines a mark writes (~19 of the ~37 its rows
- *    span): no faster — the marks wait on latency, not on bandwidth;
- *  - tables as runs of adjacent words per row (a switch on the run length):
- *    -30 % of the marks' instructions but slower (the switch mispredicts);
- *  - region cells' coordinates by products with 1/n instead of divisions:
- *    more instructions, the point step no faster;
- *  - the filter's prefetch limited to occupied cells (branches: the run
- *    1.2x slower) or to the cells on the attempt's near sides (the filter
- *    2-3x slower);
- *  - region_start's marks without their rows fetched ahead: slower;
- *  - no marks for the run's last 3-25 % of grains (marks are optional; other
- *    packings): +0.2-18 % draws, no faster;
- *  - step 4's marks limited to cells still listed (counted, not built): 34 %
- *    of their words, but only 21 % of their lines, lie in cells already full
- *    (41 % of the words gain no bit): <= 3 % to gain before a listed-cells
- *    bitmap's cost;
- *  - transparent huge pages for the marks' array: faults -37 %, user time
- *    the same, system time erratic (x1-3);
- *  - one-miss region draws (counted, not built): a copy of the cell's word in
- *    its list entry, taken at compaction, would catch 74 % of the certain
- *    rejections without reading the marks (a 32-bit fold 66 %, an 8-bit
- *    summary of 2x2x2 blocks in spare bits of the entry 51 %, of 4x2x1 blocks
- *    44 %) — but the copy doubles the list (+39 MB, ~+25 ms of first touches
- *    and unmapping) and a summary costs 8-20 operations per listed cell at
- *    each compaction: <= 2 % to gain, within the noise;
- *  - draws weighted by open slots (a list entry per 16 or 32 open fine
- *    voxels, the k-th open voxel drawn): draws x0.3-0.7, but other packings,
- *    a select per draw and popcounts per compaction (round 4's classes:
- *    +25 %): not built.
- * Round 7 (eighth session; 10^6 grains, 3D φ = 0.30, counted: the plain
- * phase places 513 000 grains from 1.27M draws, the region phase 487 000
- * from 17.8M draws, 2.62M attempts (85 % of its draws are certain
- * rejections), 534 000 survivors of step 2).  Kept: the marks OR whole
- * table rows (rsa_region.c: user time 0 to -7 %, the same marks).  Measured
- * and dropped (medians of 4-8 alternating runs, the same packings):
- * PICK_AHEAD 96, 128 or 192 instead of 64 (32: +8 % user time), mark
- * tables of at most 8 or 12 steps instead of 16 (draws per grain 20.8 and
- * 19.6 instead of 19.0): all within the noise.
- * Round 8 (ninth session; 10^6 grains, 3D φ = 0.30; wall time per phase, one
- * run: plain batches 0.08 s, region_start 0.17, picks 0.15, region attempts
- * (point, sort, filter) 0.22, step 3 0.09, step 4 0.17, compactions 0.02).
- * Kept: compaction driven by the draws into fully covered cells (below),
- * 16-byte store records (rsa_cells.h), the marks' pages written before
- * their first read and the marks near a seam by whole rows (rsa_region.c),
- * scratch renewed without realloc's copies — together 95 000 -> 62 000 page
- * faults, system time 0.16-0.20 -> 0.11-0.13 s, user time -1 to -10 %;
- * medians of 8-12 alternating runs, 10^6 grains: 0.85 -> 0.90 and
- * 0.98 -> 1.07 M placements per s in slow states of the machine, 1.03 -> 1.09
- * in a medium one, 1.07 -> 1.17 in a fast one (bench/rsa's case=machine line
- * tells them apart).  Measured
- * and dropped (medians of 4-6 alternating runs): prefetching covered[] in the
- * compaction (34 ms either way, perf); the pick's prefetches as prefetcht2
- * (within the noise); the region switch at a batch acceptance of 0.15-0.3
- * (flat); B_MAX 2^19 or 2^21, SURVIVORS 16 384 or 65 536 (flat or slower);
- * MAX_BUCKETS 1 024 to 262 144 (flat); no counting sort before the filter
- * (user time +5 %).  The pool of cells with two or more grains (2.8 % of
- * the nonempty cells at the end) now takes ~14 % of the filter's samples:
- * a chase the 32-byte records did not make, paid for by half the store.
- * Round 9 (tenth session; 10^6 grains, 3D φ = 0.30; medians of 4-6
- * alternating runs).  Kept: 512 survivors per batch instead of 32 768 (see
- * B_MIN above: 10^6 +4.5 %, 10^5 +31 %, 10^4 +46 %); the 16-bit offsets of
- * two-grain cells (rsa_cells.h: +6 %, the same packings).  Wall time per
- * phase after both, one run in a fast state (0.77 s): picks 0.14 s,
- * region_start 0.15 (its marks 0.08, the marks' first touches ~0.05), step 4
- * of region batches (marks) 0.17, region attempts' filter 0.12, their points
- * and sort 0.04, step 3 0.03, compactions 0.02, the plain phase 0.08.
- * Measured and dropped:
- *  - draws weighted by open fine voxels (cells in 7 classes by their open
- *    count o, 2^ceil(log2 o) slots each, one uniform slot per draw, the s-th
- *    open voxel by a broadword select): draws per grain 15.6 -> 6.6, but a
- *    draw cost 22 instead of 9.5 ns (the same two misses, 3x the
- *    instructions: fewer draws in flight) and a compaction became a
- *    seven-stream scatter over all cells: 10-11 % slower;
- *  - the filter in two passes (the near cells' rows first, the other rows
- *    for the points the first pass kept: 40 % fewer lines fetched): 3 %
- *    slower at 10^6, 16 % at 10^5;
- *  - with 512 survivors: PICK_AHEAD 32 (128: kept, above), MARK_AHEAD 2 or 6, the
- *    filter's look-ahead 4 or 16, STALE_PER_PASS 8 or 32, the region switch
- *    at 0.12, 0.3 or 0.4, mark tables of cbrt(m/64) or cbrt(m/256) steps,
- *    MAX_BUCKETS 256 or 1 024, B_MIN 1 024 or 2 048: all within the noise or
- *    slower; -march=native: the same;
- *  - no list until the first compaction, again (a draw's cell is its
- *    position, one miss instead of two while 30-50 % of the cells are
- *    full): -2 500 faults, draws per grain 15.31 -> 15.70, rate flat;
- *  - the mark table fetched ahead from 256 KB tables on (10^5): flat;
- *  - transparent huge pages for the marks again: the same user time, system
- *    time +0.25 s (a 2 MB page's first touch costs ~4.5 ms here). */
+/* Prefetch distance of the centres region_start marks (grains: they come in
+ * cell order from the store, each a miss in the particle array; with the
+ * marks' rows fetched ahead, mono3d_phi030_1e6: -9..11 % CPU). */
 #define START_AHEAD 16
-/* Prefetch distance of step 4's store records (grains: sorted by cell, but
- * at 10^6 grains a batch's grains are far apart; -4..-6 % CPU at 10^6 grains,
- * alternating runs; 16 the same). */
+/* Prefetch distance of step 4's store records (grains; mono3d_phi030_1e6:
+ * -4..6 % CPU). */
 #define INSERT_AHEAD 8
 
 /* Region draws, step 1a: pick B (cell, fine voxel) pairs, then look their
  * marks up, dropping the certain rejections: for a below the number returned,
  * draw w->rdraw[a] was not rejected at once; cell w->rpos[a], fine voxel
- * w->rbit[a].  At 10^6 grains a batch's draws are far sparser than the cache
- * lines of the list and of the marks, so in any order each look-up is two
- * misses; fetched ahead (the mark's address needs the list entry fetched
- * earlier) they overlap.  (Before: a
- * counting sort by list position to read both as streams — no fewer misses,
- * since the draws are too sparse to share lines; dropping it and prefetching
- * took 18 % off the run's time at 10^6 grains and 10 % at 10^5, best of 8.) */
+ * w->rbit[a].  A batch's draws are far sparser than the cache lines of the list
+ * and of the marks, so each look-up is two misses; fetched ahead (the mark's
+ * address needs the list entry fetched earlier) they overlap. */
 static size_t region_pick(const pk_rsa_region *reg, scratch *w, size_t B, pk_rng *rng)
 {
     pk_rng g0 = *rng, *g = &g0; /* a local copy: in registers, whatever the stores below */
@@ -609,12 +444,20 @@ static inline size_t draw_of(const scratch *w, int region, size_t a)
     return region ? w->ord[a] : a;
 }
 
-pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *species, size_t m,
-                                const double *lo, const double *span, const pk_rsa_params *prm,
-                                const pk_grid *grid, pk_rng *rng, pk_monitor *mon,
-                                pk_progress *pg, double box_measure, double *solid,
-                                pk_particles *out, pk_rsa_stats *st)
+/* The run in batches of attempts (README.md, steps 1-4). */
+static pk_stop_reason run_batches(const pk_rsa_batch_env *e, double r, const int32_t *species,
+                                  size_t m, const double *lo, const double *span)
 {
+    const pk_box *b = e->b;
+    const pk_rsa_params *prm = e->prm;
+    const pk_grid *grid = e->grid;
+    pk_rng *rng = e->rng;
+    pk_monitor *mon = e->mon;
+    pk_progress *pg = e->pg;
+    const double box_measure = e->box_measure;
+    double *solid = e->solid;
+    pk_particles *out = e->out;
+    pk_rsa_stats *st = e->st;
     pk_rsa_cells C;
     if (pk_rsa_cells_init(&C, b, r, prm->delta_d, lo, span) != 0)
         return PK_STOP_ERROR;
@@ -636,7 +479,7 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
     const size_t first = out->n;
     pk_rsa_region reg;
     memset(&reg, 0, sizeof reg);
-    int region = 0, region_allowed = !prm->batch_plain_draws;
+    int region = 0, region_allowed = prm->draws == PK_RSA_DRAWS_OPEN;
     uint64_t stale_since = 0; /* draws in fully covered cells since the last compaction */
 
     pk_stop_reason reason = PK_STOP_COMPLETE;
@@ -654,7 +497,7 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
             reason = PK_STOP_SATURATED; /* every fine voxel lies in an exclusion ball */
             break;
         }
-        size_t B = prm->batch_attempts;
+        size_t B = prm->test.batch_attempts;
         if (!B) {
             double want = SURVIVORS / p_surv, finish = 2.0 * (double)(m - placed) / p_acc;
             want = want < finish ? want : finish;
@@ -783,16 +626,8 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
         }
         if (reason != PK_STOP_COMPLETE)
             break;
-        /* Compaction passes over the list once (~1 ns an entry at 10^6 grains:
-         * 34 ms for the run's passes over 33 million entries, perf) and ends the
-         * draws into fully covered cells (~10 ns each, two misses): compact once
-         * those since the last compaction cost about what a pass does (8, 16 and
-         * 32 per pass measured alike; 2 and 4 compact too rarely: 19.5 and 17.7
-         * draws per grain).  (Before:
-         * once the certain rejections since then reached the list's length — one
-         * compaction at 10^6 grains, 53 % of the list stale by then; now three:
-         * draws per grain 19.0 -> 15.6, user time -2 %, medians of 8 alternating
-         * runs.) */
+        /* compaction: one pass over the list ends the draws into fully
+         * covered cells (STALE_PER_PASS) */
         if (region && (stale_since += w.stale) * STALE_PER_PASS >= reg.nlist) {
             pk_rsa_region_compact(&reg);
             stale_since = 0;
@@ -803,4 +638,16 @@ pk_stop_reason pk_rsa_batch_run(const pk_box *b, double r, const int32_t *specie
     free(map);
     pk_rsa_cells_free(&C);
     return reason;
+}
+
+int pk_rsa_batch_place(const pk_rsa_batch_env *e, double r, const int32_t *species, size_t m,
+                       const double *lo, const double *span, pk_stop_reason *why)
+{
+    const uint32_t min_run = e->prm->test.batch_min_run;
+    if (m < (min_run ? min_run : PK_RSA_BATCH_MIN_RUN) ||
+        !usable(e->b, r, e->prm->delta_d, span, m))
+        return 0;
+    *why = e->enter && e->enter(e->ctx) != 0 ? PK_STOP_ERROR
+                                              : run_batches(e, r, species, m, lo, span);
+    return 1;
 }

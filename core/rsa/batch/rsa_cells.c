@@ -1,3 +1,5 @@
+/* rsa_cells.c — the dense cell store of a batched run and its filter of
+ * attempts.  Contract: rsa_cells.h (exactness: README.md). */
 #include "rsa_cells.h"
 
 #include <stdlib.h>
@@ -302,9 +304,8 @@ static inline double qdist2(const pk_rsa_cells *C, const double *qh, const uint1
 
 /* The grains of a nonempty cell c (corner: x's cell corner + sh) against x
  * (offsets q0 from its own cell's corner).  A two-grain cell is decided by
- * its 16-bit offsets when both lie outside their band: the pool (a miss
- * per entry: 22 % of the filter's samples when every two-grain cell took
- * it, perf) only serves cells of three grains and pairs in the band. */
+ * its 16-bit offsets when both lie outside their band: the pool (a miss per
+ * entry) only serves cells of three grains and pairs in the band. */
 static inline int cell_hits(const pk_rsa_cells *C, const pk_rsa_cell1 *c, const double *q0,
                             const double *sh, const double *px, const double *x)
 {

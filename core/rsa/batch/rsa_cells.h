@@ -1,4 +1,5 @@
-/* rsa_cells.h — dense cell store of equal grains for batched RSA (internal to core/rsa/batch/rsa_batch.c).
+/* rsa_cells.h — dense cell store of equal grains for batched RSA (internal to
+ * core/rsa/batch/rsa_batch.c).
  *
  * The draw range of one grain size is cut into cells of edge h >= c, c = 2r + Δd
  * the contact distance, so a grain can only touch grains of its own and the
@@ -7,37 +8,14 @@
  * one grain inline — its offset from the cell's lower corner as floats and its
  * index in the particle array — or, for a cell with two or more grains, a
  * chain into an overflow pool and the first two grains' offsets in 16-bit
- * steps: a two-grain cell is decided without the pool (a miss per entry)
- * unless a pair falls in that test's band.  An occupancy bitmap (one bit per cell) says
- * which of the 3^dim cells around an attempt hold grains: a test reads 9 (3D)
- * or 3 (2D) runs of three bits and then the nonempty records only, so tests of
- * attempts sorted by cell index stream through memory instead of chasing
- * pointers.  16 bytes and a bit per cell: a million grains at φ = 0.3 take
- * 29 MB.  (Cells of edge ≈ c hold 0.57 grains on average there: at the end 45 %
- * are empty, 52 % hold one grain, 2.8 % two, 0.01 % three.  Records of two
- * inline grains, 32 bytes, took 58 MB and a filter row of three cells spanned
- * two cache lines instead of 1.5; 64-byte records of double centres before
- * that: 116 MB, and cachegrind counted the filter's last-level misses at 10^6
- * grains fall from 34 to 8 million on the way to 32 bytes.  With every
- * two-grain cell chasing the pool, the pool's loads took 22 % of the filter's
- * samples (perf, 10^6 grains); the 16-bit offsets: +6 % placement rate.)
+ * steps.  An occupancy bitmap (one bit per cell) says which of the 3^dim cells
+ * around an attempt hold grains, so a test reads the nonempty records only.
  *
- * Exact all the same: the floats only sort a pair into "closer than contact",
- * "not closer" and a thin band between (relative width PK_RSA_CELLS_BAND of
- * s² = c²); in the band the double positions of the particle array decide
- * with pk_rsa_cells_close, pk_grid's predicate bit for bit.  Outside the band
- * the float answer is that predicate's: an offset is at most 2c (h < 2c), its
- * float rounding at most 2^-23·c, so a squared distance below 4c² is off by
- * less than 2e-6·c² (2·|d|·√3·2^-23·c), farther pairs stay far; the band is
- * ±6e-5·c².  d = (x - corner) - shift - offset is computed in double from
- * corners lo + i·h consistent between store and query (error ~1e-16·L, far
- * below the band for any box under 10^10 contact distances).  The 16-bit
- * offsets of a two-grain cell have their own, wider band (PK_RSA_CELLS_QBAND:
- * a step's error bound above); within it the pool's floats and then the
- * double positions decide as for any pool cell.  The batched
- * path and the one-at-a-time path take the same decisions
- * (tests/unit/test_rsa_batch.c: memcmp against plain draws; queries within
- * 1e-16 of contact against the exact predicate). */
+ * Contract: every test here answers as the exact predicate pk_rsa_cells_close
+ * (pk_grid's, bit for bit) on the double positions of the particle array; the
+ * floats and 16-bit offsets only decide outside a band around contact
+ * (PK_RSA_CELLS_BAND, PK_RSA_CELLS_QBAND), inside it the doubles decide.  Why
+ * the bands suffice: core/rsa/batch/README.md, "Why it is exact". */
 #ifndef PK_RSA_CELLS_H
 #define PK_RSA_CELLS_H
 
@@ -53,10 +31,9 @@
 #define PK_RSA_CELLS_MORE 0x80000000u /* id: the cell's grains are in the pool */
 #define PK_RSA_CELLS_THREE 0x40000000u /* id, with MORE: three or more grains */
 #define PK_RSA_CELLS_POOL 0x3fffffffu /* id, with MORE: the chain's first pool entry */
-/* Offsets of a cell's first two grains in 16-bit steps of h/65536 (the
- * quick test of a two-grain cell) and the band of that test: a step's error
- * e <= √3·h/65536 < 5.3e-5·c (h < 2c) moves a squared distance near contact
- * by less than 2·c·e + e² < 1.1e-4·c², inside ±2^-12·c². */
+/* Offsets of a cell's first two grains in 16-bit steps of h/65536 and the band
+ * of their quick test: a step's error moves a squared distance near contact by
+ * < 1.1e-4·c², inside ±2^-12·c² (README.md, "Why it is exact"). */
 #define PK_RSA_CELLS_QSTEPS 65536.0
 #define PK_RSA_CELLS_QBAND 0x1p-12
 

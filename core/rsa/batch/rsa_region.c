@@ -1,3 +1,5 @@
+/* rsa_region.c — the open region of a batched run: fine-voxel marks from a
+ * table, the list of open cells, region draws.  Contract: rsa_region.h. */
 #include "rsa_region.h"
 
 #include <math.h>
@@ -70,10 +72,8 @@ int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, cons
     }
     memset(R->tcnt, NOT_MADE, ne);
     /* Write one word of each page now: a mark's first access to a page is a
-     * read (|=), which maps the shared zero page, and its write then faults a
-     * second time (10^6 grains: 24 000 of 95 000 faults; -0.01 s of system
-     * time, medians of 4 alternating runs).  The pages are the marks', touched
-     * by the run anyway. */
+     * read (|=), which maps the shared zero page, and its write would then
+     * fault a second time.  The pages are the marks', touched by the run anyway. */
     for (uint64_t i = 0; i < nc; i += 4096 / sizeof *R->covered)
         ((volatile uint64_t *)R->covered)[i] = 0;
     const int D = R->D, W = 2 * D + 1, zr = b->dim == 3;
@@ -325,11 +325,9 @@ static inline uint64_t flip_z(uint64_t v)
 /* Make entry e.  In 3D an entry whose step lies in the upper half of an
  * axis is the mirror image of the one with step Q - 1 - q there (the step
  * centres, the fine voxels and the cells around are symmetric about the
- * cell's middle): made once for the lower octant and mirrored.  Table time
- * at 10^6 grains (16 steps, 4 096 entries) 16-27 -> 5-6 ms, at 10^5 (9)
- * 2.7-4 -> 0.9-1.4 ms, at 10^4 (6) 0.6-1.0 -> 0.2-0.4 ms (2-6 % of the run).
- * A mirrored mark lies within round-off of the direct one's; the margin
- * keeps both inside the ball. */
+ * cell's middle): made once for the lower octant and mirrored.  A mirrored
+ * mark lies within round-off of the direct one's; the margin keeps both
+ * inside the ball. */
 static void make_mirrored(pk_rsa_region *R, size_t e)
 {
     const int Q = R->Q;
@@ -377,11 +375,8 @@ void pk_rsa_region_prefetch(const pk_rsa_region *R, pk_rsa_region_spot s)
         __builtin_prefetch(c + R->roff[q] + D, 1);
     }
     /* The table entry too once the table outgrows a core's cache (16 steps:
-     * 4.6 MB, 1 KB an entry): its rows were the marks' first stall (perf),
-     * and fetching them took the rate at 10^6 grains from 1.23 to 1.34 M/s
-     * (medians of 6-8 alternating runs, either order; with batches of
-     * 32 768 survivors it had gained nothing).  Entries not made yet are
-     * made by the mark itself. */
+     * 4.6 MB, 1 KB an entry; its rows are then the marks' first stall).
+     * Entries not made yet are made by the mark itself. */
     if (R->tab_far && R->tcnt[s.e] != NOT_MADE) {
         const char *t = (const char *)&R->tab[s.e * R->entry];
         for (size_t b = 0; b < R->entry * sizeof *R->tab; b += 64)
@@ -425,11 +420,8 @@ void pk_rsa_region_mark_at(pk_rsa_region *R, pk_rsa_region_spot s)
     const uint32_t rows = R->trows[e];
     if (s.inner) { /* the common case: no wrap, no wall — fixed offsets */
         uint64_t *base = &R->covered[s.word];
-        /* whole rows, two words per operation: against the entry's nonzero
-         * words one at a time (~80 of 125, each with its cell number's
-         * offset), 10^6 grains 3D φ = 0.30, the same marks: user time
-         * −6.6 %, −0.1 % and −3.3 % (three series of 5–10 alternating runs,
-         * means/medians; the machine's state moved between them) */
+        /* whole rows, two words per operation (rather than the entry's
+         * nonzero words one at a time) */
         for (uint32_t m = rows; m; m &= m - 1) {
             const int r = __builtin_ctz(m);
             or_row(base + R->roff[r] - D, w + r * (2 * D + 1), D);
@@ -447,9 +439,7 @@ void pk_rsa_region_mark_at(pk_rsa_region *R, pk_rsa_region_spot s)
             c[k][d + D] = j;
         }
     /* the entry's rows as in the inner case, each with its wrapped or dropped
-     * (y, z) cell; a row's words one by one only where x wraps or meets a wall
-     * (a word at a time over all 125 before: 16 % of the marks' time at 10^6
-     * grains for the 5 % of marks near a seam) */
+     * (y, z) cell; a row's words one by one only where x wraps or meets a wall */
     const int W = 2 * D + 1;
     const int x_whole = s.i[0] - D >= 0 && s.i[0] + D < R->n[0];
     for (uint32_t m = rows; m; m &= m - 1) {

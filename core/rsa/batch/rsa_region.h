@@ -6,17 +6,13 @@
  * S^dim = 64 fine voxels (S = 4 in 3D, 8 in 2D) with one bit each, set once
  * the fine voxel is known to lie inside the exclusion ball B(x_j, c) of one
  * placed grain (pk_rsa_region_mark / _cover; Zhang & Torquato's voxel
- * removal, at a fixed resolution).  A draw picks a listed cell uniformly and one of its 64 fine
- * voxels uniformly: a set bit is a certain rejection at once; otherwise the
+ * removal, at a fixed resolution).  A draw picks a listed cell uniformly and
+ * one of its 64 fine voxels uniformly: a set bit is a certain rejection at once; otherwise the
  * point is uniform in that fine voxel and goes to the exact test.
- * Why this is still exact RSA: all fine voxels have the same volume, so a draw
- * that is not rejected at once is uniform over the union of unmarked fine
- * voxels of the listed cells; that union contains every point still open to
- * the grain (a bit is set only for a fine voxel inside one exclusion ball;
- * cells leave the list only when all 64 bits are set), so the first point the
- * exact test accepts is uniform over the open space — the law of plain
- * draw-until-accepted.  A stale list or a mark not yet made only costs draws.
- * The bits of a cell are one 64-bit word: bit (lz·S + ly)·S + lx. */
+ * Contract: a bit is set only for a fine voxel lying entirely inside one
+ * exclusion ball, and a cell leaves the list only when all 64 bits are set —
+ * what makes region draws exact RSA (core/rsa/batch/README.md, "Why it is
+ * exact").  The bits of a cell are one 64-bit word: bit (lz·S + ly)·S + lx. */
 #ifndef PK_RSA_REGION_H
 #define PK_RSA_REGION_H
 
@@ -66,10 +62,9 @@ typedef struct pk_rsa_region {
                                    listed (nlist = ncell) and list[] is not yet written */
 } pk_rsa_region;
 
-/* Steps of the mark table per axis and cell: with cells of half the store's
- * edge (h ≈ c/2), delta = √3·h/(2·steps) ≈ 0.054 c at 8 steps (512 entries of
- * (2·2 + 1)³ words, 0.5 MB), 0.027 c at 16 (4096 entries, 4.6 MB; a mark
- * reads the rows of its entry that mark, up to 25 of 5 words in 3D). */
+/* Most steps of the mark table per axis and cell: delta = √3·h/(2·steps),
+ * 0.027 c at 16 with h ≈ c/2 (4096 entries of (2·2 + 1)³ words, 4.6 MB; a
+ * mark reads the rows of its entry that mark, up to 25 of 5 words in 3D). */
 #define PK_RSA_REGION_MAX_STEPS 16
 
 /* For the draw range lo[], span[] cut into n[k] cells per axis (the store's
