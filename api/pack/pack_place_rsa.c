@@ -8,9 +8,8 @@ static int place_rsa(const pk_pack_job *job, const pk_pack_plan *plan, const pk_
                      size_t errlen)
 {
     (void)plan;
-    json_t *opt = json_object_get(job->inputs, "rsa");
     pk_rsa_params prm = {.delta_d = job->delta_d,
-                         .max_failed_draws = (uint64_t)pk_json_int_or(opt, "max_failed_draws", 1000000),
+                         .max_failed_draws = job->opt.rsa.max_failed_draws,
                          .seed = job->seed};
     pk_rsa_stats rs;
     if (pk_rsa_place(&job->box, sz->d, sz->species, sz->n, &prm, mon, p, &rs) != 0) {
@@ -25,4 +24,12 @@ static int place_rsa(const pk_pack_job *job, const pk_pack_plan *plan, const pk_
     return 0;
 }
 
-const pk_placer pk_placer_rsa = {.name = "rsa", .check = NULL, .place = place_rsa};
+static const pk_option rsa_rows[] = {
+    {"/rsa/max_failed_draws", PK_OPT_INTEGER, PK_OPT_FIELD(pk_rsa_options, max_failed_draws),
+     .dflt = 1000000, .lo = 1, .hi = 1e10},
+};
+static const pk_option_table rsa_options =
+    PK_OPT_TABLE("pack.inputs.schema.json", pk_rsa_options, rsa_rows, NULL);
+
+const pk_placer pk_placer_rsa = {
+    .name = "rsa", .options = &rsa_options, .check = NULL, .place = place_rsa};
