@@ -1,3 +1,5 @@
+/* process.c — the process table and the one job path (parse once, run);
+ * the contract is in process.h. */
 #include "process.h"
 
 #include <stdio.h>

@@ -1,4 +1,5 @@
-/* homog_job.c — parse and check 'homogenize' inputs; build the F̄ path. */
+/* homog_job.c — the 'homogenize' process's option table, inputs → job with
+ * its checks, the F̄ path; the contract is in homog_job.h. */
 #include "homog_job.h"
 
 #include <math.h>

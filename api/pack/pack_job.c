@@ -277,7 +277,7 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
         plan->phi_resolved = plan->phi_mix = job->has_phi ? job->phi : 0;
         plan->expected_n = (double)job->count;
         if (own->check)
-            own->check(job, plan, errs);
+            own->check(job, plan, job->prepare ? &plan->prepared : NULL, errs);
         return errs->n - before;
     }
     const pk_grading *g = &job->grading;
@@ -402,7 +402,7 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
         check_periodic_jamming(job, plan, errs);
     const pk_placer *placer = pk_placer_find(job->algorithm);
     if (placer && placer->check && errs->n == before)
-        placer->check(job, plan, errs);
+        placer->check(job, plan, job->prepare ? &plan->prepared : NULL, errs);
     return errs->n - before;
 }
 
@@ -415,11 +415,21 @@ void *pk_pack_parse(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *e
     }
     if (pk_pack_job_from_json(inputs, &t->job, errs) == 0) {
         t->job.service = ctx->service;
+        t->job.prepare = !ctx->service;
         if (pk_pack_plan_make(&t->job, &t->plan, errs) == 0)
             return t;
+        pk_pack_free(t);
+        return NULL;
     }
     free(t);
     return NULL;
 }
 
-void pk_pack_free(void *task) { free(task); }
+void pk_pack_free(void *task)
+{
+    pk_pack_task *t = task;
+    const pk_placer *placer = t ? pk_placer_find(t->job.algorithm) : NULL;
+    if (placer && placer->release && t->plan.prepared)
+        placer->release(t->plan.prepared);
+    free(t);
+}

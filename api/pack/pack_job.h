@@ -39,6 +39,8 @@ typedef struct pk_pack_job {
     double wall_time_s;          /* 0 = none */
     int service;                 /* 1: checked for a request to the daemon (check_ctx.h): the
                                   * placer's check opens no file and builds no mesh */
+    int prepare;                 /* 1: the placer's check keeps what it built for the run
+                                  * (plan.prepared: tetfill's mesh, read and built once) */
 } pk_pack_job;
 
 /* What the job implies before anything is drawn. */
@@ -50,6 +52,7 @@ typedef struct pk_pack_plan {
     double expected_n;           /* expected number of grains */
     double scale;                /* expected size scale (count + phi), else 1 */
     double d_max;                /* largest diameter after scaling */
+    void *prepared;              /* the placer's, when job.prepare (pk_placer.release) */
 } pk_pack_plan;
 
 /* The options of the job itself (pack_job.c); each placer has its own. */

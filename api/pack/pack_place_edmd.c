@@ -77,8 +77,10 @@ static void read_params(const pk_pack_job *job, const pk_pack_plan *plan, pk_edm
         prm->phi_target = plan->phi_resolved;
 }
 
-static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, pk_schema_errors *errs)
+static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, void **prepared,
+                       pk_schema_errors *errs)
 {
+    (void)prepared;
     pk_edmd_params prm;
     read_params(job, plan, &prm);
     if (prm.growth == PK_EDMD_GROW_SHELL && prm.start_zero)

@@ -1,4 +1,5 @@
-/* pack_place_rsa.c — the 'rsa' placer: core/rsa/rsa with the job's "rsa" options. */
+/* pack_place_rsa.c — the 'rsa' placer: core/rsa/rsa with the job's "rsa"
+ * options; the contract is in pack_placer.h. */
 #include <stdio.h>
 
 #include "pack_placer.h"

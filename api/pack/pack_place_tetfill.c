@@ -148,20 +148,6 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
     return 0;
 }
 
-static void check_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, pk_schema_errors *errs)
-{
-    (void)plan;
-    tetfill_setup S;
-    const char *ptr, *rule;
-    char err[512];
-    if (job->service && json_object_get(job->mesh, "file"))
-        return; /* a request to the daemon: the worker reads and checks the file */
-    if (setup(job, &S, &ptr, &rule, err, sizeof err) != 0) {
-        pk_schema_errors_add(errs, ptr, rule, "%s", err);
-        return;
-    }
-    pk_mesh_free(&S.mesh);
-}
 
 static json_t *ints_json(const int64_t *v, size_t n)
 {
@@ -269,39 +255,65 @@ static void free_setup(void *extra)
     free(S);
 }
 
+/* The mesh read (or the box meshed) and the radii checked; kept for the run
+ * in *prepared when given (read once). */
+static void check_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, void **prepared,
+                          pk_schema_errors *errs)
+{
+    (void)plan;
+    const char *ptr, *rule;
+    char err[512];
+    if (job->service && json_object_get(job->mesh, "file"))
+        return; /* a request to the daemon: the worker reads and checks the file */
+    tetfill_setup *S = malloc(sizeof *S);
+    if (!S) {
+        pk_schema_errors_add(errs, "/tetfill", "memory", "out of memory");
+        return;
+    }
+    if (setup(job, S, &ptr, &rule, err, sizeof err) != 0) {
+        pk_schema_errors_add(errs, ptr, rule, "%s", err);
+        free(S);
+    } else if (prepared && !job->service)
+        *prepared = S;
+    else
+        free_setup(S);
+}
+
 static int place_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, const pk_sizes *sz,
                          pk_monitor *mon, pk_particles *p, pk_place_stats *st, char *err,
                          size_t errlen)
 {
-    (void)plan;
     (void)sz;
-    tetfill_setup *S = malloc(sizeof *S);
+    tetfill_setup *S = plan->prepared; /* the check's, or built here */
+    const int own = !S;
     const char *ptr, *rule;
-    if (!S) {
+    if (own && !(S = malloc(sizeof *S))) {
         snprintf(err, errlen, "out of memory");
         return -1;
     }
-    if (setup(job, S, &ptr, &rule, err, errlen) != 0) {
+    if (own && setup(job, S, &ptr, &rule, err, errlen) != 0) {
         free(S);
         return -1;
     }
     pk_tetfill_stats ts;
     if (pk_tetfill(&S->mesh, &S->prm, mon, p, &ts) != 0) {
         snprintf(err, errlen, "tet filling failed (%s)", pk_stop_reason_name(ts.reason));
-        free_setup(S);
+        if (own)
+            free_setup(S);
         return -1;
     }
     pk_tetfill_measures ms;
     if (pk_tetfill_measure(&S->mesh, p, S->prm.r_min, S->prm.eps, &ms) != 0) {
         snprintf(err, errlen, "out of memory measuring the packing");
-        free_setup(S);
+        if (own)
+            free_setup(S);
         return -1;
     }
     *st = (pk_place_stats){.reason = ts.reason, .placed = p->n, .requested = job->count,
                            .seconds = ts.seconds, .has_domain = 1,
                            .domain_measure = S->mesh.volume,
                            .overlap_tol = S->prm.eps * S->prm.r_min, .extra = S,
-                           .write_extra = write_mesh, .free_extra = free_setup};
+                           .write_extra = write_mesh, .free_extra = own ? free_setup : NULL};
     st->domain_box.dim = 3;
     for (int k = 0; k < 3; k++)
         st->domain_box.L[k] = S->mesh.hi[k];
@@ -314,4 +326,5 @@ const pk_placer pk_placer_tetfill = {.name = "tetfill",
                                      .own_sizes = 1,
                                      .options = &tetfill_options,
                                      .check = check_tetfill,
+                                     .release = free_setup,
                                      .place = place_tetfill};

@@ -55,8 +55,11 @@ typedef struct pk_placer {
     int own_sizes;        /* 1 = the placer makes its own sizes: no grading, no size draw */
     const pk_option_table *options; /* fills job->opt (pack_options.h), or NULL */
     /* Semantic checks of the placer's own inputs (schema already passed);
-     * may be NULL. */
-    void (*check)(const pk_pack_job *job, const pk_pack_plan *plan, pk_schema_errors *errs);
+     * may be NULL.  With job->prepare it may leave in *prepared what it built
+     * for the run (plan->prepared), freed by release. */
+    void (*check)(const pk_pack_job *job, const pk_pack_plan *plan, void **prepared,
+                  pk_schema_errors *errs);
+    void (*release)(void *prepared);
     /* Place the grains (diameters sz->d, descending) into job->box, appending
      * to p (initialised, dim = job->dim).  0 when the run ended cleanly for
      * whatever reason (st->reason), -1 on failure with err. */

@@ -1,4 +1,5 @@
-/* pack_run.c — run a 'pack' job: sizes → placement → audit → result file. */
+/* pack_run.c — run a parsed 'pack' job: sizes → placement → audit → result
+ * file; the contract is in pack_job.h (pk_pack_run). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
