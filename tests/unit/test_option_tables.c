@@ -68,6 +68,7 @@ static int check_row(json_t *doc, const pk_option_table *t, const pk_option *o, 
     json_t *dflt = pk_option_default_json(o, filled);
     int with_default = 0;
     double lo = INFINITY, hi = -INFINITY;
+    json_t *values = json_array();
     for (size_t i = 0; i < n; i++) {
         json_t *d = json_object_get(nodes[i], "default");
         if (d) {
@@ -85,21 +86,38 @@ static int check_row(json_t *doc, const pk_option_table *t, const pk_option *o, 
             lo = fmin(lo, json_number_value(mn));
         if (mx)
             hi = fmax(hi, json_number_value(mx));
-        if (o->type == PK_OPT_ENUM) { /* every schema value is a name of the row */
+        if (o->type == PK_OPT_ENUM) { /* the schema's values (enum or const) */
             json_t *vals = json_object_get(nodes[i], "enum"), *v;
+            if (json_object_get(nodes[i], "const"))
+                json_array_append(values, json_object_get(nodes[i], "const"));
             size_t k;
-            json_array_foreach(vals, k, v) {
-                int found = 0;
-                for (size_t j = 0; o->names[j]; j++)
-                    found |= json_is_string(v) && !strcmp(o->names[j], json_string_value(v));
-                if (!found) {
-                    fprintf(stderr, "  %s: schema value %s not in the table\n", o->pointer,
-                            json_string_value(v));
-                    bad++;
-                }
+            json_array_foreach(vals, k, v) json_array_append(values, v);
+        }
+    }
+    if (o->type == PK_OPT_ENUM) { /* the same names in the table and the schema */
+        size_t k;
+        json_t *v;
+        json_array_foreach(values, k, v) {
+            int found = 0;
+            for (size_t j = 0; o->names[j]; j++)
+                found |= json_is_string(v) && !strcmp(o->names[j], json_string_value(v));
+            if (!found) {
+                fprintf(stderr, "  %s: schema value %s not in the table\n", o->pointer,
+                        json_string_value(v));
+                bad++;
+            }
+        }
+        for (size_t j = 0; o->names[j]; j++) {
+            int found = 0;
+            json_array_foreach(values, k, v) found |=
+                json_is_string(v) && !strcmp(o->names[j], json_string_value(v));
+            if (!found) {
+                fprintf(stderr, "  %s: table name %s not in the schema\n", o->pointer, o->names[j]);
+                bad++;
             }
         }
     }
+    json_decref(values);
     if (dflt && !with_default) {
         fprintf(stderr, "  %s: the table has a default, the schema none\n", o->pointer);
         bad++;
