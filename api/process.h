@@ -62,12 +62,13 @@ size_t pk_job_validate(json_t *job, const pk_check_ctx *ctx, const pk_process **
 void pk_job_set_checkpoint(const char *path, const char *digest, double interval_s);
 const char *pk_job_checkpoint(const char **digest, double *interval_s);
 
-/* Validate and run a job (the one code path of `packd run` and the daemon's
- * workers) on threads threads (a deployment setting, not a job input: the
- * results are the same bits for any number).  Returns 0 when the job is successful (complete or not); 2 when
- * it failed but wrote its partial result file and a summary whose "failure"
- * says why (err holds the same text); 1 on invalid input with errs filled;
- * -1 on a runtime failure without a result file, with err. */
+/* Validate, parse once and run a job (the one code path of `packd run` and
+ * the daemon's workers) on threads threads (a deployment setting, not a job
+ * input: the results are the same bits for any number).  Returns 0 when the
+ * job is successful (complete or not); 2 when it failed but wrote its partial
+ * result file and a summary whose "failure" says why (err holds the same
+ * text); 1 on invalid input with errs filled; -1 on a runtime failure
+ * without a result file, with err. */
 int pk_job_run(json_t *job, int threads, const char *out_path, pk_monitor *mon,
                json_t **summary, pk_schema_errors *errs, char *err, size_t errlen);
 
