@@ -1,5 +1,5 @@
-/* process.c — the one table of processes packd offers (pack, homogenize).
- * Contract: api/process.h. */
+/* process.c — the process table and the one job path (parse once, run);
+ * the contract is in process.h. */
 #include "process.h"
 
 #include <stdio.h>
@@ -17,7 +17,8 @@ static const pk_process pack_process = {
     .description = "Draw grain sizes from a grading (sieve) curve and place them in a 2D or 3D "
                    "box (periodic or walled) with a minimum gap; writes an H5MD result file.",
     .inputs_schema = "pack.inputs.schema.json",
-    .check = pk_pack_check,
+    .parse = pk_pack_parse,
+    .free_job = pk_pack_free,
     .run = pk_pack_run,
 };
 
@@ -29,7 +30,8 @@ static const pk_process homogenize_process = {
                    "conditions; per step the Piola and Cauchy stress, energies, relaxation "
                    "figures and optionally the tangent (Meier 2009); writes an H5MD result file.",
     .inputs_schema = "homogenize.inputs.schema.json",
-    .check = pk_homog_check,
+    .parse = pk_homog_parse,
+    .free_job = pk_homog_free,
     .run = pk_homog_run,
 };
 
@@ -43,14 +45,27 @@ const pk_process *pk_process_find(const char *id)
     return NULL;
 }
 
+size_t pk_process_parse_inputs(const pk_process *p, json_t *inputs, const pk_check_ctx *ctx,
+                               void **parsed, pk_schema_errors *errs)
+{
+    size_t before = errs->n;
+    void *job = NULL;
+    pk_schema_validate_embedded(p->inputs_schema, inputs, errs);
+    if (errs->n == before && !(job = p->parse(inputs, ctx, errs)) && errs->n == before)
+        pk_schema_errors_add(errs, "", "parse", "the inputs could not be read");
+    if (job && (!parsed || errs->n != before)) {
+        p->free_job(job);
+        job = NULL;
+    }
+    if (parsed)
+        *parsed = job;
+    return errs->n - before;
+}
+
 size_t pk_process_validate_inputs(const pk_process *p, json_t *inputs, const pk_check_ctx *ctx,
                                   pk_schema_errors *errs)
 {
-    size_t before = errs->n;
-    pk_schema_validate_embedded(p->inputs_schema, inputs, errs);
-    if (errs->n == before && p->check)
-        p->check(inputs, ctx, errs);
-    return errs->n - before;
+    return pk_process_parse_inputs(p, inputs, ctx, NULL, errs);
 }
 
 /* Prefix the pointers of errors [from, n) with "/inputs". */
@@ -67,11 +82,13 @@ static void prefix_inputs(pk_schema_errors *errs, size_t from)
     }
 }
 
-size_t pk_job_validate(json_t *job, const pk_check_ctx *ctx, const pk_process **proc,
-                       pk_schema_errors *errs)
+size_t pk_job_parse(json_t *job, const pk_check_ctx *ctx, const pk_process **proc, void **parsed,
+                    pk_schema_errors *errs)
 {
     size_t before = errs->n;
     *proc = NULL;
+    if (parsed)
+        *parsed = NULL;
     if (pk_schema_validate_embedded("job.schema.json", job, errs) != 0)
         return errs->n - before;
     const pk_process *p = pk_process_find(json_string_value(json_object_get(job, "process")));
@@ -81,18 +98,18 @@ size_t pk_job_validate(json_t *job, const pk_check_ctx *ctx, const pk_process **
     }
     size_t mark = errs->n;
     if (pk_input_links_refuse(json_object_get(job, "inputs"), errs) == 0)
-        pk_process_validate_inputs(p, json_object_get(job, "inputs"), ctx, errs);
+        pk_process_parse_inputs(p, json_object_get(job, "inputs"), ctx, parsed, errs);
     prefix_inputs(errs, mark);
     if (errs->n == before)
         *proc = p;
     return errs->n - before;
 }
 
-static int job_threads = 1;
-
-void pk_job_set_threads(int n) { job_threads = n < 1 ? 1 : n; }
-
-int pk_job_threads(void) { return job_threads; }
+size_t pk_job_validate(json_t *job, const pk_check_ctx *ctx, const pk_process **proc,
+                       pk_schema_errors *errs)
+{
+    return pk_job_parse(job, ctx, proc, NULL, errs);
+}
 
 static const char *ckpt_path, *ckpt_digest;
 static double ckpt_interval_s = 30;
@@ -111,22 +128,25 @@ const char *pk_job_checkpoint(const char **digest, double *interval_s)
     return ckpt_path;
 }
 
-int pk_job_run(json_t *job, const char *out_path, pk_monitor *mon, json_t **summary,
-               pk_schema_errors *errs, char *err, size_t errlen)
+int pk_job_run(json_t *job, int threads, const char *out_path, pk_monitor *mon,
+               json_t **summary, pk_schema_errors *errs, char *err, size_t errlen)
 {
     const pk_process *p;
+    void *parsed;
     const pk_check_ctx local = {.service = 0}; /* the job runs here: its files are read */
     *summary = NULL;
-    if (pk_job_validate(job, &local, &p, errs) != 0) {
+    if (pk_job_parse(job, &local, &p, &parsed, errs) != 0) {
         snprintf(err, errlen, "invalid job");
         return 1;
     }
     char *text = json_dumps(job, JSON_SORT_KEYS | JSON_COMPACT);
     if (!text) {
+        p->free_job(parsed);
         snprintf(err, errlen, "out of memory");
         return -1;
     }
-    int rc = p->run(json_object_get(job, "inputs"), text, out_path, mon, summary, err, errlen);
+    int rc = p->run(parsed, threads < 1 ? 1 : threads, text, out_path, mon, summary, err, errlen);
+    p->free_job(parsed);
     free(text);
     if (rc == 0 && pk_verdict_failed(*summary)) {
         snprintf(err, errlen, "%s", json_string_value(json_object_get(*summary, "failure")));

@@ -226,7 +226,7 @@ static void job_case(const char *name, const char *path)
     json_t *sum = NULL;
     char err[512];
     const char *out = "/tmp/packd-bench-rsa.h5";
-    int rc = pk_job_run(job, out, NULL, &sum, &errs, err, sizeof err);
+    int rc = pk_job_run(job, 1, out, NULL, &sum, &errs, err, sizeof err);
     if (rc == 0) {
         double s = json_real_value(json_object_get(sum, "seconds_place"));
         json_int_t placed = json_integer_value(json_object_get(sum, "count_placed"));

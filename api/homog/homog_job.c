@@ -1,4 +1,5 @@
-/* homog_job.c — parse and check 'homogenize' inputs; build the F̄ path. */
+/* homog_job.c — the 'homogenize' process's option table, inputs → job with
+ * its checks, the F̄ path; the contract is in homog_job.h. */
 #include "homog_job.h"
 
 #include <math.h>
@@ -7,6 +8,55 @@
 #include <string.h>
 
 #include "core/homog/homog_tensor.h"
+
+static const char *const bc_names[] = {"taylor", "restricted_taylor", "periodic", NULL}; /* pk_homog_bc */
+static const char *const predictor_names[] = {"none", "affine", NULL};
+static const char *const solver_names[] = {"dr", "newton", NULL};
+static const char *const policy_names[] = {"as_generated", "radius_inflation", "precompress", NULL};
+static const char *const load_names[] = {"simple_shear", "cyclic_shear", "uniaxial_compression",
+                                         "list", NULL};
+_Static_assert(sizeof(pk_homog_bc) == sizeof(int), "named values are stored as int");
+#define F(m) PK_OPT_FIELD(pk_homog_job, m)
+static const pk_option homog_rows[] = {
+    {"/rve/file", PK_OPT_STRING, F(rve_file), PK_OPT_IMPLICIT},
+    {"/boundary_condition", PK_OPT_ENUM, F(bc), PK_OPT_IMPLICIT, .dflt = PK_BC_PERIODIC,
+     .names = bc_names},
+    {"/contact/E_n", PK_OPT_NUMBER, F(E_n), .dflt = 1},
+    {"/friction/E_t", PK_OPT_NUMBER, F(fric.E_t), PK_OPT_IMPLICIT, .dflt = NAN}, /* NAN: E_n */
+    {"/friction/rho_deg", PK_OPT_NUMBER, F(rho_deg), PK_OPT_IMPLICIT},
+    {"/friction/h", PK_OPT_NUMBER, F(fric.h)},
+    {"/relaxation/tol", PK_OPT_NUMBER, F(tol), .dflt = 1e-8},
+    {"/relaxation/abs_tol", PK_OPT_NUMBER, F(abs_tol), .dflt = 1e-13},
+    {"/relaxation/max_iter", PK_OPT_INTEGER, F(max_iter), .dflt = 1000000, .lo = 1, .hi = 1e9},
+    {"/relaxation/solver", PK_OPT_ENUM, F(newton), .names = solver_names},
+    {"/relaxation/newton_max_iter", PK_OPT_INTEGER, F(newton_max_iter), .dflt = 50, .lo = 1,
+     .hi = 10000},
+    {"/relaxation/predictor", PK_OPT_ENUM, F(affine_predictor), .dflt = 1,
+     .names = predictor_names},
+    {"/relaxation/lanczos_steps", PK_OPT_INTEGER, F(lanczos_steps), .dflt = 40, .lo = 2,
+     .hi = 1000},
+    {"/relaxation/refresh", PK_OPT_INTEGER, F(refresh), .dflt = 200, .lo = 10, .hi = 1000000},
+    {"/tangent", PK_OPT_BOOL, F(tangent)},
+    {"/initial_state/policy", PK_OPT_ENUM, F(initial_policy), PK_OPT_IMPLICIT,
+     .names = policy_names},
+    {"/initial_state/value", PK_OPT_NUMBER, F(initial_value)},
+    {"/output/micro_state", PK_OPT_BOOL, F(out_micro)},
+    {"/output/contacts", PK_OPT_BOOL, F(out_contacts)},
+    {"/limits/wall_time_s", PK_OPT_NUMBER, F(wall_time_s), PK_OPT_IMPLICIT},
+    {"/load/type", PK_OPT_ENUM, F(load.type), PK_OPT_IMPLICIT, .names = load_names},
+    {"/load/precompression", PK_OPT_NUMBER, F(load.precompression), .dflt = 0.01},
+    {"/load/pre_steps", PK_OPT_INTEGER, F(load.pre_steps), .dflt = 10, .lo = 1, .hi = 100000},
+    {"/load/steps", PK_OPT_INTEGER, F(load.steps), PK_OPT_IMPLICIT, .dflt = 1, .lo = 1,
+     .hi = 100000},
+    {"/load/shear", PK_OPT_NUMBER, F(load.shear), PK_OPT_IMPLICIT, .dflt = 1},
+    {"/load/amplitude", PK_OPT_NUMBER, F(load.amplitude), PK_OPT_IMPLICIT, .dflt = 0.5},
+    {"/load/axis", PK_OPT_INTEGER, F(load.axis), .dflt = 1, .lo = 1, .hi = 3},
+    {"/load/strain", PK_OPT_NUMBER, F(load.strain), PK_OPT_IMPLICIT, .dflt = 0.3},
+    {"/load/plane", PK_OPT_STRING, F(load.plane), .sdefault = "12"},
+};
+#undef F
+const pk_option_table pk_homog_options =
+    PK_OPT_TABLE("homogenize.inputs.schema.json", pk_homog_job, homog_rows, NULL);
 
 void pk_homog_job_free(pk_homog_job *job)
 {
@@ -57,12 +107,6 @@ static void species_stiffness(json_t *m, pk_homog_job *job, pk_schema_errors *er
             }
 }
 
-static double num(json_t *o, const char *key, double dflt)
-{
-    json_t *v = json_object_get(o, key);
-    return json_is_number(v) ? json_number_value(v) : dflt;
-}
-
 static int push_F(pk_homog_job *job, size_t *cap, const double F[9])
 {
     if (job->nstep == *cap) {
@@ -78,23 +122,23 @@ static int push_F(pk_homog_job *job, size_t *cap, const double F[9])
 }
 
 /* "12" → (0, 1) */
-static void plane_of(json_t *load, int *i, int *j)
+static void plane_of(const pk_homog_job *job, int *i, int *j)
 {
-    const char *s = json_string_value(json_object_get(load, "plane"));
-    if (!s || strlen(s) != 2)
+    const char *s = job->load.plane;
+    if (strlen(s) != 2)
         s = "12";
     *i = s[0] - '1';
     *j = s[1] - '1';
 }
 
 /* (1 − λc)1 ramped over pre_steps, then the shear history λs(t) (steps). */
-static int shear_path(pk_homog_job *job, size_t *cap, json_t *load, int cyclic)
+static int shear_path(pk_homog_job *job, size_t *cap, int cyclic)
 {
-    double lc = num(load, "precompression", 0.01);
-    int pre = (int)pk_json_int_or(load, "pre_steps", 10);
-    int steps = (int)pk_json_int_or(load, "steps", 1);
+    double lc = job->load.precompression;
+    int pre = job->load.pre_steps;
+    int steps = job->load.steps;
     int pi, pj;
-    plane_of(load, &pi, &pj);
+    plane_of(job, &pi, &pj);
     double F[9];
     for (int k = 1; k <= pre; k++) {
         pk_m3_identity(F);
@@ -103,7 +147,7 @@ static int shear_path(pk_homog_job *job, size_t *cap, json_t *load, int cyclic)
         if (push_F(job, cap, F))
             return -1;
     }
-    double amp = cyclic ? num(load, "amplitude", 0.5) : num(load, "shear", 1);
+    double amp = cyclic ? job->load.amplitude : job->load.shear;
     for (int k = 1; k <= steps; k++) {
         double t = (double)k / steps, ls;
         if (!cyclic)
@@ -128,54 +172,29 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
 {
     size_t before = errs->n;
     memset(job, 0, sizeof *job);
-    json_t *rve = json_object_get(inputs, "rve");
-    snprintf(job->rve_file, sizeof job->rve_file, "%s",
-             json_string_value(json_object_get(rve, "file")) ? json_string_value(json_object_get(rve, "file")) : "");
-    const char *bc = json_string_value(json_object_get(inputs, "boundary_condition"));
-    job->bc = bc && !strcmp(bc, "taylor") ? PK_BC_TAYLOR
-              : bc && !strcmp(bc, "restricted_taylor") ? PK_BC_RESTRICTED_TAYLOR
-                                                     : PK_BC_PERIODIC;
-    job->E_n = num(json_object_get(inputs, "contact"), "E_n", 1);
+    pk_options_fill(&pk_homog_options, inputs, job, errs);
     species_stiffness(json_object_get(json_object_get(inputs, "contact"), "E_n_species"), job, errs);
-    json_t *fr = json_object_get(inputs, "friction");
-    job->friction = json_is_object(fr);
+    job->friction = json_is_object(json_object_get(inputs, "friction"));
     if (job->friction) {
-        job->fric.E_t = num(fr, "E_t", job->E_n);
-        job->fric.tan_rho = tan(num(fr, "rho_deg", 0) * M_PI / 180);
-        job->fric.h = num(fr, "h", 0);
-    }
-    json_t *dr = json_object_get(inputs, "relaxation");
-    job->tol = num(dr, "tol", 1e-8);
-    job->abs_tol = num(dr, "abs_tol", 1e-13);
-    job->max_iter = (size_t)pk_json_int_or(dr, "max_iter", 1000000);
-    job->lanczos_steps = (int)pk_json_int_or(dr, "lanczos_steps", 40);
-    job->refresh = (size_t)pk_json_int_or(dr, "refresh", 200);
-    const char *pred = json_string_value(json_object_get(dr, "predictor"));
-    job->affine_predictor = !(pred && !strcmp(pred, "none"));
-    const char *solver = json_string_value(json_object_get(dr, "solver"));
-    job->newton = solver && !strcmp(solver, "newton");
-    job->newton_max_iter = (size_t)pk_json_int_or(dr, "newton_max_iter", 50);
-    job->tangent = json_is_true(json_object_get(inputs, "tangent"));
-    json_t *out = json_object_get(inputs, "output");
-    job->out_micro = json_is_true(json_object_get(out, "micro_state"));
-    job->out_contacts = json_is_true(json_object_get(out, "contacts"));
-    json_t *ini = json_object_get(inputs, "initial_state");
-    const char *pol = json_string_value(json_object_get(ini, "policy"));
+        if (isnan(job->fric.E_t))
+            job->fric.E_t = job->E_n;
+        job->fric.tan_rho = tan(job->rho_deg * M_PI / 180);
+    } else
+        job->fric = (pk_fric_law){0};
     job->radius_factor = 1;
-    if (pol && !strcmp(pol, "radius_inflation"))
-        job->radius_factor = 1 + num(ini, "value", 0);
-    if (pol && !strcmp(pol, "precompress"))
-        job->precompress = num(ini, "value", 0);
-    job->wall_time_s = num(json_object_get(inputs, "limits"), "wall_time_s", 0);
+    if (job->initial_policy == 1) /* radius_inflation */
+        job->radius_factor = 1 + job->initial_value;
+    if (job->initial_policy == 2) /* precompress */
+        job->precompress = job->initial_value;
 
     json_t *load = json_object_get(inputs, "load");
-    const char *type = json_string_value(json_object_get(load, "type"));
+    const int list = job->load.type == 3, uniaxial = job->load.type == 2;
     size_t cap = 0;
     int rc = 0;
-    if (type && !strcmp(type, "list")) {
-        json_t *list = json_object_get(load, "F"), *row;
+    if (list) {
+        json_t *list_F = json_object_get(load, "F"), *row;
         size_t k;
-        json_array_foreach(list, k, row) {
+        json_array_foreach(list_F, k, row) {
             size_t m = json_array_size(row);
             char ptr[64];
             snprintf(ptr, sizeof ptr, "/load/F/%zu", k);
@@ -194,9 +213,9 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
                     F[3 * a + b] = json_number_value(json_array_get(row, (size_t)(a * d + b)));
             rc |= push_F(job, &cap, F);
         }
-    } else if (type && !strcmp(type, "uniaxial_compression")) {
-        int axis = (int)pk_json_int_or(load, "axis", 1) - 1, steps = (int)pk_json_int_or(load, "steps", 1);
-        double lam = num(load, "strain", 0.3);
+    } else if (uniaxial) {
+        int axis = job->load.axis - 1, steps = job->load.steps;
+        double lam = job->load.strain;
         if (axis == 2)
             job->fdim = 3;
         for (int k = 1; k <= steps; k++) {
@@ -206,14 +225,14 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
             rc |= push_F(job, &cap, F);
         }
     } else {
-        int cyc = type && !strcmp(type, "cyclic_shear");
+        int cyc = job->load.type == 1;
         int pi, pj;
-        plane_of(load, &pi, &pj);
+        plane_of(job, &pi, &pj);
         if (pi == pj)
             pk_schema_errors_add(errs, "/load/plane", "semantic", "a shear plane needs two different axes");
         if (pi == 2 || pj == 2)
             job->fdim = 3;
-        rc |= shear_path(job, &cap, load, cyc);
+        rc |= shear_path(job, &cap, cyc);
     }
     if (rc) {
         pk_schema_errors_add(errs, "/load", "memory", "out of memory for the load path");
@@ -252,7 +271,7 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
             }
         double d = pk_m3_det(F), smin = pk_m3_sigma_min(F, d3);
         char ptr[64];
-        if (type && !strcmp(type, "list"))
+        if (list)
             snprintf(ptr, sizeof ptr, "/load/F/%zu", k);
         else
             snprintf(ptr, sizeof ptr, "/load");
@@ -279,10 +298,23 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
     return errs->n - before;
 }
 
-void pk_homog_check(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs)
+void *pk_homog_parse(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs)
 {
     (void)ctx; /* the RVE file is read by the run only */
-    pk_homog_job job;
-    if (pk_homog_job_from_json(inputs, &job, errs) == 0)
-        pk_homog_job_free(&job);
+    pk_homog_job *job = malloc(sizeof *job);
+    if (!job) {
+        pk_schema_errors_add(errs, "", "memory", "out of memory");
+        return NULL;
+    }
+    if (pk_homog_job_from_json(inputs, job, errs) == 0)
+        return job;
+    free(job);
+    return NULL;
+}
+
+void pk_homog_free(void *job)
+{
+    if (job)
+        pk_homog_job_free(job);
+    free(job);
 }

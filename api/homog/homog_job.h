@@ -9,6 +9,7 @@
 #include "api/inputs/check_ctx.h"
 #include "core/homog/homog_bc.h"
 #include "api/schemas/json_schema.h"
+#include "api/schemas/option_table.h"
 #include "core/base/progress.h"
 
 /* Every load step's F̄ (with the pre-compression): det F̄ > 0 and every
@@ -29,6 +30,7 @@ typedef struct pk_homog_job {
     size_t n_species;
     int friction;              /* "friction" given */
     pk_fric_law fric;          /* E_t, tan ρ, h (E_t defaults to E_n) */
+    double rho_deg;            /* friction angle ρ (fric.tan_rho = tan ρ) */
     double tol, abs_tol;
     size_t max_iter;
     int lanczos_steps;
@@ -38,13 +40,25 @@ typedef struct pk_homog_job {
     size_t newton_max_iter;
     int tangent;
     int out_micro, out_contacts;
+    int initial_policy;        /* initial_state policy: 0 as_generated, 1 radius_inflation,
+                                * 2 precompress */
+    double initial_value;
     double radius_factor;      /* initial_state radius_inflation */
     double precompress;        /* initial_state precompress λ₀ */
     double wall_time_s;
     size_t nstep;
+    struct {                   /* "load": the preset's parameters */
+        int type;              /* 0 simple_shear, 1 cyclic_shear, 2 uniaxial_compression, 3 list */
+        double precompression, shear, amplitude, strain;
+        int pre_steps, steps, axis;
+        char plane[3];
+    } load;
     int fdim;                  /* 2 or 3: dimension the load path is written for (0 = any) */
     double *F;                 /* [nstep][9] row-major, 3D-embedded */
 } pk_homog_job;
+
+/* The options of the process (homog_job.c). */
+extern const pk_option_table pk_homog_options;
 
 /* Inputs (schema-valid) → job; semantic errors appended with pointers
  * relative to the inputs object.  Returns their number (job->F is freed on
@@ -52,9 +66,10 @@ typedef struct pk_homog_job {
 size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_errors *errs);
 void pk_homog_job_free(pk_homog_job *job);
 
-/* process table hooks (see process.h) */
-void pk_homog_check(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
-int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_monitor *mon,
-                 json_t **summary, char *err, size_t errlen);
+/* process table hooks (see process.h): parse returns a pk_homog_job */
+void *pk_homog_parse(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
+void pk_homog_free(void *job);
+int pk_homog_run(const void *job, int threads, const char *job_json, const char *out_path,
+                 pk_monitor *mon, json_t **summary, char *err, size_t errlen);
 
 #endif

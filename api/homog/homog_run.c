@@ -130,24 +130,16 @@ static json_t *tensor_json(const double T[9], int dim)
     return a;
 }
 
-int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_monitor *mon,
-                 json_t **summary, char *err, size_t errlen)
+int pk_homog_run(const void *parsed, int threads, const char *job_json, const char *out_path,
+                 pk_monitor *mon, json_t **summary, char *err, size_t errlen)
 {
     *summary = NULL;
-    pk_homog_job job;
-    pk_schema_errors errs = {0};
-    if (pk_homog_job_from_json(inputs, &job, &errs) != 0) {
-        snprintf(err, errlen, "%s: %s", errs.items[0].pointer, errs.items[0].message);
-        pk_schema_errors_free(&errs);
-        return -1;
-    }
+    const pk_homog_job job = *(const pk_homog_job *)parsed; /* its arrays stay the caller's */
     pk_monitor_start(mon, job.wall_time_s);
     pk_box box;
     pk_particles p;
-    if (pk_h5_read_particles(job.rve_file, &box, &p, err, errlen) != 0) {
-        pk_homog_job_free(&job);
+    if (pk_h5_read_particles(job.rve_file, &box, &p, err, errlen) != 0)
         return -1;
-    }
     const int dim = box.dim;
     int rc = -1;
     pk_homog_rve rve = {0};
@@ -174,7 +166,7 @@ int pk_homog_run(json_t *inputs, const char *job_json, const char *out_path, pk_
      * every factorisation is analysed afresh — the same numbers either way */
     if (o.newton && o.newton->ctx_new)
         o.newton_ctx = nctx = o.newton->ctx_new();
-    o.par = pool = pk_par_new(pk_job_threads());
+    o.par = pool = pk_par_new(threads);
     if (pk_homog_state_init(&rve, &o, &com) != 0) {
         snprintf(err, errlen, "out of memory");
         goto out;
@@ -413,6 +405,5 @@ out:
     pk_homog_state_free(&tr);
     pk_homog_rve_free(&rve);
     pk_particles_free(&p);
-    pk_homog_job_free(&job);
     return rc;
 }

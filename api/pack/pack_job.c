@@ -1,38 +1,39 @@
-/* pack_job.c — the 'pack' process: JSON inputs to the job struct, plan, run.
- * Contract: api/pack/pack_job.h. */
+/* pack_job.c — the 'pack' process's inputs: its option table, the grading
+ * and box readers, the feasibility plan and the parse hook (pack_job.h). */
 #include "pack_job.h"
 #include "pack_placer.h"
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
-/* + 0.0: a -0 in the job reads as +0 (no -0 in results or messages) */
-static double num(json_t *o, const char *key, double dflt)
-{
-    json_t *v = json_object_get(o, key);
-    return json_is_number(v) ? json_number_value(v) + 0.0 : dflt;
-}
+#define F(m) PK_OPT_FIELD(pk_pack_job, m)
+static const char *const sampling_names[] = {"continuous", "discrete", NULL};
+static const char *const refers_names[] = {"resolved", "mix", NULL};
+static const pk_option pack_rows[] = {
+    {"/dim", PK_OPT_INTEGER, F(dim), PK_OPT_IMPLICIT, .dflt = 3, .lo = 2, .hi = 3},
+    {"/unit", PK_OPT_STRING, F(unit), .sdefault = "mm"},
+    {"/sampling", PK_OPT_ENUM, F(sampling), PK_OPT_IMPLICIT, .dflt = -1, .names = sampling_names},
+    {"/d_min", PK_OPT_NUMBER, F(d_min), PK_OPT_IMPLICIT},
+    {"/grading/q", PK_OPT_NUMBER, F(fuller_q), PK_OPT_IMPLICIT, .dflt = 0.5},
+    {"/grading/d_max", PK_OPT_NUMBER, F(fuller_d_max), PK_OPT_IMPLICIT},
+    {"/phi/value", PK_OPT_NUMBER, F(phi), PK_OPT_IMPLICIT},
+    {"/phi/refers_to", PK_OPT_ENUM, F(phi_is_mix), PK_OPT_IMPLICIT, .names = refers_names},
+    {"/count", PK_OPT_INTEGER, F(count), PK_OPT_IMPLICIT, .lo = 1, .hi = PK_PACK_MAX_COUNT},
+    {"/delta_d", PK_OPT_NUMBER, F(delta_d)},
+    {"/algorithm", PK_OPT_STRING, F(algorithm), .sdefault = "rsa"},
+    {"/seed", PK_OPT_INTEGER, F(seed), .dflt = 1, .lo = 0, .hi = 9007199254740991LL},
+    {"/limits/max_particles", PK_OPT_INTEGER, F(max_particles), .dflt = 20000000, .lo = 1,
+     .hi = PK_PACK_MAX_COUNT},
+    {"/limits/wall_time_s", PK_OPT_NUMBER, F(wall_time_s), PK_OPT_IMPLICIT},
+};
+#undef F
+const pk_option_table pk_pack_options =
+    PK_OPT_TABLE("pack.inputs.schema.json", pk_pack_job, pack_rows, NULL);
 
-/* An integer field (pk_json_int: 500.0 is 500); a value that is no exact
- * integer in [lo, hi] is an error naming the field (the schema's maxima
- * normally catch it first). */
-static long long int_field(json_t *o, const char *key, const char *ptr, long long lo,
-                           long long hi, long long dflt, pk_schema_errors *errs)
-{
-    json_t *v = json_object_get(o, key);
-    long long x;
-    if (!v)
-        return dflt;
-    if (pk_json_int(v, &x) != 0 || x < lo || x > hi) {
-        char got[32];
-        snprintf(got, sizeof got, "%.17g", json_number_value(v));
-        pk_schema_errors_add(errs, ptr, "integer", "must be an integer in [%lld, %lld] (got %s)", lo,
-                             hi, got);
-        return dflt;
-    }
-    return x;
-}
+/* An entry of a grading array (+ 0.0: a -0 reads as +0). */
+static double entry(json_t *v) { return json_number_value(v) + 0.0; }
 
 static int grading_from_json(json_t *g, pk_grading *out, int *default_discrete,
                              pk_schema_errors *errs)
@@ -44,6 +45,11 @@ static int grading_from_json(json_t *g, pk_grading *out, int *default_discrete,
     if (strcmp(type, "sieve") == 0) {
         json_t *s = json_object_get(g, "sizes"), *p = json_object_get(g, "passing");
         size_t n = json_array_size(s);
+        if (n < 2) { /* the schema's minItems: a curve needs two sieves */
+            pk_schema_errors_add(errs, "/grading/sizes", "minItems",
+                                 "needs at least 2 sieve sizes (got %zu)", n);
+            return -1;
+        }
         if (n != json_array_size(p)) {
             pk_schema_errors_add(errs, "/grading/passing", "sameLength",
                                  "must have one entry per sieve size (%zu sizes, %zu values)", n,
@@ -104,14 +110,15 @@ static int grading_from_json(json_t *g, pk_grading *out, int *default_discrete,
         double total = 0;
         for (size_t i = 0; i < n; i++) {
             json_t *ci = json_array_get(c, i);
-            d[i] = num(ci, "d", 0);
+            json_t *rho_i = json_object_get(ci, "density");
+            d[i] = entry(json_object_get(ci, "d"));
             if (json_object_get(ci, "mass_percent")) {
                 mass = 1;
-                share[i] = num(ci, "mass_percent", 0);
-                rho[i] = num(ci, "density", 1);
+                share[i] = entry(json_object_get(ci, "mass_percent"));
+                rho[i] = rho_i ? entry(rho_i) : 1;
             } else {
                 vol = 1;
-                share[i] = num(ci, "volume_percent", 0);
+                share[i] = entry(json_object_get(ci, "volume_percent"));
                 rho[i] = 1;
             }
             total += share[i];
@@ -161,12 +168,11 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
 {
     size_t before = errs->n;
     memset(job, 0, sizeof *job);
-    job->dim = (int)int_field(in, "dim", "/dim", 2, 3, 3, errs);
-    const char *unit = json_string_value(json_object_get(in, "unit"));
-    snprintf(job->unit, sizeof job->unit, "%s", unit ? unit : "mm");
+    pk_options_fill(&pk_pack_options, in, job, errs);
 
     json_t *box = json_object_get(json_object_get(in, "domain"), "box");
     json_t *size = json_object_get(box, "size");
+    job->mesh = json_object_get(json_object_get(in, "domain"), "mesh");
     job->box.dim = job->dim;
     if (!box) /* a mesh domain: the placer reports its box (pack_placer.h) */
         ;
@@ -192,13 +198,11 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
     json_t *g = json_object_get(in, "grading");
     int default_discrete = 0;
     grading_from_json(g, &job->grading, &default_discrete, errs);
-    const char *sampling = json_string_value(json_object_get(in, "sampling"));
-    job->discrete = sampling ? strcmp(sampling, "discrete") == 0 : default_discrete;
-    job->d_min = num(in, "d_min", 0);
+    job->discrete = job->sampling >= 0 ? job->sampling : default_discrete;
 
     const char *gtype = json_string_value(json_object_get(g, "type"));
     if (gtype && strcmp(gtype, "fuller") == 0) {
-        double dmax = num(g, "d_max", 0), q = num(g, "q", 0.5);
+        double dmax = job->fuller_d_max, q = job->fuller_q;
         if (!(job->d_min > 0))
             pk_schema_errors_add(errs, "/d_min", "required",
                                  "a Fuller curve needs a cut-off diameter d_min");
@@ -209,17 +213,7 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
             pk_schema_errors_add(errs, "/grading", "grading", "%s", pk_psd_error());
     }
 
-    json_t *phi = json_object_get(in, "phi");
-    if (phi) {
-        job->has_phi = 1;
-        job->phi = num(phi, "value", 0);
-        const char *ref = json_string_value(json_object_get(phi, "refers_to"));
-        job->phi_is_mix = ref && strcmp(ref, "mix") == 0;
-    }
-    job->count = (size_t)int_field(in, "count", "/count", 1, PK_PACK_MAX_COUNT, 0, errs);
-    job->delta_d = num(in, "delta_d", 0);
-    const char *algo = json_string_value(json_object_get(in, "algorithm"));
-    snprintf(job->algorithm, sizeof job->algorithm, "%s", algo ? algo : "rsa");
+    job->has_phi = json_object_get(in, "phi") != NULL;
     const pk_placer *placer = pk_placer_find(job->algorithm);
     if (!placer)
         pk_schema_errors_add(errs, "/algorithm", "enum", "no placer named \"%s\"", job->algorithm);
@@ -227,12 +221,8 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
         pk_schema_errors_add(errs, "/domain", "boxDomain",
                              "algorithm \"%s\" needs a box domain (a mesh needs \"tetfill\")",
                              job->algorithm);
-    job->inputs = in;
-    job->seed = (uint64_t)int_field(in, "seed", "/seed", 0, 9007199254740991LL, 1, errs);
-    job->max_particles = (size_t)int_field(json_object_get(in, "limits"), "max_particles",
-                                           "/limits/max_particles", 1, PK_PACK_MAX_COUNT, 20000000,
-                                           errs);
-    job->wall_time_s = num(json_object_get(in, "limits"), "wall_time_s", 0);
+    if (placer && placer->options)
+        pk_options_fill(placer->options, in, &job->opt, errs);
     return errs->n - before;
 }
 
@@ -248,12 +238,9 @@ static double class_rep_measure(int dim, double d) { return pk_ball_measure(dim,
  * ratios, the final sizes are set by jamming. */
 static int grows_until_jammed(const pk_pack_job *job)
 {
-    json_t *o = json_object_get(job->inputs, "edmd");
-    const char *until = json_string_value(json_object_get(o, "until"));
-    const char *growth = json_string_value(json_object_get(o, "growth"));
-    const char *maximize = json_string_value(json_object_get(o, "maximize"));
-    return !strcmp(job->algorithm, "edmd") && until && !strcmp(until, "jammed") &&
-           !(growth && !strcmp(growth, "shell")) && !(maximize && !strcmp(maximize, "delta_d"));
+    const pk_edmd_options *o = &job->opt.edmd;
+    return !strcmp(job->algorithm, "edmd") && o->prm.until == PK_EDMD_UNTIL_JAMMED &&
+           o->prm.growth == PK_EDMD_GROW_RELATIVE && !o->maximize_delta_d;
 }
 
 static void check_periodic_jamming(const pk_pack_job *job, const pk_pack_plan *plan,
@@ -290,7 +277,7 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
         plan->phi_resolved = plan->phi_mix = job->has_phi ? job->phi : 0;
         plan->expected_n = (double)job->count;
         if (own->check)
-            own->check(job, plan, errs);
+            own->check(job, plan, job->prepare ? &plan->prepared : NULL, errs);
         return errs->n - before;
     }
     const pk_grading *g = &job->grading;
@@ -415,16 +402,34 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
         check_periodic_jamming(job, plan, errs);
     const pk_placer *placer = pk_placer_find(job->algorithm);
     if (placer && placer->check && errs->n == before)
-        placer->check(job, plan, errs);
+        placer->check(job, plan, job->prepare ? &plan->prepared : NULL, errs);
     return errs->n - before;
 }
 
-void pk_pack_check(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs)
+void *pk_pack_parse(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs)
 {
-    pk_pack_job job;
-    if (pk_pack_job_from_json(inputs, &job, errs) != 0)
-        return;
-    job.service = ctx->service;
-    pk_pack_plan plan;
-    pk_pack_plan_make(&job, &plan, errs);
+    pk_pack_task *t = malloc(sizeof *t);
+    if (!t) {
+        pk_schema_errors_add(errs, "", "memory", "out of memory");
+        return NULL;
+    }
+    if (pk_pack_job_from_json(inputs, &t->job, errs) == 0) {
+        t->job.service = ctx->service;
+        t->job.prepare = !ctx->service;
+        if (pk_pack_plan_make(&t->job, &t->plan, errs) == 0)
+            return t;
+        pk_pack_free(t);
+        return NULL;
+    }
+    free(t);
+    return NULL;
+}
+
+void pk_pack_free(void *task)
+{
+    pk_pack_task *t = task;
+    const pk_placer *placer = t ? pk_placer_find(t->job.algorithm) : NULL;
+    if (placer && placer->release && t->plan.prepared)
+        placer->release(t->plan.prepared);
+    free(t);
 }

@@ -9,6 +9,8 @@
 #include "core/space/box.h"
 #include "api/inputs/check_ctx.h"
 #include "api/schemas/json_schema.h"
+#include "api/schemas/option_table.h"
+#include "pack_options.h"
 #include "core/base/progress.h"
 #include "core/psd/psd.h"
 
@@ -21,19 +23,24 @@ typedef struct pk_pack_job {
     pk_box box;
     char unit[8];
     pk_grading grading;          /* the whole curve, before the cut at d_min */
+    int sampling;                /* "sampling": -1 not given, 0 continuous, 1 discrete */
     int discrete;                /* 1 = one diameter per class (Meier) */
     double d_min;                /* cut-off diameter (0 = none) */
+    double fuller_q, fuller_d_max; /* "grading": {"type": "fuller"} */
     int has_phi, phi_is_mix;
     double phi;                  /* target value as given */
     size_t count;                /* 0 = not given */
     double delta_d;
     char algorithm[16];          /* placer name, see pack_placer.h */
-    json_t *inputs;              /* borrowed: placers read their own options from it */
+    pk_placer_options opt;       /* the placer's options (its table, pack_placer.h) */
+    json_t *mesh;                /* borrowed "domain": {"mesh"} of the inputs, or NULL */
     uint64_t seed;
     size_t max_particles;
     double wall_time_s;          /* 0 = none */
     int service;                 /* 1: checked for a request to the daemon (check_ctx.h): the
                                   * placer's check opens no file and builds no mesh */
+    int prepare;                 /* 1: the placer's check keeps what it built for the run
+                                  * (plan.prepared: tetfill's mesh, read and built once) */
 } pk_pack_job;
 
 /* What the job implies before anything is drawn. */
@@ -45,7 +52,17 @@ typedef struct pk_pack_plan {
     double expected_n;           /* expected number of grains */
     double scale;                /* expected size scale (count + phi), else 1 */
     double d_max;                /* largest diameter after scaling */
+    void *prepared;              /* the placer's, when job.prepare (pk_placer.release) */
 } pk_pack_plan;
+
+/* The options of the job itself (pack_job.c); each placer has its own. */
+extern const pk_option_table pk_pack_options;
+
+/* A parsed job: what the process's parse hook returns and run takes. */
+typedef struct pk_pack_task {
+    pk_pack_job job;
+    pk_pack_plan plan;
+} pk_pack_task;
 
 /* Inputs (already schema-valid) → job.  Semantic errors are appended with
  * pointers relative to the inputs object; returns their number. */
@@ -55,9 +72,10 @@ size_t pk_pack_job_from_json(json_t *inputs, pk_pack_job *job, pk_schema_errors 
  * grain size.  Returns the number of errors appended. */
 size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_errors *errs);
 
-/* process table hooks (see process.h) */
-void pk_pack_check(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
-int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_monitor *mon,
-                json_t **summary, char *err, size_t errlen);
+/* process table hooks (see process.h): parse returns a pk_pack_task */
+void *pk_pack_parse(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
+void pk_pack_free(void *task);
+int pk_pack_run(const void *task, int threads, const char *job_json, const char *out_path,
+                pk_monitor *mon, json_t **summary, char *err, size_t errlen);
 
 #endif

@@ -13,71 +13,83 @@
 #include "pack_placer.h"
 #include "api/process.h"
 
-static double num(json_t *o, const char *key, double def)
-{
-    json_t *v = json_object_get(o, key);
-    return json_is_number(v) ? json_number_value(v) : def;
-}
+static void preset(void *dst) { pk_edmd_params_default(&((pk_edmd_options *)dst)->prm); }
 
-static const char *str(json_t *o, const char *key, const char *def)
-{
-    json_t *v = json_object_get(o, key);
-    return json_is_string(v) ? json_string_value(v) : def;
-}
+/* The enums' values follow the names (pk_edmd_growth, _until, _rule;
+ * start_zero and equal_masses are 0/1). */
+_Static_assert(sizeof(pk_edmd_growth) == sizeof(int) && sizeof(pk_edmd_until) == sizeof(int) &&
+                   sizeof(pk_edmd_rule) == sizeof(int),
+               "named values are stored as int");
+static const char *const growth_names[] = {"relative", "shell", NULL};
+static const char *const until_names[] = {"target", "jammed", NULL};
+static const char *const start_names[] = {"rsa", "zero", NULL};
+static const char *const maximize_names[] = {"none", "delta_d", NULL};
+static const char *const rule_names[] = {"elastic", "lift", "meier", NULL};
+static const char *const masses_names[] = {"volume", "equal", NULL};
+static const char *const wall_gap_names[] = {"half", "none", NULL};
+#define F(m) PK_OPT_FIELD(pk_edmd_options, m)
+#define MAX_INT 9007199254740991LL
+static const pk_option edmd_rows[] = {
+    {"/edmd/start", PK_OPT_ENUM, F(prm.start_zero), .names = start_names},
+    {"/edmd/delta", PK_OPT_NUMBER, F(prm.delta), PK_OPT_IMPLICIT, .dflt = NAN},
+    {"/edmd/growth", PK_OPT_ENUM, F(prm.growth), PK_OPT_PRESET, .names = growth_names},
+    {"/edmd/until", PK_OPT_ENUM, F(prm.until), PK_OPT_PRESET, .names = until_names},
+    {"/edmd/maximize", PK_OPT_ENUM, F(maximize_delta_d), .names = maximize_names},
+    {"/edmd/growth_rate", PK_OPT_NUMBER, F(prm.growth_rate), PK_OPT_PRESET},
+    {"/edmd/jamming/reduced_pressure", PK_OPT_NUMBER, F(prm.p_max), PK_OPT_PRESET},
+    {"/edmd/jamming/rate_factor", PK_OPT_NUMBER, F(prm.jam_rate_factor), PK_OPT_PRESET},
+    {"/edmd/jamming/delta_phi", PK_OPT_NUMBER, F(prm.dphi_crit), PK_OPT_PRESET},
+    {"/edmd/jamming/events", PK_OPT_INTEGER, F(prm.dphi_events), PK_OPT_IMPLICIT, .lo = 1,
+     .hi = MAX_INT},
+    {"/edmd/stall/events", PK_OPT_INTEGER, F(prm.stall_events), PK_OPT_PRESET, .lo = 10,
+     .hi = MAX_INT},
+    {"/edmd/stall/growth", PK_OPT_NUMBER, F(prm.stall_growth), PK_OPT_PRESET},
+    {"/edmd/collision_rule", PK_OPT_ENUM, F(prm.rule), PK_OPT_PRESET, .names = rule_names},
+    {"/edmd/rescale", PK_OPT_BOOL, F(prm.rescale), PK_OPT_PRESET},
+    {"/edmd/rescale_tolerance", PK_OPT_NUMBER, F(prm.rescale_tol), PK_OPT_PRESET},
+    {"/edmd/skin", PK_OPT_NUMBER, F(prm.skin), PK_OPT_PRESET},
+    {"/edmd/masses", PK_OPT_ENUM, F(prm.equal_masses), PK_OPT_PRESET, .names = masses_names},
+    {"/edmd/max_events", PK_OPT_INTEGER, F(prm.max_events), PK_OPT_IMPLICIT, .lo = 1,
+     .hi = MAX_INT},
+    {"/edmd/wall_gap", PK_OPT_ENUM, F(wall_gap_none), .names = wall_gap_names},
+};
+#undef F
+#undef MAX_INT
+static const pk_option_table edmd_options =
+    PK_OPT_TABLE("pack.inputs.schema.json", pk_edmd_options, edmd_rows, preset);
 
-/* Options → parameters (schema-valid input assumed). */
+/* The job's options → the engine's parameters. */
 static void read_params(const pk_pack_job *job, const pk_pack_plan *plan, pk_edmd_params *prm)
 {
-    json_t *o = json_object_get(job->inputs, "edmd");
-    pk_edmd_params_default(prm);
+    const pk_edmd_options *o = &job->opt.edmd;
+    *prm = o->prm;
     prm->seed = job->seed;
     prm->delta_d = job->delta_d;
-    int maximize = strcmp(str(o, "maximize", "none"), "delta_d") == 0;
-    prm->growth = maximize || strcmp(str(o, "growth", "relative"), "shell") == 0
-                      ? PK_EDMD_GROW_SHELL
-                      : PK_EDMD_GROW_RELATIVE;
-    prm->until = maximize || strcmp(str(o, "until", "target"), "jammed") == 0 ? PK_EDMD_UNTIL_JAMMED
-                                                                             : PK_EDMD_UNTIL_TARGET;
-    prm->start_zero = strcmp(str(o, "start", "rsa"), "zero") == 0;
+    if (o->maximize_delta_d) {
+        prm->growth = PK_EDMD_GROW_SHELL;
+        prm->until = PK_EDMD_UNTIL_JAMMED;
+    }
     /* NAN: the default δ, chosen by place_edmd from the drawn sizes
      * (pk_edmd_start_delta) */
-    prm->delta = prm->growth == PK_EDMD_GROW_SHELL ? 1.0 : num(o, "delta", NAN);
+    if (prm->growth == PK_EDMD_GROW_SHELL)
+        prm->delta = 1.0;
     if (prm->growth == PK_EDMD_GROW_RELATIVE && job->has_phi)
         prm->phi_target = plan->phi_resolved;
-    prm->growth_rate = num(o, "growth_rate", prm->growth_rate);
-    json_t *jam = json_object_get(o, "jamming");
-    prm->p_max = num(jam, "reduced_pressure", prm->p_max);
-    prm->dphi_crit = num(jam, "delta_phi", prm->dphi_crit);
-    prm->jam_rate_factor = num(jam, "rate_factor", prm->jam_rate_factor);
-    prm->dphi_events = (uint64_t)pk_json_int_or(jam, "events", 0);
-    json_t *stall = json_object_get(o, "stall");
-    prm->stall_events = (uint64_t)pk_json_int_or(stall, "events", (long long)prm->stall_events);
-    prm->stall_growth = num(stall, "growth", prm->stall_growth);
-    const char *rule = str(o, "collision_rule", "elastic");
-    prm->rule = strcmp(rule, "meier") == 0  ? PK_EDMD_RULE_MEIER
-                : strcmp(rule, "lift") == 0 ? PK_EDMD_RULE_LIFT
-                                            : PK_EDMD_RULE_ELASTIC;
-    json_t *rs = json_object_get(o, "rescale");
-    if (json_is_boolean(rs))
-        prm->rescale = json_is_true(rs);
-    prm->rescale_tol = num(o, "rescale_tolerance", prm->rescale_tol);
-    prm->skin = num(o, "skin", prm->skin);
-    prm->equal_masses = strcmp(str(o, "masses", "equal"), "equal") == 0;
-    prm->max_events = (uint64_t)pk_json_int_or(o, "max_events", 0);
 }
 
-static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, pk_schema_errors *errs)
+static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, void **prepared,
+                       pk_schema_errors *errs)
 {
-    json_t *o = json_object_get(job->inputs, "edmd");
+    (void)prepared;
     pk_edmd_params prm;
     read_params(job, plan, &prm);
-    if (prm.growth == PK_EDMD_GROW_SHELL && json_object_get(o, "start") && prm.start_zero)
+    if (prm.growth == PK_EDMD_GROW_SHELL && prm.start_zero)
         pk_schema_errors_add(errs, "/edmd/start", "consistent",
                              "shell growth starts from an RSA configuration (start: rsa)");
     if (prm.growth == PK_EDMD_GROW_SHELL && prm.until == PK_EDMD_UNTIL_TARGET && !(job->delta_d > 0))
         pk_schema_errors_add(errs, "/delta_d", "consistent",
                              "shell growth to a target needs delta_d > 0 (or maximize: delta_d)");
-    if (strcmp(str(o, "wall_gap", "half"), "none") == 0 && !(job->delta_d > 0))
+    if (job->opt.edmd.wall_gap_none && !(job->delta_d > 0))
         pk_schema_errors_add(errs, "/edmd/wall_gap", "consistent",
                              "wall_gap none lets the shell reach delta_d/2 into the walls: needs delta_d > 0");
     if (prm.rule == PK_EDMD_RULE_MEIER && !prm.equal_masses)
@@ -160,8 +172,7 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     }
     /* "wall_gap": "none" (Titscher §6.3: Δd between grains only): the shell
      * may reach Δd/2 of the job into the walls */
-    json_t *o = json_object_get(job->inputs, "edmd");
-    double w = strcmp(str(o, "wall_gap", "half"), "none") == 0 ? 0.5 * job->delta_d : 0;
+    double w = job->opt.edmd.wall_gap_none ? 0.5 * job->delta_d : 0;
     ckpt_file cf = {0};
     pk_edmd_checkpoint ck = {0};
     pk_edmd_snapshot snap = {0};
@@ -304,4 +315,5 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     return 0;
 }
 
-const pk_placer pk_placer_edmd = {.name = "edmd", .check = check_edmd, .place = place_edmd};
+const pk_placer pk_placer_edmd = {
+    .name = "edmd", .options = &edmd_options, .check = check_edmd, .place = place_edmd};

@@ -1,6 +1,6 @@
-/* pack_place_rsa.c — the 'rsa' placer: core/rsa/rsa with the job's "rsa" options. */
+/* pack_place_rsa.c — the 'rsa' placer: core/rsa/rsa with the job's "rsa"
+ * options; the contract is in pack_placer.h. */
 #include <stdio.h>
-#include <string.h>
 
 #include "pack_placer.h"
 
@@ -9,13 +9,10 @@ static int place_rsa(const pk_pack_job *job, const pk_pack_plan *plan, const pk_
                      size_t errlen)
 {
     (void)plan;
-    json_t *opt = json_object_get(job->inputs, "rsa");
-    const char *draws = json_string_value(json_object_get(opt, "draws")); /* "open" | "plain" */
     pk_rsa_params prm = {.delta_d = job->delta_d,
-                         .max_failed_draws = (uint64_t)pk_json_int_or(opt, "max_failed_draws", 1000000),
+                         .max_failed_draws = job->opt.rsa.max_failed_draws,
                          .seed = job->seed,
-                         .draws = draws && strcmp(draws, "plain") == 0 ? PK_RSA_DRAWS_PLAIN
-                                                                       : PK_RSA_DRAWS_OPEN};
+                         .draws = (pk_rsa_draws)job->opt.rsa.draws};
     pk_rsa_stats rs;
     if (pk_rsa_place(&job->box, sz->d, sz->species, sz->n, &prm, mon, p, &rs) != 0) {
         snprintf(err, errlen, "RSA placement failed (%s)", pk_stop_reason_name(rs.reason));
@@ -29,4 +26,15 @@ static int place_rsa(const pk_pack_job *job, const pk_pack_plan *plan, const pk_
     return 0;
 }
 
-const pk_placer pk_placer_rsa = {.name = "rsa", .check = NULL, .place = place_rsa};
+/* In the order of pk_rsa_draws (core/rsa/rsa.h). */
+static const char *const draws_names[] = {"open", "plain", NULL};
+static const pk_option rsa_rows[] = {
+    {"/rsa/max_failed_draws", PK_OPT_INTEGER, PK_OPT_FIELD(pk_rsa_options, max_failed_draws),
+     .dflt = 1000000, .lo = 1, .hi = 1e10},
+    {"/rsa/draws", PK_OPT_ENUM, PK_OPT_FIELD(pk_rsa_options, draws), .names = draws_names},
+};
+static const pk_option_table rsa_options =
+    PK_OPT_TABLE("pack.inputs.schema.json", pk_rsa_options, rsa_rows, NULL);
+
+const pk_placer pk_placer_rsa = {
+    .name = "rsa", .options = &rsa_options, .check = NULL, .place = place_rsa};

@@ -23,17 +23,35 @@ typedef struct tetfill_setup {
     pk_tetfill_params prm;
 } tetfill_setup;
 
-static double opt_num(json_t *o, const char *k, double dflt)
-{
-    json_t *v = json_object_get(o, k);
-    return json_is_number(v) ? json_number_value(v) : dflt;
-}
+static void preset(void *dst) { pk_tetfill_defaults(&((pk_tetfill_options *)dst)->prm); }
+
+_Static_assert(sizeof(pk_tetfill_contact_rule) == sizeof(int), "named values are stored as int");
+static const char *const contact_names[] = {"tangent", "touching", NULL}; /* pk_tetfill_contact_rule */
+#define F(m) PK_OPT_FIELD(pk_tetfill_options, m)
+static const pk_option tetfill_rows[] = {
+    {"/tetfill/r_min", PK_OPT_NUMBER, F(r_min), PK_OPT_IMPLICIT},
+    {"/tetfill/r_max", PK_OPT_NUMBER, F(r_max), PK_OPT_IMPLICIT},
+    {"/tetfill/ratio", PK_OPT_NUMBER, F(ratio), PK_OPT_IMPLICIT},
+    {"/tetfill/epsilon", PK_OPT_NUMBER, F(prm.eps), PK_OPT_PRESET},
+    {"/tetfill/z_min", PK_OPT_INTEGER, F(prm.z_min), PK_OPT_PRESET, .lo = 2, .hi = 4},
+    {"/tetfill/contact_rule", PK_OPT_ENUM, F(prm.contact_rule), PK_OPT_PRESET, .names = contact_names},
+    {"/tetfill/vertex_weight", PK_OPT_NUMBER, F(prm.vertex_weight), PK_OPT_PRESET},
+    {"/tetfill/loose", PK_OPT_BOOL, F(prm.skip_tet_loci), PK_OPT_PRESET},
+    {"/tetfill/densify", PK_OPT_BOOL, F(prm.densify), PK_OPT_PRESET},
+    {"/tetfill/neighbours", PK_OPT_INTEGER, F(prm.neighbours), PK_OPT_PRESET, .lo = 4, .hi = 13},
+    {"/tetfill/max_combos", PK_OPT_INTEGER, F(prm.max_combos), PK_OPT_PRESET, .lo = 1, .hi = 715},
+    {"/tetfill/max_passes", PK_OPT_INTEGER, F(prm.max_passes), PK_OPT_PRESET, .lo = 0, .hi = 1000},
+    {"/tetfill/max_tets", PK_OPT_INTEGER, F(max_tets), .dflt = 2000000, .lo = 1, .hi = 1e9},
+};
+#undef F
+static const pk_option_table tetfill_options =
+    PK_OPT_TABLE("pack.inputs.schema.json", pk_tetfill_options, tetfill_rows, preset);
 
 /* Radii from r_min / r_max / ratio; ratio alone uses Jerier's mesh rule
  * r̄ = ℓ_mean / 8 (spec §4.1): r_min = 2 r̄/(R+1), r_max = 2 r̄ − r_min. */
-static int radii(json_t *o, double edge_mean, double *rmin, double *rmax)
+static int radii(const pk_tetfill_options *o, double edge_mean, double *rmin, double *rmax)
 {
-    double a = opt_num(o, "r_min", 0), b = opt_num(o, "r_max", 0), R = opt_num(o, "ratio", 0);
+    double a = o->r_min, b = o->r_max, R = o->ratio;
     if (a > 0 && b > 0) {
         *rmin = a;
         *rmax = b;
@@ -57,12 +75,11 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
                  char *err, size_t errlen)
 {
     memset(S, 0, sizeof *S);
-    json_t *o = json_object_get(job->inputs, "tetfill");
-    json_t *dom = json_object_get(job->inputs, "domain");
-    json_t *mesh = json_object_get(dom, "mesh");
-    size_t max_tets = (size_t)pk_json_int_or(o, "max_tets", 2000000);
+    const pk_tetfill_options *o = &job->opt.tetfill;
+    json_t *mesh = job->mesh;
+    size_t max_tets = o->max_tets;
     pk_tetfill_params *prm = &S->prm;
-    pk_tetfill_defaults(prm);
+    *prm = o->prm;
     *rule = "tetfill";
     if (job->dim != 3) {
         *ptr = "/dim";
@@ -124,17 +141,6 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
                          : pk_mesh_box(&S->mesh, job->box.L, h, max_tets, err, errlen) != 0)
             return -1;
     }
-    prm->eps = opt_num(o, "epsilon", prm->eps);
-    prm->z_min = (int)pk_json_int_or(o, "z_min", prm->z_min);
-    const char *rule_name = json_string_value(json_object_get(o, "contact_rule"));
-    if (rule_name && strcmp(rule_name, "touching") == 0)
-        prm->contact_rule = PK_TETFILL_CONTACT_TOUCHING; /* the schema admits tangent|touching */
-    prm->vertex_weight = opt_num(o, "vertex_weight", prm->vertex_weight);
-    prm->skip_tet_loci = json_is_true(json_object_get(o, "loose"));
-    prm->densify = !json_is_false(json_object_get(o, "densify"));
-    prm->neighbours = (int)pk_json_int_or(o, "neighbours", prm->neighbours);
-    prm->max_combos = (int)pk_json_int_or(o, "max_combos", prm->max_combos);
-    prm->max_passes = (int)pk_json_int_or(o, "max_passes", prm->max_passes);
     prm->phi_target = job->has_phi ? job->phi : 0;
     prm->n_target = job->count;
     prm->seed = job->seed;
@@ -142,21 +148,6 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
     return 0;
 }
 
-static void check_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, pk_schema_errors *errs)
-{
-    (void)plan;
-    tetfill_setup S;
-    const char *ptr, *rule;
-    char err[512];
-    json_t *mesh = json_object_get(json_object_get(job->inputs, "domain"), "mesh");
-    if (job->service && json_object_get(mesh, "file"))
-        return; /* a request to the daemon: the worker reads and checks the file */
-    if (setup(job, &S, &ptr, &rule, err, sizeof err) != 0) {
-        pk_schema_errors_add(errs, ptr, rule, "%s", err);
-        return;
-    }
-    pk_mesh_free(&S.mesh);
-}
 
 static json_t *ints_json(const int64_t *v, size_t n)
 {
@@ -264,39 +255,65 @@ static void free_setup(void *extra)
     free(S);
 }
 
+/* The mesh read (or the box meshed) and the radii checked; kept for the run
+ * in *prepared when given (read once). */
+static void check_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, void **prepared,
+                          pk_schema_errors *errs)
+{
+    (void)plan;
+    const char *ptr, *rule;
+    char err[512];
+    if (job->service && json_object_get(job->mesh, "file"))
+        return; /* a request to the daemon: the worker reads and checks the file */
+    tetfill_setup *S = malloc(sizeof *S);
+    if (!S) {
+        pk_schema_errors_add(errs, "/tetfill", "memory", "out of memory");
+        return;
+    }
+    if (setup(job, S, &ptr, &rule, err, sizeof err) != 0) {
+        pk_schema_errors_add(errs, ptr, rule, "%s", err);
+        free(S);
+    } else if (prepared && !job->service)
+        *prepared = S;
+    else
+        free_setup(S);
+}
+
 static int place_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, const pk_sizes *sz,
                          pk_monitor *mon, pk_particles *p, pk_place_stats *st, char *err,
                          size_t errlen)
 {
-    (void)plan;
     (void)sz;
-    tetfill_setup *S = malloc(sizeof *S);
+    tetfill_setup *S = plan->prepared; /* the check's, or built here */
+    const int own = !S;
     const char *ptr, *rule;
-    if (!S) {
+    if (own && !(S = malloc(sizeof *S))) {
         snprintf(err, errlen, "out of memory");
         return -1;
     }
-    if (setup(job, S, &ptr, &rule, err, errlen) != 0) {
+    if (own && setup(job, S, &ptr, &rule, err, errlen) != 0) {
         free(S);
         return -1;
     }
     pk_tetfill_stats ts;
     if (pk_tetfill(&S->mesh, &S->prm, mon, p, &ts) != 0) {
         snprintf(err, errlen, "tet filling failed (%s)", pk_stop_reason_name(ts.reason));
-        free_setup(S);
+        if (own)
+            free_setup(S);
         return -1;
     }
     pk_tetfill_measures ms;
     if (pk_tetfill_measure(&S->mesh, p, S->prm.r_min, S->prm.eps, &ms) != 0) {
         snprintf(err, errlen, "out of memory measuring the packing");
-        free_setup(S);
+        if (own)
+            free_setup(S);
         return -1;
     }
     *st = (pk_place_stats){.reason = ts.reason, .placed = p->n, .requested = job->count,
                            .seconds = ts.seconds, .has_domain = 1,
                            .domain_measure = S->mesh.volume,
                            .overlap_tol = S->prm.eps * S->prm.r_min, .extra = S,
-                           .write_extra = write_mesh, .free_extra = free_setup};
+                           .write_extra = write_mesh, .free_extra = own ? free_setup : NULL};
     st->domain_box.dim = 3;
     for (int k = 0; k < 3; k++)
         st->domain_box.L[k] = S->mesh.hi[k];
@@ -305,5 +322,9 @@ static int place_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, const
     return 0;
 }
 
-const pk_placer pk_placer_tetfill = {
-    .name = "tetfill", .own_sizes = 1, .check = check_tetfill, .place = place_tetfill};
+const pk_placer pk_placer_tetfill = {.name = "tetfill",
+                                     .own_sizes = 1,
+                                     .options = &tetfill_options,
+                                     .check = check_tetfill,
+                                     .release = free_setup,
+                                     .place = place_tetfill};

@@ -2,9 +2,10 @@
  *
  * The pack process draws sizes (core/psd/psd), hands them to one placer, audits
  * the result and writes the file.  A placer is one row in pk_placers[]
- * (api/pack/pack_placers.c) plus one file api/pack_place_<name>.c: it reads its
- * own parameter object from the inputs (e.g. "edmd": {...}), runs its core/
- * algorithm and reports common statistics plus any algorithm-specific
+ * (api/pack/pack_placers.c) plus one file api/pack/pack_place_<name>.c: its
+ * option table fills its options struct (pack_options.h) from its parameter
+ * object of the inputs (e.g. "edmd": {...}) once per job, and the placer reads
+ * them from job->opt; it runs its core/ algorithm and reports common statistics plus any algorithm-specific
  * observables as a JSON object, which the writer stores under
  * /observables/<name>/ (numbers, integers, strings, arrays of numbers). */
 #ifndef PK_PACK_PLACER_H
@@ -52,9 +53,13 @@ typedef struct pk_place_stats {
 typedef struct pk_placer {
     const char *name;     /* the "algorithm" value */
     int own_sizes;        /* 1 = the placer makes its own sizes: no grading, no size draw */
+    const pk_option_table *options; /* fills job->opt (pack_options.h), or NULL */
     /* Semantic checks of the placer's own inputs (schema already passed);
-     * may be NULL. */
-    void (*check)(const pk_pack_job *job, const pk_pack_plan *plan, pk_schema_errors *errs);
+     * may be NULL.  With job->prepare it may leave in *prepared what it built
+     * for the run (plan->prepared), freed by release. */
+    void (*check)(const pk_pack_job *job, const pk_pack_plan *plan, void **prepared,
+                  pk_schema_errors *errs);
+    void (*release)(void *prepared);
     /* Place the grains (diameters sz->d, descending) into job->box, appending
      * to p (initialised, dim = job->dim).  0 when the run ended cleanly for
      * whatever reason (st->reason), -1 on failure with err. */

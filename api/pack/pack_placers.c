@@ -1,5 +1,5 @@
-/* pack_placers.c — the table of placers (rsa, edmd, tetfill) of 'pack'.
- * Contract: api/pack/pack_placer.h. */
+/* pack_placers.c — the table of the pack process's placers; the contract is
+ * in pack_placer.h. */
 #include <string.h>
 
 #include "pack_placer.h"

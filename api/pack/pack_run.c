@@ -1,4 +1,5 @@
-/* pack_run.c — run a 'pack' job: sizes → placement → audit → result file. */
+/* pack_run.c — run a parsed 'pack' job: sizes → placement → audit → result
+ * file; the contract is in pack_job.h (pk_pack_run). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -197,18 +198,13 @@ done:
     return pk_h5_commit(h, err, errlen);
 }
 
-int pk_pack_run(json_t *inputs, const char *job_json, const char *out_path, pk_monitor *mon,
-                json_t **summary, char *err, size_t errlen)
+int pk_pack_run(const void *task, int threads, const char *job_json, const char *out_path,
+                pk_monitor *mon, json_t **summary, char *err, size_t errlen)
 {
-    pk_pack_job job;
-    pk_pack_plan plan;
-    pk_schema_errors errs = {0};
+    (void)threads; /* the placers run serially */
+    const pk_pack_job job = ((const pk_pack_task *)task)->job;
+    const pk_pack_plan plan = ((const pk_pack_task *)task)->plan;
     *summary = NULL;
-    if (pk_pack_job_from_json(inputs, &job, &errs) || pk_pack_plan_make(&job, &plan, &errs)) {
-        snprintf(err, errlen, "%s: %s", errs.items[0].pointer, errs.items[0].message);
-        pk_schema_errors_free(&errs);
-        return -1;
-    }
     pk_monitor own = {0}; /* the job's wall time holds without a caller's monitor too */
     if (!mon && job.wall_time_s > 0)
         mon = &own;

@@ -6,6 +6,8 @@
 
 #include "edmd.h"
 
+/* The engine's defaults are the jobs' too: the edmd option table presets with
+ * them (api/pack/pack_place_edmd.c), and its test holds the schema's equal. */
 void pk_edmd_params_default(pk_edmd_params *prm)
 {
     *prm = (pk_edmd_params){

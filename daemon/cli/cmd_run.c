@@ -121,7 +121,6 @@ int cmd_run(int argc, char **argv)
     pk_schema_errors errs = {0};
     json_t *summary = NULL;
     char err[1024] = "";
-    pk_job_set_threads(threads);
     /* a checkpoint resumes only the job (and packd version) that wrote it */
     char digest[65];
     if (ckpt_path) {
@@ -142,7 +141,7 @@ int cmd_run(int argc, char **argv)
         free(text);
         pk_job_set_checkpoint(ckpt_path, digest, ckpt_interval);
     }
-    int rc = pk_job_run(job, out_path, &mon, &summary, &errs, err, sizeof err);
+    int rc = pk_job_run(job, threads, out_path, &mon, &summary, &errs, err, sizeof err);
     int status;
     if (rc == 1) {
         cli_print_errors(job_path, &errs);

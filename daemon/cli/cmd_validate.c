@@ -18,19 +18,17 @@ int cmd_validate(int argc, char **argv)
         return 1;
     pk_schema_errors errs = {0};
     const pk_process *proc;
+    void *parsed = NULL;
     int rc = 0;
     const pk_check_ctx local = {.service = 0}; /* the user's own machine: files are read */
-    if (pk_job_validate(job, &local, &proc, &errs) != 0) {
+    if (pk_job_parse(job, &local, &proc, &parsed, &errs) != 0) {
         cli_print_errors(argv[1], &errs);
         rc = 1;
     } else {
         json_t *out = json_pack("{s:b,s:s,s:s}", "valid", 1, "file", argv[1], "process", proc->id);
         if (strcmp(proc->id, "pack") == 0) {
             /* what the job implies, so a user sees the cost before running it */
-            pk_pack_job pj;
-            pk_pack_plan plan;
-            pk_pack_job_from_json(json_object_get(job, "inputs"), &pj, &errs);
-            pk_pack_plan_make(&pj, &plan, &errs);
+            const pk_pack_plan plan = ((const pk_pack_task *)parsed)->plan;
             json_object_set_new(out, "plan",
                                 json_pack("{s:f,s:f,s:f,s:f,s:f,s:i}", "expected_grains",
                                           plan.expected_n, "phi_target_mix", plan.phi_mix,
@@ -41,6 +39,7 @@ int cmd_validate(int argc, char **argv)
         json_dumpf(out, stdout, JSON_INDENT(2));
         putchar('\n');
         json_decref(out);
+        proc->free_job(parsed);
     }
     pk_schema_errors_free(&errs);
     json_decref(job);
