@@ -44,7 +44,7 @@ typedef struct newton_run {
  * fire_after-th attempt point that is not solved DR stops there (hook
  * result 2) for FIRE to go on. */
 typedef struct attempt_ctx {
-    newton_run sy;     /* sy.c = the attempts' own pair list */
+    newton_run sy;     /* sy.s.c = the attempts' own pair list */
     newton_work *w;
     double target;
     size_t *budget;

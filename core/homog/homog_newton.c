@@ -558,9 +558,8 @@ static int fire_on(const newton_run *sy, double *x, double target, pk_dr_hook *h
     return rc;
 }
 
-/* DR from x with the hook, then FIRE from DR's point when the hook stops DR
- * (hook->fn returned 2; not when hook->poll stopped it: *handed_over = 0).
- * The path both hybrids share. */
+/* DR, then FIRE (homog_hybrid.h): the path the serial step and the
+ * speculative runner share. */
 int pk_hybrid_relax_then_fire(const newton_run *sy, double *x, double target, pk_dr_hook *hook,
                               size_t *fire_after, int *in_fire, pk_dr_stats *st,
                               pk_dr_stats *st_dr, pk_newton_stats *ns)

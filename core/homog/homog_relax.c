@@ -137,8 +137,8 @@ static double fric_rayleigh(const relax_run *R, double *x, double *u, const doub
  * pk_dr_params.plain_lambda_min.  Late in a relaxation the increments run
  * along the softest modes, which a 40-step Lanczos run misses by orders of
  * magnitude near jamming, over-damping DR there (with the increments DR
- * alone takes 5–17× fewer iterations near jamming: docs/perf/homog.md).  The two sums
- * ride on the move and on the residual's pass. */
+ * alone takes 5–17× fewer iterations near jamming: docs/perf/homog.md).
+ * The two sums ride on the move and on the residual's pass. */
 static int estimate(const relax_run *R, const double *f, double *x, double *u, const double *gu,
                     double inc_rq, pk_dr_stats *st)
 {
