@@ -1,3 +1,5 @@
+/* homog_audit.c — the checks every load step passes before it counts as
+ * successful (converged, balanced, contained, finite, overlap).  Contract: homog_audit.h. */
 #include "homog_audit.h"
 
 #include <math.h>

@@ -1,3 +1,5 @@
+/* homog_bc.c — one macroscopic load step: prescribe by the boundary condition
+ * (4.24)/(4.27)/(4.33), relax, homogenize (ch. 5); trial/commit.  Contract: homog_bc.h. */
 #include "homog_bc.h"
 
 #include <math.h>
@@ -6,6 +8,7 @@
 
 #include "core/dem/dem_contact.h"
 #include "core/dem/dem_rattler.h"
+#include "homog_speculative.h"
 #include "homog_tensor.h"
 
 void pk_homog_state_free(pk_homog_state *s)
@@ -192,17 +195,17 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     size_t nfree = 0;
     for (size_t i = 0; i < n; i++)
         nfree += is_free[i];
+    const pk_dem_system sys = {&c, &g, rve->r, n, o->E_n, is_free};
     if (o->friction) {
         geom_of(rve, &fc.g_n);
         pk_dem_geom_set_F(&fc.g_n, committed->F);
-        rc = pk_homog_relax_fric(&c, &g, trial->x, rve->r, n, o->E_n, is_free, &o->dr, &fc,
-                                 trial->u, mon, &out->dr, &ftot);
+        rc = pk_homog_relax_fric(&sys, trial->x, &o->dr, &fc, trial->u, mon, &out->dr, &ftot);
     } else if (o->newton && nfree) {
         out->used_newton = 1;
-        rc = pk_homog_newton(&c, &g, trial->x, rve->r, n, o->E_n, is_free, &o->dr, o->newton,
-                             o->newton_ctx, o->newton_max_iter, mon, &out->dr, &out->newton);
+        const pk_newton_opts no = {o->newton, o->newton_ctx, o->newton_max_iter};
+        rc = pk_homog_newton_speculative(&sys, trial->x, &o->dr, &no, mon, &out->dr, &out->newton);
     } else {
-        rc = pk_homog_relax(&c, &g, trial->x, rve->r, n, o->E_n, is_free, &o->dr, mon, &out->dr);
+        rc = pk_homog_relax(&sys, trial->x, &o->dr, mon, &out->dr);
     }
     if (rc != 0)
         goto done;

@@ -1,3 +1,5 @@
+/* homog_eigen.c — extreme eigenvalue estimates of the free stiffness for
+ * DR's parameters (4.47): Lanczos, Rayleigh quotients.  Contract: homog_eigen.h. */
 #include "homog_eigen.h"
 
 #include <math.h>
@@ -127,18 +129,10 @@ double pk_homog_lanczos_min(const pk_dem_pairs *c, int dim, size_t np, double E,
     double nq = sqrt(pk_homog_dot_mask(q, q, mask, np, dim));
     for (size_t k = 0; k < 3 * np; k++)
         q[k] /= nq;
-    /* 40 steps at 10⁴ grains: 6.5 ms, of which 2.7 ms K·v and 0.5 ms the
-     * blocks; the rest is the vector passes (measured, round 7: fusing the
-     * update of w with |w|² and swapping q/qp instead of copying, bit for
-     * bit the same, saved 5 % of it — dropped).  Round 8: q = w·(1/β)
-     * instead of 3·np divisions, with the swap: 5.5–6.5 → 4.4–5.2 ms (10⁴
-     * grains, 16,700 contacts) — but λ_min's round-off change moved the
-     * plastic events of the bench step (near-jamming 10⁴, seeds 6/7: 12/5 →
-     * 19/12 factorisations, 2.4/2.4 → 3.2/3.7 CPU s, seed 7 in another
-     * minimum, ΔΦ/Φ = +1e-4): dropped.  Kept: the vector passes over the
-     * masked entries only (the others, and z in 2D, stay 0 — K·v reads v
-     * on the mask only: the same numbers): 4.5 → 4.1–4.4 ms (seed 7 bench
-     * step, CPU time). */
+    /* the vector passes run over the masked entries only (the others, and
+     * z in 2D, stay 0: K·v reads v on the mask only); a cheaper q = w·(1/β)
+     * moves λ_min's rounding and with it the bench's plastic paths
+     * (docs/perf/homog.md) */
     int m = 0;
     double beta = 0;
     for (int it = 0; it < steps; it++) {

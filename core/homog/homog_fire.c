@@ -1,3 +1,5 @@
+/* homog_fire.c — FIRE relaxation of the free particles, the Newton hybrid's
+ * inner relaxation after DR.  Contract: homog_fire.h. */
 #include "homog_fire.h"
 
 #include <math.h>
@@ -6,11 +8,8 @@
 
 #include "homog_eigen.h"
 
-/* Measured (round 7, whole near-jamming 10⁴ bench pipeline, seeds 5/6/8,
- * CPU s of the step; the RVEs move since they are relaxed by the same
- * hybrid): these 1.3/2.7/2.2; FIRE 2.0's α_start 0.25: 1.5/2.8/2.0 (the
- * same minima on 5 and 8, another on 6: ΔΦ/Φ −6.5e-8); with its N_delay 20
- * as well: 3.2/271/2.7 (seed 6: 1.28·10⁶ FIRE iterations) — kept. */
+/* Bitzek et al.'s parameters; FIRE 2.0's α_start 0.25 and N_delay 20 were
+ * slower on the near-jamming 10⁴ bench steps (docs/perf/homog.md). */
 pk_fire_params pk_fire_params_default(void)
 {
     pk_fire_params p = {.n_min = 5, .f_inc = 1.1, .f_dec = 0.5, .alpha0 = 0.1, .f_alpha = 0.99,
@@ -68,14 +67,19 @@ static fire_sums fire_sums_at(const double *f, const double *v, double *w, const
                     : fire_pass(f, v, w, is_free, np, dim, dt);
 }
 
-int pk_homog_fire_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
-                         size_t np, double E, const uint8_t *is_free, const pk_dr_params *prm,
+int pk_homog_fire_hooked(const pk_dem_system *sy, double *x, const pk_dr_params *prm,
                          const pk_fire_params *fp, pk_dr_hook *hook, pk_monitor *mon,
                          pk_dr_stats *st)
 {
+    pk_dem_pairs *c = sy->c;
+    const pk_dem_geom *g = sy->g;
+    const double *r = sy->r;
+    const size_t np = sy->np;
+    const double E = sy->E;
+    const uint8_t *is_free = sy->is_free;
     const int dim = g->dim;
     size_t nfree;
-    int rc = pk_relax_begin(c, g, x, r, np, is_free, prm, st, &nfree);
+    int rc = pk_relax_begin(sy, x, prm, st, &nfree);
     if (rc != 0)
         return rc;
     const size_t n3 = 3 * (np ? np : 1);
@@ -86,13 +90,8 @@ int pk_homog_fire_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const
     }
     pk_dem_eval(c, g, x, r, np, E, f, NULL, NULL);
     size_t n_pos = 0;
-    /* Measured (round 9, near-jamming 10⁴ bench, seed 6): four passes
-     * besides the evaluation (P, v + Δt f, the mixed move, |f|) took 0.028
-     * ms + 2 dot products per iteration against DR's 0.018 ms + 1.  Now
-     * fire_pass and the move (pk_relax_move), the same bits (test_homog_fire):
-     * FIRE's own passes 4.03 → 2.75·10⁹ instructions, all FIRE calls of the
-     * bench (F̄ = 1 and the step) 42.6 → 41.3·10⁹ (−3 %: the evaluation is
-     * 59 %); the step 2.89/2.76 → 2.74/2.68 s CPU back to back. */
+    /* one pass after each evaluation (fire_pass) and the shared move: the
+     * same bits as separate passes (test_homog_fire) */
     fire_sums s = fire_sums_at(f, v, w, is_free, np, dim, 0);
     st->f0 = st->f = sqrt(s.ff);
     double target;
@@ -103,7 +102,7 @@ int pk_homog_fire_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const
     const double dt_max = fp->dt_scale * 2 / sqrt(st->lambda_max);
     double dt = 0.5 * dt_max, alpha = fp->alpha0;
     pk_progress pr = {.stage = "relax", .fraction = -1, .phi = -1, .eta_s = -1};
-    pk_relax_geom geo = {c, g, r, np, E, 1}; /* pk_dem_eval_forces */
+    pk_relax_geom geo = {sy, 1}; /* pk_dem_eval_forces */
     for (size_t k = 0;; k++) {
         double vv;
         if (s.fv > 0) { /* P = f·v > 0: downhill; v + Δt f is in w (fire_pass) */

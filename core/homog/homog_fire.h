@@ -9,8 +9,8 @@
  * free DOFs that DR's Δt (4.47) is dominated by; λ_min/λ_max ~ 1e-5 at 10⁴
  * grains does not change it): the stability bound of the stiffest mode.
  * Bitzek's Δt_max ~ 10 Δt_MD assumes an MD step well below that bound; DR's
- * is already at it — measured with dt_scale 1.4 and 2: 5–20x more
- * iterations (blow-ups, restarts).  Δt starts at Δt_max/2.  Same contract
+ * is already at it (dt_scale 1.4 and 2: 5–20× more iterations, blow-ups and
+ * restarts).  Δt starts at Δt_max/2.  Same contract
  * as pk_homog_relax_hooked: convergence |f| <= max(tol·|f⁰|, abs_floor),
  * cap max_iter, the hook called when |f| <= hook->at (results 0, 1, 2 and
  * errors as there).  In st: dt the last Δt, γ = 0, λ_max, refreshes = the
@@ -32,8 +32,7 @@ typedef struct pk_fire_params {
 /* The standard parameters of Bitzek et al. and the measured dt_scale. */
 pk_fire_params pk_fire_params_default(void);
 
-int pk_homog_fire_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
-                         size_t np, double E, const uint8_t *is_free, const pk_dr_params *prm,
+int pk_homog_fire_hooked(const pk_dem_system *s, double *x, const pk_dr_params *prm,
                          const pk_fire_params *fp, pk_dr_hook *hook, pk_monitor *mon,
                          pk_dr_stats *st);
 

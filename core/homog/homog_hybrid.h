@@ -1,8 +1,8 @@
-/* homog_hybrid.h — the parts of the Newton/DR hybrid (homog_newton.c) that
- * its speculative variant (homog_speculative.c) shares: the solve's problem
- * and work arrays, one Newton phase, one attempt from a relaxation's point,
- * and DR-then-FIRE.  Internal to core/homog/homog_newton.c and
- * core/homog/homog_speculative.c. */
+/* homog_hybrid.h — the serial Newton/DR hybrid's step (homog_newton.c) in
+ * parts, for the speculative runner that wraps it (homog_speculative.c): the
+ * solve's problem and work arrays, its prologue and end, one Newton phase,
+ * one attempt from a relaxation's point, and DR-then-FIRE.  Internal to
+ * core/homog; homog_newton.c does not know the speculative runner. */
 #ifndef PK_HOMOG_HYBRID_H
 #define PK_HOMOG_HYBRID_H
 
@@ -27,20 +27,16 @@ typedef struct newton_work {
     pk_sparse_sym K;
 } newton_work;
 
-/* The problem one solve works on. */
-typedef struct newton_sys {
-    pk_dem_pairs *c;
-    const pk_dem_geom *g;
-    const double *r;
-    size_t np;
-    double E;
-    const uint8_t *is_free;
+/* One solve: the system (its pair list the one this solve's phases use)
+ * and how it runs. */
+typedef struct newton_run {
+    pk_dem_system s;
     const pk_dr_params *prm;
     const pk_sparse_solver *solver;
     pk_sparse_ctx *sctx; /* the solver's context over the load path; NULL: none */
     pk_monitor *mon;
     const atomic_int *abort; /* nonzero: stop as if cancelled (speculative attempts); NULL: none */
-} newton_sys;
+} newton_run;
 
 /* The Newton attempts DR (then FIRE) makes along its way (pk_dr_hook):
  * Newton runs on a copy of the relaxation's point with a pair list of its
@@ -48,7 +44,7 @@ typedef struct newton_sys {
  * fire_after-th attempt point that is not solved DR stops there (hook
  * result 2) for FIRE to go on. */
 typedef struct attempt_ctx {
-    newton_sys sy;     /* sy.c = the attempts' own pair list */
+    newton_run sy;     /* sy.s.c = the attempts' own pair list */
     newton_work *w;
     double target;
     size_t *budget;
@@ -61,7 +57,7 @@ typedef struct attempt_ctx {
 
 /* One Newton phase from x (w->f, *phi, *fn describe x on entry and on exit);
  * see homog_newton.c.  Returns 0, -1 (memory), -2 (box), 1 (cancelled). */
-int pk_hybrid_newton_phase(const newton_sys *sy, newton_work *w, double *x, double *phi,
+int pk_hybrid_newton_phase(const newton_run *sy, newton_work *w, double *x, double *phi,
                            double *fn, double target, size_t stall, int shift, size_t *budget,
                            pk_newton_stats *ns, pk_dr_stats *st);
 
@@ -79,13 +75,11 @@ pk_dr_params pk_hybrid_fire_params(const pk_dr_params *prm, double target, const
 void pk_hybrid_fire_merge(pk_dr_stats *st, const pk_dr_stats *fs, const pk_dr_params *prm,
                           pk_newton_stats *ns);
 
-/* DR from x with the hook, then FIRE from DR's point when the hook stops DR
- * (hook->fn returned 2; not when hook->poll did): *fire_after = 0 and
- * *in_fire = 1 as FIRE begins, *st_dr = DR's statistics at its end. */
-int pk_hybrid_relax_then_fire(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
-                              size_t np, double E, const uint8_t *is_free,
-                              const pk_dr_params *prm, double target, pk_dr_hook *hook,
-                              size_t *fire_after, int *in_fire, pk_monitor *mon, pk_dr_stats *st,
+/* DR from x on sy->s with the hook, then FIRE from DR's point when the
+ * hook stops DR (hook->fn returned 2; not when hook->poll did): *fire_after
+ * = 0 and *in_fire = 1 as FIRE begins, *st_dr = DR's statistics at its end. */
+int pk_hybrid_relax_then_fire(const newton_run *sy, double *x, double target, pk_dr_hook *hook,
+                              size_t *fire_after, int *in_fire, pk_dr_stats *st,
                               pk_dr_stats *st_dr, pk_newton_stats *ns);
 
 /* How the hybrid makes its attempts: the first phase's stall count, the
@@ -96,15 +90,27 @@ typedef struct pk_hybrid_plan {
     size_t crawl;
 } pk_hybrid_plan;
 
-#if !defined(__STDC_NO_THREADS__)
-/* The hybrid after pk_homog_newton's prologue with its attempts made
- * speculatively on a second thread (homog_speculative.c): the serial
- * hybrid's result, bit for bit.  sy and w as the prologue left them (w->f
- * the forces at x, phi0 and f0 its energy and residual), c2 a pair list of
- * the worker's own. */
-int pk_hybrid_speculative(const newton_sys *sy, newton_work *w, pk_dem_pairs *c2, double *x,
-                          double phi0, double f0, double target, size_t *budget,
-                          const pk_hybrid_plan *plan, pk_dr_stats *st, pk_newton_stats *ns);
-#endif
+/* One step of the hybrid: its problem, work, the attempts' own pair list,
+ * and what the prologue found at the start point. */
+typedef struct pk_hybrid {
+    newton_run sy;           /* sy.s.c: the caller's pair list */
+    newton_work w;
+    pk_dem_pairs c2;         /* the attempts' */
+    double phi0, f0, target; /* at the start point (w.f: its forces) */
+    size_t budget;           /* factorisations left */
+} pk_hybrid;
+
+/* The prologue: ns and st cleared, the pair list built and evaluated at x,
+ * the work arrays, the DOF numbering, f⁰ and the target.  0, -1 (memory),
+ * -2 (box); pk_hybrid_end is due in every case. */
+int pk_hybrid_begin(pk_hybrid *h, const pk_dem_system *s, const double *x,
+                    const pk_dr_params *prm, const pk_newton_opts *no, pk_monitor *mon,
+                    pk_dr_stats *st, pk_newton_stats *ns);
+/* The serial step after the prologue: the Newton phase from x, then DR (and
+ * FIRE) with the attempts. */
+int pk_hybrid_step(pk_hybrid *h, double *x, pk_dr_stats *st, pk_newton_stats *ns);
+void pk_hybrid_end(pk_hybrid *h);
+/* The serial step's plan (its constants, its first threshold). */
+pk_hybrid_plan pk_hybrid_plan_of(const pk_hybrid *h);
 
 #endif

@@ -1,3 +1,5 @@
+/* homog_newton.c — the serial Newton/DR/FIRE hybrid and its step in parts.
+ * Contract: homog_newton.h (public), homog_hybrid.h (the parts). */
 #include "homog_newton.h"
 #include "homog_hybrid.h"
 
@@ -9,19 +11,10 @@
 #include "homog_eigen.h"
 #include "homog_fire.h"
 #include "homog_stiffness.h"
-#include "core/base/par.h"
 
-/* Where a near-jamming 10⁴ step goes (round 9, bench seed 6, HEAD 5f20cc2,
- * 2.36 s CPU: 12 factorisations, 571 DR + 5,651 FIRE iterations): force
- * evaluations 0.87 s (6,554 × 0.133 ms), CHOLMOD factorisations 0.48 s
- * (40 ms each: rattlers 1.4 ms, assembly 1 ms, the rest analyse + factor in
- * api/solver/sparse_cholmod.c), FIRE's vector passes 0.19 s + ~0.2 s of dot
- * products (fused since), L-BFGS solves 0.20 s (98 × 2.1 ms), pair-list
- * builds 0.19 s (47 × 4.0 ms, 88 % of it pk_grid's scan) — 39 of the 47 in
- * the line search: a full step moves its largest grain MAX_MOVE = skin/2,
- * so most first trials are stale (seed 8: 53 of 61).  Fewer or cheaper
- * builds move the list's order and with it the rounding (see
- * pk_dem_pairs_build). */
+/* Tuned constants: the measurements behind each are in docs/perf/homog.md,
+ * under its name; the figures quoted come from bench/homog (near-jamming
+ * and dense 10⁴-grain RVEs, one 0.1 % compression step). */
 /* Stiffness added on rattler DOFs (× E): a rattler without contacts has no
  * stiffness at all, and its force is zero, so any small shift gives the
  * right step (zero) without spoiling the conditioning of the jammed part. */
@@ -31,119 +24,43 @@
 /* Below this relative size the energy difference is round-off: judge the
  * step by the residual instead (near convergence f·Δx ~ |f|²/λ is ~1e-18 Φ). */
 #define ENERGY_ROUNDOFF 1e-11
-/* Factorisations without halving the residual before Newton, from the step's
- * start, hands the step to DR — and before an attempt from one of DR's
- * points is given up.  An attempt gets more: near the end of a plastic
- * event Newton may first slide on along a soft mode (the residual rises,
- * Φ_n falls) before it converges (measured at 10⁴ grains: 5 factorisations,
- * where DR needs ~3,000 more iterations to the next attempt; with 3 also
- * from FIRE's points, 10 attempts instead of 3 on the near-jamming bench RVE).
- * From the step's start one factorisation whose L-BFGS steps do not halve
- * the residual is enough (was 3): DR starts from
- * the step's start, not from where Newton stopped, so the result only
- * changes where Newton would have converged after a factorisation that did
- * not halve the residual — none measured (40 plastic and elastic steps of
- * 200–400 grains; the 10⁴ bench steps and relaxations at F̄ = 1, where the
- * 2nd or 3rd factorisation was indefinite: 1–2 factorisations and their
- * L-BFGS window, ~0.1–0.25 s, saved per step, same DR path). */
+/* Factorisations without halving the residual after which Newton hands the
+ * step to DR (from the step's start: DR restarts there anyway) or gives an
+ * attempt up (more: it may first slide along a soft mode; 5 seen at 10⁴). */
 #define STALL_FACTORS 1
 #define ATTEMPT_STALL 6
-/* Rises of the residual from one factorisation's point to the next after
- * which an attempt is given up.  A converging attempt rises at most once
- * (the slide along the soft mode) and then falls at every factorisation;
- * the failed attempts measured rise again within 1–2 factorisations and then
- * creep on (Φ_n −1e-5 relative) until ATTEMPT_STALL: near-jamming 10⁴ bench
- * RVE 19 → 11 factorisations, dense 10⁴ and test_homog_newton's cases the
- * same attempts succeed, same minima. */
+/* Residual rises between factorisation points that end an attempt: a
+ * converging one rises at most once (near-jamming 10⁴: 19 → 11 factorisations). */
 #define ATTEMPT_RISES 2
-/* Residuals (× |f⁰|) of DR's (then FIRE's) points from which Newton tries
- * to finish a step it could not take from the start: HANDOVER,
- * × HANDOVER_STEP, … (see pk_homog_newton).  With failed attempts cheap
- * (ATTEMPT_RISES) denser attempts pay: near-jamming 10⁴ bench RVE, step 0.3 /
- * 0.4 / 0.5 / 0.6 / 0.7: 6,073 / 4,711 / 4,066 / 3,786 / 3,587 DR+FIRE
- * iterations, 11 / 13 / 7 / 7 / 9 factorisations; every value from 0.3 to
- * 0.7 ends in DR's minimum on it and on test_homog_newton's cases. */
-/* Sixth session, with DR's increments in its λ_min (homog_relax.c): the
- * failed attempts of the cached near-jamming 10⁴ steps all end with
- * block_not_positive_definite — seed 7's two at their first factorisation,
- * seed 6's four and seed 8's three at their second or third, after the residual
- * climbed ×3–×60 from DR's point — and cost seed 6 8 of its 12
- * factorisations and most of its 95 L-BFGS steps (estimated from their
- * unit costs, ~45 ms a factorisation and ~6 ms a step: ~0.8 of ~2.1 s).
- * Dropped: no attempt while the Rayleigh quotient of DR's increments since
- * the last estimate is negative (DR inside a rearrangement) — it never was
- * at an attempt (seeds 6–8: the same attempts, the same path).  Dropped
- * too: an attempt's factor refreshed as soon as its residual climbed above
- * 2× / 4× that at the factorisation (instead of REFRESH_WINDOW steps on):
- * the refreshed blocks were positive definite, the attempts went on and
- * failed later — seeds 5–9, 7 / 12 / 7 / 11 / 5 → 17 / 24 / 7 / 13 / 7
- * factorisations (2×), seed 6 2.3 → 4.0 s.  And the next threshold halved
- * once more after a failed attempt (×0.25): seed 6 12 → 8 factorisations but
- * 2.06 → 2.21 s (DR runs longer before FIRE), seed 7 1.96 → 3.19 s (13,602
- * creeping DR iterations), seeds 5/8/9 1.24/2.01/0.86 → 1.07/1.52/1.26 s. */
-/* Seventh session, measured and not kept: FIRE's thresholds ×0.25 apart
- * instead of ×0.5 (one failing attempt fewer on seed 6: 1.71 → 1.60 s, the
- * same minimum; seeds 5, 7–9 ±0.07 s); ×0.125 and ×0.05 slower (seed 6:
- * 5,681 → 11,809 FIRE iterations) — a gain on one RVE is no rule. */
+/* Residuals (× |f⁰|) of DR's (then FIRE's) points where Newton attempts to
+ * finish the step: HANDOVER, × HANDOVER_STEP, …; 0.3–0.7 all end in DR's
+ * minimum, 0.5 fewest factorisations (near-jamming 10⁴: 7). */
 #define HANDOVER 1e-3
 #define HANDOVER_STEP 0.5
-/* DR iterations after a failed attempt in which the residual neither
- * reached the next threshold nor rose above the attempt's (pk_dr_hook.crawl)
- * after which the next attempt is made anyway: DR creeps along a mode far
- * softer than its λ_min estimate (Lanczos, 40 steps: 4e-3, where the block's
- * λ_min is ~1e-5 at 10⁴ grains near jamming) — measured 8,750 iterations
- * from 1.05e-4 to 5.3e-5 on one RVE; the attempt fails there too, so FIRE
- * (FIRE_AFTER) takes the creep over.  Between DR's attempts the residual
- * halves within 200–550 iterations on the other bench RVEs and never creeps
- * 1,000 iterations in test_homog_newton's cases (500 changes one 10⁴ path). */
+/* DR iterations after a failed attempt without reaching the next threshold
+ * nor rising (pk_dr_hook.crawl) after which the next attempt is made anyway:
+ * DR creeps along a mode softer than its λ_min (one 10⁴ RVE: 8,750 iterations). */
 #define CRAWL 1000
-/* Failed attempts from DR's points after which FIRE replaces DR.  1 is 2x
- * faster on the 10⁴ bench RVEs, but two of the three plastic cases of
- * test_homog_newton then end in another minimum of HIGHER energy (ΔΦ/Φ up to
- * +3e-3; all three with the first attempt at 3e-3): FIRE from rest at DR's
- * point leaves DR's path while the rearrangement still goes on (even where
- * the block is positive definite there: the 400-grain case).  After 2, every
- * case measured ends in DR's minimum (FIRE then starts at HANDOVER ×
- * HANDOVER_STEP = 5e-4·|f⁰| at the earliest). */
+/* Unsolved attempt points after which FIRE replaces DR: with 1 FIRE leaves
+ * DR's path during the rearrangement (2 of 3 plastic test cases end higher);
+ * with 2 every case measured ends in DR's minimum. */
 #define FIRE_AFTER 2
 /* Quasi-Newton steps per factorisation: at most, and the window within which
  * the residual must halve before the preconditioner is refreshed. */
 #define MAX_INNER 60
 #define REFRESH_WINDOW 12
-/* Line-search cuts before the direction is given up.  A cut takes the
- * minimiser of the quadratic through Φ(0), Φ'(0) and Φ(s) (Nocedal & Wright
- * §3.5), kept within [CUT_MIN, CUT_MAX]·s; halving when the energy change is
- * round-off.  Near jamming the first trials overshoot by far (contacts close
- * along a soft mode): halving took 7 evaluations per accepted step,
- * the interpolation 2.5–3.5 (near-jamming 10⁴ bench RVEs: 433 → 319 and
- * 644 → 279 evaluations in the Newton attempts, 12 → 10 factorisations on
- * the second, the same minima). */
+/* Line-search cuts before the direction is given up; a cut takes the minimiser
+ * of the quadratic through Φ(0), Φ'(0), Φ(s) (Nocedal & Wright §3.5) within
+ * [CUT_MIN, CUT_MAX]·s: 2.5–3.5 evaluations per step near jamming, halving 7. */
 #define MAX_CUTS 12
 #define CUT_MIN 0.1
 #define CUT_MAX 0.5
-/* Largest displacement of a grain per step, × the Verlet skin.  Measured
- * (seventh session, cached 10⁴ bench steps, alternating pairs, CPU s): 0.3
- * cuts the pair-list builds 3–5× (a full first trial no longer leaves the
- * list's reach), the same DR/FIRE paths and minima (Φ to 1e-14), seeds 5, 7,
- * 8, 9 10–27 % faster — but seed 6 1.82–1.86 → 1.99–2.14 s (14 instead of
- * 12 factorisations, 138 instead of 95 steps in its failing attempts) and
- * the dense RVE 0.49–0.53 → 0.58 s; 0.2 and 0.4 alike.  Kept at 0.5. */
+/* Largest displacement of a grain per step, × the Verlet skin (a trust region
+ * in the max norm); 0.2–0.4 faster on four 10⁴ seeds, slower on the worst. */
 #define MAX_MOVE 0.5
-/* Levenberg–Marquardt shifts (× E) of an attempt from DR's point: the first,
- * the largest, and the one below which the shift is dropped; at most
- * SHIFT_RAISES raises per attempt (a converging attempt needed 2 at 10⁴
- * grains; attempts that need more creep along a valley DR is faster down:
- * measured 7 raises and 13–17 factorisations in the relaxation of random
- * overlaps).  No shift once the attempt's residual has risen above its value
- * at DR's point: Newton then slid along a soft mode into another instability.
- * Measured (round 7): such shifted continuations converged in 0 of 10
- * attempts on the 10⁴ bench steps (near jamming seeds 5–9, dense 5–6) — each
- * cost 2–8 factorisations: step factorisations 9/24/7/21/5 → 7/14/7/12/5,
- * dense 7 → 6, same DR/FIRE path, same minima — and in 2 of 8 on 40 steps of
- * 200–400 grains (there the hybrid then needs 600–1,200 more relaxation
- * iterations, same minima).  With the rule no shift was made at all in those
- * 40 and 216 more 200–800-grain steps (φ 0.85–0.88, 0.5–2 %): the shift is
- * kept for a block that turns indefinite while the residual falls. */
+/* Levenberg–Marquardt shifts (× E) of an attempt: first, largest, dropped
+ * below; at most SHIFT_RAISES raises (a converging 10⁴ attempt needed 2), and
+ * none once the residual rose above DR's point (0 of 10 such ones converged). */
 #define SHIFT_FIRST 1e-3
 #define SHIFT_MAX 1e-1
 #define SHIFT_MIN 1e-6
@@ -298,25 +215,23 @@ static void gather_gradient(const double *f, const int32_t *dof, size_t np, int 
 
 /* Rattlers at the current contacts, K + μ1 assembled and factorised (one
  * factorisation counted).  NULL with info->status FAILED on error. */
-static pk_sparse_factor *factor_block(const newton_sys *sy, newton_work *w, double mu,
+static pk_sparse_factor *factor_block(const newton_run *sy, newton_work *w, double mu,
                                       size_t *budget, pk_newton_stats *ns, pk_sparse_info *info)
 {
-    const int dim = sy->g->dim;
+    const int dim = sy->s.g->dim;
     info->status = PK_SPARSE_FAILED;
-    if (pk_dem_rattlers(sy->c, dim, sy->np, sy->is_free, w->rat) == (size_t)-1)
+    if (pk_dem_rattlers(sy->s.c, dim, sy->s.np, sy->s.is_free, w->rat) == (size_t)-1)
         return NULL;
     w->K.nnz = 0;
     w->K.n = w->mem.nd;
-    if (assemble(sy->c, dim, sy->E, w->dof, w->rat, mu, sy->np, &w->K) != 0)
+    if (assemble(sy->s.c, dim, sy->s.E, w->dof, w->rat, mu, sy->s.np, &w->K) != 0)
         return NULL;
     if (*budget > 0) /* the check of a shifted end point may come with the budget spent */
         (*budget)--;
     ns->iterations++;
     /* Newton asks "PD?" only; an unchanged contact pattern reuses the
-     * previous analysis, same numbers (measured round 10: it never repeats
-     * within one relaxation of the bench RVEs or test cases, but in 12 of 25
-     * factorisations over 20 elastic 0.01 % steps of a dense 10³ RVE: the
-     * context spans the load path, api/homog/homog_run.c) */
+     * previous analysis, same numbers (it repeats across elastic steps of a
+     * load path, not within one relaxation: the context spans the path) */
     pk_sparse_factor *F = sy->sctx ? sy->solver->factor_pd_ctx(sy->sctx, &w->K, info)
                                    : sy->solver->factor_pd(&w->K, info);
     ns->reused += info->reused_analysis != 0;
@@ -337,23 +252,22 @@ static pk_sparse_factor *factor_block(const newton_sys *sy, newton_work *w, doub
  * indefinite block gets a Levenberg–Marquardt shift μ instead: SHIFT_FIRST·E,
  * ×10 while indefinite (at most SHIFT_RAISES times), ÷10 per positive
  * definite factorisation except the first after a raise (held once: the
- * lower μ was just found indefinite; measured: one indefinite factorisation
- * less on both dense 10⁴ bench RVEs, one more on the 400-grain case of
- * test_homog_newton), 0 below SHIFT_MIN·E — but only while the residual is
- * at most its value at the entry point (above: the phase ends).  A point
+ * lower μ was just found indefinite), 0 below SHIFT_MIN·E — but only while
+ * the residual is at most its value at the entry point (above: the phase
+ * ends).  A point
  * reached with μ > 0 counts as converged only if the unshifted block is
  * positive definite there (a minimum, not a saddle).
  * *budget factorisations at most (decremented).
  * Returns 0, -1 (memory), -2 (box), 1 (cancelled: st->stop set). */
-int pk_hybrid_newton_phase(const newton_sys *sy, newton_work *w, double *x, double *phi, double *fn,
+int pk_hybrid_newton_phase(const newton_run *sy, newton_work *w, double *x, double *phi, double *fn,
                         double target, size_t stall, int shift, size_t *budget,
                         pk_newton_stats *ns, pk_dr_stats *st)
 {
-    pk_dem_pairs *c = sy->c;
-    const pk_dem_geom *g = sy->g;
+    pk_dem_pairs *c = sy->s.c;
+    const pk_dem_geom *g = sy->s.g;
     const int dim = g->dim;
-    const size_t np = sy->np, nd = w->mem.nd;
-    const double E = sy->E;
+    const size_t np = sy->s.np, nd = w->mem.nd;
+    const double E = sy->s.E;
     double best = *fn, mu = 0, mu_used = 0;
     const double f_entry = *fn; /* no shift once the residual rose above it */
     size_t since_best = 0;
@@ -446,10 +360,10 @@ int pk_hybrid_newton_phase(const newton_sys *sy, newton_work *w, double *x, doub
                     if (w->dof[i] >= 0)
                         for (int a = 0; a < dim; a++)
                             w->xt[3 * i + a] += s * w->d[w->dof[i] + a];
-                rc = eval_at(c, g, w->xt, sy->r, np, E, sy->prm, w->ft, &phit);
+                rc = eval_at(c, g, w->xt, sy->s.r, np, E, sy->prm, w->ft, &phit);
                 if (rc != 0)
                     break;
-                ftn = sqrt(pk_homog_dot_mask(w->ft, w->ft, sy->is_free, np, dim));
+                ftn = sqrt(pk_homog_dot_mask(w->ft, w->ft, sy->s.is_free, np, dim));
                 double lin = -s * gd; /* predicted decrease to first order */
                 if (lin <= ENERGY_ROUNDOFF * fabs(*phi))
                     ok = ftn < *fn; /* energy change lost in round-off */
@@ -505,7 +419,7 @@ int pk_hybrid_newton_phase(const newton_sys *sy, newton_work *w, double *x, doub
         sy->solver->release(fac);
         if (rc != 0)
             return rc;
-        rc = eval_at(c, g, x, sy->r, np, E, sy->prm, w->f, phi); /* contacts of the current point */
+        rc = eval_at(c, g, x, sy->s.r, np, E, sy->prm, w->f, phi); /* contacts of the current point */
         if (rc != 0)
             return rc;
         if (failed_first) {
@@ -552,16 +466,16 @@ void pk_hybrid_next_threshold(double *at, double target)
 int pk_hybrid_attempt_from(attempt_ctx *a, double *xn, double *fres)
 {
     newton_work *w = a->w;
-    const int dim = a->sy.g->dim;
-    const size_t np = a->sy.np;
+    const int dim = a->sy.s.g->dim;
+    const size_t np = a->sy.s.np;
     if (*a->budget == 0)
         return 0;
-    int rc = pk_dem_pairs_build(a->sy.c, a->sy.g, xn, a->sy.r, np, a->sy.prm->skin);
+    int rc = pk_dem_pairs_build(a->sy.s.c, a->sy.s.g, xn, a->sy.s.r, np, a->sy.prm->skin);
     if (rc != 0)
         return rc;
     double phi;
-    pk_dem_eval(a->sy.c, a->sy.g, xn, a->sy.r, np, a->sy.E, w->f, &phi, NULL);
-    double fn = sqrt(pk_homog_dot_mask(w->f, w->f, a->sy.is_free, np, dim));
+    pk_dem_eval(a->sy.s.c, a->sy.s.g, xn, a->sy.s.r, np, a->sy.s.E, w->f, &phi, NULL);
+    double fn = sqrt(pk_homog_dot_mask(w->f, w->f, a->sy.s.is_free, np, dim));
     a->ns->attempts++;
     pk_dr_stop keep = a->st->stop;
     rc = pk_hybrid_newton_phase(&a->sy, w, xn, &phi, &fn, a->target, ATTEMPT_STALL, 1, a->budget, a->ns,
@@ -592,12 +506,12 @@ static int newton_attempt(void *vctx, double *x, double *fres, double *at)
     attempt_ctx *a = vctx;
     pk_hybrid_next_threshold(at, a->target);
     double *xn = a->w->x0;
-    memcpy(xn, x, 3 * a->sy.np * sizeof *x);
+    memcpy(xn, x, 3 * a->sy.s.np * sizeof *x);
     int rc = pk_hybrid_attempt_from(a, xn, fres);
     if (rc < 0)
         return rc;
     if (rc == 1) {
-        memcpy(x, xn, 3 * a->sy.np * sizeof *x);
+        memcpy(x, xn, 3 * a->sy.s.np * sizeof *x);
         return 1;
     }
     return unsolved(a);
@@ -631,109 +545,101 @@ void pk_hybrid_fire_merge(pk_dr_stats *st, const pk_dr_stats *fs, const pk_dr_pa
 
 /* FIRE from DR's point after a failed attempt (the attempts go on from
  * FIRE's points through the same hook) to the step's target; st (DR's
- * statistics so far) gets FIRE's iterations added and its end.
- * Measured and dropped (round 10, cached bench RVEs near-jamming 10⁴ seeds 6
- * and 8, HEAD 1.9–2.4 / 1.75–2.0 s CPU): instead of FIRE, L-BFGS
- * preconditioned by the Gauss–Newton stiffness Σ E n⊗n + μ·1 (always
- * positive definite; exact K whenever it is PD; Packwood et al., JCP 144,
- * 164109 (2016)): same minima (ΔΦ/Φ ≤ 1e-15), but 682 / 283 steps, 34 / 16
- * factorisations, 4.6 / 3.1 s (μ = 1e-4·E; 1e-3·E and 1e-5·E no better;
- * refreshing every 12 steps: 17 factorisations and then FIRE anyway).  The
- * tail is FIRE rolling out of a flat region into the next rearrangement
- * (seed 6: |f| rising ×10 over 3,500 iterations, the block positive definite
- * at FIRE's points): cutting the iterations 8× does not pay a solve
- * (~2 ms ≈ 15 force evaluations) per step.  An earlier first attempt
- * (HANDOVER 2e-3 / 3e-3, seed 7's 3,000 crawling DR iterations): same minima
- * on all six cached RVEs, total CPU of the six steps 9.0 s → 11.8 / 10.0 s.
- * Dropped too (seventh session): FIRE's Δt_max and DR's Δt from a λ_max
- * below Gershgorin's bound (which is 1.65× the power iteration's on these
- * blocks; scaled by 0.65): DR 15–20 % fewer iterations, but FIRE slower and
- * on seed 8 unstable (53,458 instead of 1,296 iterations). */
-static int fire_on(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
-                   double E, const uint8_t *is_free, const pk_dr_params *prm, double target,
-                   pk_dr_hook *hook, pk_monitor *mon, pk_dr_stats *st, pk_newton_stats *ns)
+ * statistics so far) gets FIRE's iterations added and its end.  (What was
+ * tried instead of FIRE here: docs/perf/homog.md, fire_on.) */
+static int fire_on(const newton_run *sy, double *x, double target, pk_dr_hook *hook,
+                   pk_dr_stats *st, pk_newton_stats *ns)
 {
     pk_fire_params fp = pk_fire_params_default();
-    pk_dr_params p = pk_hybrid_fire_params(prm, target, st);
+    pk_dr_params p = pk_hybrid_fire_params(sy->prm, target, st);
     pk_dr_stats fs;
-    int rc = pk_homog_fire_hooked(c, g, x, r, np, E, is_free, &p, &fp, hook, mon, &fs);
-    pk_hybrid_fire_merge(st, &fs, prm, ns);
+    int rc = pk_homog_fire_hooked(&sy->s, x, &p, &fp, hook, sy->mon, &fs);
+    pk_hybrid_fire_merge(st, &fs, sy->prm, ns);
     return rc;
 }
 
-/* DR from x with the hook, then FIRE from DR's point when the hook stops DR
- * (hook->fn returned 2; not when hook->poll stopped it: *handed_over = 0).
- * The path both hybrids share. */
-int pk_hybrid_relax_then_fire(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
-                           size_t np, double E, const uint8_t *is_free, const pk_dr_params *prm,
-                           double target, pk_dr_hook *hook, size_t *fire_after, int *in_fire,
-                           pk_monitor *mon, pk_dr_stats *st, pk_dr_stats *st_dr,
-                           pk_newton_stats *ns)
+/* DR, then FIRE (homog_hybrid.h): the path the serial step and the
+ * speculative runner share. */
+int pk_hybrid_relax_then_fire(const newton_run *sy, double *x, double target, pk_dr_hook *hook,
+                              size_t *fire_after, int *in_fire, pk_dr_stats *st,
+                              pk_dr_stats *st_dr, pk_newton_stats *ns)
 {
-    int rc = pk_homog_relax_hooked(c, g, x, r, np, E, is_free, prm, hook, mon, st);
+    int rc = pk_homog_relax_hooked(&sy->s, x, sy->prm, hook, sy->mon, st);
     *st_dr = *st;
     if (rc == 0 && st->stop == PK_DR_HANDED_OVER && !(hook->poll && hook->poll(hook->ctx))) {
         *fire_after = 0;
         *in_fire = 1;
         hook->crawl = 0; /* FIRE does not creep: a slow FIRE climbs out of a saddle */
-        rc = fire_on(c, g, x, r, np, E, is_free, prm, target, hook, mon, st, ns);
+        rc = fire_on(sy, x, target, hook, st, ns);
     }
     return rc;
 }
 
-
-int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
-                    double E, const uint8_t *is_free, const pk_dr_params *prm,
-                    const pk_sparse_solver *solver, pk_sparse_ctx *sctx, size_t max_newton,
-                    pk_monitor *mon, pk_dr_stats *st, pk_newton_stats *ns)
+int pk_hybrid_begin(pk_hybrid *h, const pk_dem_system *s, const double *x,
+                    const pk_dr_params *prm, const pk_newton_opts *no, pk_monitor *mon,
+                    pk_dr_stats *st, pk_newton_stats *ns)
 {
-    const int dim = g->dim;
+    pk_dem_pairs *c = s->c;
+    const int dim = s->g->dim;
+    const size_t np = s->np;
+    memset(h, 0, sizeof *h);
     memset(ns, 0, sizeof *ns);
     memset(st, 0, sizeof *st);
-    int rc = pk_dem_pairs_build(c, g, x, r, np, prm->skin);
+    int rc = pk_dem_pairs_build(c, s->g, x, s->r, np, prm->skin);
     if (rc != 0)
         return rc;
-    newton_work w;
-    pk_dem_pairs c2 = {0};
-    pk_dem_pairs_stiffness(&c2, c->kclass, c->kmat, c->nclass, c->kref);
-    c2.par = c->par;
-    if (work_alloc(&w, np, dim) != 0) {
-        rc = -1;
-        goto out;
-    }
-    newton_sys sy = {c, g, r, np, E, is_free, prm, solver, sctx, mon, NULL};
-    double phi;
-    pk_dem_eval(c, g, x, r, np, E, w.f, &phi, NULL);
-    double f0 = sqrt(pk_homog_dot_mask(w.f, w.f, is_free, np, dim)), fn = f0;
-    double target = fmax(prm->tol * f0, prm->abs_floor);
+    newton_work *w = &h->w;
+    pk_dem_pairs_stiffness(&h->c2, c->kclass, c->kmat, c->nclass, c->kref);
+    h->c2.par = c->par;
+    if (work_alloc(w, np, dim) != 0)
+        return -1;
+    h->sy = (newton_run){*s, prm, no->solver, no->sctx, mon, NULL};
+    pk_dem_eval(c, s->g, x, s->r, np, s->E, w->f, &h->phi0, NULL);
+    h->f0 = sqrt(pk_homog_dot_mask(w->f, w->f, s->is_free, np, dim));
+    h->target = fmax(prm->tol * h->f0, prm->abs_floor);
     size_t nd = 0;
     for (size_t i = 0; i < np; i++)
-        w.dof[i] = is_free[i] ? (int32_t)(dim * nd++) : -1;
-    w.mem.nd = nd * (size_t)dim;
-    size_t budget = max_newton;
-#if !defined(__STDC_NO_THREADS__)
-    if (pk_par_threads(c->par) >= 2 && fn > target) {
-        pk_hybrid_plan plan = {STALL_FACTORS, FIRE_AFTER, HANDOVER * f0 > target ? HANDOVER * f0 : 0,
-                               CRAWL};
-        rc = pk_hybrid_speculative(&sy, &w, &c2, x, phi, f0, target, &budget, &plan, st, ns);
-        goto out;
-    }
-#endif
-    memcpy(w.x0, x, 3 * np * sizeof *x);
-    rc = pk_hybrid_newton_phase(&sy, &w, x, &phi, &fn, target, STALL_FACTORS, 0, &budget, ns, st);
+        w->dof[i] = s->is_free[i] ? (int32_t)(dim * nd++) : -1;
+    w->mem.nd = nd * (size_t)dim;
+    h->budget = no->max_iter;
+    return 0;
+}
+
+void pk_hybrid_end(pk_hybrid *h)
+{
+    pk_dem_pairs_free(&h->c2);
+    work_free(&h->w);
+}
+
+pk_hybrid_plan pk_hybrid_plan_of(const pk_hybrid *h)
+{
+    pk_hybrid_plan plan = {STALL_FACTORS, FIRE_AFTER,
+                           HANDOVER * h->f0 > h->target ? HANDOVER * h->f0 : 0, CRAWL};
+    return plan;
+}
+
+int pk_hybrid_step(pk_hybrid *h, double *x, pk_dr_stats *st, pk_newton_stats *ns)
+{
+    const newton_run *sy = &h->sy;
+    pk_dem_pairs *c = sy->s.c;
+    const size_t np = sy->s.np;
+    const double f0 = h->f0, target = h->target;
+    double phi = h->phi0, fn = f0;
+    memcpy(h->w.x0, x, 3 * np * sizeof *x);
+    int rc = pk_hybrid_newton_phase(sy, &h->w, x, &phi, &fn, target, STALL_FACTORS, 0, &h->budget,
+                                    ns, st);
     if (rc == 1) { /* cancelled */
         st->f0 = f0;
         st->f = fn;
-        rc = 0;
-        goto out;
+        return 0;
     }
     if (rc != 0)
-        goto out;
+        return rc;
     if (ns->exit == PK_NEWTON_CONVERGED) {
         st->f0 = f0;
         st->f = fn;
-        st->stop = fn <= prm->tol * f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
-        goto out;
+        st->stop = fn <= sy->prm->tol * f0 ? PK_DR_CONVERGED : PK_DR_CONVERGED_ABS;
+        return 0;
     }
     /* Newton left its region: the step crosses instabilities (contacts
      * open and close, grains rearrange — a plastic event).  DR takes the
@@ -743,23 +649,29 @@ int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const doub
      * tail near the new minimum from a copy of DR's point.  After FIRE_AFTER
      * failed attempts FIRE (homog_fire.h) goes on from DR's point, with the
      * further attempts from its points: in that tail DR spends most of its
-     * iterations (near-jamming 10⁴ RVE: 23,000 of 27,500) and FIRE needs
-     * ~15x fewer.  FIRE from the start is faster still, but on the dense 10⁴
-     * RVE it lands in another minimum of HIGHER energy (ΔΦ/Φ = +4e-5). */
-    memcpy(x, w.x0, 3 * np * sizeof *x);
-    attempt_ctx a = {sy, &w, target, &budget, ns, st, FIRE_AFTER, 0};
-    a.sy.c = &c2;
+     * iterations and FIRE needs far fewer (docs/perf/homog.md). */
+    memcpy(x, h->w.x0, 3 * np * sizeof *x);
+    attempt_ctx a = {*sy, &h->w, target, &h->budget, ns, st, FIRE_AFTER, 0};
+    a.sy.s.c = &h->c2;
     pk_dr_hook hook = {.fn = newton_attempt, .ctx = &a,
                        .at = HANDOVER * f0 > target ? HANDOVER * f0 : 0, .crawl = CRAWL};
     pk_dr_stats st_dr;
     int in_fire = 0;
-    rc = pk_hybrid_relax_then_fire(c, g, x, r, np, E, is_free, prm, target, &hook, &a.fire_after, &in_fire,
-                         mon, st, &st_dr, ns);
+    rc = pk_hybrid_relax_then_fire(sy, x, target, &hook, &a.fire_after, &in_fire, st, &st_dr, ns);
     /* an attempt's point may be beyond DR's candidate list: the caller evaluates c at x */
-    if (rc == 0 && pk_dem_pairs_stale(c, x, dim))
-        rc = pk_dem_pairs_build(c, g, x, r, np, prm->skin);
-out:
-    pk_dem_pairs_free(&c2);
-    work_free(&w);
+    if (rc == 0 && pk_dem_pairs_stale(c, x, sy->s.g->dim))
+        rc = pk_dem_pairs_build(c, sy->s.g, x, sy->s.r, np, sy->prm->skin);
+    return rc;
+}
+
+int pk_homog_newton(const pk_dem_system *s, double *x, const pk_dr_params *prm,
+                    const pk_newton_opts *no, pk_monitor *mon, pk_dr_stats *st,
+                    pk_newton_stats *ns)
+{
+    pk_hybrid h;
+    int rc = pk_hybrid_begin(&h, s, x, prm, no, mon, st, ns);
+    if (rc == 0)
+        rc = pk_hybrid_step(&h, x, st, ns);
+    pk_hybrid_end(&h);
     return rc;
 }

@@ -1,7 +1,7 @@
 /* homog_newton.h — equilibrium of the free particles with the stiffness the
- * tangent needs anyway (issue 6; not in the thesis, which uses dynamic
- * relaxation only): Newton's method where it is fast, dynamic relaxation
- * through plastic events.
+ * tangent needs anyway (not in the thesis, which uses dynamic relaxation
+ * only): Newton's method where it is fast, dynamic relaxation through
+ * plastic events.
  * Newton phase: per factorisation, rattlers detected, K assembled over every
  * free grain (exact (4.11)–(4.14) between jammed grains, Gauss–Newton E n⊗n
  * on rattler contacts plus a small shift) and factorised by the injected
@@ -25,21 +25,21 @@
  * where the block it factorised last was positive definite: the end point is
  * a local minimum.  Which one, when the step crosses a plastic event, is
  * path dependent (docs/homogenization.md).
- * With a pool of two threads or more (c->par) the attempts run on a second
- * thread while the relaxation goes on (homog_speculative.c): the same
- * result, bit for bit. */
+ * pk_homog_newton is the serial hybrid; pk_homog_newton_speculative
+ * (homog_speculative.h) wraps its step and, with a pool of two threads or
+ * more, makes the attempts on a second thread: the same result, bit for bit. */
 #ifndef PK_HOMOG_NEWTON_H
 #define PK_HOMOG_NEWTON_H
 
-#include "homog_relax.h"
 #include "core/base/sparse.h"
+#include "homog_relax.h"
 
 typedef enum pk_newton_exit {
     PK_NEWTON_CONVERGED = 0,     /* the last Newton phase converged (after DR or not) */
     PK_NEWTON_BLOCK_NOT_PD,      /* exact block not positive definite (instability) → DR */
     PK_NEWTON_LINE_SEARCH,       /* no descent along a fresh Newton direction → DR */
     PK_NEWTON_CAP,               /* factorisation budget spent → DR to the end */
-    PK_NEWTON_STALLED            /* residual not halved in 3 factorisations → DR */
+    PK_NEWTON_STALLED            /* residual not halved over the stall count → DR */
 } pk_newton_exit;
 
 const char *pk_newton_exit_name(pk_newton_exit e);
@@ -54,15 +54,21 @@ typedef struct pk_newton_stats {
     pk_newton_exit exit;         /* of the last Newton phase */
 } pk_newton_stats;
 
-/* Same contract as pk_homog_relax (st describes the DR part, if any, with
- * st->f0 the initial and st->f the final residual of the whole solve).
- * max_newton caps the factorisations over all Newton phases.  sctx: the
- * solver's context (solver->ctx_new) kept by the caller over the steps of a
- * load path, so that a contact pattern seen before reuses its analysis; NULL:
- * every factorisation analysed afresh (the numbers are the same). */
-int pk_homog_newton(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
-                    double E, const uint8_t *is_free, const pk_dr_params *prm,
-                    const pk_sparse_solver *solver, pk_sparse_ctx *sctx, size_t max_newton,
-                    pk_monitor *mon, pk_dr_stats *st, pk_newton_stats *ns);
+/* The sparse solver a solve factorises with. */
+typedef struct pk_newton_opts {
+    const pk_sparse_solver *solver;
+    /* the solver's context (solver->ctx_new) kept by the caller over the
+     * steps of a load path, so that a contact pattern seen before reuses its
+     * analysis; NULL: every factorisation analysed afresh (the same numbers) */
+    pk_sparse_ctx *sctx;
+    size_t max_iter; /* factorisations over all Newton phases */
+} pk_newton_opts;
+
+/* The serial hybrid.  Same contract as pk_homog_relax (st describes the DR
+ * part, if any, with st->f0 the initial and st->f the final residual of the
+ * whole solve). */
+int pk_homog_newton(const pk_dem_system *s, double *x, const pk_dr_params *prm,
+                    const pk_newton_opts *no, pk_monitor *mon, pk_dr_stats *st,
+                    pk_newton_stats *ns);
 
 #endif

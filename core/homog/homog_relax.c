@@ -1,3 +1,5 @@
+/* homog_relax.c — dynamic relaxation of the free particles (Meier 2009 §4.4)
+ * and the iteration parts it shares with FIRE.  Contract: homog_relax.h. */
 #include "homog_relax.h"
 
 #include <math.h>
@@ -34,47 +36,46 @@ static void optimal_params(pk_dr_stats *st)
     st->gamma = 2 * sqrt(lmin * lmax / (lmin + lmax));
 }
 
-/* Forces at (x, u): normal (4.10) plus, with friction, tangential (7.19) and
- * couples gu (7.23).  -1 on allocation failure. */
-typedef struct relax_sys {
-    pk_dem_pairs *c;
-    const pk_dem_geom *g;
-    const double *r;
-    size_t np;
-    double E;
-    const uint8_t *is_free;
+/* One relaxation: the system, its friction and the work arrays of the
+ * estimates. */
+typedef struct relax_run {
+    const pk_dem_system *s;
     pk_fric_ctx *fc; /* NULL: frictionless */
     int fric_active;
-} relax_sys;
+    int lanczos;     /* Lanczos steps of an estimate */
+    uint8_t *rat, *mask;
+    double *work;
+} relax_run;
 
-static int forces(const relax_sys *s, const double *x, const double *u, double *f, double *gu,
+/* Forces at (x, u): normal (4.10) plus, with friction, tangential (7.19) and
+ * couples gu (7.23).  -1 on allocation failure. */
+static int forces(const relax_run *R, const double *x, const double *u, double *f, double *gu,
                   pk_fric_totals *tot)
 {
+    const pk_dem_system *s = R->s;
     pk_dem_eval(s->c, s->g, x, s->r, s->np, s->E, f, NULL, NULL);
-    if (!s->fc)
+    if (!R->fc)
         return 0;
-    return pk_dem_fric_eval(s->c, s->fc, x, u, s->r, s->np, s->E, f, gu, NULL, tot);
+    return pk_dem_fric_eval(s->c, R->fc, x, u, s->r, s->np, s->E, f, gu, NULL, tot);
 }
 
 void pk_relax_geom_refresh(pk_relax_geom *gm, const double *x)
 {
     if (gm->fresh)
         return;
-    pk_dem_eval(gm->c, gm->g, x, gm->r, gm->np, gm->E, NULL, NULL, NULL);
+    const pk_dem_system *s = gm->s;
+    pk_dem_eval(s->c, s->g, x, s->r, s->np, s->E, NULL, NULL, NULL);
     gm->fresh = 1;
 }
 
-/* (Measured and dropped, fifth session: the residual's sum in four partial
- * sums instead of one chain — it only decides stops and hand-overs, so the
- * path stayed the same — seed 7's cached 10⁴ step 1.93–1.99 → 1.94–2.02 s:
- * the chain is not what a DR iteration waits on.) */
-static double resid_norm(const relax_sys *s, const double *f, const double *gu, const double *v,
+static double resid_norm(const relax_run *R, const double *f, const double *gu, const double *v,
                          double *fv)
 {
+    const pk_dem_system *s = R->s;
     double a = sqrt(v ? pk_homog_dot2_mask(f, f, v, s->is_free, s->np, s->g->dim, fv)
                       : pk_homog_dot_mask(f, f, s->is_free, s->np, s->g->dim)),
            b = 0;
-    if (s->fc)
+    if (R->fc)
         for (size_t i = 0; i < s->np; i++)
             b += gu[i] * gu[i];
     return sqrt(a * a + b);
@@ -83,9 +84,10 @@ static double resid_norm(const relax_sys *s, const double *f, const double *gu, 
 /* Rayleigh quotient vᵀKv/vᵀv of the frictional system along the residual v,
  * by a forward difference of the force (K = −∂F/∂z); restores the pair data
  * at (x, u).  0 when not available. */
-static double fric_rayleigh(const relax_sys *s, double *x, double *u, const double *f,
+static double fric_rayleigh(const relax_run *R, double *x, double *u, const double *f,
                             const double *gu, double *work)
 {
+    const pk_dem_system *s = R->s;
     const int dim = s->g->dim;
     size_t np = s->np;
     double vv = 0, rmean = 0;
@@ -106,7 +108,7 @@ static double fric_rayleigh(const relax_sys *s, double *x, double *u, const doub
             for (int a = 0; a < dim; a++)
                 x[3 * i + a] += eta * f[3 * i + a];
     }
-    int rc = forces(s, x, u, f2, g2, NULL);
+    int rc = forces(R, x, u, f2, g2, NULL);
     double num = 0;
     for (size_t i = 0; i < np; i++) {
         u[i] -= eta * gu[i];
@@ -117,7 +119,7 @@ static double fric_rayleigh(const relax_sys *s, double *x, double *u, const doub
                 num -= (f2[3 * i + a] - f[3 * i + a]) * f[3 * i + a];
             }
     }
-    if (rc != 0 || forces(s, x, u, f2, g2, NULL) != 0)
+    if (rc != 0 || forces(R, x, u, f2, g2, NULL) != 0)
         return NAN;
     return num / (eta * vv);
 }
@@ -134,29 +136,19 @@ static double fric_rayleigh(const relax_sys *s, double *x, double *u, const doub
  * region of negative curvature: a plastic event), unless
  * pk_dr_params.plain_lambda_min.  Late in a relaxation the increments run
  * along the softest modes, which a 40-step Lanczos run misses by orders of
- * magnitude near jamming (4e-3 against ~1e-5 at 10⁴ grains), so DR was
- * over-damped there.  Measured (sixth session, cached bench RVEs,
- * near-jamming 10⁴, one compression step): DR alone, seeds 6/7/8, 719,644 /
- * 210,649 / 84,635 → 42,987 / 22,327 / 11,586 iterations (same minima on 6
- * and 8; on 7 another one, ΔΦ/Φ −7.6e-4); the Newton hybrid, seeds 5–9,
- * 1.23 / 2.30 / 1.90 / 1.77 / 0.77 s against 1.2–1.5 / 2.2–2.4 / 1.9–2.1 /
- * 2.0–2.3 / 0.9–1.0 s (seed 7 in the lower minimum DR alone finds too).
- * The two sums ride on the move and on the residual's pass.  (A fifth
- * session's measurement of this on the uncached bench pipeline had it
- * slower on 4 of 5 seeds — but there every variant relaxed its own RVEs.)
- * Cost (round 7, near-jamming 10⁴ step): one estimate 10.8 ms — rattlers
- * 4.7, Lanczos 5.6, Gershgorin and Rayleigh quotient 0.5 — against 0.18–0.25
- * ms per DR iteration: ~20 % of DR's time at refresh = 200 (seed 7: 35
- * estimates, 0.38 s of 2.7 s).  Round 8 (same bench, CPU time, loaded
- * machine, old and new back to back): 12.7–13.1 → 6.3–6.6 ms — rattlers
- * 7.7–8.0 → 1.7 (only the grains whose neighbourhood changed re-tested),
- * Lanczos 4.5 → 4.1–4.4 (vector passes on the masked entries only); the
- * same rattler sets and λ_min, so the same DR path. */
-static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t *is_free,
-                    const double *f, uint8_t *rat, uint8_t *mask, double *work, int lanczos,
-                    pk_dr_stats *st, const relax_sys *sys, double *x, double *u, const double *gu,
-                    double inc_rq)
+ * magnitude near jamming, over-damping DR there (with the increments DR
+ * alone takes 5–17× fewer iterations near jamming: docs/perf/homog.md).
+ * The two sums ride on the move and on the residual's pass. */
+static int estimate(const relax_run *R, const double *f, double *x, double *u, const double *gu,
+                    double inc_rq, pk_dr_stats *st)
 {
+    pk_dem_pairs *c = R->s->c;
+    const int dim = R->s->g->dim;
+    const size_t np = R->s->np;
+    const double E = R->s->E;
+    const uint8_t *is_free = R->s->is_free;
+    uint8_t *rat = R->rat, *mask = R->mask;
+    double *work = R->work;
     size_t nr = pk_dem_rattlers(c, dim, np, is_free, rat);
     if (nr == (size_t)-1)
         return -1;
@@ -170,7 +162,7 @@ static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t
     /* stability needs λ_max over every moving DOF, rattlers included */
     double lmax = pk_dem_gershgorin(c, dim, np, E, is_free);
     st->lambda_max = lmax > 0 ? lmax : E; /* no contact: any scale will do */
-    double lmin = nj ? pk_homog_lanczos_min(c, dim, np, E, mask, lanczos) : 0;
+    double lmin = nj ? pk_homog_lanczos_min(c, dim, np, E, mask, R->lanczos) : 0;
     if (isnan(lmin))
         return -1;
     double rq = pk_homog_rayleigh(c, dim, np, E, m, f, work);
@@ -178,9 +170,9 @@ static int estimate(pk_dem_pairs *c, int dim, size_t np, double E, const uint8_t
         lmin = rq;
     if (inc_rq != 0 && (fabs(inc_rq) < lmin || !(lmin > 0)))
         lmin = fabs(inc_rq);
-    if (sys->fric_active) {
-        st->lambda_max += pk_dem_fric_gershgorin(c, sys->fc, np);
-        double fq = fric_rayleigh(sys, x, u, f, gu, work);
+    if (R->fric_active) {
+        st->lambda_max += pk_dem_fric_gershgorin(c, R->fc, np);
+        double fq = fric_rayleigh(R, x, u, f, gu, work);
         if (isnan(fq))
             return -1;
         if (fq > 0 && (fq < lmin || !(lmin > 0)))
@@ -233,12 +225,9 @@ static inline int move(double *restrict x, double *restrict v, const double *res
 /* move for dim 2 with the x, y components of a grain in one SSE2 register
  * (baseline x86-64): the same elementwise products and sums, and s = d0² +
  * d1² (move's 0 + d0² + d1²: 0 + d0² = d0², as d0² is +0, positive or NaN),
- * so the same bits (tests/unit/test_homog_relax_move.c).
- * Measured (round 11, near-jamming 10⁴ step, seed 7, 6,942 DR iterations,
- * callgrind): pk_relax_move 3.05 → 1.87·10⁹ instructions (≈ 44 → 27 per
- * grain; the generic loop reloaded c->xb after every store to x, no
- * restrict); alone on 10⁴ grains 1.9–2.8 → 1.2–1.3 ns per grain.  The
- * branch on is_free is kept: nearly every grain is free (predicted). */
+ * so the same bits (tests/unit/test_homog_relax_move.c).  ~27 instructions
+ * per grain against the generic loop's ~44 (docs/perf/homog.md); the branch
+ * on is_free is kept: nearly every grain is free (predicted). */
 static inline int move_2d_sse2(double *restrict x, double *restrict v, const double *restrict f,
                                const uint8_t *restrict is_free, size_t np, pk_relax_coef cf,
                                const double *restrict xb, double lim2, const int want, double *acc)
@@ -298,15 +287,14 @@ int pk_relax_move(double *x, double *v, const double *f, const uint8_t *is_free,
     return pk_relax_move_acc(x, v, f, is_free, np, dim, cf, c, NULL);
 }
 
-int pk_relax_begin(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
-                   size_t np, const uint8_t *is_free, const pk_dr_params *prm, pk_dr_stats *st,
-                   size_t *nfree)
+int pk_relax_begin(const pk_dem_system *s, const double *x, const pk_dr_params *prm,
+                   pk_dr_stats *st, size_t *nfree)
 {
     memset(st, 0, sizeof *st);
     *nfree = 0;
-    for (size_t i = 0; i < np; i++)
-        *nfree += is_free[i] != 0;
-    return pk_dem_pairs_build(c, g, x, r, np, prm->skin);
+    for (size_t i = 0; i < s->np; i++)
+        *nfree += s->is_free[i] != 0;
+    return pk_dem_pairs_build(s->c, s->g, x, s->r, s->np, prm->skin);
 }
 
 void pk_relax_hook_solved(pk_dr_stats *st, const pk_dr_params *prm, double fres)
@@ -379,21 +367,26 @@ int pk_relax_settled(pk_dr_stats *st, const pk_dr_params *prm, int nothing_moves
     return 1;
 }
 
-static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
-                 double E, const uint8_t *is_free, const pk_dr_params *prm, pk_fric_ctx *fc,
+static int relax(const pk_dem_system *sy, double *x, const pk_dr_params *prm, pk_fric_ctx *fc,
                  double *u, pk_dr_hook *hook, pk_monitor *mon, pk_dr_stats *st,
                  pk_fric_totals *tot)
 {
+    pk_dem_pairs *c = sy->c;
+    const pk_dem_geom *g = sy->g;
+    const double *r = sy->r;
+    const size_t np = sy->np;
+    const double E = sy->E;
+    const uint8_t *is_free = sy->is_free;
     const int dim = g->dim;
     size_t nfree;
-    int rc = pk_relax_begin(c, g, x, r, np, is_free, prm, st, &nfree);
+    int rc = pk_relax_begin(sy, x, prm, st, &nfree);
     if (rc != 0)
         return rc;
     double *f = malloc(3 * np * sizeof *f), *v = calloc(3 * np, sizeof *v);
     double *work = malloc(4 * (np ? np : 1) * sizeof *work);
     double *gu = calloc(np ? np : 1, sizeof *gu), *vu = calloc(np ? np : 1, sizeof *vu);
     uint8_t *rat = malloc(np ? np : 1), *mask = malloc(np ? np : 1);
-    relax_sys sys = {c, g, r, np, E, is_free, fc, fc && pk_fric_law_active(fc->law)};
+    relax_run sys = {sy, fc, fc && pk_fric_law_active(fc->law), prm->lanczos_steps, rat, mask, work};
     if (!f || !v || !work || !gu || !vu || !rat || !mask || forces(&sys, x, u, f, gu, tot) != 0) {
         rc = -1;
         goto out;
@@ -402,13 +395,13 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
     double target;
     if (pk_relax_settled(st, prm, nfree == 0 && !sys.fric_active, &target))
         goto out;
-    if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu, 0) != 0) {
+    if (estimate(&sys, f, x, u, gu, 0, st) != 0) {
         rc = -1;
         goto out;
     }
     pk_progress pr = {.stage = "relax", .fraction = -1, .phi = -1, .eta_s = -1};
     double fbest = st->f0;
-    pk_relax_geom geo = {c, g, r, np, E, 1}; /* pk_dem_eval_forces */
+    pk_relax_geom geo = {sy, 1}; /* pk_dem_eval_forces */
     /* Σ −Δx·Δf and Σ Δx·Δx over the iterations since the last estimate
      * (frictionless: the increments of x alone), Δx = Δt v: the Rayleigh
      * quotient of DR's own increments (estimate) */
@@ -436,14 +429,6 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
                 goto out;
             st->rebuilds++;
         }
-        /* Measured (round 11, near-jamming 10⁴ step, seed 7, callgrind, with
-         * eval_2d_loop inlined per call): the evaluations 14.6 → 12.6·10⁹
-         * instructions, the step 28.5 → 25.4·10⁹ with the move; CPU s
-         * 2.11–2.27 → 1.93–2.04 (old/new alternating, loaded machine).
-         * Dropped: the memset of f cut to the two components used in 2D —
-         * 240 kB zeroed take 1.6–2.5 µs of a ~300 µs iteration (callgrind
-         * counts rep stosb per byte: its 7.5 % is not time); a loop over
-         * x, y alone took longer (2.6–2.7 µs). */
         if (!fc) { /* frictionless: the forces alone (friction reads the geometry) */
             pk_dem_eval_forces(c, g, x, r, np, E, f);
             geo.fresh = 0;
@@ -465,8 +450,7 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
         if (!isfinite(st->f) || st->f > 1e3 * fbest) {
             /* diverging: the spectrum moved (new contacts) — fresh estimates, restart at rest */
             pk_relax_geom_refresh(&geo, x);
-            if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu,
-                         inc.dd > 0 ? inc.df / inc.dd : 0) != 0) {
+            if (estimate(&sys, f, x, u, gu, inc.dd > 0 ? inc.df / inc.dd : 0, st) != 0) {
                 rc = -1;
                 goto out;
             }
@@ -480,8 +464,7 @@ static int relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double 
         fbest = fmin(fbest, st->f);
         if (prm->refresh && st->iterations % prm->refresh == 0) {
             pk_relax_geom_refresh(&geo, x);
-            if (estimate(c, dim, np, E, is_free, f, rat, mask, work, prm->lanczos_steps, st, &sys, x, u, gu,
-                         inc.dd > 0 ? inc.df / inc.dd : 0) != 0) {
+            if (estimate(&sys, f, x, u, gu, inc.dd > 0 ? inc.df / inc.dd : 0, st) != 0) {
                 rc = -1;
                 goto out;
             }
@@ -501,24 +484,21 @@ out:
     return rc;
 }
 
-int pk_homog_relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
-                   double E, const uint8_t *is_free, const pk_dr_params *prm, pk_monitor *mon,
+int pk_homog_relax(const pk_dem_system *s, double *x, const pk_dr_params *prm, pk_monitor *mon,
                    pk_dr_stats *st)
 {
-    return relax(c, g, x, r, np, E, is_free, prm, NULL, NULL, NULL, mon, st, NULL);
+    return relax(s, x, prm, NULL, NULL, NULL, mon, st, NULL);
 }
 
-int pk_homog_relax_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
-                          size_t np, double E, const uint8_t *is_free, const pk_dr_params *prm,
+int pk_homog_relax_hooked(const pk_dem_system *s, double *x, const pk_dr_params *prm,
                           pk_dr_hook *hook, pk_monitor *mon, pk_dr_stats *st)
 {
-    return relax(c, g, x, r, np, E, is_free, prm, NULL, NULL, hook, mon, st, NULL);
+    return relax(s, x, prm, NULL, NULL, hook, mon, st, NULL);
 }
 
-int pk_homog_relax_fric(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
-                        size_t np, double E, const uint8_t *is_free, const pk_dr_params *prm,
+int pk_homog_relax_fric(const pk_dem_system *s, double *x, const pk_dr_params *prm,
                         pk_fric_ctx *fc, double *u, pk_monitor *mon, pk_dr_stats *st,
                         pk_fric_totals *tot)
 {
-    return relax(c, g, x, r, np, E, is_free, prm, fc, u, NULL, mon, st, tot);
+    return relax(s, x, prm, fc, u, NULL, mon, st, tot);
 }

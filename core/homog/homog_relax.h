@@ -12,9 +12,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "core/dem/dem_contact.h"
 #include "core/dem/dem_friction.h"
 #include "core/base/progress.h"
+#include "homog_system.h"
 
 typedef enum pk_dr_stop {
     PK_DR_CONVERGED = 0,     /* relative tolerance met */
@@ -51,11 +51,11 @@ typedef struct pk_dr_stats {
     size_t rattlers;         /* at the last refresh */
 } pk_dr_stats;
 
-/* Relax x (the entries of particles with is_free[i]) at fixed geometry g.
- * The pair list c is (re)built here as needed.  Returns 0 (see st->stop),
- * -1 on allocation failure, -2 when a periodic box is too small for F̄. */
-int pk_homog_relax(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r, size_t np,
-                   double E, const uint8_t *is_free, const pk_dr_params *prm, pk_monitor *mon,
+/* Relax x (the entries of particles with s->is_free[i]) at fixed geometry
+ * s->g.  The pair list s->c is (re)built here as needed.  Returns 0 (see
+ * st->stop), -1 on allocation failure, -2 when a periodic box is too small
+ * for F̄. */
+int pk_homog_relax(const pk_dem_system *s, double *x, const pk_dr_params *prm, pk_monitor *mon,
                    pk_dr_stats *st);
 
 /* A hook into a frictionless relaxation (the Newton/DR hybrid,
@@ -92,9 +92,8 @@ void pk_relax_hook_solved(pk_dr_stats *st, const pk_dr_params *prm, double fres)
 
 /* The start of a relaxation, shared by DR and FIRE: st cleared, the pair
  * list built at x (returns its rc), *nfree the number of free grains. */
-int pk_relax_begin(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
-                   size_t np, const uint8_t *is_free, const pk_dr_params *prm, pk_dr_stats *st,
-                   size_t *nfree);
+int pk_relax_begin(const pk_dem_system *s, const double *x, const pk_dr_params *prm,
+                   pk_dr_stats *st, size_t *nfree);
 
 /* After the first residual st->f0, shared by DR and FIRE: *target = the
  * residual to reach (tol·|f⁰|, at least abs_floor); returns 1 with st->stop
@@ -128,11 +127,7 @@ extern int pk_relax_scalar_move;
  * stiffness), before a hook (the pair data are then those of DR's last
  * evaluation, whatever x the hook returns) and on return. */
 typedef struct pk_relax_geom {
-    pk_dem_pairs *c;
-    const pk_dem_geom *g;
-    const double *r;
-    size_t np;
-    double E;
+    const pk_dem_system *s;
     int fresh;
 } pk_relax_geom;
 void pk_relax_geom_refresh(pk_relax_geom *gm, const double *x);
@@ -148,8 +143,7 @@ int pk_relax_iteration_end(pk_dr_stats *st, const pk_dr_params *prm, double targ
                            pk_relax_geom *gm);
 
 /* pk_homog_relax with a hook (hook->at: the first threshold). */
-int pk_homog_relax_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
-                          size_t np, double E, const uint8_t *is_free, const pk_dr_params *prm,
+int pk_homog_relax_hooked(const pk_dem_system *s, double *x, const pk_dr_params *prm,
                           pk_dr_hook *hook, pk_monitor *mon, pk_dr_stats *st);
 
 /* The same with inter-particle friction (2D, dem_friction.h): relaxes the
@@ -162,8 +156,7 @@ int pk_homog_relax_hooked(pk_dem_pairs *c, const pk_dem_geom *g, double *x, cons
  * (frictional) force.  An inactive law (tan ρ = h = 0) carries no tangential
  * force and leaves the frictionless iteration unchanged.  tot (may be NULL)
  * gets the tangential totals at the final state. */
-int pk_homog_relax_fric(pk_dem_pairs *c, const pk_dem_geom *g, double *x, const double *r,
-                        size_t np, double E, const uint8_t *is_free, const pk_dr_params *prm,
+int pk_homog_relax_fric(const pk_dem_system *s, double *x, const pk_dr_params *prm,
                         pk_fric_ctx *fc, double *u, pk_monitor *mon, pk_dr_stats *st,
                         pk_fric_totals *tot);
 

@@ -1,3 +1,5 @@
+/* homog_rve.c — the discrete RVE of a packing per boundary condition (Meier
+ * 2009 §3.5, §4.3): hull, unfolding, periodic primaries.  Contract: homog_rve.h. */
 #include "homog_rve.h"
 
 #include <math.h>

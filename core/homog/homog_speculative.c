@@ -1,7 +1,7 @@
 /* homog_speculative.c — the Newton/DR hybrid with its attempts made
- * speculatively on a second thread (issue 6; homog_hybrid.h).
+ * speculatively on a second thread, a wrapper of the serial hybrid's step.
+ * Contract: homog_speculative.h; the parts it wraps: homog_hybrid.h.
  *
- * With a pool of two threads or more (pk_dem_pairs.par).
  * An attempt that fails leaves DR's path as it was, so the path is that of
  * a hybrid whose attempts all fail until one converges: the relaxation runs
  * on along it on the calling thread while a worker thread makes the Newton
@@ -12,24 +12,21 @@
  * as they were at that point (the list rebuilt where it had been built).
  * Without a winner the relaxation's own end stands.  Same bits as the
  * serial hybrid, on any machine (tests/unit/test_homog_speculative.c); the
- * time is about the longer of the two threads' work instead of the sum
- * (failed attempts were 40 % of the near-jamming 10⁴ bench step, seed 6).
+ * time is about the longer of the two threads' work instead of the sum.
  * A point copies 6·N doubles (x and the list's build positions); at most
- * SPEC_QUEUE wait, beyond that the relaxation waits for the worker.
- * Measured and dropped: lending the relaxation the worker's thread for its
- * parallel evaluation while the worker waits (pk_dem_pairs.par switched per
- * iteration: the same bits) — seed 7 of the bench, whose attempts are few,
- * 1.5–1.7 s → 1.7–2.4 s on 2 threads (the pool's worker and the attempts'
- * thread then contend for the second core). */
+ * SPEC_QUEUE wait, beyond that the relaxation waits for the worker.  On two
+ * threads the relaxation's evaluations are serial: the second core is the
+ * worker's (docs/perf/homog.md). */
+#include "homog_speculative.h"
 #include "homog_hybrid.h"
+
+#include "core/base/par.h"
 
 #if !defined(__STDC_NO_THREADS__)
 #include <stdlib.h>
 #include <string.h>
 #include <threads.h>
 #include <time.h>
-
-#include "core/base/par.h"
 
 #define SPEC_QUEUE 8
 
@@ -124,7 +121,7 @@ static int spec_first(spec *s, spec_point *p)
                                     a->budget, a->ns, a->st);
     if (rc < 0)
         return rc;
-    memcpy(p->xb, a->sy.c->xb, 3 * a->sy.np * sizeof *p->xb);
+    memcpy(p->xb, a->sy.s.c->xb, 3 * a->sy.s.np * sizeof *p->xb);
     p->fres = fn;
     return rc == 0 && a->ns->exit == PK_NEWTON_CONVERGED;
 }
@@ -167,7 +164,7 @@ static int spec_hook(void *vctx, double *x, double *fres, double *at)
     (void)fres;
     spec *s = vctx;
     pk_hybrid_next_threshold(at, s->target);
-    spec_point *p = point_new(s->a->sy.np, x, s->c->xb);
+    spec_point *p = point_new(s->a->sy.s.np, x, s->c->xb);
     if (!p)
         return -1;
     p->st = *s->hook->running;
@@ -214,13 +211,13 @@ static void spec_wait(spec *s, pk_monitor *mon)
 /* The step as the serial hybrid ends at the point solved, p: x, st, ns's
  * FIRE iterations and the relaxation's pair list c (rebuilt where it had
  * been built then; its geometry is the caller's to evaluate at x). */
-static int spec_apply(const spec *s, const spec_point *p, pk_dem_pairs *c, const pk_dem_geom *g,
-                      double *x, const double *r, const pk_dr_params *prm, const pk_dr_stats *st_dr,
-                      pk_dr_stats *st, pk_newton_stats *ns)
+static int spec_apply(const spec *s, const spec_point *p, const newton_run *sy, double *x,
+                      const pk_dr_stats *st_dr, pk_dr_stats *st, pk_newton_stats *ns)
 {
-    const size_t np = s->a->sy.np;
+    const pk_dr_params *prm = sy->prm;
+    const size_t np = sy->s.np;
     memcpy(x, p->x, 3 * np * sizeof *x);
-    int rc = pk_dem_pairs_build(c, g, p->xb, r, np, prm->skin);
+    int rc = pk_dem_pairs_build(sy->s.c, sy->s.g, p->xb, sy->s.r, np, prm->skin);
     if (rc != 0)
         return rc;
     ns->fire_iterations = 0; /* unless the point is FIRE's (pk_hybrid_fire_merge) */
@@ -244,19 +241,25 @@ static int spec_apply(const spec *s, const spec_point *p, pk_dem_pairs *c, const
     return 0;
 }
 
-int pk_hybrid_speculative(const newton_sys *sy, newton_work *w, pk_dem_pairs *c2, double *x,
-                          double phi0, double f0, double target, size_t *budget,
-                          const pk_hybrid_plan *plan, pk_dr_stats *st, pk_newton_stats *ns)
+/* The hybrid after pk_hybrid_begin with its attempts made speculatively on
+ * a second thread: the serial step's result (pk_hybrid_step), bit for bit. */
+static int speculative(pk_hybrid *h, double *x, const pk_hybrid_plan *plan, pk_dr_stats *st,
+                       pk_newton_stats *ns)
 {
-    pk_dem_pairs *c = sy->c;
-    const size_t np = sy->np;
+    const newton_run *sy = &h->sy;
+    newton_work *w = &h->w;
+    pk_dem_pairs *c2 = &h->c2;
+    const double phi0 = h->phi0, f0 = h->f0, target = h->target;
+    size_t *budget = &h->budget;
+    pk_dem_pairs *c = sy->s.c;
+    const size_t np = sy->s.np;
     pk_par *par = c->par;
     if (pk_par_threads(par) <= 2) /* the two threads are the relaxation's and the worker's */
         c->par = c2->par = NULL;
     /* c2 := c (the same build, the same geometry) for the first phase */
-    int rc = pk_dem_pairs_build(c2, sy->g, x, sy->r, np, sy->prm->skin);
+    int rc = pk_dem_pairs_build(c2, sy->s.g, x, sy->s.r, np, sy->prm->skin);
     if (rc == 0)
-        pk_dem_eval(c2, sy->g, x, sy->r, np, sy->E, NULL, NULL, NULL);
+        pk_dem_eval(c2, sy->s.g, x, sy->s.r, np, sy->s.E, NULL, NULL, NULL);
     pk_newton_stats nsw = *ns;
     pk_dr_stats stw = {0}, st_dr = {0};
     spec s = {.f0 = f0, .phi0 = phi0, .target = target, .c = c, .fire_after = plan->fire_after,
@@ -264,7 +267,7 @@ int pk_hybrid_speculative(const newton_sys *sy, newton_work *w, pk_dem_pairs *c2
     atomic_init(&s.stop, 0);
     atomic_init(&s.abort, 0);
     attempt_ctx a = {*sy, w, target, budget, &nsw, &stw, plan->fire_after, 0};
-    a.sy.c = c2;
+    a.sy.s.c = c2;
     a.sy.mon = NULL; /* the relaxation ticks the monitor; the worker stops on s.abort */
     a.sy.abort = &s.abort;
     s.a = &a;
@@ -295,8 +298,8 @@ int pk_hybrid_speculative(const newton_sys *sy, newton_work *w, pk_dem_pairs *c2
             point_free(first);
         rc = -1;
     } else {
-        rc = pk_hybrid_relax_then_fire(c, sy->g, x, sy->r, np, sy->E, sy->is_free, sy->prm, target, &hook,
-                             &s.fire_after, &s.fire, sy->mon, st, &st_dr, ns);
+        rc = pk_hybrid_relax_then_fire(sy, x, target, &hook, &s.fire_after, &s.fire, st, &st_dr,
+                                       ns);
         /* the points queued are the serial hybrid's all the same (it made
          * them before the end the relaxation reached alone) — unless this
          * was a cancel or an error */
@@ -313,11 +316,11 @@ int pk_hybrid_speculative(const newton_sys *sy, newton_work *w, pk_dem_pairs *c2
         rc = s.worker_rc;
     const spec_point *won = rc == 0 && s.solved ? s.pt[s.solved - 1] : NULL;
     if (won)
-        rc = spec_apply(&s, won, c, sy->g, x, sy->r, sy->prm, &st_dr, st, ns);
+        rc = spec_apply(&s, won, sy, x, &st_dr, st, ns);
     /* as the serial hybrid: after the relaxation (and an attempt from one of
      * its points) c is refreshed where x left it; not after the first phase */
-    if (rc == 0 && !(won && won->first) && pk_dem_pairs_stale(c, x, sy->g->dim))
-        rc = pk_dem_pairs_build(c, sy->g, x, sy->r, np, sy->prm->skin);
+    if (rc == 0 && !(won && won->first) && pk_dem_pairs_stale(c, x, sy->s.g->dim))
+        rc = pk_dem_pairs_build(c, sy->s.g, x, sy->s.r, np, sy->prm->skin);
     for (size_t k = 0; k < s.n; k++)
         point_free(s.pt[k]);
     free(s.pt);
@@ -326,3 +329,23 @@ int pk_hybrid_speculative(const newton_sys *sy, newton_work *w, pk_dem_pairs *c2
     return rc;
 }
 #endif
+
+int pk_homog_newton_speculative(const pk_dem_system *s, double *x, const pk_dr_params *prm,
+                                const pk_newton_opts *no, pk_monitor *mon, pk_dr_stats *st,
+                                pk_newton_stats *ns)
+{
+    pk_hybrid h;
+    int rc = pk_hybrid_begin(&h, s, x, prm, no, mon, st, ns);
+#if !defined(__STDC_NO_THREADS__)
+    if (rc == 0 && pk_par_threads(s->c->par) >= 2 && h.f0 > h.target) {
+        pk_hybrid_plan plan = pk_hybrid_plan_of(&h);
+        rc = speculative(&h, x, &plan, st, ns);
+        pk_hybrid_end(&h);
+        return rc;
+    }
+#endif
+    if (rc == 0)
+        rc = pk_hybrid_step(&h, x, st, ns);
+    pk_hybrid_end(&h);
+    return rc;
+}

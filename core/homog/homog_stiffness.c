@@ -1,3 +1,5 @@
+/* homog_stiffness.c — the contact Hessian (4.11)–(4.14) and its entry into
+ * the sparse free stiffness.  Contract: homog_stiffness.h. */
 #include "homog_stiffness.h"
 
 void pk_homog_pair_hessian(double E, double len, double eps, const double *l, double H[9])

@@ -1,3 +1,5 @@
+/* homog_tangent.c — the macroscopic tangent Ā = dP̄/dF̄ by static
+ * condensation (ch. 6, (6.18)–(6.20)).  Contract: homog_tangent.h. */
 #include "homog_tangent.h"
 
 #include <math.h>

@@ -172,6 +172,13 @@ static inline void relax_problem_make(relax_problem *pb)
     }
 }
 
+/* The system the relaxations of pb work on. */
+static inline pk_dem_system relax_problem_system(relax_problem *pb)
+{
+    pk_dem_system s = {&pb->c, &pb->g, pb->rve.r, pb->rve.n, pb->o.E_n, pb->is_free};
+    return s;
+}
+
 static inline void relax_problem_free(relax_problem *pb)
 {
     pk_dem_pairs_free(&pb->c);

@@ -34,14 +34,12 @@ static void test_fire_reaches_dr_minimum(void)
 {
     relax_problem pb;
     relax_problem_make(&pb);
-    size_t n = pb.rve.n;
+    pk_dem_system sys = relax_problem_system(&pb);
     double *xd = copy_x(&pb), *xf = copy_x(&pb);
     pk_dr_stats sd, sf;
     pk_fire_params fp = pk_fire_params_default();
-    CHECK(pk_homog_relax(&pb.c, &pb.g, xd, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, NULL, &sd) ==
-          0);
-    CHECK(pk_homog_fire_hooked(&pb.c, &pb.g, xf, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, &fp,
-                               NULL, NULL, &sf) == 0);
+    CHECK(pk_homog_relax(&sys, xd, &pb.o.dr, NULL, &sd) == 0);
+    CHECK(pk_homog_fire_hooked(&sys, xf, &pb.o.dr, &fp, NULL, NULL, &sf) == 0);
     CHECK_MSG(sf.stop == PK_DR_CONVERGED, "FIRE: %s", pk_dr_stop_name(sf.stop));
     CHECK(pk_dr_stop_ok(sd.stop));
     double phid, phif, Sd[9], Sf[9], fd, ff;
@@ -119,6 +117,7 @@ static void test_fused_loop_is_the_reference(void)
 {
     relax_problem pb;
     relax_problem_make(&pb);
+    pk_dem_system sys = relax_problem_system(&pb);
     size_t n = pb.rve.n;
     double F[9];
     diagF(F, 0.99, 1.0, 1.0);
@@ -132,8 +131,7 @@ static void test_fused_loop_is_the_reference(void)
     pk_dr_params prm = pb.o.dr;
     prm.tol = 0, prm.abs_floor = 0, prm.max_iter = iters; /* stops at the cap */
     pk_dr_stats st;
-    CHECK(pk_homog_fire_hooked(&pb.c, &pb.g, xf, pb.rve.r, n, pb.o.E_n, pb.is_free, &prm, &fp, NULL,
-                               NULL, &st) == 0);
+    CHECK(pk_homog_fire_hooked(&sys, xf, &prm, &fp, NULL, NULL, &st) == 0);
     CHECK(st.stop == PK_DR_MAX_ITER && st.iterations == iters);
     CHECK_MSG(st.refreshes == restarts, "restarts %zu, reference %zu", st.refreshes, restarts);
     CHECK_MSG(restarts >= 2, "only %zu restart(s): the uphill branch is not exercised", restarts);
@@ -171,16 +169,15 @@ static void test_hook_and_cap(void)
 {
     relax_problem pb;
     relax_problem_make(&pb);
+    pk_dem_system sys = relax_problem_system(&pb);
     size_t n = pb.rve.n;
     pk_fire_params fp = pk_fire_params_default();
     double *xa = copy_x(&pb), *xb = copy_x(&pb);
     pk_dr_stats sa, sb;
-    CHECK(pk_homog_fire_hooked(&pb.c, &pb.g, xa, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, &fp,
-                               NULL, NULL, &sa) == 0);
+    CHECK(pk_homog_fire_hooked(&sys, xa, &pb.o.dr, &fp, NULL, NULL, &sa) == 0);
     spy s0 = {0, 0, 0};
     pk_dr_hook h0 = {.fn = spy_fn, .ctx = &s0, .at = 1e-2 * sa.f0};
-    CHECK(pk_homog_fire_hooked(&pb.c, &pb.g, xb, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, &fp,
-                               &h0, NULL, &sb) == 0);
+    CHECK(pk_homog_fire_hooked(&sys, xb, &pb.o.dr, &fp, &h0, NULL, &sb) == 0);
     CHECK(s0.calls >= 3 && s0.late == 0); /* thresholds 1e-2, 1e-3, 1e-4 … all passed */
     CHECK(sb.iterations == sa.iterations && memcmp(xa, xb, 3 * n * sizeof *xa) == 0);
 
@@ -188,8 +185,7 @@ static void test_hook_and_cap(void)
     memcpy(xb, pb.x0, 3 * n * sizeof *xb);
     spy s1 = {1, 0, 0};
     pk_dr_hook h1 = {.fn = spy_fn, .ctx = &s1, .at = 1e-2 * sa.f0};
-    CHECK(pk_homog_fire_hooked(&pb.c, &pb.g, xb, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, &fp,
-                               &h1, NULL, &sb) == 0);
+    CHECK(pk_homog_fire_hooked(&sys, xb, &pb.o.dr, &fp, &h1, NULL, &sb) == 0);
     CHECK(s1.calls == 1 && sb.f <= 1e-2 * sa.f0 && sb.iterations < sa.iterations);
     CHECK(sb.stop == PK_DR_CONVERGED_ABS); /* |f| > tol·|f⁰|: only the "floor" branch is left */
 
@@ -197,8 +193,7 @@ static void test_hook_and_cap(void)
     memcpy(xb, pb.x0, 3 * n * sizeof *xb);
     spy s2 = {2, 0, 0};
     pk_dr_hook h2 = {.fn = spy_fn, .ctx = &s2, .at = 1e-2 * sa.f0};
-    CHECK(pk_homog_relax_hooked(&pb.c, &pb.g, xb, pb.rve.r, n, pb.o.E_n, pb.is_free, &pb.o.dr, &h2,
-                                NULL, &sb) == 0);
+    CHECK(pk_homog_relax_hooked(&sys, xb, &pb.o.dr, &h2, NULL, &sb) == 0);
     CHECK_MSG(sb.stop == PK_DR_HANDED_OVER, "%s", pk_dr_stop_name(sb.stop));
     double phi, S[9], fr;
     measure(&pb, xb, &phi, S, &fr);
@@ -209,8 +204,7 @@ static void test_hook_and_cap(void)
     memcpy(xb, pb.x0, 3 * n * sizeof *xb);
     pk_dr_params capped = pb.o.dr;
     capped.max_iter = 5;
-    CHECK(pk_homog_fire_hooked(&pb.c, &pb.g, xb, pb.rve.r, n, pb.o.E_n, pb.is_free, &capped, &fp,
-                               NULL, NULL, &sb) == 0);
+    CHECK(pk_homog_fire_hooked(&sys, xb, &capped, &fp, NULL, NULL, &sb) == 0);
     CHECK(sb.stop == PK_DR_MAX_ITER && sb.iterations == 5);
     free(xa);
     free(xb);

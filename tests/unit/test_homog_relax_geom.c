@@ -53,16 +53,15 @@ static outcome relax(int store, int fire)
 {
     relax_problem pb; /* (homog_fixture.h) relaxed from its affine start x0 in place */
     relax_problem_make(&pb);
+    pk_dem_system sys = relax_problem_system(&pb);
     pb.o.dr.refresh = 25; /* many estimates, each after a forces-only evaluation */
     hook_ctx h = {&pb, 0, 0};
     pk_dr_hook hook = {.fn = look, .ctx = &h, .at = 1e-3};
     outcome o = {0};
     pk_dem_forces_store = store;
     pk_fire_params fp = pk_fire_params_default();
-    int rc = fire ? pk_homog_fire_hooked(&pb.c, &pb.g, pb.x0, pb.rve.r, pb.rve.n, pb.o.E_n,
-                                         pb.is_free, &pb.o.dr, &fp, &hook, NULL, &o.st)
-                  : pk_homog_relax_hooked(&pb.c, &pb.g, pb.x0, pb.rve.r, pb.rve.n, pb.o.E_n,
-                                          pb.is_free, &pb.o.dr, &hook, NULL, &o.st);
+    int rc = fire ? pk_homog_fire_hooked(&sys, pb.x0, &pb.o.dr, &fp, &hook, NULL, &o.st)
+                  : pk_homog_relax_hooked(&sys, pb.x0, &pb.o.dr, &hook, NULL, &o.st);
     pk_dem_forces_store = 0;
     CHECK(rc == 0);
     CHECK(pk_dr_stop_ok(o.st.stop));

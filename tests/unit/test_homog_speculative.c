@@ -1,5 +1,5 @@
 /* test_homog_speculative.c — the Newton/DR hybrid with speculative attempts
- * (core/homog/homog_newton.c, hybrid_speculative: a pool of two threads or more)
+ * (core/homog/homog_speculative.c: a pool of two threads or more)
  * gives the serial hybrid's step bit for bit: the end point, P̄, the energy
  * and every statistic of the path (DR/FIRE iterations, rebuilds, stop,
  * residuals, factorisations, quasi-Newton steps, attempts, FIRE
