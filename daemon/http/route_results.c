@@ -169,6 +169,11 @@ enum MHD_Result route_results(pk_req *r)
         return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
     pk_exec_opts o;
     pk_results_opts_load(r, r->seg[1], &o);
+    /* a client that takes only JSON (packd fetch) gets the document of a raw job */
+    const char *accept = pk_header(r, "Accept");
+    if (o.serve[0] && accept && !strstr(accept, "*/*") &&
+        !strstr(accept, pk_output_find(o.serve)->type))
+        o.serve[0] = 0;
     enum MHD_Result rc = pk_send_results(r, row, &o);
     pk_exec_opts_free(&o);
     return rc;
