@@ -78,9 +78,9 @@ static enum MHD_Result sync_check(pk_req *r)
             r->resume = NULL;
             return pk_send_results(r, row, &w->opts);
         }
+        int gone = !strcmp(st, "dismissed");
         json_decref(row);
-        int parked = !strcmp(st, "dismissed") || pk_queue_now() >= w->deadline
-                         ? -1 : pk_park(w->park, seq, w->deadline);
+        int parked = gone || pk_queue_now() >= w->deadline ? -1 : pk_park(w->park, seq, w->deadline);
         if (parked > 0)
             return MHD_YES;
         if (parked < 0) {
