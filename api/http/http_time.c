@@ -78,7 +78,7 @@ int pk_time_parse_rfc3339(const char *s, double *epoch, double *span)
     int off = 0;
     if (*s == 'Z' || *s == 'z') {
         s++;
-    } else if (*s == '+' || *s == '-') {
+    } else if (*s == '+' || *s == '-' || *s == ' ') { /* ' ': a '+' form-decoded in a query */
         int sign = *s++ == '-' ? -1 : 1;
         int oh = digits(&s, 2);
         if (oh < 0 || oh > 23 || *s++ != ':')

@@ -17,6 +17,7 @@ static void test_parse(void)
     /* the same instant with an offset, lower-case separators */
     double u;
     CHECK(pk_time_parse_rfc3339("2026-11-22t05:04:05.123+02:00", &u, &span) == 0 && fabs(u - t) < 1e-6);
+    CHECK(pk_time_parse_rfc3339("2026-11-22T05:04:05.123 02:00", &u, &span) == 0 && fabs(u - t) < 1e-6);
     CHECK(pk_time_parse_rfc3339("2024-02-29T12:00:00-00:30", &u, &span) == 0);
     CHECK_NEAR(u, 1709208000 + 1800, 1e-6); /* 12:00 at -00:30 is 12:30 UTC */
     /* what statusInfo prints parses back to the millisecond it names */
