@@ -51,6 +51,7 @@ static const struct key {
     {"max_connections", K_INT, F(max_connections), 16, 1000000, "open HTTP connections in total (restart to change)"},
     {"max_connections_per_ip", K_INT, F(max_connections_per_ip), 0, 1000000, "open HTTP connections per client address, 0 = no limit (restart to change)"},
     {"idle_timeout_s", K_INT, F(idle_timeout_s), 1, 86400, "close a connection silent this long (restart to change)"},
+    {"sync_wait_s", K_DOUBLE, F(sync_wait_s), 0, 300, "Prefer: respond-sync: seconds an execute request waits for its job (then 201 async)"},
     {"body_timeout_s", K_DOUBLE, F(body_timeout_s), 1, 86400, "seconds a request body may take after its headers (beyond: connection closed)"},
     {"log_level", K_LEVEL, F(log_level), 0, 0, "debug | info | warn | error"},
     {"public_url", K_STR, F(public_url), 0, 0, "base URL of absolute links (reverse proxy); unset: http://<Host header>"},
@@ -91,6 +92,7 @@ void pk_config_defaults(pk_config *c)
     c->max_connections_per_ip = 128;
     c->idle_timeout_s = 20;
     c->body_timeout_s = 120;
+    c->sync_wait_s = 10;
     c->checkpoint_interval_s = 30;
     c->log_level = PK_LOG_INFO;
 }

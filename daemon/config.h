@@ -33,6 +33,7 @@ typedef struct pk_config {
     int max_connections_per_ip; /* open HTTP connections of one client address (0: no limit) */
     int idle_timeout_s;       /* a connection silent this long is closed (headers, body, keep-alive) */
     double body_timeout_s;    /* a request body must arrive within this time after its headers */
+    double sync_wait_s;       /* Prefer: respond-sync waits this long for the job, then 201 */
     double checkpoint_interval_s; /* between two checkpoints of a long job (job dir checkpoint.h5) */
     pk_log_level log_level;
     pk_auth_mode auth;        /* bearer tokens required (daemon/http/auth.c) */

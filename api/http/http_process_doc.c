@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "http_outputs.h"
 #include "http_status_info.h"
 #include "api/schemas/json_schema.h"
 
@@ -18,9 +19,11 @@ json_t *pk_process_summary(const pk_process *p)
     snprintf(href, sizeof href, "/processes/%s", p->id);
     char exec[180];
     snprintf(exec, sizeof exec, "/processes/%s/execution", p->id);
-    return json_pack("{s:s,s:s,s:s,s:s,s:[s],s:[s],s:[{s:s,s:s,s:s},{s:s,s:s,s:s}]}", "id", p->id,
+    /* sync-execute: Prefer: respond-sync waits up to sync_wait_s (docs/service.md) */
+    return json_pack("{s:s,s:s,s:s,s:s,s:[s,s],s:[s,s],s:[{s:s,s:s,s:s},{s:s,s:s,s:s}]}", "id", p->id,
                      "title", p->title, "description", p->description, "version", PACKD_VERSION,
-                     "jobControlOptions", "async-execute", "outputTransmission", "reference",
+                     "jobControlOptions", "async-execute", "sync-execute", "outputTransmission",
+                     "reference", "value",
                      "links", "href", href, "rel", "self", "type", "application/json", "href", exec,
                      "rel", "http://www.opengis.net/def/rel/ogc/1.0/execute", "type",
                      "application/json");
@@ -91,10 +94,19 @@ json_t *pk_process_description(const pk_process *p)
         json_object_set_new(inputs, name, in);
     }
     json_object_set_new(d, "inputs", inputs);
-    json_object_set_new(d, "outputs",
-                        json_pack("{s:{s:s,s:s,s:{s:s,s:s}}}", "result", "title", "result file",
-                                  "description", "HDF5 (H5MD 1.1) result file, see docs/result-format.md",
-                                  "schema", "type", "string", "contentMediaType", PK_RESULT_MEDIA_TYPE));
+    json_t *outputs = json_object();
+    for (const pk_output *o = pk_outputs; o->id; o++) {
+        json_t *os = !strcmp(o->type, "application/json")
+                             ? json_pack("{s:s,s:s}", "type", "object", "contentMediaType", o->type)
+                             : json_pack("{s:s,s:s,s:s}", "type", "string", "contentEncoding",
+                                         strncmp(o->type, "image/svg", 9) && strcmp(o->type, "application/xml")
+                                             ? "binary" : "8bit",
+                                         "contentMediaType", o->type);
+        json_t *out = json_pack("{s:s,s:s,s:o}", "title", o->title, "description", o->description,
+                                "schema", os);
+        json_object_set_new(outputs, o->id, out);
+    }
+    json_object_set_new(d, "outputs", outputs);
     json_object_set(d, "inputsSchema", schema ? schema : json_null());
     return d;
 }

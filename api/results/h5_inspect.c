@@ -1,6 +1,7 @@
 /* h5_inspect.c — a JSON view of a result file (`packd inspect`, results document).
  * Contract: api/results/h5_inspect.h. */
 #include "h5_inspect.h"
+#include "result_digest.h"
 
 #include <hdf5.h>
 #include <stdio.h>
@@ -134,6 +135,13 @@ json_t *pk_h5_inspect(const char *path, size_t max_array, char *err, size_t errl
             H5Gclose(pg);
         }
         H5Fclose(f);
+    }
+    char stored[65], computed[65];
+    if (pk_result_digest_stored(path, stored) == 0) {
+        json_object_set_new(out, "result_digest", json_string(stored));
+        json_object_set_new(out, "result_digest_verified",
+                            json_boolean(pk_result_digest_file(path, computed) == 0 &&
+                                         !strcmp(stored, computed)));
     }
     return out;
 }

@@ -6,7 +6,9 @@
 #include <jansson.h>
 #include <stddef.h>
 
-/* New JSON object, or NULL with err.  Arrays longer than max_array elements
+/* New JSON object, or NULL with err; with "result_digest" (stored) and
+ * "result_digest_verified" (recomputed from the file, equal) when the file
+ * states one (result_digest.h).  Arrays longer than max_array elements
  * are summarised by their shape. */
 json_t *pk_h5_inspect(const char *path, size_t max_array, char *err, size_t errlen);
 

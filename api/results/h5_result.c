@@ -1,6 +1,7 @@
 /* h5_result.c — the H5MD 1.1 result file writer (docs/result-format.md).
  * Contract: api/results/h5_result.h. */
 #include "h5_result.h"
+#include "result_digest.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -378,8 +379,32 @@ static int write_all(int fd, const unsigned char *buf, size_t n)
     return 0;
 }
 
+/* /parameters/result_digest of a result (job and grains written): the
+ * content hash of result_digest.h, with the method as its attribute. */
+static void write_result_digest(pk_h5 *h)
+{
+    char hex[65];
+    hid_t g;
+    H5E_BEGIN_TRY
+    {
+        g = pk_result_digest_compute(h->file, hex) == 0 ? H5Gopen2(h->file, "parameters", H5P_DEFAULT) : -1;
+    }
+    H5E_END_TRY
+    if (g < 0)
+        return;
+    hid_t t = string_type(sizeof hex);
+    if (write_dataset(g, H5P_DEFAULT, "result_digest", t, 0, NULL, hex, NULL) == 0) {
+        hid_t d = H5Dopen2(g, "result_digest", H5P_DEFAULT);
+        attr_string(d, "method", PK_RESULT_DIGEST_METHOD);
+        H5Dclose(d);
+    }
+    H5Tclose(t);
+    H5Gclose(g);
+}
+
 int pk_h5_commit(pk_h5 *h, char *err, size_t errlen)
 {
+    write_result_digest(h);
     unsigned char *img = NULL;
     ssize_t n = H5Fflush(h->file, H5F_SCOPE_GLOBAL) < 0 ? -1 : H5Fget_file_image(h->file, NULL, 0);
     if (n > 0 && (img = malloc((size_t)n)) != NULL &&

@@ -6,7 +6,8 @@
  *   /particles/grains/radius    [N] float64, attr unit      (packd element; H5MD has none)
  *   /particles/grains/species   [N] int32 (size class, 0 = coarsest)
  *   /particles/grains/id        [N] int64 (H5MD identity 0..N-1)
- *   /parameters                 attrs job (JSON text), process, seed, packd_version
+ *   /parameters                 attrs process, seed, packd_version; datasets job (JSON text),
+ *                               result_digest (result_digest.h; written by pk_h5_commit)
  *   /observables/<name>         scalars, arrays and strings written by the process
  *
  * A file is built in memory (HDF5's core driver), written by pk_h5_commit()

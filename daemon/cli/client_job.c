@@ -8,6 +8,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "api/results/result_digest.h"
+
 const char *pk_doc_str(const json_t *doc, const char *key)
 {
     const char *s = json_string_value(json_object_get(doc, key));
@@ -236,6 +238,25 @@ static int download_verified(const pk_client *c, const char *href, const char *o
     return 0;
 }
 
+/* The content hash the server states (summary "result_digest") against the
+ * one recomputed from the downloaded file: the same grains for the same
+ * job, whatever the timings in the file.  0 (or nothing stated), or 2 with
+ * the file removed. */
+static int check_result_digest(const char *out, const char *stated, json_t *info)
+{
+    if (!stated)
+        return 0;
+    char got[65];
+    if (pk_result_digest_file(out, got) != 0 || strcmp(got, stated) != 0) {
+        fprintf(stderr, "packd fetch: %s: result_digest %s, the server states %s; file removed\n",
+                out, pk_result_digest_file(out, got) == 0 ? got : "cannot be computed", stated);
+        remove(out);
+        return 2;
+    }
+    json_object_set_new(info, "result_digest", json_string(got));
+    return 0;
+}
+
 int pk_client_fetch(const pk_client *c, const char *id, const char *out, json_t **info_out)
 {
     char path[200];
@@ -262,6 +283,8 @@ int pk_client_fetch(const pk_client *c, const char *id, const char *out, json_t 
         json_t *v = json_object_get(json_object_get(doc, "summary"), "value");
         if (v)
             json_object_set(info, "summary", v);
+        if (rc == 0)
+            rc = check_result_digest(out, json_string_value(json_object_get(v, "result_digest")), info);
     } else if (r.status == 422 && type && strstr(type, "job-failed")) {
         /* the job failed: say why; its partial file is still worth keeping */
         pk_client_report("fetch", &r);

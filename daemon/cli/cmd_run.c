@@ -11,6 +11,7 @@
 #include "api/picture/picture.h"
 #include "api/process.h"
 #include "daemon/store/sha256.h"
+#include "api/results/result_digest.h"
 #include "api/results/xdmf.h"
 
 static volatile sig_atomic_t cancel_requested;
@@ -153,6 +154,9 @@ int cmd_run(int argc, char **argv)
         if (rc == 2) /* failed, with its partial file and summary */
             fprintf(stderr, "packd run: failed: %s (partial result in %s)\n", err, out_path);
         json_object_set_new(summary, "output", json_string(out_path));
+        char digest_hex[65];
+        if (pk_result_digest_stored(out_path, digest_hex) == 0)
+            json_object_set_new(summary, "result_digest", json_string(digest_hex));
         if (xdmf_path) {
             /* the XML names the HDF5 file by its path relative to the XML */
             if (pk_xdmf_write(out_path, NULL, xdmf_path, err, sizeof err) != 0)

@@ -32,6 +32,14 @@ typedef struct pk_req {
     int admin;                 /* sees every owner's jobs and uploads */
     int answered;              /* answered from the headers alone (413, 415): the body is not read */
     double started;            /* when the headers were complete (pk_queue_now clock) */
+    /* A request that waits without a thread (http_park.h): once its
+     * connection resumes, resume is called instead of the route; wait is
+     * its state, freed by wait_free when the request ends. */
+    enum MHD_Result (*resume)(struct pk_req *r);
+    void *wait;
+    void (*wait_free)(void *wait);
+    char sync_job[40];         /* answered synchronously for this job (Prefer: respond-sync):
+                                  pk_send adds Preference-Applied and Link rel=monitor */
 } pk_req;
 
 typedef enum MHD_Result (*pk_handler)(pk_req *r);

@@ -96,6 +96,13 @@ enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp)
         MHD_del_response_header(resp, "Location", loc);
         MHD_add_response_header(resp, "Location", abs);
     }
+    if (r->sync_job[0]) { /* OGC /req/core/job-results-success-sync: a monitor link to the job */
+        char base[300], link[500];
+        base_url(r, base, sizeof base);
+        snprintf(link, sizeof link, "<%s/jobs/%s>; rel=\"monitor\"", base, r->sync_job);
+        MHD_add_response_header(resp, "Link", link);
+        MHD_add_response_header(resp, "Preference-Applied", "respond-sync");
+    }
     if (status < 600)
         __atomic_add_fetch(&r->svc->responses[status], 1, __ATOMIC_RELAXED);
     MHD_add_response_header(resp, "Server", "packd/" PACKD_VERSION);

@@ -230,6 +230,8 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
     }
     if (r->answered)
         return MHD_YES;
+    if (r->resume)
+        return r->resume(r);
     if (r->too_large) {
         pk_config cfg = pk_service_config(svc);
         char d[128];
@@ -244,6 +246,8 @@ static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
 {
     pk_req *r = *con_cls;
     if (r) {
+        if (r->wait_free)
+            r->wait_free(r->wait);
         free(r->body);
         free(r);
     }

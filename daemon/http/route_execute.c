@@ -1,20 +1,118 @@
 /* POST /processes/{pid}/execution — validate by the process's schema (the
  * same code path as `packd validate`), apply the server's caps, queue the job:
  * 201 + Location + statusInfo.  Idempotency-Key: the same key and request
- * return the same job; the same key with another request is 422. */
+ * return the same job; the same key with another request is 422.
+ * "Prefer: respond-sync" (RFC 7240, optionally "wait=N") waits up to
+ * sync_wait_s for the job, parked without a thread (http_park.h), and answers
+ * 200 with its results as "response"/"outputs" ask; a job not finished by
+ * then is answered 201 as usual. */
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "auth.h"
 #include "http.h"
+#include "http_park.h"
+#include "results_send.h"
 #include "daemon/input_refs.h"
 #include "api/http/http_process_doc.h"
 #include "api/http/http_status_info.h"
 #include "api/inputs/input_confine.h"
 #include "daemon/log.h"
 #include "daemon/store/sha256.h"
+
+/* A synchronous execute waiting for its job. */
+typedef struct sync_wait {
+    char id[37];
+    double deadline;           /* pk_queue_now clock */
+    pk_parked *park;
+    pk_exec_opts opts;
+    int replayed;
+} sync_wait;
+
+static void sync_wait_free(void *p)
+{
+    sync_wait *w = p;
+    pk_park_unregister(w->park);
+    pk_exec_opts_free(&w->opts);
+    free(w);
+}
+
+/* Seconds "Prefer" asks to wait for the answer: 0 unless it holds
+ * respond-sync; its wait=N (RFC 7240 4.3) shortens the service's bound. */
+static double sync_seconds(const char *prefer, double bound)
+{
+    int sync = 0;
+    double wait = bound;
+    for (const char *p = prefer; p && *p;) {
+        p += strspn(p, " \t,");
+        size_t n = strcspn(p, ",;");
+        if (n == 12 && !strncasecmp(p, "respond-sync", 12))
+            sync = 1;
+        else if (n > 5 && !strncasecmp(p, "wait=", 5)) {
+            double v = strtod(p + 5, NULL);
+            if (v >= 0 && v < wait)
+                wait = v;
+        }
+        p += n;
+        p += strcspn(p, ","); /* parameters of a preference (";…") are not used */
+    }
+    return sync ? wait : 0;
+}
+
+static enum MHD_Result reply_job(pk_req *r, const char *id, int replayed);
+
+/* Look at the job; answer once it is final or the wait is over, else park
+ * (MHD calls again when the connection resumes). */
+static enum MHD_Result sync_check(pk_req *r)
+{
+    sync_wait *w = r->wait;
+    for (;;) {
+        long long seq = pk_queue_event_seq(r->svc->q);
+        json_t *row = pk_queue_get(r->svc->q, w->id);
+        const char *st = row ? json_string_value(json_object_get(row, "status")) : "dismissed";
+        if (!strcmp(st, "successful") || !strcmp(st, "failed")) {
+            snprintf(r->sync_job, sizeof r->sync_job, "%s", w->id);
+            r->resume = NULL;
+            return pk_send_results(r, row, &w->opts);
+        }
+        int gone = !strcmp(st, "dismissed");
+        json_decref(row);
+        int parked = gone || pk_queue_now() >= w->deadline ? -1 : pk_park(w->park, seq, w->deadline);
+        if (parked > 0)
+            return MHD_YES;
+        if (parked < 0) {
+            r->resume = NULL;
+            return reply_job(r, w->id, w->replayed);
+        }
+    }
+}
+
+/* Answer the job submitted (or replayed): wait for it first when the
+ * client prefers a synchronous answer. */
+static enum MHD_Result answer(pk_req *r, const char *id, int replayed, pk_exec_opts *opts)
+{
+    pk_config cfg = pk_service_config(r->svc);
+    double secs = sync_seconds(pk_header(r, "Prefer"), cfg.sync_wait_s);
+    sync_wait *w = secs > 0 ? calloc(1, sizeof *w) : NULL;
+    if (w)
+        w->park = pk_park_register(r->conn);
+    if (!w || !w->park) {
+        free(w);
+        pk_exec_opts_free(opts);
+        return reply_job(r, id, replayed);
+    }
+    snprintf(w->id, sizeof w->id, "%s", id);
+    w->deadline = pk_queue_now() + secs;
+    w->opts = *opts; /* moved */
+    w->replayed = replayed;
+    r->wait = w;
+    r->wait_free = sync_wait_free;
+    r->resume = sync_check;
+    return sync_check(r);
+}
 
 static enum MHD_Result reply_job(pk_req *r, const char *id, int replayed)
 {
@@ -54,7 +152,15 @@ enum MHD_Result route_execute(pk_req *r)
         return pk_send_problem(r, 400, PK_PROBLEM_GENERIC, "Bad Request", d, NULL, 0);
     }
     json_t *inputs = json_object_get(body, "inputs");
+    pk_exec_opts opts = {0};
+    char bad_opts[200];
+    if (json_is_object(body) && pk_exec_opts_parse(body, &opts, bad_opts, sizeof bad_opts) != 0) {
+        json_decref(body);
+        return pk_send_problem(r, 400, PK_PROBLEM_INVALID_INPUT, "Invalid execute request", bad_opts,
+                               NULL, 0);
+    }
     if (!json_is_object(body) || !json_is_object(inputs)) {
+        pk_exec_opts_free(&opts);
         pk_schema_errors e = {0};
         pk_schema_errors_add(&e, json_is_object(body) ? "/inputs" : "", json_is_object(body) ? "required" : "type",
                              "the body must be an object with an \"inputs\" object");
@@ -69,6 +175,7 @@ enum MHD_Result route_execute(pk_req *r)
         pk_schema_errors e = {0};
         pk_schema_errors_add(&e, "/process", "const", "this is POST /processes/%s/execution", p->id);
         json_decref(body);
+        pk_exec_opts_free(&opts);
         enum MHD_Result rc = pk_send_problem_doc(r, 400, pk_problem_invalid(400, "process mismatch", &e), 0);
         pk_schema_errors_free(&e);
         return rc;
@@ -95,6 +202,7 @@ enum MHD_Result route_execute(pk_req *r)
         char d[80];
         snprintf(d, sizeof d, "%zu invalid input%s", errs.n, errs.n == 1 ? "" : "s");
         json_decref(body);
+        pk_exec_opts_free(&opts);
         enum MHD_Result rc = pk_send_problem_doc(r, 422, pk_problem_invalid(422, d, &errs), 0);
         pk_schema_errors_free(&errs);
         return rc;
@@ -116,13 +224,18 @@ enum MHD_Result route_execute(pk_req *r)
                    .max_queued = cfg.max_queued, .max_queued_per_owner = cfg.max_queued_per_owner};
     int rc = pk_queue_submit(svc->q, &s, id);
     free(text);
+    if (rc == PK_Q_OK && pk_results_opts_save(r, id, &opts) != 0)
+        pk_log(PK_LOG_WARN, "cannot store the execute options; results answer as a document",
+               "{s:s}", "job", id);
+    if (rc != PK_Q_OK && rc != PK_Q_EXISTING)
+        pk_exec_opts_free(&opts);
     switch (rc) {
     case PK_Q_OK:
         pk_log(PK_LOG_INFO, "job accepted", "{s:s,s:s,s:s}", "job", id, "process", p->id, "owner", owner);
         pk_supervisor_wake(svc->sup);
-        return reply_job(r, id, 0);
+        return answer(r, id, 0, &opts);
     case PK_Q_EXISTING:
-        return reply_job(r, id, 1);
+        return answer(r, id, 1, &opts);
     case PK_Q_KEY_CONFLICT:
         return pk_send_problem(r, 422, PK_PROBLEM_PACKD "idempotency-key-reused", "Idempotency key reused",
                                "this Idempotency-Key was used for a different request",

@@ -1,4 +1,5 @@
-/* GET /jobs, GET /jobs/{id} (ETag/If-None-Match), DELETE /jobs/{id}. */
+/* GET /jobs/{id} (ETag/If-None-Match), DELETE /jobs/{id}; the list GET /jobs
+ * is route_job_list.c. */
 #include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -9,47 +10,6 @@
 #include "http.h"
 #include "api/http/http_status_info.h"
 #include "daemon/log.h"
-
-static int valid_status(const char *s)
-{
-    const char *all[] = {"accepted", "running", "successful", "failed", "dismissed"};
-    for (size_t i = 0; i < 5; i++)
-        if (!strcmp(s, all[i]))
-            return 1;
-    return 0;
-}
-
-enum MHD_Result route_jobs(pk_req *r)
-{
-    const char *status = pk_query(r, "status"), *process = pk_query(r, "processID");
-    long long limit, offset;
-    char d[160];
-    /* offset bounded so offset + limit stays far from any overflow */
-    if (pk_query_int(r, "limit", 100, 1, 1000, &limit, d, sizeof d) != 0 ||
-        pk_query_int(r, "offset", 0, 0, 1000000000, &offset, d, sizeof d) != 0)
-        return pk_send_problem(r, 400, PK_PROBLEM_INVALID_INPUT, "Invalid query", d, NULL, 0);
-    if (status && !valid_status(status))
-        return pk_send_problem(r, 400, PK_PROBLEM_INVALID_INPUT, "Invalid query",
-                               "status in accepted|running|successful|failed|dismissed", NULL, 0);
-    int total = 0;
-    json_t *rows = pk_queue_list(r->svc->q, status, process, pk_scope(r), (int)limit, (int)offset, &total);
-    json_t *jobs = json_array();
-    size_t i;
-    json_t *row;
-    json_array_foreach(rows, i, row) json_array_append_new(jobs, pk_status_info(row));
-    json_decref(rows);
-    json_t *links = json_array();
-    char self[400], qs[300];
-    snprintf(qs, sizeof qs, "%s%s%s%s", status ? "&status=" : "", status ? status : "",
-             process ? "&processID=" : "", process ? process : "");
-    snprintf(self, sizeof self, "/jobs?limit=%lld&offset=%lld%s", limit, offset, qs);
-    json_array_append_new(links, json_pack("{s:s,s:s,s:s}", "href", self, "rel", "self", "type", "application/json"));
-    if (offset + limit < total) {
-        snprintf(self, sizeof self, "/jobs?limit=%lld&offset=%lld%s", limit, offset + limit, qs);
-        json_array_append_new(links, json_pack("{s:s,s:s,s:s}", "href", self, "rel", "next", "type", "application/json"));
-    }
-    return pk_send_json(r, 200, json_pack("{s:o,s:i,s:o}", "jobs", jobs, "numberMatched", total, "links", links), NULL);
-}
 
 enum MHD_Result route_job(pk_req *r)
 {

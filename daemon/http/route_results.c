@@ -1,35 +1,56 @@
-/* GET /jobs/{id}/results (document) and /jobs/{id}/results/{output} (file). */
+/* GET /jobs/{id}/results (the results document, or the bytes of one output
+ * when the execute request asked for raw / one output by value) and
+ * /jobs/{id}/results/{output} (one output).  The outputs are the table of
+ * api/http/http_outputs.h, the same the process descriptions declare. */
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "auth.h"
 #include "http.h"
+#include "results_send.h"
 #include "api/http/http_status_info.h"
 #include "api/picture/picture.h"
-#include "daemon/store/sha256.h"
 #include "api/results/xdmf.h"
+#include "daemon/store/sha256.h"
 
-/* The pictures a worker draws beside the result (api/picture/picture.h). */
-static const struct {
-    const char *file, *type, *title;
-} pictures[] = {
-    {"picture.png", "image/png", "the packing"},
-    {"picture.svg", "image/svg+xml", "the packing"},
-    {"grading.png", "image/png", "the grading curve, target and achieved"},
-    {"grading.svg", "image/svg+xml", "the grading curve, target and achieved"},
-};
+#define EXEC_OPTS_FILE "execute.json" /* in the job directory, only when not the defaults */
 
-/* The row of a successful job (or, with partial_ok, of a failed job that
- * kept its partial result file), or NULL after replying with the problem:
- * a failed job's results answer why it failed. */
-static json_t *successful_job(pk_req *r, int partial_ok, enum MHD_Result *rc)
+void pk_results_opts_load(pk_req *r, const char *id, pk_exec_opts *o)
 {
-    json_t *row = pk_job_visible(r, r->seg[1]);
-    if (!row) {
-        *rc = pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
-        return NULL;
-    }
+    pk_config cfg = pk_service_config(r->svc);
+    char dir[1200], path[1300];
+    pk_job_dir(cfg.data, id, dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/" EXEC_OPTS_FILE, dir);
+    json_t *j = access(path, R_OK) == 0 ? json_load_file(path, 0, NULL) : NULL;
+    pk_exec_opts_from_json(j, o);
+    json_decref(j);
+}
+
+int pk_results_opts_save(pk_req *r, const char *id, const pk_exec_opts *o)
+{
+    json_t *j = pk_exec_opts_json(o);
+    if (!j)
+        return 0;
+    pk_config cfg = pk_service_config(r->svc);
+    char dir[1200], path[1300];
+    pk_job_dir(cfg.data, id, dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/" EXEC_OPTS_FILE, dir);
+    char jobs[1300];
+    snprintf(jobs, sizeof jobs, "%s/jobs", cfg.data);
+    mkdir(jobs, 0750); /* the supervisor makes the same directories when it claims the job */
+    mkdir(dir, 0750);
+    int rc = json_dump_file(j, path, JSON_COMPACT) == 0 ? 0 : -1;
+    json_decref(j);
+    return rc;
+}
+
+/* The row of job id if visible, successful (or, with partial_ok, failed
+ * with its partial result file), else NULL after replying with the problem. */
+static json_t *finished_job(pk_req *r, json_t *row, int partial_ok, enum MHD_Result *rc)
+{
+    const char *id = json_string_value(json_object_get(row, "id"));
     const char *st = json_string_value(json_object_get(row, "status"));
     if (partial_ok && pk_has_partial_result(row))
         return row;
@@ -42,91 +63,135 @@ static json_t *successful_job(pk_req *r, int partial_ok, enum MHD_Result *rc)
         char d[400];
         snprintf(d, sizeof d, "the job is %s: %s", st, json_string_value(json_object_get(row, "message")));
         *rc = pk_send_problem(r, 404, PK_PROBLEM_RESULT_NOT_READY, "Result not ready", d,
-                              json_pack("{s:s,s:s}", "jobID", r->seg[1], "jobStatus", st), 0);
+                              json_pack("{s:s,s:s}", "jobID", id, "jobStatus", st), 0);
         json_decref(row);
         return NULL;
     }
     return row;
 }
 
-enum MHD_Result route_results(pk_req *r)
+static int selected(const pk_exec_opts *o, const char *output)
 {
-    enum MHD_Result rc;
-    json_t *row = successful_job(r, 0, &rc);
-    if (!row)
-        return rc;
-    json_t *doc = pk_results_document(row);
-    json_decref(row);
-    pk_config cfg = pk_service_config(r->svc);
-    char dir[1200], path[1300], href[200];
-    pk_job_dir(cfg.data, r->seg[1], dir, sizeof dir);
-    for (size_t i = 0; i < sizeof pictures / sizeof *pictures; i++) {
-        snprintf(path, sizeof path, "%s/%s", dir, pictures[i].file);
-        if (access(path, R_OK) != 0)
-            continue;
-        snprintf(href, sizeof href, "/jobs/%s/results/%s", r->seg[1], pictures[i].file);
-        json_object_set_new(doc, pictures[i].file,
-                            json_pack("{s:s,s:s,s:s}", "href", href, "type", pictures[i].type,
-                                      "title", pictures[i].title));
-    }
-    return pk_send_json(r, 200, doc, NULL);
+    if (!o || !o->select)
+        return 1;
+    size_t i;
+    json_t *v;
+    json_array_foreach(o->select, i, v) if (!strcmp(json_string_value(v), output)) return 1;
+    return 0;
 }
 
-/* Outputs: "result" (the HDF5 file) and "xdmf" (its XDMF 3 description for
- * ParaView, made on first request; it names the HDF5 file as the download's
- * file name "<id>.h5", so both saved side by side open together). */
-enum MHD_Result route_result_file(pk_req *r)
+static void job_file(pk_req *r, const char *id, const char *name, char *path, size_t n)
 {
-    int want_xdmf = strcmp(r->seg[3], "xdmf") == 0, picture = -1;
-    for (size_t i = 0; i < sizeof pictures / sizeof *pictures; i++)
-        if (!strcmp(r->seg[3], pictures[i].file))
-            picture = (int)i;
-    if (strcmp(r->seg[3], "result") != 0 && !want_xdmf && picture < 0)
-        return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output",
-                               "outputs: result, xdmf, picture.png, picture.svg, grading.png, "
-                               "grading.svg", NULL, 0);
-    enum MHD_Result rc;
-    json_t *row = successful_job(r, picture < 0, &rc);
-    if (!row)
-        return rc;
     pk_config cfg = pk_service_config(r->svc);
-    char dir[1200], path[1300], name[200];
-    pk_job_dir(cfg.data, r->seg[1], dir, sizeof dir);
-    if (picture >= 0) {
+    char dir[1200];
+    pk_job_dir(cfg.data, id, dir, sizeof dir);
+    snprintf(path, n, "%s/%s", dir, name);
+}
+
+/* The results document: summary, result, xdmf and the pictures drawn. */
+static json_t *results_document(pk_req *r, json_t *row, const pk_exec_opts *o)
+{
+    const char *id = json_string_value(json_object_get(row, "id"));
+    json_t *doc = pk_results_document(row);
+    for (const pk_output *out = pk_outputs; out->id; out++) {
+        char path[1300], href[200];
+        job_file(r, id, out->id, path, sizeof path);
+        if (out->optional && access(path, R_OK) == 0) {
+            snprintf(href, sizeof href, "/jobs/%s/results/%s", id, out->id);
+            json_object_set_new(doc, out->id, json_pack("{s:s,s:s,s:s}", "href", href, "type",
+                                                        out->type, "title", out->title));
+        }
+        if (!selected(o, out->id))
+            json_object_del(doc, out->id);
+    }
+    return doc;
+}
+
+/* One output of a row that finished_job accepted (stolen). */
+static enum MHD_Result send_output(pk_req *r, json_t *row, const pk_output *out)
+{
+    const char *id = json_string_value(json_object_get(row, "id"));
+    char path[1300], name[200];
+    enum MHD_Result rc;
+    if (!strcmp(out->id, "summary")) {
+        json_t *s = json_object_get(row, "summary");
+        rc = pk_send_json(r, 200, json_is_object(s) ? json_incref(s) : json_object(), NULL);
+    } else if (out->optional) {
         char hex[65];
-        snprintf(path, sizeof path, "%s/%s", dir, pictures[picture].file);
-        json_decref(row);
+        job_file(r, id, out->id, path, sizeof path);
         if (access(path, R_OK) != 0 || pk_sha256_file_hex(path, hex) != 0) {
             char d[200];
             snprintf(d, sizeof d, "this job has no such picture (SVG packings are drawn up to %d "
                      "grains, grading curves for pack results)", PK_PICTURE_SVG_MAX_GRAINS);
-            return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output", d,
-                                   NULL, 0);
+            rc = pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output", d, NULL, 0);
+        } else {
+            rc = pk_send_file(r, path, out->type, hex, NULL); /* shown inline */
         }
-        return pk_send_file(r, path, pictures[picture].type, hex, NULL); /* shown inline */
+    } else if (!strcmp(out->id, "xdmf")) {
+        char xpath[1300], xname[200], err[512], hex[65];
+        job_file(r, id, "result.h5", path, sizeof path);
+        job_file(r, id, "result.xdmf", xpath, sizeof xpath);
+        snprintf(name, sizeof name, "%s.h5", id);
+        snprintf(xname, sizeof xname, "%s.xdmf", id);
+        if (access(xpath, R_OK) != 0 && pk_xdmf_write(path, name, xpath, err, sizeof err) != 0)
+            rc = pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error", err, NULL, 0);
+        else if (pk_sha256_file_hex(xpath, hex) != 0)
+            rc = pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error",
+                                 "cannot read the XDMF file", NULL, 0);
+        else
+            rc = pk_send_file(r, xpath, out->type, hex, xname);
+    } else {
+        job_file(r, id, "result.h5", path, sizeof path);
+        snprintf(name, sizeof name, "%s.h5", id);
+        rc = pk_send_file(r, path, out->type, json_string_value(json_object_get(row, "result_sha256")),
+                          name);
     }
-    snprintf(path, sizeof path, "%s/result.h5", dir);
-    snprintf(name, sizeof name, "%s.h5", r->seg[1]);
-    if (want_xdmf) {
-        char xpath[1300], xname[200], err[512];
-        snprintf(xpath, sizeof xpath, "%s/result.xdmf", dir);
-        snprintf(xname, sizeof xname, "%s.xdmf", r->seg[1]);
-        if (access(xpath, R_OK) != 0 && pk_xdmf_write(path, name, xpath, err, sizeof err) != 0) {
-            json_decref(row);
-            return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error", err, NULL, 0);
-        }
-        char hex[65];
-        if (pk_sha256_file_hex(xpath, hex) != 0) {
-            json_decref(row);
-            return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error",
-                                   "cannot read the XDMF file", NULL, 0);
-        }
-        rc = pk_send_file(r, xpath, "application/xml", hex, xname);
-        json_decref(row);
-        return rc;
-    }
-    rc = pk_send_file(r, path, PK_RESULT_MEDIA_TYPE,
-                      json_string_value(json_object_get(row, "result_sha256")), name);
     json_decref(row);
     return rc;
+}
+
+enum MHD_Result pk_send_results(pk_req *r, json_t *row, const pk_exec_opts *o)
+{
+    enum MHD_Result rc;
+    if (!(row = finished_job(r, row, 0, &rc)))
+        return rc;
+    if (o->serve[0])
+        return send_output(r, row, pk_output_find(o->serve));
+    json_t *doc = results_document(r, row, o);
+    json_decref(row);
+    return pk_send_json(r, 200, doc, NULL);
+}
+
+enum MHD_Result route_results(pk_req *r)
+{
+    json_t *row = pk_job_visible(r, r->seg[1]);
+    if (!row)
+        return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
+    pk_exec_opts o;
+    pk_results_opts_load(r, r->seg[1], &o);
+    /* a client that takes only JSON (packd fetch) gets the document of a raw job */
+    const char *accept = pk_header(r, "Accept");
+    if (o.serve[0] && accept && !strstr(accept, "*/*") &&
+        !strstr(accept, pk_output_find(o.serve)->type))
+        o.serve[0] = 0;
+    enum MHD_Result rc = pk_send_results(r, row, &o);
+    pk_exec_opts_free(&o);
+    return rc;
+}
+
+enum MHD_Result route_result_file(pk_req *r)
+{
+    const pk_output *out = pk_output_find(r->seg[3]);
+    if (!out)
+        return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output",
+                               "outputs: summary, result, xdmf, picture.png, picture.svg, "
+                               "grading.png, grading.svg", NULL, 0);
+    json_t *row = pk_job_visible(r, r->seg[1]);
+    if (!row)
+        return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
+    enum MHD_Result rc;
+    /* a failed job's partial result file stays downloadable */
+    if (!(row = finished_job(r, row, !strcmp(out->id, "result") || !strcmp(out->id, "xdmf"), &rc)))
+        return rc;
+    return send_output(r, row, out);
 }

@@ -312,20 +312,32 @@ json_t *pk_queue_get(pk_queue *q, const char *id)
     return r;
 }
 
-json_t *pk_queue_list(pk_queue *q, const char *status, const char *process, const char *owner,
-                      int limit, int offset, int *total)
+json_t *pk_queue_list(pk_queue *q, const pk_job_filter *f, int limit, int offset, int *total)
 {
+    /* Arrays are bound as JSON text and unpacked by json_each; a NaN bound
+     * as a double is NULL in SQLite, so NAN means "no bound" below. */
+    const char *where =
+        " WHERE (?1 IS NULL OR status IN (SELECT value FROM json_each(?1)))"
+        " AND (?2 IS NULL OR process IN (SELECT value FROM json_each(?2)))"
+        " AND (?5 IS NULL OR owner=?5)"
+        " AND (?6 IS NULL OR created >= ?6) AND (?7 IS NULL OR created < ?7)"
+        " AND ((?8 IS NULL AND ?9 IS NULL) OR (started IS NOT NULL AND"
+        "  (finished IS NOT NULL OR status='running') AND"
+        "  coalesce(finished, ?10) - started BETWEEN coalesce(?8, -1e300) AND coalesce(?9, 1e300)))";
+    char sql[1024];
+    double now = pk_queue_now();
     pthread_mutex_lock(&q->mu);
-    const char *where = " WHERE (?1 IS NULL OR status=?1) AND (?2 IS NULL OR process=?2)"
-                        " AND (?5 IS NULL OR owner=?5)";
-    char sql[512];
     snprintf(sql, sizeof sql, "SELECT count(*) FROM jobs%s", where);
     if (total)
-        *total = (int)scalar(q, prep(q, sql, "ssiis", status, process, 0, 0, owner));
+        *total = (int)scalar(q, prep(q, sql, "ssiisddddd", f->status_json, f->process_json, 0, 0,
+                                     f->owner, f->created_from, f->created_before, f->min_duration,
+                                     f->max_duration, now));
     snprintf(sql, sizeof sql,
              "SELECT id, process, status, progress, message, created, started, finished, updated, rev"
              " FROM jobs%s ORDER BY seq DESC LIMIT ?3 OFFSET ?4", where);
-    json_t *r = rows(prep(q, sql, "ssiis", status, process, limit, offset, owner));
+    json_t *r = rows(prep(q, sql, "ssiisddddd", f->status_json, f->process_json, limit, offset,
+                          f->owner, f->created_from, f->created_before, f->min_duration,
+                          f->max_duration, now));
     pthread_mutex_unlock(&q->mu);
     return r;
 }

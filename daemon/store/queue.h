@@ -42,9 +42,19 @@ int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37]);
 /* The job row, or NULL if unknown. */
 json_t *pk_queue_get(pk_queue *q, const char *id);
 
-/* Newest first; status/process/owner may be NULL (any). */
-json_t *pk_queue_list(pk_queue *q, const char *status, const char *process, const char *owner,
-                      int limit, int offset, int *total);
+/* Which jobs GET /jobs lists (OGC job-list); an absent filter matches all. */
+typedef struct pk_job_filter {
+    const char *status_json;   /* JSON array of statuses (any of them), or NULL */
+    const char *process_json;  /* JSON array of process ids (any of them), or NULL */
+    const char *owner;         /* NULL: every owner's */
+    double created_from, created_before;  /* created in [from, before); NAN: open */
+    /* started..finished, or ..now while running; a job without both (never
+     * started, or re-queued) has no duration and fails either bound */
+    double min_duration, max_duration;    /* seconds; NAN: none */
+} pk_job_filter;
+
+/* Newest first: at most limit rows after offset; *total all that match. */
+json_t *pk_queue_list(pk_queue *q, const pk_job_filter *f, int limit, int offset, int *total);
 
 /* Move the oldest accepted job to running (attempts + 1).  Returns the job
  * row (new ref) or NULL when none waits. */

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """fake_service.py PORTFILE LOGFILE — a stand-in packd service on 127.0.0.1
 for the client's failure paths (test_client.sh): results whose bytes do not
-match their SHA-256, a download cut short, a failed job with a partial file,
+match their SHA-256 or their stated result_digest, a download cut short, a failed job with a partial file,
 a result link naming another host.
 Writes its port to PORTFILE and each request's Authorization header to
 LOGFILE."""
@@ -37,11 +37,14 @@ class Handler(http.server.BaseHTTPRequestHandler):
                    "detail": "ran out of wall time", "jobID": job, "jobStatus": "failed",
                    "partial_result": {"href": "/jobs/failed/results/result", "sha256": SHA}}
             return self.reply(422, json.dumps(doc).encode(), "application/problem+json")
-        if parts[-1] == "results" and job in ("good", "tampered", "short", "badheader", "abs"):
+        if parts[-1] == "results" and job in ("good", "tampered", "short", "badheader", "abs", "digest"):
             # "abs": a public URL the client does not use (a proxy's name)
             base = "http://public.invalid:9" if job == "abs" else ""
+            summary = {"fake": True}
+            if job == "digest":  # states a content hash the bytes do not have
+                summary["result_digest"] = "0" * 64
             doc = {"result": {"href": base + "/jobs/%s/results/result" % job, "sha256": SHA,
-                              "size": len(BODY)}, "summary": {"value": {"fake": True}}}
+                              "size": len(BODY)}, "summary": {"value": summary}}
             return self.reply(200, json.dumps(doc).encode())
         if parts[-1] == "result":
             hdr = {"X-Content-SHA256": "0" * 64 if job == "badheader" else SHA}

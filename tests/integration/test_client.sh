@@ -69,12 +69,13 @@ check fake_good_exit_0 test $? = 0
 check token_sent_as_bearer grep -q '^/jobs/good/results/result Bearer secret-t$' "$T/fake.log"
 "$PACKD" fetch abs -o "$T/abs.bin" --server "$F" --token t2 >/dev/null 2>&1
 check absolute_link_fetched_from_server sh -c "[ -s '$T/abs.bin' ] && grep -q '^/jobs/abs/results/result Bearer t2$' '$T/fake.log'"
-for bad in tampered short badheader; do
+for bad in tampered short badheader digest; do
     "$PACKD" fetch $bad -o "$T/$bad.bin" --server "$F" --token x >/dev/null 2>"$T/$bad.err"
     check "${bad}_download_exit_2" test $? = 2
     check "${bad}_download_removed" test ! -e "$T/$bad.bin" -a ! -e "$T/$bad.bin.part"
 done
 check tampered_says_mismatch grep -q 'SHA-256 mismatch' "$T/tampered.err"
+check digest_says_stated grep -q 'result_digest .*the server states 0000' "$T/digest.err"
 "$PACKD" fetch failed -o "$T/partial.bin" --server "$F" >/dev/null 2>"$T/failed.err"
 check failed_job_exit_3 test $? = 3
 check failed_job_reason_printed grep -q 'ran out of wall time' "$T/failed.err"

@@ -1,6 +1,7 @@
 /* test_queue.c — daemon/store/queue.c on a real SQLite file: submission limits,
  * idempotency keys, atomic claims, events, dismissal, recovery after a daemon
  * death (bounded attempts), concurrent writers through two connections. */
+#include <math.h>
 #include <pthread.h>
 #include <sqlite3.h>
 #include <stdio.h>
@@ -69,7 +70,9 @@ static void test_submit_limits_and_keys(void)
     CHECK(submit(q, "cid", NULL, NULL, b) == PK_Q_OK);
     CHECK(submit(q, "dan", NULL, NULL, b) == PK_Q_FULL);       /* 5 waiting in all */
     int total = 0;
-    json_t *l = pk_queue_list(q, "accepted", NULL, NULL, 2, 0, &total);
+    pk_job_filter acc = {.status_json = "[\"accepted\"]", .created_from = NAN, .created_before = NAN,
+                         .min_duration = NAN, .max_duration = NAN};
+    json_t *l = pk_queue_list(q, &acc, 2, 0, &total);
     CHECK(total == 5 && json_array_size(l) == 2);
     json_decref(l);
     pk_queue_close(q);
@@ -209,7 +212,9 @@ static void test_concurrent_connections(void)
     }
     CHECK(!bad);
     int total = 0;
-    json_decref(pk_queue_list(q1, NULL, NULL, NULL, 1, 0, &total));
+    pk_job_filter all = {.created_from = NAN, .created_before = NAN, .min_duration = NAN,
+                         .max_duration = NAN};
+    json_decref(pk_queue_list(q1, &all, 1, 0, &total));
     CHECK_MSG(total == 20, "jobs = %d (2 owners x 10 keys)", total);
     CHECK(w[0].claimed + w[1].claimed + w[2].claimed + w[3].claimed == 20);
     pk_queue_close(q1);
