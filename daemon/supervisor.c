@@ -16,7 +16,7 @@
 #include <unistd.h>
 
 #include "log.h"
-#include "daemon/store/sha256.h"
+#include "daemon/store/digest.h"
 
 #define MAX_SLOTS 1024
 #define POLL_MS 200          /* cancel requests are seen within this (+ the worker's tick) */

@@ -8,7 +8,7 @@
 #include "cli.h"
 #include "api/picture/picture.h"
 #include "api/process.h"
-#include "daemon/store/sha256.h"
+#include "daemon/store/digest.h"
 #include "api/results/xdmf.h"
 
 static volatile sig_atomic_t cancel_requested;

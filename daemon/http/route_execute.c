@@ -14,7 +14,7 @@
 #include "api/http/http_status_info.h"
 #include "api/inputs/input_confine.h"
 #include "daemon/log.h"
-#include "daemon/store/sha256.h"
+#include "daemon/store/digest.h"
 
 static enum MHD_Result reply_job(pk_req *r, const char *id, int replayed)
 {

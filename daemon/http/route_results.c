@@ -7,7 +7,7 @@
 #include "http.h"
 #include "api/http/http_status_info.h"
 #include "api/picture/picture.h"
-#include "daemon/store/sha256.h"
+#include "daemon/store/digest.h"
 #include "api/results/xdmf.h"
 
 /* The pictures a worker draws beside the result (api/picture/picture.h). */
