@@ -1,4 +1,5 @@
-/* GET /jobs, GET /jobs/{id} (ETag/If-None-Match), DELETE /jobs/{id}. */
+/* route_jobs.c — GET /jobs, GET /jobs/{id} (ETag/If-None-Match), DELETE
+ * /jobs/{id}; routes in routes.c, replies in http.h. */
 #include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -9,6 +10,7 @@
 #include "http.h"
 #include "api/http/http_status_info.h"
 #include "daemon/log.h"
+#include "daemon/store/job_files.h"
 
 static int valid_status(const char *s)
 {

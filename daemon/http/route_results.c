@@ -1,4 +1,5 @@
-/* GET /jobs/{id}/results (document) and /jobs/{id}/results/{output} (file). */
+/* route_results.c — GET /jobs/{id}/results (document) and
+ * /jobs/{id}/results/{output} (file); routes in routes.c, replies in http.h. */
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
@@ -8,6 +9,7 @@
 #include "api/http/http_status_info.h"
 #include "api/picture/picture.h"
 #include "daemon/store/digest.h"
+#include "daemon/store/job_files.h"
 #include "api/results/xdmf.h"
 
 /* The pictures a worker draws beside the result (api/picture/picture.h). */
@@ -105,11 +107,11 @@ enum MHD_Result route_result_file(pk_req *r)
         }
         return pk_send_file(r, path, pictures[picture].type, hex, NULL); /* shown inline */
     }
-    snprintf(path, sizeof path, "%s/result.h5", dir);
+    pk_job_file_path(dir, PK_JOB_RESULT, path, sizeof path);
     snprintf(name, sizeof name, "%s.h5", r->seg[1]);
     if (want_xdmf) {
         char xpath[1300], xname[200], err[512];
-        snprintf(xpath, sizeof xpath, "%s/result.xdmf", dir);
+        pk_job_file_path(dir, PK_JOB_XDMF, xpath, sizeof xpath);
         snprintf(xname, sizeof xname, "%s.xdmf", r->seg[1]);
         if (access(xpath, R_OK) != 0 && pk_xdmf_write(path, name, xpath, err, sizeof err) != 0) {
             json_decref(row);
