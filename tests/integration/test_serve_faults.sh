@@ -34,7 +34,7 @@ check modes_data_dir_0750 test "$(stat -c %a "$D")" = 750
 # --- disk full --------------------------------------------------------------
 mkdir -p "$T/full"
 if ! mount -t tmpfs -o size=8m tmpfs "$T/full" 2>"$T/mount.err"; then
-    echo "SKIP disk_full: cannot mount a tmpfs here ($(cat "$T/mount.err")); needs root"
+    skip disk_full "cannot mount a tmpfs here ($(cat "$T/mount.err")); needs root"
     exit 0
 fi
 trap 'cleanup; umount "$T/full" 2>/dev/null; rm -rf "$T"' EXIT
