@@ -83,5 +83,5 @@ J2=$(submit "$T/big.json")
 check disk_freed_big_job_succeeds wait_status "$J2" successful 60
 kill -9 "$DPID" 2>/dev/null
 wait "$DPID" 2>/dev/null
-sleep 0.2
+wait_for 5 no_workers
 cleanup_full

@@ -8,20 +8,8 @@
 # bounded generously only as a guard against a hang.
 . "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
 
-# wait_for SECONDS COMMAND...: 0 as soon as COMMAND succeeds, 1 after SECONDS (scaled)
-wait_for() {
-    end=$(($(date +%s) + $1 * SLOW))
-    shift
-    until "$@"; do
-        [ "$(date +%s)" -le "$end" ] || return 1
-        sleep 0.05
-    done
-}
-gone() { ! kill -0 "$1" 2>/dev/null; }
 has_worker() { [ -n "$(worker_pid "$1")" ]; }
 logged() { grep "\"msg\":\"$1\"" "$LOG" | grep -q "$2"; } # msg, pattern
-# dead = gone, or a zombie left to an init that does not reap (containers)
-dead() { [ -n "$1" ] && ! ps -o stat= -p "$1" | grep -qv Z; }
 
 slow_body 60 >"$T/slow.json"   # runs until cancelled (60 s safety net)
 slow_body 6 >"$T/slow6.json"   # ends by its own wall-time limit after 6 s: failed, partial file kept
