@@ -1,3 +1,5 @@
+/* cmd_run.c — `packd run JOB.json -o OUT.h5`: one job in this process (what a
+ * worker runs); usage in main.c, exit statuses in docs/architecture.md. */
 #include <errno.h>
 #include <signal.h>
 #include <stdio.h>

@@ -1,3 +1,5 @@
+/* job_metrics.c — counters and the run-time histogram of ended jobs in the
+ * queue database; contract in job_metrics.h. */
 #include "job_metrics.h"
 
 #include <math.h>
