@@ -1,5 +1,5 @@
-/* input_refs.c — file inputs by link ({"href"}) resolved to server paths.
- * Contract: daemon/input_refs.h. */
+/* input_refs.c — resolve an input's {"href"} links to files of the data
+ * directory; contract in input_refs.h. */
 #include "input_refs.h"
 
 #include <stdio.h>
@@ -7,7 +7,7 @@
 #include <unistd.h>
 
 #include "api/inputs/input_links.h"
-#include "supervisor.h"
+#include "daemon/store/job_files.h"
 
 static int all_hex(const char *s, size_t n)
 {
@@ -59,7 +59,7 @@ static int resolve_one(const char *href, const char *data, pk_queue *q, const ch
         json_decref(row);
         char dir[1200];
         pk_job_dir(data, id, dir, sizeof dir);
-        snprintf(path, n, "%s/result.h5", dir);
+        pk_job_file_path(dir, PK_JOB_RESULT, path, n);
         return 0;
     }
     snprintf(why, wn, "links must be /files/<id> or /jobs/<id>/results/result (got %s)", href);

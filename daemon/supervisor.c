@@ -1,5 +1,6 @@
-/* supervisor.c — the worker processes: claim jobs, fork/exec `packd run`, reap.
- * Contract: daemon/supervisor.h. */
+/* supervisor.c — the worker processes: claim a job, fork and exec `packd run`
+ * in its directory, relay progress, enforce wall time and cancels, record the
+ * end; contract in supervisor.h. */
 #include "supervisor.h"
 
 #include <dirent.h>
@@ -18,7 +19,8 @@
 #include <unistd.h>
 
 #include "log.h"
-#include "daemon/store/sha256.h"
+#include "api/digest.h"
+#include "daemon/store/job_files.h"
 
 #define MAX_SLOTS 1024
 #define POLL_MS 200          /* cancel requests are seen within this (+ the worker's tick) */
@@ -53,11 +55,6 @@ struct pk_supervisor {
     int busy;
     slot slots[MAX_SLOTS];
 };
-
-void pk_job_dir(const char *data, const char *id, char *out, size_t n)
-{
-    snprintf(out, n, "%s/jobs/%s", data, id);
-}
 
 static int mkdirs(const char *path)
 {
@@ -149,13 +146,12 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
     char dir[1200], job_path[1300], out_path[1300], sum_path[1300], log_path[1300], lock_path[1300],
         ckpt_path[1300];
     pk_job_dir(s->data, id, dir, sizeof dir);
-    snprintf(job_path, sizeof job_path, "%s/job.json", dir);
-    snprintf(out_path, sizeof out_path, "%s/result.h5", dir);
-    snprintf(sum_path, sizeof sum_path, "%s/summary.json", dir);
-    snprintf(log_path, sizeof log_path, "%s/worker.log", dir);
-    snprintf(lock_path, sizeof lock_path, "%s/worker.lock", dir);
-    /* kept across attempts: a re-queued job resumes from it */
-    snprintf(ckpt_path, sizeof ckpt_path, "%s/checkpoint.h5", dir);
+    pk_job_file_path(dir, PK_JOB_INPUT, job_path, sizeof job_path);
+    pk_job_file_path(dir, PK_JOB_RESULT, out_path, sizeof out_path);
+    pk_job_file_path(dir, PK_JOB_SUMMARY, sum_path, sizeof sum_path);
+    pk_job_file_path(dir, PK_JOB_LOG, log_path, sizeof log_path);
+    pk_job_file_path(dir, PK_JOB_LOCK, lock_path, sizeof lock_path);
+    pk_job_file_path(dir, PK_JOB_CHECKPOINT, ckpt_path, sizeof ckpt_path);
     char why[1400];
     if (mkdirs(dir) != 0) {
         snprintf(why, sizeof why, "cannot create the job directory: %s", strerror(errno));
@@ -291,7 +287,7 @@ static void finished(pk_supervisor *s, slot *sl, int wstatus)
      * summary says why (docs/job-format.md, "Status") */
     int code = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1;
     if (code == 0 || code == 3) {
-        snprintf(path, sizeof path, "%s/summary.json", dir);
+        pk_job_file_path(dir, PK_JOB_SUMMARY, path, sizeof path);
         json_t *sum = json_load_file(path, 0, NULL);
         json_object_del(sum, "output"); /* a path inside the data directory */
         json_object_del(sum, "xdmf");
@@ -311,7 +307,7 @@ static void finished(pk_supervisor *s, slot *sl, int wstatus)
         json_decref(sum);
         char hex[65];
         struct stat st;
-        snprintf(path, sizeof path, "%s/result.h5", dir);
+        pk_job_file_path(dir, PK_JOB_RESULT, path, sizeof path);
         if (pk_sha256_file_hex(path, hex) == 0 && stat(path, &st) == 0)
             ended = pk_queue_finish(s->q, sl->id, status, msg, text, hex, (long long)st.st_size);
         else
@@ -319,7 +315,7 @@ static void finished(pk_supervisor *s, slot *sl, int wstatus)
                                     NULL, 0);
         free(text);
     } else {
-        snprintf(path, sizeof path, "%s/worker.log", dir);
+        pk_job_file_path(dir, PK_JOB_LOG, path, sizeof path);
         last_log_line(path, tail, sizeof tail);
         if (sl->killed_for_time)
             snprintf(msg, sizeof msg, "worker killed: wall time exceeded");
@@ -333,7 +329,7 @@ static void finished(pk_supervisor *s, slot *sl, int wstatus)
     }
     if (!strcmp(ended, "dismissed")) { /* nobody will download it */
         remove_tmp_files(dir);
-        snprintf(path, sizeof path, "%s/result.h5", dir);
+        pk_job_file_path(dir, PK_JOB_RESULT, path, sizeof path);
         unlink(path);
     }
     pk_log(ended[0] == 'f' ? PK_LOG_WARN : PK_LOG_INFO, "worker ended", "{s:s,s:i,s:s,s:i,s:f}",

@@ -44,7 +44,4 @@ int pk_supervisor_capacity(const pk_supervisor *s);
 void pk_supervisor_stop(pk_supervisor *s, double grace_s);
 void pk_supervisor_free(pk_supervisor *s);
 
-/* The directory of a job's files: DATA/jobs/<id> (out must hold 1200 bytes). */
-void pk_job_dir(const char *data, const char *id, char *out, size_t n);
-
 #endif

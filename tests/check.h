@@ -5,8 +5,10 @@
  *
  * Each RUN is one test case: it passes if none of its CHECKs failed.  The
  * binary prints "PASS name" / "FAIL name" lines and exits non-zero on any
- * failure; tests/run.sh adds the cases of all binaries into the final
- * "N passed, N failed" line. */
+ * failure; a case that cannot run on this machine is SKIP(name, reason...)
+ * instead ("SKIP name: reason", neither passed nor failed).  tests/run.sh
+ * adds the cases of all binaries into the final "N passed, N failed, N
+ * skipped" line. */
 #ifndef PK_CHECK_H
 #define PK_CHECK_H
 
@@ -55,6 +57,14 @@ static int check_case_failed, check_passed, check_failed;
             check_passed++;                                                      \
             printf("PASS %s\n", #fn);                                            \
         }                                                                        \
+        fflush(stdout);                                                          \
+    } while (0)
+
+#define SKIP(fn, ...)                                                            \
+    do {                                                                         \
+        printf("SKIP %s: ", #fn);                                                \
+        printf(__VA_ARGS__);                                                     \
+        putchar('\n');                                                           \
         fflush(stdout);                                                          \
     } while (0)
 

@@ -2,27 +2,29 @@
  * (contract in result_digest.h). */
 #include "result_digest.h"
 
-#include <openssl/evp.h>
+#include "api/digest.h"
+
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 /* One part: name, NUL, byte length as uint64 LE, bytes. */
-static void feed(EVP_MD_CTX *ctx, const char *name, const void *bytes, uint64_t n)
+static int feed(pk_sha256 *ctx, const char *name, const void *bytes, uint64_t n)
 {
     unsigned char len[8];
     for (int i = 0; i < 8; i++)
         len[i] = (unsigned char)(n >> (8 * i));
-    EVP_DigestUpdate(ctx, name, strlen(name) + 1);
-    EVP_DigestUpdate(ctx, len, sizeof len);
+    int rc = pk_sha256_update(ctx, name, strlen(name) + 1);
+    rc |= pk_sha256_update(ctx, len, sizeof len);
     if (n)
-        EVP_DigestUpdate(ctx, bytes, (size_t)n);
+        rc |= pk_sha256_update(ctx, bytes, (size_t)n);
+    return rc;
 }
 
 /* A numeric dataset read as mem_type (a fixed little-endian type, so the
  * bytes are the same on any host) into the hash; -1 when absent. */
-static int feed_dataset(EVP_MD_CTX *ctx, hid_t file, const char *path, hid_t mem_type)
+static int feed_dataset(pk_sha256 *ctx, hid_t file, const char *path, hid_t mem_type)
 {
     hid_t d = H5Dopen2(file, path, H5P_DEFAULT);
     if (d < 0)
@@ -33,7 +35,7 @@ static int feed_dataset(EVP_MD_CTX *ctx, hid_t file, const char *path, hid_t mem
     void *buf = n >= 0 ? malloc((size_t)(n ? n : 1) * size) : NULL;
     int rc = buf && (n == 0 || H5Dread(d, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0) ? 0 : -1;
     if (rc == 0)
-        feed(ctx, path, buf, (uint64_t)n * size);
+        rc = feed(ctx, path, buf, (uint64_t)n * size);
     free(buf);
     if (s >= 0)
         H5Sclose(s);
@@ -66,24 +68,24 @@ static char *read_string(hid_t file, const char *path)
 int pk_result_digest_compute(hid_t file, char hex[65])
 {
     char *job = read_string(file, "/parameters/job");
-    EVP_MD_CTX *ctx = job ? EVP_MD_CTX_new() : NULL;
-    int rc = ctx && EVP_DigestInit_ex(ctx, EVP_sha256(), NULL) == 1 ? 0 : -1;
+    pk_sha256 *ctx = job ? pk_sha256_new() : NULL;
+    int rc = ctx ? 0 : -1;
     if (rc == 0) {
-        feed(ctx, "/parameters/job", job, strlen(job));
+        rc |= feed(ctx, "/parameters/job", job, strlen(job));
         rc |= feed_dataset(ctx, file, "/particles/grains/box/edges", H5T_IEEE_F64LE);
         rc |= feed_dataset(ctx, file, "/particles/grains/position", H5T_IEEE_F64LE);
         rc |= feed_dataset(ctx, file, "/particles/grains/radius", H5T_IEEE_F64LE);
         rc |= feed_dataset(ctx, file, "/particles/grains/species", H5T_STD_I32LE);
     }
-    unsigned char md[EVP_MAX_MD_SIZE];
-    unsigned len = 0;
-    if (rc == 0 && EVP_DigestFinal_ex(ctx, md, &len) == 1 && len == 32) {
-        for (unsigned i = 0; i < 32; i++)
-            snprintf(hex + 2 * i, 3, "%02x", md[i]);
-    } else {
-        rc = -1;
-    }
-    EVP_MD_CTX_free(ctx);
+    unsigned char md[32];
+    if (rc == 0)
+        rc = pk_sha256_final(ctx, md); /* frees ctx */
+    else
+        pk_sha256_free(ctx);
+    if (rc == 0)
+        pk_hex(md, sizeof md, hex);
+    else
+        hex[0] = 0;
     free(job);
     return rc;
 }

@@ -1,14 +1,15 @@
-/* client_http.c — the client's HTTP over libcurl: JSON, hashed downloads, SSE.
- * Contract: daemon/cli/client_http.h. */
+/* client_http.c — the command-line client's HTTP requests, hashed downloads
+ * and SSE over libcurl; contract in client_http.h. */
 #include "client_http.h"
 
 #include <curl/curl.h>
 #include <errno.h>
-#include <openssl/evp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+
+#include "api/digest.h"
 
 #ifndef PACKD_VERSION
 #define PACKD_VERSION "0.0.0"
@@ -26,18 +27,12 @@ json_t *pk_reply_json(const pk_reply *r)
     return r->body ? json_loadb(r->body, r->len, 0, NULL) : NULL;
 }
 
-static void to_hex(const unsigned char *d, unsigned n, char *hex)
-{
-    for (unsigned i = 0; i < n; i++)
-        snprintf(hex + 2 * i, 3, "%02x", d[i]);
-}
-
 /* ---------------------------------------------------------------- sinks */
 
 typedef struct sink {
     pk_reply *r;
     FILE *file;          /* download target, or NULL: collect into r->body */
-    EVP_MD_CTX *md;      /* hash of what goes to file */
+    pk_sha256 *md;       /* hash of what goes to file */
     int write_failed;
     /* SSE */
     pk_sse_fn fn;
@@ -114,7 +109,7 @@ static size_t on_body(char *d, size_t size, size_t nmemb, void *p)
             s->write_failed = errno ? errno : EIO;
             return 0;
         }
-        EVP_DigestUpdate(s->md, d, k);
+        pk_sha256_update(s->md, d, k);
         s->r->len += k;
         return k;
     }
@@ -262,12 +257,12 @@ int pk_client_download(const pk_client *c, const char *path, const char *file, c
 {
     memset(r, 0, sizeof *r);
     hex[0] = 0;
-    sink s = {.r = r, .file = fopen(file, "wb"), .md = EVP_MD_CTX_new()};
-    if (!s.file || !s.md || !EVP_DigestInit_ex(s.md, EVP_sha256(), NULL)) {
+    sink s = {.r = r, .file = fopen(file, "wb"), .md = pk_sha256_new()};
+    if (!s.file || !s.md) {
         snprintf(r->error, sizeof r->error, "%s: %s", file, s.file ? "cannot hash" : strerror(errno));
         if (s.file)
             fclose(s.file);
-        EVP_MD_CTX_free(s.md);
+        pk_sha256_free(s.md);
         return -1;
     }
     int rc = perform(c, "GET", path, NULL, NULL, DOWNLOAD, &s);
@@ -276,12 +271,10 @@ int pk_client_download(const pk_client *c, const char *path, const char *file, c
         r->status = 0;
         rc = -1;
     }
-    unsigned char d[EVP_MAX_MD_SIZE];
-    unsigned n = 0;
-    EVP_DigestFinal_ex(s.md, d, &n);
-    EVP_MD_CTX_free(s.md);
-    if (rc == 0 && r->status >= 200 && r->status < 300)
-        to_hex(d, n, hex);
+    unsigned char d[32];
+    int hashed = pk_sha256_final(s.md, d) == 0;
+    if (rc == 0 && r->status >= 200 && r->status < 300 && hashed)
+        pk_hex(d, sizeof d, hex);
     else
         remove(file);
     return rc;
@@ -296,29 +289,6 @@ int pk_client_events(const pk_client *c, const char *path, const char *last_even
     free(s.line);
     free(s.data);
     return rc;
-}
-
-int pk_client_sha256_file(const char *path, char hex[65])
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return -1;
-    EVP_MD_CTX *md = EVP_MD_CTX_new();
-    int ok = md && EVP_DigestInit_ex(md, EVP_sha256(), NULL);
-    unsigned char buf[1 << 16];
-    size_t k;
-    while (ok && (k = fread(buf, 1, sizeof buf, f)) > 0)
-        ok = EVP_DigestUpdate(md, buf, k);
-    ok = ok && !ferror(f);
-    unsigned char d[EVP_MAX_MD_SIZE];
-    unsigned n = 0;
-    ok = ok && EVP_DigestFinal_ex(md, d, &n);
-    EVP_MD_CTX_free(md);
-    fclose(f);
-    if (!ok)
-        return -1;
-    to_hex(d, n, hex);
-    return 0;
 }
 
 int pk_client_verify(const char *got, const char *declared_doc, const char *declared_header,

@@ -1,6 +1,6 @@
 /* client_http.h — the HTTP side of packd's command-line client (submit, jobs,
  * cancel, fetch) over libcurl: JSON requests, streamed downloads hashed with
- * SHA-256 on the way (OpenSSL EVP), and Server-Sent Events.  Every request
+ * SHA-256 on the way (api/digest.h), and Server-Sent Events.  Every request
  * carries `Authorization: Bearer TOKEN` when a token is set. */
 #ifndef PK_CLIENT_HTTP_H
 #define PK_CLIENT_HTTP_H
@@ -44,9 +44,6 @@ int pk_client_download(const pk_client *c, const char *path, const char *file, c
 typedef int (*pk_sse_fn)(const char *event, const char *data, const char *id, void *ctx);
 int pk_client_events(const pk_client *c, const char *path, const char *last_event_id, pk_sse_fn fn,
                      void *ctx, pk_reply *r);
-
-/* SHA-256 of a file as 64 lowercase hex digits; 0, or -1 on I/O error. */
-int pk_client_sha256_file(const char *path, char hex[65]);
 
 /* Check a downloaded file's digest against what the service declared (the
  * results document's sha256 and the X-Content-SHA256 header; either may be

@@ -1,5 +1,5 @@
-/* cmd_run.c — `packd run JOB.json -o OUT.h5`: one job in this process (batch use
- * and the daemon's workers).  Contract: daemon/cli/cli.h; processes in api/process.h. */
+/* cmd_run.c — `packd run JOB.json -o OUT.h5`: one job in this process (what a
+ * worker runs); usage in main.c, exit statuses in docs/architecture.md. */
 #include <errno.h>
 #include <signal.h>
 #include <stdio.h>
@@ -10,7 +10,7 @@
 #include "cli.h"
 #include "api/picture/picture.h"
 #include "api/process.h"
-#include "daemon/store/sha256.h"
+#include "api/digest.h"
 #include "api/results/result_digest.h"
 #include "api/results/xdmf.h"
 

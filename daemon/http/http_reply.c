@@ -9,7 +9,7 @@
 
 #include "http.h"
 #include "daemon/log.h"
-#include "daemon/store/sha256.h"
+#include "api/digest.h"
 
 /* The base of absolute links: public_url, else http://<Host> when the Host
  * header is a plain host[:port], else http://localhost. */
@@ -186,21 +186,6 @@ const char *pk_query(pk_req *r, const char *name)
 
 void pk_owner(pk_req *r, char *out, size_t n) { snprintf(out, n, "%s", r->owner); }
 
-static void base64(const unsigned char *in, size_t n, char *out)
-{
-    static const char t[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        unsigned v = (unsigned)in[i] << 16 | (i + 1 < n ? (unsigned)in[i + 1] << 8 : 0) |
-                     (i + 2 < n ? in[i + 2] : 0);
-        out[o++] = t[v >> 18 & 63];
-        out[o++] = t[v >> 12 & 63];
-        out[o++] = i + 1 < n ? t[v >> 6 & 63] : '=';
-        out[o++] = i + 2 < n ? t[v & 63] : '=';
-    }
-    out[o] = 0;
-}
-
 /* "bytes=a-b" | "bytes=a-" | "bytes=-n" → [*from, *to]; 0 ok, -1 unsatisfiable,
  * 1 ignore (malformed or multi-range: serve the whole file). */
 static int parse_range(const char *h, long long size, long long *from, long long *to)
@@ -284,7 +269,7 @@ enum MHD_Result pk_send_file(pk_req *r, const char *path, const char *ctype, con
     unsigned char digest[32];
     char b64[48], digest_hdr[80], disp[200];
     if (pk_sha256_from_hex(sha256_hex, digest) == 0) {
-        base64(digest, 32, b64);
+        pk_base64(digest, 32, b64);
         snprintf(digest_hdr, sizeof digest_hdr, "sha-256=:%s:", b64);
         MHD_add_response_header(resp, "Repr-Digest", digest_hdr);
     }

@@ -21,7 +21,7 @@
 #include "api/http/http_status_info.h"
 #include "api/inputs/input_confine.h"
 #include "daemon/log.h"
-#include "daemon/store/sha256.h"
+#include "api/digest.h"
 
 /* A synchronous execute waiting for its job. */
 typedef struct sync_wait {

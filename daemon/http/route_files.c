@@ -10,7 +10,7 @@
 
 #include "auth.h"
 #include "http.h"
-#include "daemon/store/sha256.h"
+#include "api/digest.h"
 
 static int write_all(const char *path, const char *data, size_t n)
 {

@@ -10,6 +10,7 @@
 #include "http.h"
 #include "api/http/http_status_info.h"
 #include "daemon/log.h"
+#include "daemon/store/job_files.h"
 
 enum MHD_Result route_job(pk_req *r)
 {

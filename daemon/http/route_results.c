@@ -13,16 +13,15 @@
 #include "api/http/http_status_info.h"
 #include "api/picture/picture.h"
 #include "api/results/xdmf.h"
-#include "daemon/store/sha256.h"
-
-#define EXEC_OPTS_FILE "execute.json" /* in the job directory, only when not the defaults */
+#include "api/digest.h"
+#include "daemon/store/job_files.h"
 
 void pk_results_opts_load(pk_req *r, const char *id, pk_exec_opts *o)
 {
     pk_config cfg = pk_service_config(r->svc);
     char dir[1200], path[1300];
     pk_job_dir(cfg.data, id, dir, sizeof dir);
-    snprintf(path, sizeof path, "%s/" EXEC_OPTS_FILE, dir);
+    pk_job_file_path(dir, PK_JOB_EXEC_OPTS, path, sizeof path);
     json_t *j = access(path, R_OK) == 0 ? json_load_file(path, 0, NULL) : NULL;
     pk_exec_opts_from_json(j, o);
     json_decref(j);
@@ -36,7 +35,7 @@ int pk_results_opts_save(pk_req *r, const char *id, const pk_exec_opts *o)
     pk_config cfg = pk_service_config(r->svc);
     char dir[1200], path[1300];
     pk_job_dir(cfg.data, id, dir, sizeof dir);
-    snprintf(path, sizeof path, "%s/" EXEC_OPTS_FILE, dir);
+    pk_job_file_path(dir, PK_JOB_EXEC_OPTS, path, sizeof path);
     char jobs[1300];
     snprintf(jobs, sizeof jobs, "%s/jobs", cfg.data);
     mkdir(jobs, 0750); /* the supervisor makes the same directories when it claims the job */
@@ -129,8 +128,8 @@ static enum MHD_Result send_output(pk_req *r, json_t *row, const pk_output *out)
         }
     } else if (!strcmp(out->id, "xdmf")) {
         char xpath[1300], xname[200], err[512], hex[65];
-        job_file(r, id, "result.h5", path, sizeof path);
-        job_file(r, id, "result.xdmf", xpath, sizeof xpath);
+        job_file(r, id, pk_job_file_name(PK_JOB_RESULT), path, sizeof path);
+        job_file(r, id, pk_job_file_name(PK_JOB_XDMF), xpath, sizeof xpath);
         snprintf(name, sizeof name, "%s.h5", id);
         snprintf(xname, sizeof xname, "%s.xdmf", id);
         if (access(xpath, R_OK) != 0 && pk_xdmf_write(path, name, xpath, err, sizeof err) != 0)
@@ -141,7 +140,7 @@ static enum MHD_Result send_output(pk_req *r, json_t *row, const pk_output *out)
         else
             rc = pk_send_file(r, xpath, out->type, hex, xname);
     } else {
-        job_file(r, id, "result.h5", path, sizeof path);
+        job_file(r, id, pk_job_file_name(PK_JOB_RESULT), path, sizeof path);
         snprintf(name, sizeof name, "%s.h5", id);
         rc = pk_send_file(r, path, out->type, json_string_value(json_object_get(row, "result_sha256")),
                           name);

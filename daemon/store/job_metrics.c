@@ -1,5 +1,5 @@
-/* job_metrics.c — counters of ended jobs that never go down (Prometheus).
- * Contract: daemon/store/job_metrics.h. */
+/* job_metrics.c — counters and the run-time histogram of ended jobs in the
+ * queue database; contract in job_metrics.h. */
 #include "job_metrics.h"
 
 #include <math.h>

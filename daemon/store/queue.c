@@ -1,9 +1,8 @@
-/* queue.c — the durable SQLite job queue (jobs, inputs, states, events).
- * Contract: daemon/store/queue.h. */
+/* queue.c — the durable job queue over one SQLite file: submit, claim,
+ * progress, finish, events, uploads; contract in queue.h. */
 #include "queue.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <pthread.h>
 #include <sqlite3.h>
@@ -12,10 +11,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 
 #include "job_metrics.h"
 #include "migrations.h"
+#include "uuid.h"
 
 struct pk_queue {
     sqlite3 *db;
@@ -35,28 +34,6 @@ double pk_queue_now(void)
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
     return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
-void pk_uuid4(char out[37])
-{
-    unsigned char b[16];
-    int fd = open("/dev/urandom", O_RDONLY | O_CLOEXEC);
-    ssize_t got = fd >= 0 ? read(fd, b, sizeof b) : -1;
-    if (fd >= 0)
-        close(fd);
-    if (got != (ssize_t)sizeof b) { /* no urandom: time and pid, still unique per daemon */
-        struct timespec ts;
-        clock_gettime(CLOCK_REALTIME, &ts);
-        static unsigned counter;
-        unsigned long long v[2] = {(unsigned long long)ts.tv_sec * 1000000000ULL + ts.tv_nsec,
-                                   ((unsigned long long)getpid() << 32) | __atomic_add_fetch(&counter, 1, __ATOMIC_RELAXED)};
-        memcpy(b, v, sizeof b);
-    }
-    b[6] = (unsigned char)((b[6] & 0x0f) | 0x40);
-    b[8] = (unsigned char)((b[8] & 0x3f) | 0x80);
-    snprintf(out, 37, "%02x%02x%02x%02x-%02x%02x-%02x%02x-%02x%02x-%02x%02x%02x%02x%02x%02x", b[0],
-             b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11], b[12], b[13], b[14],
-             b[15]);
 }
 
 /* Prepare and bind: types "s" text (NULL ok), "i" int, "I" long long, "d" double. */
@@ -273,7 +250,10 @@ int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37])
         rc = PK_Q_OWNER_FULL;
         goto out;
     }
-    pk_uuid4(id);
+    if (pk_uuid4(id) != 0) {
+        rollback(q);
+        goto out;
+    }
     double now = pk_queue_now();
     if (run(q, prep(q, "INSERT INTO jobs(id, process, inputs, owner, status, message, created, updated)"
                        " VALUES (?,?,?,?,'accepted','queued',?,?)",

@@ -115,7 +115,4 @@ int pk_queue_add_file(pk_queue *q, const char *id, const char *sha256, long long
                       const char *media_type, const char *owner);
 json_t *pk_queue_get_file(pk_queue *q, const char *id, const char *owner);
 
-/* A random RFC 4122 version 4 UUID (37 bytes with NUL). */
-void pk_uuid4(char out[37]);
-
 #endif

@@ -1,8 +1,7 @@
-/* tokens.c — bearer tokens of the job service (hashed, made, listed, revoked).
- * Contract: daemon/store/tokens.h. */
+/* tokens.c — bearer tokens in the queue database: make, list, revoke, check;
+ * contract in tokens.h. */
 #include "tokens.h"
 
-#include <openssl/evp.h>
 #include <openssl/rand.h>
 #include <pthread.h>
 #include <sqlite3.h>
@@ -11,6 +10,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "api/digest.h"
 #include "migrations.h"
 
 #define LAST_USED_EVERY_S 60.0 /* last_used is a write: not on every request */
@@ -68,32 +68,20 @@ int pk_token_name_ok(const char *name)
 
 int pk_token_generate(char out[PK_TOKEN_LEN + 1])
 {
-    static const char b64url[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-_";
-    unsigned char b[33]; /* 32 random bytes + a zero pad byte: 44 sextets, 43 used */
-    memset(b, 0, sizeof b);
-    if (RAND_bytes(b, 32) != 1)
+    unsigned char b[32];
+    char enc[45];
+    if (RAND_bytes(b, sizeof b) != 1)
         return -1;
-    size_t k = strlen(PK_TOKEN_PREFIX);
-    memcpy(out, PK_TOKEN_PREFIX, k);
-    for (size_t i = 0; i < 33; i += 3) {
-        unsigned v = (unsigned)b[i] << 16 | (unsigned)b[i + 1] << 8 | b[i + 2];
-        for (int s = 18; s >= 0 && k < PK_TOKEN_LEN; s -= 6)
-            out[k++] = b64url[(v >> s) & 63];
-    }
-    out[k] = 0;
+    pk_base64url(b, sizeof b, enc); /* 43 characters and the NUL */
+    _Static_assert(sizeof PK_TOKEN_PREFIX - 1 + 43 == PK_TOKEN_LEN, "token length");
+    memcpy(out, PK_TOKEN_PREFIX, sizeof PK_TOKEN_PREFIX - 1);
+    memcpy(out + sizeof PK_TOKEN_PREFIX - 1, enc, 44);
     return 0;
 }
 
 void pk_token_hash(const char *token, char hex[65])
 {
-    unsigned char md[EVP_MAX_MD_SIZE];
-    unsigned int n = 0;
-    if (EVP_Digest(token, strlen(token), md, &n, EVP_sha256(), NULL) != 1 || n != 32) {
-        hex[0] = 0; /* matches no stored hash */
-        return;
-    }
-    for (unsigned i = 0; i < 32; i++)
-        snprintf(hex + 2 * i, 3, "%02x", md[i]);
+    pk_sha256_hex(token, strlen(token), hex); /* "" on failure: matches no stored hash */
 }
 
 int pk_tokens_add(pk_tokens *t, const char *name, int admin, char out[PK_TOKEN_LEN + 1], char *err,

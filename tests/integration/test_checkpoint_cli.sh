@@ -25,7 +25,12 @@ print(json.dumps(j))" "$SRC/examples/homogenize/homogenize-friction-taylor-2d.js
 pid=$!
 i=0
 while [ ! -f ck.h5 ] && kill -0 $pid 2>/dev/null && [ $i -lt 3000 ]; do sleep 0.01; i=$((i + 1)); done
-sleep 0.2 # a few more steps saved
+# a later step saved: each checkpoint is written aside and renamed, a new inode
+first=$(stat -c %i ck.h5 2>/dev/null)
+while [ "$(stat -c %i ck.h5 2>/dev/null)" = "$first" ] && kill -0 $pid 2>/dev/null && [ $i -lt 3000 ]; do
+    sleep 0.01
+    i=$((i + 1))
+done
 kill -9 $pid 2>/dev/null
 wait $pid 2>/dev/null
 check checkpoint_homog_saved test -f ck.h5

@@ -8,7 +8,7 @@ SRC=${PACKD_SRC:-$(pwd)}
 FB=${FUZZ_BUILD:-$SRC/build-fuzz}
 S=${FUZZ_TEST_SECONDS:-2}
 if [ ! -f "$FB/.fuzzer-ok" ]; then
-    echo "skipped: no libFuzzer build in $FB (clang -fsanitize=fuzzer missing; apt-get install clang libclang-rt-14-dev)"
+    skip fuzz "no libFuzzer build in $FB (clang -fsanitize=fuzzer missing; apt-get install clang libclang-rt-14-dev)"
     exit 0
 fi
 T=$(mktemp -d)

@@ -34,7 +34,7 @@ check modes_data_dir_0750 test "$(stat -c %a "$D")" = 750
 # --- disk full --------------------------------------------------------------
 mkdir -p "$T/full"
 if ! mount -t tmpfs -o size=8m tmpfs "$T/full" 2>"$T/mount.err"; then
-    echo "SKIP disk_full: cannot mount a tmpfs here ($(cat "$T/mount.err")); needs root"
+    skip disk_full "cannot mount a tmpfs here ($(cat "$T/mount.err")); needs root"
     exit 0
 fi
 trap 'cleanup; umount "$T/full" 2>/dev/null; rm -rf "$T"' EXIT
@@ -83,5 +83,5 @@ J2=$(submit "$T/big.json")
 check disk_freed_big_job_succeeds wait_status "$J2" successful 60
 kill -9 "$DPID" 2>/dev/null
 wait "$DPID" 2>/dev/null
-sleep 0.2
+wait_for 5 no_workers
 cleanup_full

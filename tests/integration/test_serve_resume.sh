@@ -45,7 +45,7 @@ check resume_progress_moves_before_kill sh -c "[ -f '$CK' ] && [ '${pct:-0}' -ge
 W=$(worker_pid "$J")
 kill -9 "$DPID" ${W:+"$W"} 2>/dev/null
 wait "$DPID" 2>/dev/null
-sleep 0.3
+[ -z "$W" ] || wait_for 10 dead "$W"
 
 start_daemon r1 --config "$T/packd.conf" || { fail serve_restarts; exit 1; }
 check resume_job_finishes wait_status "$J" successful $((120))

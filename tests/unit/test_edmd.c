@@ -385,13 +385,28 @@ static void test_renumbering_large_n(void)
     pk_particles_free(&q);
 }
 
-static int cancel_after(const pk_progress *pr, void *ctx)
+/* Cancels once the run has made progress (events done), not after a time. */
+typedef struct {
+    size_t cancel_at, done_at_cancel;
+    int calls_after_cancel, cancelled;
+} cancel_probe;
+
+static int cancel_when_done(const pk_progress *pr, void *ctx)
 {
-    (void)ctx;
-    return pr->elapsed_s > 0.2;
+    cancel_probe *c = ctx;
+    if (c->cancelled)
+        c->calls_after_cancel++;
+    else if (pr->done >= c->cancel_at) {
+        c->cancelled = 1;
+        c->done_at_cancel = pr->done;
+    }
+    return c->cancelled;
 }
 
-/* Cancel via the callback: honoured within a second. */
+/* Cancel via the callback: the run stops at that check (the events count no
+ * further than the check's stride of 1024) and says it was cancelled.  Its
+ * growth rate would run for minutes; max_events is only a hang guard (a run
+ * that ignored the cancel ends there, with another reason). */
 static void test_cancel(void)
 {
     int n = 2000;
@@ -400,12 +415,16 @@ static void test_cancel(void)
     pk_edmd_params prm;
     setup(&b, &p, &prm, 3, cube_edge(n, 0.5, 0.6), 1, n, 0.5, 0.5);
     prm.until = PK_EDMD_UNTIL_JAMMED;
-    prm.growth_rate = 1e-4; /* would run for minutes */
-    pk_monitor mon = {.fn = cancel_after, .interval_s = 0.05};
+    prm.growth_rate = 1e-4;
+    prm.max_events = 50000000;
+    cancel_probe probe = {.cancel_at = 200000};
+    pk_monitor mon = {.fn = cancel_when_done, .ctx = &probe, .interval_s = 1e-9};
     pk_edmd_stats st;
     CHECK(pk_edmd_run(&b, &p, &prm, &mon, &st) == 0);
-    CHECK(st.reason == PK_STOP_CANCELLED);
-    CHECK(st.seconds < 1.5);
+    CHECK_MSG(st.reason == PK_STOP_CANCELLED, "stop reason %d", (int)st.reason);
+    CHECK(probe.cancelled && probe.calls_after_cancel == 0);
+    CHECK_MSG(st.events >= probe.done_at_cancel && st.events < probe.done_at_cancel + 1024,
+              "events %llu, cancelled at %zu", (unsigned long long)st.events, probe.done_at_cancel);
     check_no_overlap(&b, &p, 0);
     pk_particles_free(&p);
 }

@@ -1,12 +1,13 @@
-/* test_sha256.c — daemon/store/sha256.c against the FIPS 180-4 / NIST CAVP example
- * vectors (exact digests: no tolerance) and split-update equivalence. */
+/* test_sha256.c — api/digest.c against the FIPS 180-4 / NIST CAVP example
+ * vectors (exact digests: no tolerance), split-update equivalence, and its
+ * base64 / base64url against the RFC 4648 §10 test vectors. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "check.h"
-#include "daemon/store/sha256.h"
+#include "api/digest.h"
 
 static void test_nist_abc(void)
 {
@@ -32,18 +33,18 @@ static void test_nist_two_blocks(void)
 
 static void test_nist_million_a_in_odd_chunks(void)
 {
-    pk_sha256 s;
+    pk_sha256 *s = pk_sha256_new();
     unsigned char d[32], want[32];
     char chunk[997];
     memset(chunk, 'a', sizeof chunk);
-    pk_sha256_init(&s);
+    CHECK(s != NULL);
     size_t left = 1000000;
     while (left) {
         size_t n = left < sizeof chunk ? left : sizeof chunk;
-        pk_sha256_update(&s, chunk, n);
+        CHECK(pk_sha256_update(s, chunk, n) == 0);
         left -= n;
     }
-    pk_sha256_final(&s, d);
+    CHECK(pk_sha256_final(s, d) == 0);
     CHECK(pk_sha256_from_hex("cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0", want) == 0);
     CHECK(!memcmp(d, want, 32));
 }
@@ -58,12 +59,11 @@ static void test_padding_boundaries(void)
     for (size_t n = 50; n <= 130; n++) {
         char one[65];
         pk_sha256_hex(msg, n, one);
-        pk_sha256 s;
+        pk_sha256 *s = pk_sha256_new();
         unsigned char d[32];
-        pk_sha256_init(&s);
         for (size_t i = 0; i < n; i++)
-            pk_sha256_update(&s, msg + i, 1);
-        pk_sha256_final(&s, d);
+            pk_sha256_update(s, msg + i, 1);
+        CHECK(pk_sha256_final(s, d) == 0);
         unsigned char o[32];
         CHECK(pk_sha256_from_hex(one, o) == 0);
         CHECK_MSG(!memcmp(o, d, 32), "n=%zu", n);
@@ -84,6 +84,39 @@ static void test_file_digest(void)
     CHECK(pk_sha256_file_hex(path, hex) == -1);
 }
 
+static void test_hex_round_trip(void)
+{
+    unsigned char d[32], back[32];
+    char hex[65];
+    for (int i = 0; i < 32; i++)
+        d[i] = (unsigned char)(i * 37 + 5);
+    pk_hex(d, 32, hex);
+    CHECK(strlen(hex) == 64 && pk_sha256_from_hex(hex, back) == 0 && !memcmp(d, back, 32));
+    hex[10] = 'g';
+    CHECK(pk_sha256_from_hex(hex, back) == -1);
+    CHECK(pk_sha256_from_hex("abc", back) == -1);
+}
+
+static void test_base64_rfc4648(void)
+{
+    static const char *in[] = {"", "f", "fo", "foo", "foob", "fooba", "foobar"};
+    static const char *want[] = {"", "Zg==", "Zm8=", "Zm9v", "Zm9vYg==", "Zm9vYmE=", "Zm9vYmFy"};
+    static const char *want_url[] = {"", "Zg", "Zm8", "Zm9v", "Zm9vYg", "Zm9vYmE", "Zm9vYmFy"};
+    char out[16];
+    for (int i = 0; i < 7; i++) {
+        pk_base64((const unsigned char *)in[i], strlen(in[i]), out);
+        CHECK_MSG(!strcmp(out, want[i]), "%s -> %s", in[i], out);
+        pk_base64url((const unsigned char *)in[i], strlen(in[i]), out);
+        CHECK_MSG(!strcmp(out, want_url[i]), "%s -> %s", in[i], out);
+    }
+    /* the two alphabets differ in 62 and 63 only */
+    const unsigned char hi[3] = {0xfb, 0xff, 0xbf};
+    pk_base64(hi, 3, out);
+    CHECK(!strcmp(out, "+/+/"));
+    pk_base64url(hi, 3, out);
+    CHECK(!strcmp(out, "-_-_"));
+}
+
 int main(void)
 {
     RUN(test_nist_abc);
@@ -92,5 +125,7 @@ int main(void)
     RUN(test_nist_million_a_in_odd_chunks);
     RUN(test_padding_boundaries);
     RUN(test_file_digest);
+    RUN(test_hex_round_trip);
+    RUN(test_base64_rfc4648);
     return check_summary();
 }

@@ -311,15 +311,47 @@ static void test_targets(void)
     pk_particles_free(&p);
 }
 
+/* Records the progress it sees; cancels at the first report with spheres placed. */
+typedef struct {
+    int calls, cancelled;
+    size_t done_at_cancel;
+} cancel_probe;
+
+static int cancel_when_placed(const pk_progress *pr, void *ctx)
+{
+    cancel_probe *c = ctx;
+    c->calls++;
+    if (!c->cancelled && pr->done > 0) {
+        c->cancelled = 1;
+        c->done_at_cancel = pr->done;
+    }
+    return c->cancelled;
+}
+
+/* A cancel stops the run and it says so, whether the cancel comes from the
+ * flag (the worker's SIGTERM) or from the callback: the direct spheres (one
+ * bounded pass over the mesh's edges and nodes) are finished, no geometric
+ * locus is tried after it (the full run adds thousands of spheres there). */
 static void test_cancel(void)
 {
-    volatile sig_atomic_t flag = 1;
-    pk_monitor mon = {.cancel = &flag, .interval_s = 0.01};
     pk_particles p;
     pk_tetfill_stats st;
+    volatile sig_atomic_t flag = 1;
+    cancel_probe by_flag = {0};
+    pk_monitor mon = {.fn = cancel_when_placed, .ctx = &by_flag, .cancel = &flag, .interval_s = 1e-9};
     run_box(1, 10, 0, 0, &p, &st, &mon);
-    CHECK(st.reason == PK_STOP_CANCELLED);
-    CHECK(st.seconds < 1);
+    CHECK_MSG(st.reason == PK_STOP_CANCELLED, "stop reason %d", (int)st.reason);
+    CHECK(by_flag.calls == 0); /* the flag wins before any report */
+    CHECK_MSG(st.n_direct > 0 && st.n_final <= st.n_direct, "%zu spheres, %zu direct", st.n_final,
+              st.n_direct);
+    pk_particles_free(&p);
+
+    cancel_probe by_fn = {0};
+    pk_monitor mon2 = {.fn = cancel_when_placed, .ctx = &by_fn, .interval_s = 1e-9};
+    run_box(1, 10, 0, 0, &p, &st, &mon2);
+    CHECK_MSG(st.reason == PK_STOP_CANCELLED, "stop reason %d", (int)st.reason);
+    CHECK(by_fn.cancelled && by_fn.done_at_cancel > 0 && by_fn.done_at_cancel <= st.n_direct);
+    CHECK_MSG(st.n_final <= st.n_direct, "%zu spheres, %zu direct", st.n_final, st.n_direct);
     pk_particles_free(&p);
 }
 
