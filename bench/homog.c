@@ -43,7 +43,7 @@
 
 #include "core/edmd/edmd.h"
 #include "core/homog/homog_tangent.h"
-#include "core/homog/homog_tensor.h"
+#include "core/space/mat3.h"
 #include "core/base/par.h"
 #include "core/base/rng.h"
 #include "api/solver/sparse_cholmod.h"

@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/homog/homog_tensor.h"
+#include "core/space/mat3.h"
 
 static const char *const bc_names[] = {"taylor", "restricted_taylor", "periodic", NULL}; /* pk_homog_bc */
 static const char *const predictor_names[] = {"none", "affine", NULL};

@@ -13,7 +13,7 @@
 #include "homog_job.h"
 #include "homog_record.h"
 #include "core/homog/homog_tangent.h"
-#include "core/homog/homog_tensor.h"
+#include "core/space/mat3.h"
 #include "api/job_verdict.h"
 #include "core/base/par.h"
 #include "api/process.h"

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/homog/homog_tensor.h"
+#include "core/space/mat3.h"
 #include "core/space/grid.h"
 #include "dem_internal.h"
 

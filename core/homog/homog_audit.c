@@ -6,7 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "homog_tensor.h"
+#include "core/space/mat3.h"
 
 static int all_finite(const double *v, size_t n)
 {

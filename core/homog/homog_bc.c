@@ -9,7 +9,7 @@
 #include "core/dem/dem_contact.h"
 #include "core/dem/dem_rattler.h"
 #include "homog_speculative.h"
-#include "homog_tensor.h"
+#include "core/space/mat3.h"
 
 void pk_homog_state_free(pk_homog_state *s)
 {

@@ -9,7 +9,7 @@
 #include "core/dem/dem_contact.h"
 #include "core/dem/dem_rattler.h"
 #include "homog_stiffness.h"
-#include "homog_tensor.h"
+#include "core/space/mat3.h"
 #include "core/base/progress.h"
 
 int pk_homog_tangent(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homog_state *s,

@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "core/homog/homog_bc.h"
-#include "core/homog/homog_tensor.h"
+#include "core/space/mat3.h"
 #include "core/base/rng.h"
 
 static inline pk_homog_opts opts(double rmean)

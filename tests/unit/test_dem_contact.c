@@ -7,7 +7,7 @@
 #include "check.h"
 #include "core/dem/dem_contact.h"
 #include "core/dem/dem_rattler.h"
-#include "core/homog/homog_tensor.h"
+#include "core/space/mat3.h"
 #include "core/base/rng.h"
 
 static void geom_init(pk_dem_geom *g, int dim, int periodic, double L, const double F[9])

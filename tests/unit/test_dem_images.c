@@ -16,7 +16,7 @@
 
 #include "check.h"
 #include "core/dem/dem_contact.h"
-#include "core/homog/homog_tensor.h"
+#include "core/space/mat3.h"
 #include "core/base/rng.h"
 
 #define E_N 3.0

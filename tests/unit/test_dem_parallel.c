@@ -15,7 +15,7 @@
 
 #include "check.h"
 #include "core/dem/dem_contact.h"
-#include "core/homog/homog_tensor.h"
+#include "core/space/mat3.h"
 #include "core/base/par.h"
 #include "core/base/rng.h"
 

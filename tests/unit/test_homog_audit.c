@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "core/homog/homog_audit.h"
-#include "core/homog/homog_tensor.h"
+#include "core/space/mat3.h"
 #include "core/base/progress.h"
 
 /* A limit set on a monitor nobody began (as pk_homog_run did): the clock must

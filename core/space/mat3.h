@@ -1,8 +1,8 @@
-/* homog_tensor.h — small dense tensors of the homogenization (row-major 3×3,
+/* mat3.h — small dense 3×3 tensors (F̄, P̄, branch maps; row-major 3×3,
  * only the leading dim×dim block is used; unused entries are kept 0, and
  * F[2][2] = 1 in 2D so det/inverse work unchanged). */
-#ifndef PK_HOMOG_TENSOR_H
-#define PK_HOMOG_TENSOR_H
+#ifndef PK_MAT3_H
+#define PK_MAT3_H
 
 #include <math.h>
 
