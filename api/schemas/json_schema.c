@@ -228,12 +228,6 @@ int pk_json_int(const json_t *v, long long *out)
     return 0;
 }
 
-long long pk_json_int_or(const json_t *obj, const char *key, long long dflt)
-{
-    long long v;
-    return pk_json_int(json_object_get(obj, key), &v) == 0 ? v : dflt;
-}
-
 /* A non-negative integer keyword value (3 or 3.0). */
 static int get_count(const json_t *v, size_t *out)
 {

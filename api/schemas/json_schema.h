@@ -66,10 +66,6 @@ json_t *pk_schema_get(const char *schema_file);
  * jansson's json_integer_value reads 0 for a real. */
 int pk_json_int(const json_t *v, long long *out);
 
-/* obj[key] through pk_json_int; dflt when absent or not an integer (inputs
- * that passed their schema always are). */
-long long pk_json_int_or(const json_t *obj, const char *key, long long dflt);
-
 /* Render the errors as a JSON array of {"pointer","rule","message"} (new ref). */
 json_t *pk_schema_errors_json(const pk_schema_errors *e);
 
