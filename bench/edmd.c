@@ -1,4 +1,4 @@
-/* bench/edmd — EDMD growth packing (issue 3).  One machine-readable line per case:
+/* bench/edmd — EDMD growth packing.  One machine-readable line per case:
  *   bench=edmd case=NAME n=N phi=F reason=R criterion=C events=E collisions=C
  *         seconds=S cpu_s=T collisions_per_cpu_s=X events_per_cpu_s=Y peak_rss_mb=M p=P
  *         runner_up=K (invalid events replaced by their runner-up, no prediction)
@@ -10,7 +10,7 @@
  * N = 2000 slow/fast (the MRJ band and the rate dependence), Fuller-like
  * 3D diameters 1–16 (counts ∝ d^-2.5) N = 10^4 to jamming — both from zero
  * radii (Meier) and, …_rsa030, from an RSA start at φ = 0.30 (Titscher/Kansal;
- * the jobs' default start since the eighth session, δ by
+ * the jobs' default start, δ by
  * pk_edmd_start_delta: the dilute phase, where list rebuilds outnumber
  * collisions, is skipped; its RSA time counts), with the monodisperse
  * cases from the same start beside them for the ratio — Meier's 2D
@@ -240,7 +240,7 @@ int main(void)
     for (int s = 1; s <= 3; s++)
         meier("meier_a32_2d_jam", A32, 100.0, s);
     /* From zero radii (Meier) and from an RSA start at φ = 0.30 (below RSA's
-     * saturation 0.384; issue 2's density): the same growth rate, and the
+     * saturation 0.384): the same growth rate, and the
      * same reduced pressure at φ = 0.55 within the spread of single runs
      * (N = 2·10⁴: p = 25.3 from zero, 25.4/26.6/24.9 from RSA at 0.2/0.3/0.4),
      * for half the events: the dilute flights from zero radii cost a list

@@ -1,4 +1,4 @@
-/* bench/edmd_jam — "until jammed" criteria side by side (issue 21).  One
+/* bench/edmd_jam — "until jammed" criteria side by side.  One
  * machine-readable line per case:
  *   bench=edmd_jam case=NAME mode=M n=N phi=F p=P criterion=C events=E
  *         cpu_s=T z=Z rattlers=R tol=TOL kinetic_ratio=K growth_changes=G

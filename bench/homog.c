@@ -1,5 +1,5 @@
-/* bench/homog — speed of the RVE homogenization (issue 6 bar: one periodic
- * load step of a 10⁴-grain 2D RVE relaxed to 1e-8 in < 2 s, tangent < 1 s).
+/* bench/homog — speed of the RVE homogenization (the bar: one periodic load
+ * step of a 10⁴-grain 2D RVE relaxed to 1e-8 in < 2 s, tangent < 1 s).
  * Prints one line per case:
  *   bench=homog case=jam_2d rve=KIND n=N ... (making the RVE)
  *   bench=homog case=periodic_step_{dr,newton}_2d rve=KIND n=N iterations=K seconds=S ...
@@ -30,10 +30,7 @@
  * cache also freezes RVEs that today's code would build differently (any
  * change of the EDMD event order or of the relaxation moves them): figures
  * for a speed bar come from RVEs built by the commit measured (a fresh
- * DIR); a cache compares two builds on the same RVEs.  Eighth session:
- * the seventh session's cached seeds 5–9 took 0.6–1.9 s serial, but its
- * own commit builds another seed 6 (2.4 s serial), and today's build
- * (calendar event queue) seeds 5–9 of 0.74–2.2 s. */
+ * DIR); a cache compares two builds on the same RVEs (docs/perf/homog.md). */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
