@@ -90,8 +90,9 @@ int pk_sha256_from_hex(const char *hex, unsigned char out[32])
         for (int j = 0; j < 2; j++) {
             char c = hex[2 * i + j];
             unsigned x = c >= '0' && c <= '9' ? (unsigned)(c - '0')
-                       : c >= 'a' && c <= 'f' ? (unsigned)(c - 'a' + 10)
-                       : c >= 'A' && c <= 'F' ? (unsigned)(c - 'A' + 10) : 16u;
+                : c >= 'a' && c <= 'f'        ? (unsigned)(c - 'a' + 10)
+                : c >= 'A' && c <= 'F'        ? (unsigned)(c - 'A' + 10)
+                                              : 16u;
             if (x > 15)
                 return -1;
             v = v * 16 + x;

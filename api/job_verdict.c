@@ -57,12 +57,13 @@ int pk_verdict_write_h5(pk_h5 *h, const json_t *summary)
     json_t *w = json_object_get(summary, "warnings");
     size_t n = json_array_size(w), len = 1, i;
     json_t *e;
-    json_array_foreach(w, i, e) len += strlen(json_string_value(e)) + 1;
+    json_array_foreach (w, i, e)
+        len += strlen(json_string_value(e)) + 1;
     char *text = malloc(len);
     if (!text)
         return -1;
     text[0] = 0;
-    json_array_foreach(w, i, e) {
+    json_array_foreach (w, i, e) {
         strcat(text, json_string_value(e));
         if (i + 1 < n)
             strcat(text, "\n");

@@ -128,8 +128,8 @@ const char *pk_job_checkpoint(const char **digest, double *interval_s)
     return ckpt_path;
 }
 
-int pk_job_run(json_t *job, int threads, const char *out_path, pk_monitor *mon,
-               json_t **summary, pk_schema_errors *errs, char *err, size_t errlen)
+int pk_job_run(json_t *job, int threads, const char *out_path, pk_monitor *mon, json_t **summary,
+               pk_schema_errors *errs, char *err, size_t errlen)
 {
     const pk_process *p;
     void *parsed;

@@ -12,10 +12,10 @@
 #include "core/base/progress.h"
 
 typedef struct pk_process {
-    const char *id;             /* "pack" */
+    const char *id; /* "pack" */
     const char *title;
     const char *description;
-    const char *inputs_schema;  /* file name in schemas/ */
+    const char *inputs_schema; /* file name in schemas/ */
     /* Schema-valid inputs → the parsed job (the process's option table
      * filled, semantic checks beyond the schema: cross-field rules,
      * feasibility), released by free_job; NULL with errors appended (JSON
@@ -69,7 +69,7 @@ const char *pk_job_checkpoint(const char **digest, double *interval_s);
  * result file and a summary whose "failure" says why (err holds the same
  * text); 1 on invalid input with errs filled; -1 on a runtime failure
  * without a result file, with err. */
-int pk_job_run(json_t *job, int threads, const char *out_path, pk_monitor *mon,
-               json_t **summary, pk_schema_errors *errs, char *err, size_t errlen);
+int pk_job_run(json_t *job, int threads, const char *out_path, pk_monitor *mon, json_t **summary,
+               pk_schema_errors *errs, char *err, size_t errlen);
 
 #endif

@@ -53,7 +53,7 @@ static double cpu_s(void)
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
     return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
-           (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+        (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
 }
 
 static void line(const char *name, size_t n, const pk_edmd_stats *st, double cpu)
@@ -72,8 +72,8 @@ static void line(const char *name, size_t n, const pk_edmd_stats *st, double cpu
 /* radii r[i] in a periodic cube filled to phi0 at those radii; from zero
  * radii (Meier), or with rsa_phi > 0 from an RSA configuration at δ·d with
  * δ^dim = rsa_phi/phi0 (Titscher §6.2, Kansal), whose CPU time counts */
-static void run_core(const char *name, int dim, const double *r, size_t n, double phi0,
-                     double rate, int jammed, double phi_target, double rsa_phi, pk_edmd_stats *st)
+static void run_core(const char *name, int dim, const double *r, size_t n, double phi0, double rate,
+                     int jammed, double phi_target, double rsa_phi, pk_edmd_stats *st)
 {
     double vol = 0;
     for (size_t i = 0; i < n; i++)
@@ -185,8 +185,7 @@ static void job_case(const char *name, const char *json)
                json_real_value(json_object_get(sum, "phi_mix")),
                json_string_value(json_object_get(sum, "termination_reason")),
                json_string_value(json_object_get(o, "termination_criterion")), ev, coll, s, cpu,
-               coll / s, ev / s, peak_mb(),
-               json_real_value(json_object_get(o, "delta_d_reached")),
+               coll / s, ev / s, peak_mb(), json_real_value(json_object_get(o, "delta_d_reached")),
                json_real_value(json_object_get(o, "reduced_pressure")));
     } else {
         printf("bench=edmd case=%s error=\"%s\" cpu_s=%.3f\n", name, err, cpu);
@@ -200,12 +199,14 @@ static void job_case(const char *name, const char *json)
 
 static const char *QUARTZ =
     "{\"type\":\"classes\",\"classes\":[{\"d\":0.25,\"volume_percent\":2.5},{\"d\":0.16,"
-    "\"volume_percent\":39.72},{\"d\":0.125,\"volume_percent\":44.22},{\"d\":0.1,\"volume_percent\":"
+    "\"volume_percent\":39.72},{\"d\":0.125,\"volume_percent\":44.22},{\"d\":0.1,\"volume_"
+    "percent\":"
     "9.58},{\"d\":0.063,\"volume_percent\":3.7},{\"d\":0.05,\"volume_percent\":0.28}]}";
-static const char *A32 =
-    "{\"type\":\"classes\",\"classes\":[{\"d\":16,\"volume_percent\":38},{\"d\":8,\"volume_percent\":"
-    "24},{\"d\":4,\"volume_percent\":15},{\"d\":2,\"volume_percent\":9},{\"d\":1,\"volume_percent\":"
-    "14}]}";
+static const char *A32 = "{\"type\":\"classes\",\"classes\":[{\"d\":16,\"volume_percent\":38},{"
+                         "\"d\":8,\"volume_percent\":"
+                         "24},{\"d\":4,\"volume_percent\":15},{\"d\":2,\"volume_percent\":9},{"
+                         "\"d\":1,\"volume_percent\":"
+                         "14}]}";
 
 static void meier(const char *name, const char *grading, double L, int seed)
 {

@@ -28,7 +28,7 @@ static double cpu_s(void)
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
     return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
-           (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+        (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
 }
 
 static int wanted(const char *name, const char *mode)
@@ -103,11 +103,12 @@ static void run(const char *name, const char *mode, int dim, const double *r, si
     double tol = pk_contact_tolerance(dim, st.pressure);
     pk_contact_stats cs;
     pk_contact_stats_compute(&b, &p, 0, tol, &cs);
-    printf("bench=edmd_jam case=%s mode=%s n=%zu phi=%.5f p=%.3g criterion=%s events=%llu cpu_s=%.2f "
-           "z=%.3f rattlers=%.4f tol=%.2g kinetic_ratio=%.3g growth_changes=%llu\n",
-           name, mode, n, st.phi, st.pressure, pk_edmd_criterion_name(st.criterion),
-           (unsigned long long)st.events, cpu, cs.mean_contacts, cs.rattler_fraction, tol,
-           st.kinetic_ratio, (unsigned long long)st.growth_changes);
+    printf(
+        "bench=edmd_jam case=%s mode=%s n=%zu phi=%.5f p=%.3g criterion=%s events=%llu cpu_s=%.2f "
+        "z=%.3f rattlers=%.4f tol=%.2g kinetic_ratio=%.3g growth_changes=%llu\n",
+        name, mode, n, st.phi, st.pressure, pk_edmd_criterion_name(st.criterion),
+        (unsigned long long)st.events, cpu, cs.mean_contacts, cs.rattler_fraction, tol,
+        st.kinetic_ratio, (unsigned long long)st.growth_changes);
     fflush(stdout);
     pk_particles_free(&p);
 }

@@ -18,13 +18,10 @@ static double cpu_s(void)
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
     return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
-           (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+        (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
 }
 
-static double num(json_t *o, const char *key)
-{
-    return json_number_value(json_object_get(o, key));
-}
+static double num(json_t *o, const char *key) { return json_number_value(json_object_get(o, key)); }
 
 /* maximize: grow the shell until jammed (job delta_d 0.5 as the floor). */
 static void a16(const char *name, double phi_mix, int seed, const char *wall_gap, int maximize)
@@ -35,8 +32,8 @@ static void a16(const char *name, double phi_mix, int seed, const char *wall_gap
              "\"periodic\":false}},\"grading\":{\"type\":\"preset\",\"name\":\"A16\"},\"d_min\":2,"
              "\"phi\":{\"value\":%g,\"refers_to\":\"mix\"},\"delta_d\":%g,\"algorithm\":\"edmd\","
              "\"edmd\":{%s\"growth_rate\":0.01,\"wall_gap\":\"%s\"},\"seed\":%d}}",
-             phi_mix, maximize ? 0.5 : 1.0, maximize ? "\"maximize\":\"delta_d\"," : "\"growth\":\"shell\",",
-             wall_gap, seed);
+             phi_mix, maximize ? 0.5 : 1.0,
+             maximize ? "\"maximize\":\"delta_d\"," : "\"growth\":\"shell\",", wall_gap, seed);
     json_error_t e;
     json_t *job = json_loads(txt, 0, &e);
     pk_schema_errors errs = {0};
@@ -46,17 +43,19 @@ static void a16(const char *name, double phi_mix, int seed, const char *wall_gap
     double c0 = cpu_s();
     int rc = job ? pk_job_run(job, 1, out, NULL, &sum, &errs, err, sizeof err) : -1;
     double cpu = cpu_s() - c0;
-    printf("bench=edmd_titscher case=%s phi_M=%g seed=%d wall_gap=%s ", name, phi_mix, seed, wall_gap);
+    printf("bench=edmd_titscher case=%s phi_M=%g seed=%d wall_gap=%s ", name, phi_mix, seed,
+           wall_gap);
     if (rc == 0) {
         json_t *o = json_object_get(sum, "edmd");
         double dd = num(o, "delta_d_reached");
-        printf("n=%lld reached=%s delta_d=%.4f phi_mix=%.4f phi_shell=%.4f criterion=%s events=%.0f "
-               "seconds=%.2f cpu_s=%.2f\n",
-               (long long)json_integer_value(json_object_get(sum, "count_placed")),
-               dd >= 1 - 1e-12 ? "yes" : "no", dd, num(sum, "phi_mix"),
-               num(o, "phi_shell"), json_string_value(json_object_get(o, "termination_criterion")),
-               (double)json_integer_value(json_object_get(o, "events")), num(sum, "seconds_place"),
-               cpu);
+        printf(
+            "n=%lld reached=%s delta_d=%.4f phi_mix=%.4f phi_shell=%.4f criterion=%s events=%.0f "
+            "seconds=%.2f cpu_s=%.2f\n",
+            (long long)json_integer_value(json_object_get(sum, "count_placed")),
+            dd >= 1 - 1e-12 ? "yes" : "no", dd, num(sum, "phi_mix"), num(o, "phi_shell"),
+            json_string_value(json_object_get(o, "termination_criterion")),
+            (double)json_integer_value(json_object_get(o, "events")), num(sum, "seconds_place"),
+            cpu);
     } else {
         printf("reached=no error=\"%s\" cpu_s=%.2f\n", err, cpu);
     }
@@ -79,7 +78,8 @@ int main(void)
             for (int s = 1; s <= 5; s++)
                 a16("a16_dd1_walls_none_sweep", phis[k], s, "none", 0);
     } else {
-        printf("bench=edmd_titscher case=a16_dd1_walls_none_sweep skipped=set_PACKD_BENCH_LARGE=1\n");
+        printf(
+            "bench=edmd_titscher case=a16_dd1_walls_none_sweep skipped=set_PACKD_BENCH_LARGE=1\n");
     }
     return 0;
 }

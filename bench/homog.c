@@ -138,9 +138,8 @@ static void build_rve(size_t n, int near_jamming, pk_homog_rve *rve, pk_homog_st
     printf("bench=homog case=jam_2d rve=%s n=%zu phi_packed=%.4f edmd_seconds=%.3f "
            "factorisations=%zu qn_steps=%zu dr_iterations=%zu seconds=%.3f exit=%s stop=%s\n",
            near_jamming ? "near_jamming" : "dense", n, phi_pack, tpack, st.newton.iterations,
-           st.newton.steps,
-           st.dr.iterations, pk_wall_seconds() - t0, pk_newton_exit_name(st.newton.exit),
-           pk_dr_stop_name(st.dr.stop));
+           st.newton.steps, st.dr.iterations, pk_wall_seconds() - t0,
+           pk_newton_exit_name(st.newton.exit), pk_dr_stop_name(st.dr.stop));
     pk_homog_state_free(&s0);
     pk_particles_free(&p);
 }
@@ -184,18 +183,23 @@ static int cache_arrays(FILE *fp, pk_homog_rve *rve, pk_homog_state *s, int writ
 {
     size_t n = rve->n;
     return io(fp, rve->X, sizeof *rve->X, 3 * n, write) | io(fp, rve->r, sizeof *rve->r, n, write) |
-           io(fp, rve->grain, sizeof *rve->grain, n, write) |
-           io(fp, rve->species, sizeof *rve->species, n, write) |
-           io(fp, rve->fixed, 1, n, write) | io(fp, rve->hull, 1, n, write) |
-           io(fp, s->x, sizeof *s->x, 3 * n, write) |
-           io(fp, s->keys, sizeof *s->keys, s->ncontact, write);
+        io(fp, rve->grain, sizeof *rve->grain, n, write) |
+        io(fp, rve->species, sizeof *rve->species, n, write) | io(fp, rve->fixed, 1, n, write) |
+        io(fp, rve->hull, 1, n, write) | io(fp, s->x, sizeof *s->x, 3 * n, write) |
+        io(fp, s->keys, sizeof *s->keys, s->ncontact, write);
 }
 
 static void cache_save(const char *path, int near_jamming, pk_homog_rve *rve, pk_homog_state *s)
 {
-    rve_cache_head h = {.magic = CACHE_MAGIC, .n = rve->n, .ncontact = s->ncontact,
-                        .seed = rve_seed(), .near_jamming = near_jamming, .dim = rve->dim,
-                        .bc = (int32_t)rve->bc, .periodic = rve->periodic, .V = rve->V};
+    rve_cache_head h = {.magic = CACHE_MAGIC,
+                        .n = rve->n,
+                        .ncontact = s->ncontact,
+                        .seed = rve_seed(),
+                        .near_jamming = near_jamming,
+                        .dim = rve->dim,
+                        .bc = (int32_t)rve->bc,
+                        .periodic = rve->periodic,
+                        .V = rve->V};
     memcpy(h.L, rve->L, sizeof h.L);
     memcpy(h.F, s->F, sizeof h.F);
     FILE *fp = fopen(path, "wb");
@@ -214,11 +218,11 @@ static int cache_load(const char *path, size_t n, int near_jamming, pk_homog_rve
     if (!fp)
         return 0;
     rve_cache_head h;
-    int ok = io(fp, &h, sizeof h, 1, 0) == 0 && memcmp(h.magic, CACHE_MAGIC, 8) == 0 &&
-             h.n == n && h.seed == rve_seed() && h.near_jamming == near_jamming &&
-             h.ncontact <= 8 * n && fseek(fp, 0, SEEK_END) == 0 &&
-             (size_t)ftell(fp) == sizeof h + cache_body_bytes(n, h.ncontact) &&
-             fseek(fp, (long)sizeof h, SEEK_SET) == 0;
+    int ok = io(fp, &h, sizeof h, 1, 0) == 0 && memcmp(h.magic, CACHE_MAGIC, 8) == 0 && h.n == n &&
+        h.seed == rve_seed() && h.near_jamming == near_jamming && h.ncontact <= 8 * n &&
+        fseek(fp, 0, SEEK_END) == 0 &&
+        (size_t)ftell(fp) == sizeof h + cache_body_bytes(n, h.ncontact) &&
+        fseek(fp, (long)sizeof h, SEEK_SET) == 0;
     if (ok) {
         memset(rve, 0, sizeof *rve);
         memset(s, 0, sizeof *s);
@@ -241,7 +245,7 @@ static int cache_load(const char *path, size_t n, int near_jamming, pk_homog_rve
         s->u = calloc(n, sizeof *s->u);
         s->keys = malloc((h.ncontact ? h.ncontact : 1) * sizeof *s->keys);
         ok = rve->X && rve->r && rve->grain && rve->species && rve->fixed && rve->hull && s->x &&
-             s->u && s->keys && cache_arrays(fp, rve, s, 0) == 0;
+            s->u && s->keys && cache_arrays(fp, rve, s, 0) == 0;
         if (!ok) {
             pk_homog_rve_free(rve);
             pk_homog_state_free(s);
@@ -372,20 +376,24 @@ static void step_threads_case(const pk_homog_rve *rve, const pk_homog_opts *on,
     double t = pk_wall_seconds() - t0;
     /* the same step: end point, stress, energy and the path's statistics */
     int same = memcmp(&sp.energy, &sn->energy, sizeof sp.energy) == 0 &&
-               memcmp(sp.P, sn->P, sizeof sp.P) == 0 &&
-               memcmp(tp.x, tn->x, 3 * rve->n * sizeof *tp.x) == 0 &&
-               sp.dr.iterations == sn->dr.iterations && sp.dr.rebuilds == sn->dr.rebuilds &&
-               sp.dr.stop == sn->dr.stop && sp.newton.iterations == sn->newton.iterations &&
-               sp.newton.steps == sn->newton.steps && sp.newton.attempts == sn->newton.attempts &&
-               sp.newton.fire_iterations == sn->newton.fire_iterations &&
-               sp.newton.exit == sn->newton.exit;
+        memcmp(sp.P, sn->P, sizeof sp.P) == 0 &&
+        memcmp(tp.x, tn->x, 3 * rve->n * sizeof *tp.x) == 0 &&
+        sp.dr.iterations == sn->dr.iterations && sp.dr.rebuilds == sn->dr.rebuilds &&
+        sp.dr.stop == sn->dr.stop && sp.newton.iterations == sn->newton.iterations &&
+        sp.newton.steps == sn->newton.steps && sp.newton.attempts == sn->newton.attempts &&
+        sp.newton.fire_iterations == sn->newton.fire_iterations &&
+        sp.newton.exit == sn->newton.exit;
     if (!same)
-        fprintf(stderr, "DIFF energy %d P %d x %d it %zu/%zu reb %zu/%zu stop %d/%d fac %zu/%zu steps %zu/%zu att %zu/%zu fire %zu/%zu exit %d/%d\n",
-                memcmp(&sp.energy, &sn->energy, sizeof sp.energy) == 0, memcmp(sp.P, sn->P, sizeof sp.P) == 0,
-                memcmp(tp.x, tn->x, 3 * rve->n * sizeof *tp.x) == 0, sp.dr.iterations, sn->dr.iterations,
-                sp.dr.rebuilds, sn->dr.rebuilds, sp.dr.stop, sn->dr.stop, sp.newton.iterations, sn->newton.iterations,
-                sp.newton.steps, sn->newton.steps, sp.newton.attempts, sn->newton.attempts,
-                sp.newton.fire_iterations, sn->newton.fire_iterations, sp.newton.exit, sn->newton.exit);
+        fprintf(stderr,
+                "DIFF energy %d P %d x %d it %zu/%zu reb %zu/%zu stop %d/%d fac %zu/%zu steps "
+                "%zu/%zu att %zu/%zu fire %zu/%zu exit %d/%d\n",
+                memcmp(&sp.energy, &sn->energy, sizeof sp.energy) == 0,
+                memcmp(sp.P, sn->P, sizeof sp.P) == 0,
+                memcmp(tp.x, tn->x, 3 * rve->n * sizeof *tp.x) == 0, sp.dr.iterations,
+                sn->dr.iterations, sp.dr.rebuilds, sn->dr.rebuilds, sp.dr.stop, sn->dr.stop,
+                sp.newton.iterations, sn->newton.iterations, sp.newton.steps, sn->newton.steps,
+                sp.newton.attempts, sn->newton.attempts, sp.newton.fire_iterations,
+                sn->newton.fire_iterations, sp.newton.exit, sn->newton.exit);
     printf("bench=homog case=periodic_step_newton_2d rve=%s n=%zu threads=2 seconds=%.3f "
            "serial_seconds=%.3f speedup=%.2f same_bits=%d\n",
            kind, rve->n, t, tnw, tnw / t, same);
@@ -448,27 +456,29 @@ static double step_case(size_t n, int near_jamming)
         t0 = pk_wall_seconds();
         pk_homog_eval(&rve, &op, &s0, F, &tp, &sp, NULL);
         double tpl = pk_wall_seconds() - t0;
-        printf("bench=homog case=periodic_step_dr_plain_2d rve=%s n=%zu iterations=%zu seconds=%.3f "
-               "stop=%s energy=%.12g P_rel_diff_vs_increments=%.2g speedup_of_increments=%.2f\n",
-               kind, n, sp.dr.iterations, tpl, pk_dr_stop_name(sp.dr.stop), sp.energy,
-               P_rel_diff(&sd, &sp),
-               tpl / tdr);
+        printf(
+            "bench=homog case=periodic_step_dr_plain_2d rve=%s n=%zu iterations=%zu seconds=%.3f "
+            "stop=%s energy=%.12g P_rel_diff_vs_increments=%.2g speedup_of_increments=%.2f\n",
+            kind, n, sp.dr.iterations, tpl, pk_dr_stop_name(sp.dr.stop), sp.energy,
+            P_rel_diff(&sd, &sp), tpl / tdr);
         pk_homog_state_free(&tp);
     }
     printf("bench=homog case=periodic_step_newton_2d rve=%s n=%zu factorisations=%zu qn_steps=%zu "
-           "dr_iterations=%zu fire_iterations=%zu attempts=%zu shift_raises=%zu seconds=%.3f cpu_s=%.3f "
+           "dr_iterations=%zu fire_iterations=%zu attempts=%zu shift_raises=%zu seconds=%.3f "
+           "cpu_s=%.3f "
            "exit=%s stop=%s residual_rel=%.2g "
            "contacts=%zu rattlers=%zu energy=%.17g P11=%.17g P22=%.17g speedup_vs_dr=%.2f\n",
            kind, n, sn.newton.iterations, sn.newton.steps,
-           sn.dr.iterations - sn.newton.fire_iterations, sn.newton.fire_iterations, sn.newton.attempts,
-           sn.newton.shifts, tnw, cnw,
-           pk_newton_exit_name(sn.newton.exit), pk_dr_stop_name(sn.dr.stop), sn.dr.f / sn.dr.f0,
-           sn.contacts, sn.rattlers, sn.energy, sn.P[0], sn.P[4], tdr > 0 ? tdr / tnw : -1);
+           sn.dr.iterations - sn.newton.fire_iterations, sn.newton.fire_iterations,
+           sn.newton.attempts, sn.newton.shifts, tnw, cnw, pk_newton_exit_name(sn.newton.exit),
+           pk_dr_stop_name(sn.dr.stop), sn.dr.f / sn.dr.f0, sn.contacts, sn.rattlers, sn.energy,
+           sn.P[0], sn.P[4], tdr > 0 ? tdr / tnw : -1);
     step_threads_case(&rve, &on, &s0, F, &tn, &sn, tnw, kind);
     double A[81];
     pk_tangent_info ti;
     int rc = pk_homog_tangent(&rve, &o, &tn, &pk_sparse_cholmod, A, &ti);
-    printf("bench=homog case=tangent_periodic_2d rve=%s n=%zu tangent_s=%.3f free_dofs=%zu status=%s rc=%d "
+    printf("bench=homog case=tangent_periodic_2d rve=%s n=%zu tangent_s=%.3f free_dofs=%zu "
+           "status=%s rc=%d "
            "A1111=%.4g\n",
            kind, n, ti.seconds, ti.free_dofs, pk_sparse_status_name(ti.block.status), rc, A[0]);
     pk_homog_state_free(&s0);

@@ -49,7 +49,7 @@ enum path { PLAIN, VOXELS, BATCH_PLAIN, BATCHED };
 static double cpu_seconds(const struct rusage *ru)
 {
     return (double)(ru->ru_utime.tv_sec + ru->ru_stime.tv_sec) +
-           1e-6 * (double)(ru->ru_utime.tv_usec + ru->ru_stime.tv_usec);
+        1e-6 * (double)(ru->ru_utime.tv_usec + ru->ru_stime.tv_usec);
 }
 
 static double sys_seconds(const struct rusage *ru)
@@ -87,8 +87,8 @@ static double dram_chase_ns(void)
 
 /* One placement of n unit spheres (dim, phi, path): its rate; *line gets the
  * case's line, with the gap audit when audit is set. */
-static double mono_once(const char *name, int dim, size_t n, double phi, enum path path,
-                        int audit, char *line, size_t size)
+static double mono_once(const char *name, int dim, size_t n, double phi, enum path path, int audit,
+                        char *line, size_t size)
 {
     /* box edge so that n unit spheres fill phi */
     double v = dim == 3 ? 3.14159265358979 / 6 : 3.14159265358979 / 4;
@@ -100,7 +100,9 @@ static double mono_once(const char *name, int dim, size_t n, double phi, enum pa
         d[i] = 1.0;
     pk_particles p;
     pk_particles_init(&p, dim, n);
-    pk_rsa_params prm = {.delta_d = 0, .max_failed_draws = 1000000, .seed = 1,
+    pk_rsa_params prm = {.delta_d = 0,
+                         .max_failed_draws = 1000000,
+                         .seed = 1,
                          .draws = path == PLAIN || path == BATCH_PLAIN ? PK_RSA_DRAWS_PLAIN
                                                                        : PK_RSA_DRAWS_OPEN,
                          .test.one_at_a_time = path == PLAIN || path == VOXELS};
@@ -136,8 +138,8 @@ static double mono_once(const char *name, int dim, size_t n, double phi, enum pa
  * first touches, as a job's worker does (in one process the heap keeps the
  * pages an earlier run freed: 10^5 grains then ran at ~1.9 M/s instead of
  * ~1.2, with 400 page faults instead of 9 000).  NAN if the child failed. */
-static double mono_child(const char *name, int dim, size_t n, double phi, enum path path,
-                         int audit, char *line, size_t size)
+static double mono_child(const char *name, int dim, size_t n, double phi, enum path path, int audit,
+                         char *line, size_t size)
 {
     int fd[2];
     fflush(stdout);
@@ -271,9 +273,11 @@ int main(int argc, char **argv)
     double r6 = mono("mono3d_phi030_1e6", 3, 1000000, 0.30, BATCHED, REPS_1E6);
     printf("bench=rsa case=speedup rate_ratio_batched_over_plain_1e4=%.3f "
            "rate_ratio_batched_over_plain_1e5=%.3f rate_ratio_batched_over_voxels_1e4=%.3f "
-           "rate_ratio_batched_over_voxels_1e5=%.3f\n", r4 / p4, r5 / p5, r4 / v4, r5 / v5);
+           "rate_ratio_batched_over_voxels_1e5=%.3f\n",
+           r4 / p4, r5 / p5, r4 / v4, r5 / v5);
     printf("bench=rsa case=region rate_ratio_over_batch_plain_1e5=%.3f "
-           "rate_ratio_over_batch_plain_1e6=%.3f\n", r5 / b5, r6 / b6);
+           "rate_ratio_over_batch_plain_1e6=%.3f\n",
+           r5 / b5, r6 / b6);
     printf("bench=rsa case=scaling rate_ratio_1e6_over_1e4=%.3f rate_ratio_1e5_over_1e4=%.3f\n",
            r6 / r4, r5 / r4);
     return 0;

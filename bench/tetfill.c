@@ -92,9 +92,9 @@ static int sweep_case(const char *path, double R, pk_tetfill_contact_rule rule)
                "F3=%.4f z_tangent_steps1_6=%.3f passes=%d seconds=%.3f\n",
                rule == PK_TETFILL_CONTACT_TOUCHING ? "_touching" : "", R,
                (unsigned long long)prm.seed, dens ? "saturated" : "steps1-6", m.ntet, p.n,
-               (double)p.n / (double)m.ntet,
-               o.phi, o.z_mean, o.z_tangent, o.z_touching, o.fabric_eig[0], o.fabric_eig[1],
-               o.fabric_eig[2], st.geometric.z_tangent, st.passes, st.seconds);
+               (double)p.n / (double)m.ntet, o.phi, o.z_mean, o.z_tangent, o.z_touching,
+               o.fabric_eig[0], o.fabric_eig[1], o.fabric_eig[2], st.geometric.z_tangent, st.passes,
+               st.seconds);
         fflush(stdout);
         pk_tetfill_measures_free(&o);
         pk_particles_free(&p);

@@ -13,32 +13,35 @@ typedef enum { PK_LOG_DEBUG, PK_LOG_INFO, PK_LOG_WARN, PK_LOG_ERROR } pk_log_lev
 typedef enum { PK_AUTH_AUTO, PK_AUTH_ON, PK_AUTH_OFF } pk_auth_mode;
 
 typedef struct pk_config {
-    char bind[64];            /* listen address (IPv4 dotted quad) */
-    char public_url[256];     /* base of absolute links, e.g. https://packd.lab.example; "" = from Host */
+    char bind[64]; /* listen address (IPv4 dotted quad) */
+    char public_url
+        [256]; /* base of absolute links, e.g. https://packd.lab.example; "" = from Host */
     int port;
-    char data[1024];          /* data directory: queue.db, jobs/, files/ */
-    char input_dir[1024];     /* "" = requests name no server path; else the directory they may name files in */
-    long input_max_bytes;     /* largest file a request may name in input_dir */
-    int workers;              /* concurrent worker processes */
-    int job_threads;          /* threads of each job's parallel sections (same results for any) */
-    long max_body_bytes;      /* largest request body (POST /files, /execution) */
-    long max_particles;       /* cap on limits.max_particles of each job */
-    double max_wall_time_s;   /* cap on limits.wall_time_s; the worker is killed 30 s after */
-    int max_queued;           /* accepted (waiting) jobs in total; beyond: 503 */
-    int max_queued_per_owner; /* accepted jobs per owner; beyond: 429 */
-    int max_attempts;         /* runs of one job interrupted by daemon deaths before it fails */
-    double grace_s;           /* SIGTERM: time running jobs get to finish */
-    int http_threads;         /* HTTP event-loop threads (epoll each) */
-    int max_connections;      /* open HTTP connections in total */
+    char data[1024]; /* data directory: queue.db, jobs/, files/ */
+    char input_dir
+        [1024]; /* "" = requests name no server path; else the directory they may name files in */
+    long input_max_bytes;       /* largest file a request may name in input_dir */
+    int workers;                /* concurrent worker processes */
+    int job_threads;            /* threads of each job's parallel sections (same results for any) */
+    long max_body_bytes;        /* largest request body (POST /files, /execution) */
+    long max_particles;         /* cap on limits.max_particles of each job */
+    double max_wall_time_s;     /* cap on limits.wall_time_s; the worker is killed 30 s after */
+    int max_queued;             /* accepted (waiting) jobs in total; beyond: 503 */
+    int max_queued_per_owner;   /* accepted jobs per owner; beyond: 429 */
+    int max_attempts;           /* runs of one job interrupted by daemon deaths before it fails */
+    double grace_s;             /* SIGTERM: time running jobs get to finish */
+    int http_threads;           /* HTTP event-loop threads (epoll each) */
+    int max_connections;        /* open HTTP connections in total */
     int max_connections_per_ip; /* open HTTP connections of one client address (0: no limit) */
-    int idle_timeout_s;       /* a connection silent this long is closed (headers, body, keep-alive) */
-    double body_timeout_s;    /* a request body must arrive within this time after its headers */
-    double sync_wait_s;       /* Prefer: respond-sync waits this long for the job, then 201 */
-    double checkpoint_interval_s; /* between two checkpoints of a long job (job dir checkpoint.h5) */
+    int idle_timeout_s;    /* a connection silent this long is closed (headers, body, keep-alive) */
+    double body_timeout_s; /* a request body must arrive within this time after its headers */
+    double sync_wait_s;    /* Prefer: respond-sync waits this long for the job, then 201 */
+    double
+        checkpoint_interval_s; /* between two checkpoints of a long job (job dir checkpoint.h5) */
     pk_log_level log_level;
-    pk_auth_mode auth;        /* bearer tokens required (daemon/http/auth.c) */
-    char trusted_proxy[64];   /* peer whose X-Packd-Owner is honoured; "" = none */
-    char config_file[1024];   /* the file read, "" if none (kept for SIGHUP) */
+    pk_auth_mode auth;      /* bearer tokens required (daemon/http/auth.c) */
+    char trusted_proxy[64]; /* peer whose X-Packd-Owner is honoured; "" = none */
+    char config_file[1024]; /* the file read, "" if none (kept for SIGHUP) */
 } pk_config;
 
 /* Embedded defaults: 127.0.0.1:8080, data ./var, workers = online cores. */

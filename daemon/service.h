@@ -11,13 +11,13 @@
 #include "daemon/store/tokens.h"
 
 typedef struct pk_service {
-    pthread_mutex_t mu;          /* guards cfg (SIGHUP replaces it) */
+    pthread_mutex_t mu; /* guards cfg (SIGHUP replaces it) */
     pk_config cfg;
     pk_queue *q;
-    pk_tokens *tokens;           /* bearer tokens (auth.c); its own connection to queue.db */
+    pk_tokens *tokens; /* bearer tokens (auth.c); its own connection to queue.db */
     pk_supervisor *sup;
-    int draining;                /* SIGTERM received: refuse new jobs (atomic) */
-    int stopping;                /* streams must end now (atomic) */
+    int draining; /* SIGTERM received: refuse new jobs (atomic) */
+    int stopping; /* streams must end now (atomic) */
     double started;
     unsigned long long responses[600]; /* by HTTP status (atomic) */
 } pk_service;

@@ -23,17 +23,17 @@
 #include "daemon/store/job_files.h"
 
 #define MAX_SLOTS 1024
-#define POLL_MS 200          /* cancel requests are seen within this (+ the worker's tick) */
+#define POLL_MS 200 /* cancel requests are seen within this (+ the worker's tick) */
 /* A cancelled worker stops placing within a second (the core's cancel flag)
  * but then saves what it placed; the daemon discards that file, so a worker
  * still alive this long after SIGTERM gets SIGKILL. */
 #define KILL_AFTER_TERM_S 2
-#define WALL_MARGIN_S 30     /* hard stop this long after the job's own wall-time limit */
+#define WALL_MARGIN_S 30 /* hard stop this long after the job's own wall-time limit */
 
 typedef struct slot {
-    pid_t pid;               /* 0 = free */
+    pid_t pid; /* 0 = free */
     char id[37];
-    int fd;                  /* progress pipe (read end) */
+    int fd; /* progress pipe (read end) */
     char line[8192];
     size_t nline;
     double started, term_sent;
@@ -168,7 +168,8 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
     char threads[16], interval[32];
     pthread_mutex_lock(&s->mu);
     snprintf(threads, sizeof threads, "%d", s->job_threads);
-    snprintf(interval, sizeof interval, "%g", s->checkpoint_interval_s > 0 ? s->checkpoint_interval_s : 30);
+    snprintf(interval, sizeof interval, "%g",
+             s->checkpoint_interval_s > 0 ? s->checkpoint_interval_s : 30);
     pthread_mutex_unlock(&s->mu);
     int p[2];
     if (wrote != 0 || cloexec_pipe(p, 0) != 0) {
@@ -202,8 +203,8 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
             dup2(p[1], 3) < 0)
             _exit(125);
         execl(s->exe, "packd", "run", job_path, "-o", out_path, "--progress-fd", "3", "--threads",
-              threads, "--pictures", dir, "--checkpoint", ckpt_path, "--checkpoint-interval", interval,
-              (char *)NULL);
+              threads, "--pictures", dir, "--checkpoint", ckpt_path, "--checkpoint-interval",
+              interval, (char *)NULL);
         _exit(127);
     }
     close(p[1]);
@@ -345,7 +346,7 @@ static void send_cancels(pk_supervisor *s)
     size_t i;
     json_t *r;
     double now = pk_queue_now();
-    json_array_foreach(req, i, r) {
+    json_array_foreach (req, i, r) {
         const char *id = json_string_value(json_object_get(r, "id"));
         for (int k = 0; k < MAX_SLOTS; k++) {
             slot *sl = &s->slots[k];
@@ -354,7 +355,8 @@ static void send_cancels(pk_supervisor *s)
             if (sl->term_sent == 0) {
                 kill(sl->pid, SIGTERM);
                 sl->term_sent = now;
-                pk_log(PK_LOG_INFO, "cancelling worker", "{s:s,s:i}", "job", id, "pid", (int)sl->pid);
+                pk_log(PK_LOG_INFO, "cancelling worker", "{s:s,s:i}", "job", id, "pid",
+                       (int)sl->pid);
             } else if (now - sl->term_sent > KILL_AFTER_TERM_S) {
                 kill(sl->pid, SIGKILL);
             }
@@ -396,7 +398,8 @@ static void *loop(void *arg)
                 kill(sl->pid, SIGKILL);
                 waitpid(sl->pid, NULL, 0);
                 close(sl->fd);
-                pk_queue_requeue(s->q, sl->id, "re-queued: the daemon stopped before the job finished");
+                pk_queue_requeue(s->q, sl->id,
+                                 "re-queued: the daemon stopped before the job finished");
                 pk_log(PK_LOG_WARN, "job re-queued at shutdown", "{s:s}", "job", sl->id);
                 sl->pid = 0;
                 __atomic_sub_fetch(&s->busy, 1, __ATOMIC_RELAXED);
@@ -458,16 +461,14 @@ pk_supervisor *pk_supervisor_start(pk_queue *q, const char *exe, const char *dat
     s->max_wall_time_s = max_wall_time_s;
     s->job_threads = job_threads;
     pthread_mutex_init(&s->mu, NULL);
-    if (cloexec_pipe(s->wake, 1) != 0 ||
-        pthread_create(&s->thread, NULL, loop, s) != 0) {
+    if (cloexec_pipe(s->wake, 1) != 0 || pthread_create(&s->thread, NULL, loop, s) != 0) {
         free(s);
         return NULL;
     }
     return s;
 }
 
-void pk_supervisor_configure(pk_supervisor *s, int workers, double max_wall_time_s,
-                             int job_threads)
+void pk_supervisor_configure(pk_supervisor *s, int workers, double max_wall_time_s, int job_threads)
 {
     pthread_mutex_lock(&s->mu);
     s->workers = workers > MAX_SLOTS ? MAX_SLOTS : workers;
@@ -492,7 +493,10 @@ void pk_supervisor_wake(pk_supervisor *s)
     }
 }
 
-int pk_supervisor_busy(const pk_supervisor *s) { return __atomic_load_n(&s->busy, __ATOMIC_RELAXED); }
+int pk_supervisor_busy(const pk_supervisor *s)
+{
+    return __atomic_load_n(&s->busy, __ATOMIC_RELAXED);
+}
 
 int pk_supervisor_capacity(const pk_supervisor *s)
 {

@@ -12,7 +12,17 @@
 
 #define G "checkpoint/"
 
-enum { C_DONE, C_NOT_CONVERGED, C_TOTAL_ITER, C_MAX_ITER, C_HAVE_A, C_N, C_NCONTACT, C_NHIST, C_COUNT };
+enum {
+    C_DONE,
+    C_NOT_CONVERGED,
+    C_TOTAL_ITER,
+    C_MAX_ITER,
+    C_HAVE_A,
+    C_N,
+    C_NCONTACT,
+    C_NHIST,
+    C_COUNT
+};
 
 int pk_homog_ckpt_save(const char *path, const char *digest, const pk_homog_ckpt *c,
                        const pk_homog_state *com, json_t *rec, char *err, size_t errlen)
@@ -29,15 +39,21 @@ int pk_homog_ckpt_save(const char *path, const char *digest, const pk_homog_ckpt
     }
     if (com->u)
         memcpy(u, com->u, com->n * sizeof *u);
-    const int64_t cnt[C_COUNT] = {(int64_t)c->done, (int64_t)c->not_converged, (int64_t)c->total_iter,
-                                  (int64_t)c->max_iter_step, c->have_A, (int64_t)com->n,
-                                  (int64_t)com->ncontact, (int64_t)com->hist.n};
+    const int64_t cnt[C_COUNT] = {(int64_t)c->done,
+                                  (int64_t)c->not_converged,
+                                  (int64_t)c->total_iter,
+                                  (int64_t)c->max_iter_step,
+                                  c->have_A,
+                                  (int64_t)com->n,
+                                  (int64_t)com->ncontact,
+                                  (int64_t)com->hist.n};
     int rc = pk_h5_obs_string(h, G "digest", digest);
     rc |= pk_h5_obs_ints(h, G "counters", cnt, C_COUNT);
     rc |= pk_h5_obs_doubles(h, G "F", com->F, 9, NULL);
     rc |= pk_h5_obs_doubles(h, G "A", c->A, 81, NULL);
     /* the step report as it is in memory: the digest names the packd version */
-    rc |= pk_h5_obs_doubles(h, G "last_step", (const double *)&c->last, sizeof c->last / sizeof(double), NULL);
+    rc |= pk_h5_obs_doubles(h, G "last_step", (const double *)&c->last,
+                            sizeof c->last / sizeof(double), NULL);
     rc |= pk_h5_obs_doubles(h, G "x", com->x, 3 * com->n, NULL);
     rc |= pk_h5_obs_ints(h, G "keys", (const int64_t *)com->keys, com->ncontact);
     rc |= pk_h5_obs_doubles(h, G "u", u, com->n, NULL);
@@ -71,8 +87,8 @@ int pk_homog_ckpt_load(const char *path, const char *digest, pk_homog_ckpt *c, p
     pk_homog_state s = {0};
     pk_fric_hist hist = {0};
     char *text = NULL;
-    if (pk_ckpt_read(f, "counters", H5T_NATIVE_INT64, cnt, C_COUNT) != 0 || cnt[C_N] != (int64_t)com->n ||
-        cnt[C_NCONTACT] < 0 || cnt[C_NHIST] < 0)
+    if (pk_ckpt_read(f, "counters", H5T_NATIVE_INT64, cnt, C_COUNT) != 0 ||
+        cnt[C_N] != (int64_t)com->n || cnt[C_NCONTACT] < 0 || cnt[C_NHIST] < 0)
         goto bad;
     s.n = com->n;
     s.ncontact = (size_t)cnt[C_NCONTACT];
@@ -87,7 +103,8 @@ int pk_homog_ckpt_load(const char *path, const char *digest, pk_homog_ckpt *c, p
     if (!s.x || !s.u || !s.keys || !hist.key || !hist.gamma || !hist.gamma_pl || !hist.alpha ||
         pk_ckpt_read(f, "F", H5T_NATIVE_DOUBLE, s.F, 9) != 0 ||
         pk_ckpt_read(f, "A", H5T_NATIVE_DOUBLE, in.A, 81) != 0 ||
-        pk_ckpt_read(f, "last_step", H5T_NATIVE_DOUBLE, &in.last, sizeof in.last / sizeof(double)) != 0 ||
+        pk_ckpt_read(f, "last_step", H5T_NATIVE_DOUBLE, &in.last,
+                     sizeof in.last / sizeof(double)) != 0 ||
         pk_ckpt_read(f, "x", H5T_NATIVE_DOUBLE, s.x, 3 * s.n) != 0 ||
         pk_ckpt_read(f, "keys", H5T_NATIVE_INT64, s.keys, s.ncontact) != 0 ||
         pk_ckpt_read(f, "u", H5T_NATIVE_DOUBLE, s.u, s.n) != 0 ||

@@ -15,7 +15,7 @@ typedef struct pk_homog_ckpt {
     size_t done, not_converged, total_iter, max_iter_step;
     int have_A;
     double A[81];
-    pk_homog_step last;    /* the report of step done − 1 */
+    pk_homog_step last; /* the report of step done − 1 */
 } pk_homog_ckpt;
 
 /* 0, or -1 with err. */

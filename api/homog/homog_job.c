@@ -9,7 +9,8 @@
 
 #include "core/space/mat3.h"
 
-static const char *const bc_names[] = {"taylor", "restricted_taylor", "periodic", NULL}; /* pk_homog_bc */
+static const char *const bc_names[] = {"taylor", "restricted_taylor", "periodic",
+                                       NULL}; /* pk_homog_bc */
 static const char *const predictor_names[] = {"none", "affine", NULL};
 static const char *const solver_names[] = {"dr", "newton", NULL};
 static const char *const policy_names[] = {"as_generated", "radius_inflation", "precompress", NULL};
@@ -99,10 +100,10 @@ static void species_stiffness(json_t *m, pk_homog_job *job, pk_schema_errors *er
             if (job->E_n_species[a * n + b] != job->E_n_species[b * n + a]) {
                 char ptr[64];
                 snprintf(ptr, sizeof ptr, "/contact/E_n_species/%zu/%zu", a, b);
-                pk_schema_errors_add(errs, ptr, "semantic",
-                                     "E_n_species must be symmetric: [%zu][%zu] = %g but [%zu][%zu] = %g",
-                                     a, b, job->E_n_species[a * n + b], b, a,
-                                     job->E_n_species[b * n + a]);
+                pk_schema_errors_add(
+                    errs, ptr, "semantic",
+                    "E_n_species must be symmetric: [%zu][%zu] = %g but [%zu][%zu] = %g", a, b,
+                    job->E_n_species[a * n + b], b, a, job->E_n_species[b * n + a]);
                 return;
             }
 }
@@ -173,7 +174,8 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
     size_t before = errs->n;
     memset(job, 0, sizeof *job);
     pk_options_fill(&pk_homog_options, inputs, job, errs);
-    species_stiffness(json_object_get(json_object_get(inputs, "contact"), "E_n_species"), job, errs);
+    species_stiffness(json_object_get(json_object_get(inputs, "contact"), "E_n_species"), job,
+                      errs);
     job->friction = json_is_object(json_object_get(inputs, "friction"));
     if (job->friction) {
         if (isnan(job->fric.E_t))
@@ -194,17 +196,19 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
     if (list) {
         json_t *list_F = json_object_get(load, "F"), *row;
         size_t k;
-        json_array_foreach(list_F, k, row) {
+        json_array_foreach (list_F, k, row) {
             size_t m = json_array_size(row);
             char ptr[64];
             snprintf(ptr, sizeof ptr, "/load/F/%zu", k);
             if (m != 4 && m != 9) {
-                pk_schema_errors_add(errs, ptr, "semantic", "F̄ needs 4 (2D) or 9 (3D) numbers, got %zu", m);
+                pk_schema_errors_add(errs, ptr, "semantic",
+                                     "F̄ needs 4 (2D) or 9 (3D) numbers, got %zu", m);
                 continue;
             }
             int d = m == 4 ? 2 : 3;
             if (job->fdim && job->fdim != d)
-                pk_schema_errors_add(errs, ptr, "semantic", "all F̄ of a path must have the same dimension");
+                pk_schema_errors_add(errs, ptr, "semantic",
+                                     "all F̄ of a path must have the same dimension");
             job->fdim = d;
             double F[9];
             pk_m3_identity(F);
@@ -229,7 +233,8 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
         int pi, pj;
         plane_of(job, &pi, &pj);
         if (pi == pj)
-            pk_schema_errors_add(errs, "/load/plane", "semantic", "a shear plane needs two different axes");
+            pk_schema_errors_add(errs, "/load/plane", "semantic",
+                                 "a shear plane needs two different axes");
         if (pi == 2 || pj == 2)
             job->fdim = 3;
         rc |= shear_path(job, &cap, cyc);
@@ -238,14 +243,16 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
         pk_schema_errors_add(errs, "/load", "memory", "out of memory for the load path");
     }
     if (job->friction && job->tangent)
-        pk_schema_errors_add(errs, "/tangent", "semantic",
-                             "no tangent with friction: the consistent tangent of the return map is not "
-                             "implemented (ch. 7 derives none); use finite differences of the stress");
+        pk_schema_errors_add(
+            errs, "/tangent", "semantic",
+            "no tangent with friction: the consistent tangent of the return map is not "
+            "implemented (ch. 7 derives none); use finite differences of the stress");
     if (job->friction && job->newton)
         pk_schema_errors_add(errs, "/relaxation/solver", "semantic",
                              "friction needs solver \"dr\" (Newton has no frictional stiffness)");
     if (job->friction && job->fdim == 3)
-        pk_schema_errors_add(errs, "/friction", "semantic", "friction is 2D only (Meier 2009 ch. 7)");
+        pk_schema_errors_add(errs, "/friction", "semantic",
+                             "friction is 2D only (Meier 2009 ch. 7)");
     if (job->friction && pk_fric_law_active(&job->fric) && job->bc != PK_BC_TAYLOR)
         pk_schema_errors_add(errs, "/friction", "semantic",
                              "friction with rho_deg > 0 or h > 0 needs boundary_condition taylor "
@@ -281,17 +288,19 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
         else if (!(d > 0))
             pk_schema_errors_add(errs, ptr, "semantic",
                                  "det F̄ of step %zu%s is %g: must be > 0 (no inversion or collapse "
-                                 "of the cell)", k, pre, d);
+                                 "of the cell)",
+                                 k, pre, d);
         else if (!(smin >= PK_HOMOG_MIN_STRETCH))
             pk_schema_errors_add(errs, ptr, "semantic",
                                  "F̄ of step %zu%s has a principal stretch %.4g (det F̄ %.4g): each "
                                  "must be >= %g; below, touching grains overlap by more than a "
-                                 "radius (the contact law needs ε ≪ r)", k, pre, smin, d,
-                                 PK_HOMOG_MIN_STRETCH);
+                                 "radius (the contact law needs ε ≪ r)",
+                                 k, pre, smin, d, PK_HOMOG_MIN_STRETCH);
         else if (!(sqrt(fro) <= PK_HOMOG_MAX_STRETCH))
             pk_schema_errors_add(errs, ptr, "semantic",
                                  "|F̄| of step %zu%s is %.4g: must be <= %g (every contact is open "
-                                 "long before)", k, pre, sqrt(fro), PK_HOMOG_MAX_STRETCH);
+                                 "long before)",
+                                 k, pre, sqrt(fro), PK_HOMOG_MAX_STRETCH);
     }
     if (errs->n != before)
         pk_homog_job_free(job);

@@ -26,35 +26,35 @@ typedef struct pk_homog_job {
     char rve_file[1024];
     pk_homog_bc bc;
     double E_n;
-    double *E_n_species;       /* [n_species²] row-major, NULL = uniform E_n */
+    double *E_n_species; /* [n_species²] row-major, NULL = uniform E_n */
     size_t n_species;
-    int friction;              /* "friction" given */
-    pk_fric_law fric;          /* E_t, tan ρ, h (E_t defaults to E_n) */
-    double rho_deg;            /* friction angle ρ (fric.tan_rho = tan ρ) */
+    int friction;     /* "friction" given */
+    pk_fric_law fric; /* E_t, tan ρ, h (E_t defaults to E_n) */
+    double rho_deg;   /* friction angle ρ (fric.tan_rho = tan ρ) */
     double tol, abs_tol;
     size_t max_iter;
     int lanczos_steps;
     size_t refresh;
     int affine_predictor;
-    int newton;                /* relaxation.solver = newton */
+    int newton; /* relaxation.solver = newton */
     size_t newton_max_iter;
     int tangent;
     int out_micro, out_contacts;
-    int initial_policy;        /* initial_state policy: 0 as_generated, 1 radius_inflation,
+    int initial_policy; /* initial_state policy: 0 as_generated, 1 radius_inflation,
                                 * 2 precompress */
     double initial_value;
-    double radius_factor;      /* initial_state radius_inflation */
-    double precompress;        /* initial_state precompress λ₀ */
+    double radius_factor; /* initial_state radius_inflation */
+    double precompress;   /* initial_state precompress λ₀ */
     double wall_time_s;
     size_t nstep;
-    struct {                   /* "load": the preset's parameters */
-        int type;              /* 0 simple_shear, 1 cyclic_shear, 2 uniaxial_compression, 3 list */
+    struct {      /* "load": the preset's parameters */
+        int type; /* 0 simple_shear, 1 cyclic_shear, 2 uniaxial_compression, 3 list */
         double precompression, shear, amplitude, strain;
         int pre_steps, steps, axis;
         char plane[3];
     } load;
-    int fdim;                  /* 2 or 3: dimension the load path is written for (0 = any) */
-    double *F;                 /* [nstep][9] row-major, 3D-embedded */
+    int fdim;  /* 2 or 3: dimension the load path is written for (0 = any) */
+    double *F; /* [nstep][9] row-major, 3D-embedded */
 } pk_homog_job;
 
 /* The options of the process (homog_job.c). */

@@ -47,16 +47,37 @@ static void tensor_series(json_t *parent, const char *name, int dim, int skew_on
     json_object_set_new(parent, name, t);
 }
 
-static const char *const scalar_series[] = {
-    "J", "energy", "energy_density", "contacts", "contacts_formed", "contacts_broken",
-    "coordination", "rattlers", "max_overlap_ratio", "sum_force", "reaction_defect",
-    "energy_tangential", "dissipation", "contacts_sliding", NULL};
-static const char *const dr_series[] = {"newton_iterations", "newton_steps", "newton_exit_code",
-                                        "newton_attempts", "newton_shifts", "fire_iterations",
+static const char *const scalar_series[] = {"J",
+                                            "energy",
+                                            "energy_density",
+                                            "contacts",
+                                            "contacts_formed",
+                                            "contacts_broken",
+                                            "coordination",
+                                            "rattlers",
+                                            "max_overlap_ratio",
+                                            "sum_force",
+                                            "reaction_defect",
+                                            "energy_tangential",
+                                            "dissipation",
+                                            "contacts_sliding",
+                                            NULL};
+static const char *const dr_series[] = {"newton_iterations",
+                                        "newton_steps",
+                                        "newton_exit_code",
+                                        "newton_attempts",
+                                        "newton_shifts",
+                                        "fire_iterations",
                                         "iterations",
-                                        "residual", "residual_initial", "stop_code",
-                                        "dt", "gamma", "lambda_min", "lambda_max",
-                                        "lambda_min_clamped", NULL};
+                                        "residual",
+                                        "residual_initial",
+                                        "stop_code",
+                                        "dt",
+                                        "gamma",
+                                        "lambda_min",
+                                        "lambda_max",
+                                        "lambda_min_clamped",
+                                        NULL};
 
 json_t *pk_homog_record_new(int dim, int with_tangent)
 {
@@ -141,7 +162,8 @@ int pk_homog_record_step(json_t *rec, int dim, const pk_homog_step *st)
     json_t *dr = json_object_get(rec, "dr");
     rc |= put(dr, "newton_iterations", json_integer((json_int_t)st->newton.iterations));
     rc |= put(dr, "newton_steps", json_integer((json_int_t)st->newton.steps));
-    rc |= put(dr, "newton_exit_code", json_integer(st->used_newton ? (json_int_t)st->newton.exit : -1));
+    rc |= put(dr, "newton_exit_code",
+              json_integer(st->used_newton ? (json_int_t)st->newton.exit : -1));
     rc |= put(dr, "newton_attempts", json_integer((json_int_t)st->newton.attempts));
     rc |= put(dr, "newton_shifts", json_integer((json_int_t)st->newton.shifts));
     rc |= put(dr, "fire_iterations", json_integer((json_int_t)st->newton.fire_iterations));
@@ -180,9 +202,9 @@ int pk_homog_record_tangent(json_t *rec, int dim, size_t step, const double A[81
     return rc ? -1 : 0;
 }
 
-static const char *const audit_series[] = {"passed", "failed_checks", "residual_ratio",
-                                           "balance_ratio", "grains_outside", "escape_radii",
-                                           "overlap_ratio", NULL};
+static const char *const audit_series[] = {
+    "passed",         "failed_checks", "residual_ratio", "balance_ratio",
+    "grains_outside", "escape_radii",  "overlap_ratio",  NULL};
 
 json_t *pk_homog_record_audit_new(void)
 {

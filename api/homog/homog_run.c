@@ -44,9 +44,9 @@ static void opts_of(const pk_homog_job *job, const pk_homog_rve *rve, pk_homog_o
 static const char *eval_error(int rc)
 {
     return rc == -2 ? "the periodic box is too small for this F̄ (an image contact could be missed)"
-           : rc == -3 ? "det F̄ <= 0"
-           : rc == -4 ? "friction is 2D only (Meier 2009 ch. 7) and this RVE is 3D"
-                      : "out of memory";
+        : rc == -3  ? "det F̄ <= 0"
+        : rc == -4  ? "friction is 2D only (Meier 2009 ch. 7) and this RVE is 3D"
+                    : "out of memory";
 }
 
 /* An object of the n named values (taking their references). */
@@ -78,8 +78,8 @@ static int final_state_json(const pk_homog_rve *rve, const pk_homog_opts *o,
             rc = -1;
     }
     if (rc == 0 && micro) {
-        json_t *x = json_array(), *xi = json_array(), *ra = json_array(),
-               *gr = json_array(), *fx = json_array(), *hu = json_array();
+        json_t *x = json_array(), *xi = json_array(), *ra = json_array(), *gr = json_array(),
+               *fx = json_array(), *hu = json_array();
         for (size_t i = 0; i < rve->n; i++) {
             double X[3];
             pk_m3_vec(g.Finv, &s->x[3 * i], X);
@@ -98,8 +98,8 @@ static int final_state_json(const pk_homog_rve *rve, const pk_homog_opts *o,
                                       (json_t *const[]){x, xi, ra, gr, fx, hu}, 6));
     }
     if (rc == 0 && contacts) {
-        json_t *ci = json_array(), *cj = json_array(), *ov = json_array(),
-               *fn = json_array(), *br = json_array();
+        json_t *ci = json_array(), *cj = json_array(), *ov = json_array(), *fn = json_array(),
+               *br = json_array();
         for (size_t p = 0; p < c.n; p++) {
             if (!(c.eps[p] >= 0) || !(c.len[p] > 0))
                 continue;
@@ -110,10 +110,10 @@ static int final_state_json(const pk_homog_rve *rve, const pk_homog_opts *o,
             for (int a = 0; a < dim; a++)
                 json_array_append_new(br, json_real(c.l[3 * p + a]));
         }
-        json_object_set_new(rec, "final_contacts",
-                            object_of((const char *const[]){"i", "j", "overlap", "normal_force",
-                                                            "branch"},
-                                      (json_t *const[]){ci, cj, ov, fn, br}, 5));
+        json_object_set_new(
+            rec, "final_contacts",
+            object_of((const char *const[]){"i", "j", "overlap", "normal_force", "branch"},
+                      (json_t *const[]){ci, cj, ov, fn, br}, 5));
     }
     pk_dem_pairs_free(&c);
     free(fr);
@@ -155,8 +155,10 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
         goto out;
     for (size_t i = 0; job.E_n_species && i < p.n; i++)
         if (p.species[i] < 0 || (size_t)p.species[i] >= job.n_species) {
-            snprintf(err, errlen, "/contact/E_n_species: grain %zu has species %d but the matrix "
-                     "covers species 0..%zu", i, (int)p.species[i], job.n_species - 1);
+            snprintf(err, errlen,
+                     "/contact/E_n_species: grain %zu has species %d but the matrix "
+                     "covers species 0..%zu",
+                     i, (int)p.species[i], job.n_species - 1);
             goto out;
         }
     pk_homog_opts o;
@@ -189,11 +191,14 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
     double ck_every, ck_last = pk_wall_seconds();
     const char *ck_path = pk_job_checkpoint(&ck_digest, &ck_every);
     char ck_err[300] = "";
-    int ck_loaded = ck_path ? pk_homog_ckpt_load(ck_path, ck_digest, &ck, &com, &rec, ck_err, sizeof ck_err) : 1;
+    int ck_loaded = ck_path
+        ? pk_homog_ckpt_load(ck_path, ck_digest, &ck, &com, &rec, ck_err, sizeof ck_err)
+        : 1;
     const size_t first = ck_loaded == 0 ? ck.done : 0;
     if (ck_loaded == 0)
         st = last = ck.last;
-    if (job.precompress > 0 && ck_loaded != 0) { /* initial-state policy: relaxed, committed, not recorded */
+    if (job.precompress > 0 &&
+        ck_loaded != 0) { /* initial-state policy: relaxed, committed, not recorded */
         int e = pk_homog_eval(&rve, &o, &com, F0, &tr, &st, mon);
         if (e != 0) {
             snprintf(err, errlen, "pre-compression: %s", eval_error(e));
@@ -203,7 +208,8 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
             reason = pk_dr_stop_name(st.dr.stop);
         else if (pk_homog_audit_step(&rve, &o, &tr, &st, &au)) {
             pk_homog_audit_describe(&au, &st, what, sizeof what);
-            snprintf(failure, sizeof failure, "the pre-compression step failed its audit: %s", what);
+            snprintf(failure, sizeof failure, "the pre-compression step failed its audit: %s",
+                     what);
             reason = "audit_failed";
         } else
             pk_homog_commit(&com, &tr);
@@ -266,9 +272,11 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
                 goto out;
             }
             if (t == 0 && ti.jammed_contacts == 0) {
-                snprintf(err, errlen,
-                         "tangent asked but the RVE has no jammed contact at load step %zu (a loose "
-                         "packing: use a jammed RVE or initial_state precompress)", k);
+                snprintf(
+                    err, errlen,
+                    "tangent asked but the RVE has no jammed contact at load step %zu (a loose "
+                    "packing: use a jammed RVE or initial_state precompress)",
+                    k);
                 goto out;
             }
             have_A = t == 0;
@@ -340,25 +348,34 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
     json_object_set_new(sum, "threads", json_integer(pk_par_threads(pool)));
     json_t *sa = json_object();
     json_object_set_new(sa, "passed", json_boolean(!failure[0]));
-    json_object_set_new(sa, "steps_audited", json_integer((json_int_t)json_array_size(
-                                                  json_object_get(aud, "passed"))));
-    json_object_set_new(sa, "max_residual_ratio", json_real(isfinite(worst_resid) ? worst_resid : DBL_MAX));
-    json_object_set_new(sa, "max_balance_ratio", json_real(isfinite(worst_balance) ? worst_balance : DBL_MAX));
-    json_object_set_new(sa, "max_overlap_ratio", json_real(isfinite(worst_overlap) ? worst_overlap : DBL_MAX));
+    json_object_set_new(sa, "steps_audited",
+                        json_integer((json_int_t)json_array_size(json_object_get(aud, "passed"))));
+    json_object_set_new(sa, "max_residual_ratio",
+                        json_real(isfinite(worst_resid) ? worst_resid : DBL_MAX));
+    json_object_set_new(sa, "max_balance_ratio",
+                        json_real(isfinite(worst_balance) ? worst_balance : DBL_MAX));
+    json_object_set_new(sa, "max_overlap_ratio",
+                        json_real(isfinite(worst_overlap) ? worst_overlap : DBL_MAX));
     json_object_set_new(sa, "overlap_ratio_bound", json_real(PK_AUDIT_OVERLAP_MAX));
     json_object_set_new(sum, "audit", sa);
     if (failure[0])
-        pk_verdict_fail(sum, "%s (the result file holds the %zu steps before it and the failed "
-                        "step's audit)", failure, done);
+        pk_verdict_fail(sum,
+                        "%s (the result file holds the %zu steps before it and the failed "
+                        "step's audit)",
+                        failure, done);
     else if (!strcmp(reason, "wall_time"))
-        pk_verdict_fail(sum, "ran out of wall time (limits.wall_time_s %g s) after %zu of %zu load "
-                        "steps", job.wall_time_s, done, job.nstep);
+        pk_verdict_fail(sum,
+                        "ran out of wall time (limits.wall_time_s %g s) after %zu of %zu load "
+                        "steps",
+                        job.wall_time_s, done, job.nstep);
     else if (!strcmp(reason, "cancelled"))
         pk_verdict_fail(sum, "cancelled after %zu of %zu load steps", done, job.nstep);
     if (unjammed)
-        pk_verdict_warn(sum, "%zu of %zu load steps had no jammed grain (every free grain a "
+        pk_verdict_warn(sum,
+                        "%zu of %zu load steps had no jammed grain (every free grain a "
                         "rattler or no contact at all): their stresses are those of a loose "
-                        "packing (zero without contacts)", unjammed, done);
+                        "packing (zero without contacts)",
+                        unjammed, done);
     if (done) {
         json_object_set_new(sum, "F", tensor_json(com.F, dim));
         json_object_set_new(sum, "P", tensor_json(last.P, dim));
@@ -370,8 +387,8 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
             json_t *a = json_array();
             for (int i = 0; i < dim * dim; i++)
                 for (int j = 0; j < dim * dim; j++)
-                    json_array_append_new(a, json_real(A[(3 * (i / dim) + i % dim) * 9 +
-                                                         3 * (j / dim) + j % dim]));
+                    json_array_append_new(
+                        a, json_real(A[(3 * (i / dim) + i % dim) * 9 + 3 * (j / dim) + j % dim]));
             json_object_set_new(sum, "tangent", a);
         }
     }

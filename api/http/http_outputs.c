@@ -13,11 +13,16 @@ const pk_output pk_outputs[] = {
     {"result", PK_RESULT_MEDIA_TYPE, "result file",
      "HDF5 (H5MD 1.1) result file, see docs/result-format.md", 0},
     {"xdmf", "application/xml", "XDMF 3 description",
-     "the grains as points with radius and species, for ParaView; refers to the result as <jobID>.h5", 0},
+     "the grains as points with radius and species, for ParaView; refers to the result as "
+     "<jobID>.h5",
+     0},
     {"picture.png", "image/png", "the packing", "PNG picture of the packing", 1},
-    {"picture.svg", "image/svg+xml", "the packing", "SVG picture of the packing (up to 20 000 grains)", 1},
-    {"grading.png", "image/png", "the grading curve", "target and achieved grading curves (pack jobs)", 1},
-    {"grading.svg", "image/svg+xml", "the grading curve", "target and achieved grading curves (pack jobs)", 1},
+    {"picture.svg", "image/svg+xml", "the packing",
+     "SVG picture of the packing (up to 20 000 grains)", 1},
+    {"grading.png", "image/png", "the grading curve",
+     "target and achieved grading curves (pack jobs)", 1},
+    {"grading.svg", "image/svg+xml", "the grading curve",
+     "target and achieved grading curves (pack jobs)", 1},
     {NULL, NULL, NULL, NULL, 0},
 };
 
@@ -46,10 +51,12 @@ int pk_exec_opts_parse(json_t *body, pk_exec_opts *o, char *detail, size_t n)
     const char *key, *value_one = NULL;
     json_t *v;
     size_t values = 0;
-    json_object_foreach(outs, key, v) {
+    json_object_foreach (outs, key, v) {
         if (!pk_output_find(key)) {
-            snprintf(detail, n, "/outputs/%.60s: no such output (summary, result, xdmf, "
-                     "picture.png, picture.svg, grading.png, grading.svg)", key);
+            snprintf(detail, n,
+                     "/outputs/%.60s: no such output (summary, result, xdmf, "
+                     "picture.png, picture.svg, grading.png, grading.svg)",
+                     key);
             return -1;
         }
         json_t *tm = json_object_get(v, "transmissionMode");
@@ -65,12 +72,14 @@ int pk_exec_opts_parse(json_t *body, pk_exec_opts *o, char *detail, size_t n)
     }
     if (json_object_size(outs)) {
         o->select = json_array();
-        json_object_foreach(outs, key, v) json_array_append_new(o->select, json_string(key));
+        json_object_foreach (outs, key, v)
+            json_array_append_new(o->select, json_string(key));
     }
     if (!strcmp(mode, "raw")) {
         const char *one = "result";
         if (json_object_size(outs) == 1)
-            json_object_foreach(outs, key, v) one = key;
+            json_object_foreach (outs, key, v)
+                one = key;
         snprintf(o->serve, sizeof o->serve, "%s", one);
     } else if (json_object_size(outs) == 1 && values == 1) {
         snprintf(o->serve, sizeof o->serve, "%s", value_one);

@@ -8,10 +8,10 @@
 #include <jansson.h>
 
 typedef struct pk_output {
-    const char *id;          /* key in the results document, last segment of /results/{id} */
-    const char *type;        /* media type */
+    const char *id;   /* key in the results document, last segment of /results/{id} */
+    const char *type; /* media type */
     const char *title, *description;
-    int optional;            /* present only for some jobs (pictures) */
+    int optional; /* present only for some jobs (pictures) */
 } pk_output;
 
 /* Every output, terminated by {NULL}. */
@@ -25,7 +25,7 @@ const pk_output *pk_output_find(const char *id);
  * results document), select the outputs a document lists (NULL: all). */
 typedef struct pk_exec_opts {
     char serve[32];
-    json_t *select;          /* array of output ids, or NULL */
+    json_t *select; /* array of output ids, or NULL */
 } pk_exec_opts;
 
 /* From an execute request body: 0, or -1 with detail (pointer and rule) for

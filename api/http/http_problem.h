@@ -13,10 +13,11 @@
 #define PK_PROBLEM_NO_SUCH_PROCESS PK_OGC_EXC "no-such-process"
 #define PK_PROBLEM_RESULT_NOT_READY PK_OGC_EXC "result-not-ready"
 #define PK_PROBLEM_JOB_FAILED "urn:packd:problem:job-failed"
-#define PK_PROBLEM_INVALID_INPUT "http://www.opengis.net/def/exceptions/ogcapi-common-1/1.0/invalid-parameter-value"
+#define PK_PROBLEM_INVALID_INPUT                                                                   \
+    "http://www.opengis.net/def/exceptions/ogcapi-common-1/1.0/invalid-parameter-value"
 /* packd's own types, for conditions the standards do not name */
 #define PK_PROBLEM_PACKD "urn:packd:problem:"
-#define PK_PROBLEM_GENERIC "about:blank"  /* the HTTP status says it all */
+#define PK_PROBLEM_GENERIC "about:blank" /* the HTTP status says it all */
 
 /* {"type","title","status","detail"} (detail omitted when NULL). */
 json_t *pk_problem(int status, const char *type, const char *title, const char *detail);

@@ -20,13 +20,12 @@ json_t *pk_process_summary(const pk_process *p)
     char exec[180];
     snprintf(exec, sizeof exec, "/processes/%s/execution", p->id);
     /* sync-execute: Prefer: respond-sync waits up to sync_wait_s (docs/service.md) */
-    return json_pack("{s:s,s:s,s:s,s:s,s:[s,s],s:[s,s],s:[{s:s,s:s,s:s},{s:s,s:s,s:s}]}", "id", p->id,
-                     "title", p->title, "description", p->description, "version", PACKD_VERSION,
-                     "jobControlOptions", "async-execute", "sync-execute", "outputTransmission",
-                     "reference", "value",
-                     "links", "href", href, "rel", "self", "type", "application/json", "href", exec,
-                     "rel", "http://www.opengis.net/def/rel/ogc/1.0/execute", "type",
-                     "application/json");
+    return json_pack("{s:s,s:s,s:s,s:s,s:[s,s],s:[s,s],s:[{s:s,s:s,s:s},{s:s,s:s,s:s}]}", "id",
+                     p->id, "title", p->title, "description", p->description, "version",
+                     PACKD_VERSION, "jobControlOptions", "async-execute", "sync-execute",
+                     "outputTransmission", "reference", "value", "links", "href", href, "rel",
+                     "self", "type", "application/json", "href", exec, "rel",
+                     "http://www.opengis.net/def/rel/ogc/1.0/execute", "type", "application/json");
 }
 
 /* Add to `into` every definition of `defs` that node refers to as
@@ -36,12 +35,13 @@ static void collect_defs(json_t *node, json_t *defs, json_t *into)
     if (json_is_array(node)) {
         size_t i;
         json_t *e;
-        json_array_foreach(node, i, e) collect_defs(e, defs, into);
+        json_array_foreach (node, i, e)
+            collect_defs(e, defs, into);
         return;
     }
     const char *key;
     json_t *v;
-    json_object_foreach(node, key, v) {
+    json_object_foreach (node, key, v) {
         const char *ref = json_string_value(v);
         if (!strcmp(key, "$ref") && ref && !strncmp(ref, "#/$defs/", 8)) {
             json_t *def = json_object_get(defs, ref + 8);
@@ -78,11 +78,11 @@ json_t *pk_process_description(const pk_process *p)
     json_t *inputs = json_object();
     const char *name;
     json_t *ps;
-    json_object_foreach(props, name, ps) {
+    json_object_foreach (props, name, ps) {
         int req = 0;
         size_t i;
         json_t *r;
-        json_array_foreach(required, i, r) {
+        json_array_foreach (required, i, r) {
             if (json_is_string(r) && !strcmp(json_string_value(r), name))
                 req = 1;
         }
@@ -97,11 +97,12 @@ json_t *pk_process_description(const pk_process *p)
     json_t *outputs = json_object();
     for (const pk_output *o = pk_outputs; o->id; o++) {
         json_t *os = !strcmp(o->type, "application/json")
-                             ? json_pack("{s:s,s:s}", "type", "object", "contentMediaType", o->type)
-                             : json_pack("{s:s,s:s,s:s}", "type", "string", "contentEncoding",
-                                         strncmp(o->type, "image/svg", 9) && strcmp(o->type, "application/xml")
-                                             ? "binary" : "8bit",
-                                         "contentMediaType", o->type);
+            ? json_pack("{s:s,s:s}", "type", "object", "contentMediaType", o->type)
+            : json_pack("{s:s,s:s,s:s}", "type", "string", "contentEncoding",
+                        strncmp(o->type, "image/svg", 9) && strcmp(o->type, "application/xml")
+                            ? "binary"
+                            : "8bit",
+                        "contentMediaType", o->type);
         json_t *out = json_pack("{s:s,s:s,s:o}", "title", o->title, "description", o->description,
                                 "schema", os);
         json_object_set_new(outputs, o->id, out);

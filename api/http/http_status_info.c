@@ -32,10 +32,10 @@ json_t *pk_status_info(json_t *row)
 {
     const char *id = json_string_value(json_object_get(row, "id"));
     const char *status = json_string_value(json_object_get(row, "status"));
-    json_t *s = json_pack("{s:s,s:O,s:s,s:s,s:O,s:O}", "jobID", id, "processID",
-                          json_object_get(row, "process"), "type", "process", "status", status,
-                          "message", json_object_get(row, "message"), "progress",
-                          json_object_get(row, "progress"));
+    json_t *s =
+        json_pack("{s:s,s:O,s:s,s:s,s:O,s:O}", "jobID", id, "processID",
+                  json_object_get(row, "process"), "type", "process", "status", status, "message",
+                  json_object_get(row, "message"), "progress", json_object_get(row, "progress"));
     set_time(s, "created", row, "created");
     set_time(s, "started", row, "started");
     set_time(s, "finished", row, "finished");
@@ -45,15 +45,18 @@ json_t *pk_status_info(json_t *row)
     snprintf(href, sizeof href, "/jobs/%s", id);
     json_array_append_new(links, mklink(href, "self", "application/json", "this job"));
     snprintf(href, sizeof href, "/jobs/%s/events", id);
-    json_array_append_new(links, mklink(href, "monitor", "text/event-stream", "live status and progress"));
+    json_array_append_new(links,
+                          mklink(href, "monitor", "text/event-stream", "live status and progress"));
     if (!strcmp(status, "successful")) {
         snprintf(href, sizeof href, "/jobs/%s/results", id);
-        json_array_append_new(links, mklink(href, "http://www.opengis.net/def/rel/ogc/1.0/results",
-                                          "application/json", "results"));
+        json_array_append_new(links,
+                              mklink(href, "http://www.opengis.net/def/rel/ogc/1.0/results",
+                                     "application/json", "results"));
     } else if (pk_has_partial_result(row)) {
         snprintf(href, sizeof href, "/jobs/%s/results/result", id);
-        json_array_append_new(links, mklink(href, "partial-result", PK_RESULT_MEDIA_TYPE,
-                                          "the failed job's partial result file"));
+        json_array_append_new(links,
+                              mklink(href, "partial-result", PK_RESULT_MEDIA_TYPE,
+                                     "the failed job's partial result file"));
     }
     json_object_set_new(s, "links", links);
     /* the verdict (job_verdict.h): complete, warnings, failure */
@@ -71,7 +74,7 @@ int pk_has_partial_result(json_t *row)
 {
     const char *status = json_string_value(json_object_get(row, "status"));
     return status && !strcmp(status, "failed") &&
-           json_is_string(json_object_get(row, "result_sha256"));
+        json_is_string(json_object_get(row, "result_sha256"));
 }
 
 json_t *pk_failed_results_problem(json_t *row)
@@ -87,8 +90,9 @@ json_t *pk_failed_results_problem(json_t *row)
         char href[128];
         snprintf(href, sizeof href, "/jobs/%s/results/result", id);
         json_object_set_new(doc, "partial_result",
-                            json_pack("{s:s,s:s,s:O,s:O}", "href", href, "type", PK_RESULT_MEDIA_TYPE,
-                                      "size", json_object_get(row, "result_size"), "sha256",
+                            json_pack("{s:s,s:s,s:O,s:O}", "href", href, "type",
+                                      PK_RESULT_MEDIA_TYPE, "size",
+                                      json_object_get(row, "result_size"), "sha256",
                                       json_object_get(row, "result_sha256")));
     }
     return doc;
@@ -102,10 +106,9 @@ json_t *pk_results_document(json_t *row)
     char xdmf[128];
     snprintf(xdmf, sizeof xdmf, "/jobs/%s/results/xdmf", id);
     json_t *summary = json_object_get(row, "summary");
-    return json_pack("{s:{s:o},s:{s:s,s:s,s:O,s:O},s:{s:s,s:s}}", "summary", "value",
-                     json_is_object(summary) ? json_incref(summary) : json_object(), "result",
-                     "href", href, "type", PK_RESULT_MEDIA_TYPE, "size",
-                     json_object_get(row, "result_size"), "sha256",
-                     json_object_get(row, "result_sha256"), "xdmf", "href", xdmf, "type",
-                     "application/xml");
+    return json_pack(
+        "{s:{s:o},s:{s:s,s:s,s:O,s:O},s:{s:s,s:s}}", "summary", "value",
+        json_is_object(summary) ? json_incref(summary) : json_object(), "result", "href", href,
+        "type", PK_RESULT_MEDIA_TYPE, "size", json_object_get(row, "result_size"), "sha256",
+        json_object_get(row, "result_sha256"), "xdmf", "href", xdmf, "type", "application/xml");
 }

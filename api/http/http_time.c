@@ -95,7 +95,8 @@ int pk_time_parse_rfc3339(const char *s, double *epoch, double *span)
     if (*s)
         return -1;
     *epoch = (double)(days_from_civil(y, (unsigned)mo, (unsigned)d) * 86400 + h * 3600 + mi * 60 +
-                      sec - off) + frac;
+                      sec - off) +
+        frac;
     *span = unit;
     return 0;
 }

@@ -10,7 +10,7 @@
 #define PK_CHECK_CTX_H
 
 typedef struct pk_check_ctx {
-    int service;   /* 1: a request to the daemon: open no input file, build no mesh */
+    int service; /* 1: a request to the daemon: open no input file, build no mesh */
 } pk_check_ctx;
 
 #endif

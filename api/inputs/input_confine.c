@@ -12,8 +12,8 @@
 #include "input_links.h"
 
 typedef struct {
-    const char *dir;      /* as configured */
-    char root[PATH_MAX];  /* resolved; "" when unusable */
+    const char *dir;     /* as configured */
+    char root[PATH_MAX]; /* resolved; "" when unusable */
     long long max_bytes;
     pk_schema_errors *errs;
 } confine_ctx;
@@ -139,14 +139,17 @@ static void confine_one(json_t *obj, const char *file, const char *pointer, void
         pk_schema_errors_add(c->errs, ptr, "serverPath",
                              "the service takes no server path: upload the file (POST /files) "
                              "and give {\"href\": \"/files/<sha256>\"}%s",
-                             strstr(pointer, "rve") ? ", or {\"href\": "
-                             "\"/jobs/<id>/results/result\"} for a finished job's result" : "");
+                             strstr(pointer, "rve")
+                                 ? ", or {\"href\": "
+                                   "\"/jobs/<id>/results/result\"} for a finished job's result"
+                                 : "");
         return;
     }
     if (confine(c, file, out, sizeof out, &why) != 0) {
-        pk_schema_errors_add(c->errs, ptr, "inputDir", "\"%.200s\" %s (only regular files inside "
-                             "the service's input directory, up to %lld bytes)", file, why,
-                             c->max_bytes);
+        pk_schema_errors_add(c->errs, ptr, "inputDir",
+                             "\"%.200s\" %s (only regular files inside "
+                             "the service's input directory, up to %lld bytes)",
+                             file, why, c->max_bytes);
         return;
     }
     json_object_set_new(obj, "file", json_string(out));

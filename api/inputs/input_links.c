@@ -8,8 +8,8 @@
 typedef struct {
     void (*fn)(json_t *, const char *, const char *, void *);
     void *ctx;
-    const char *key;  /* the string member looked for */
-    int alone;        /* 1: only objects with no other member */
+    const char *key; /* the string member looked for */
+    int alone;       /* 1: only objects with no other member */
     size_t count;
     char ptr[256];
 } walker;
@@ -26,8 +26,7 @@ static void walk(walker *w, json_t *v)
         }
         const char *key;
         json_t *child;
-        json_object_foreach(v, key, child)
-        {
+        json_object_foreach (v, key, child) {
             if (!json_is_object(child) && !json_is_array(child))
                 continue;
             size_t o = len; /* RFC 6901 escaping of the key */
@@ -47,8 +46,7 @@ static void walk(walker *w, json_t *v)
     } else if (json_is_array(v)) {
         size_t i;
         json_t *child;
-        json_array_foreach(v, i, child)
-        {
+        json_array_foreach (v, i, child) {
             if (!json_is_object(child) && !json_is_array(child))
                 continue;
             snprintf(w->ptr + len, sizeof w->ptr - len, "/%zu", i);
@@ -59,7 +57,8 @@ static void walk(walker *w, json_t *v)
 }
 
 size_t pk_input_links_each(json_t *inputs,
-                           void (*fn)(json_t *link, const char *href, const char *pointer, void *ctx),
+                           void (*fn)(json_t *link, const char *href, const char *pointer,
+                                      void *ctx),
                            void *ctx)
 {
     walker w = {.fn = fn, .ctx = ctx, .key = "href", .alone = 1};
@@ -68,7 +67,8 @@ size_t pk_input_links_each(json_t *inputs,
 }
 
 size_t pk_input_files_each(json_t *inputs,
-                           void (*fn)(json_t *obj, const char *file, const char *pointer, void *ctx),
+                           void (*fn)(json_t *obj, const char *file, const char *pointer,
+                                      void *ctx),
                            void *ctx)
 {
     walker w = {.fn = fn, .ctx = ctx, .key = "file", .alone = 0};
@@ -83,7 +83,8 @@ static void refuse(json_t *link, const char *href, const char *pointer, void *ct
     snprintf(p, sizeof p, "%s/href", pointer);
     pk_schema_errors_add(ctx, p, "href",
                          "links (%s) are resolved by packd serve; a job file names the file by "
-                         "path: {\"file\": \"...\"}", href);
+                         "path: {\"file\": \"...\"}",
+                         href);
 }
 
 size_t pk_input_links_refuse(json_t *inputs, pk_schema_errors *errs)

@@ -12,13 +12,15 @@
  * inputs, with the JSON pointer of that object relative to inputs.  Returns
  * the number of links visited. */
 size_t pk_input_links_each(json_t *inputs,
-                           void (*fn)(json_t *link, const char *href, const char *pointer, void *ctx),
+                           void (*fn)(json_t *link, const char *href, const char *pointer,
+                                      void *ctx),
                            void *ctx);
 
 /* Calls fn for every object with a string member "file" (a path), with
  * its pointer relative to inputs.  Returns the number visited. */
 size_t pk_input_files_each(json_t *inputs,
-                           void (*fn)(json_t *obj, const char *file, const char *pointer, void *ctx),
+                           void (*fn)(json_t *obj, const char *file, const char *pointer,
+                                      void *ctx),
                            void *ctx);
 
 /* For job files: every link is an error (rule "href"). */

@@ -10,8 +10,12 @@
 
 static const char *kind(mode_t m)
 {
-    return S_ISDIR(m) ? "a directory" : S_ISFIFO(m) ? "a FIFO" : S_ISCHR(m) ? "a character device"
-         : S_ISBLK(m) ? "a block device" : S_ISSOCK(m) ? "a socket" : "not a regular file";
+    return S_ISDIR(m) ? "a directory"
+        : S_ISFIFO(m) ? "a FIFO"
+        : S_ISCHR(m)  ? "a character device"
+        : S_ISBLK(m)  ? "a block device"
+        : S_ISSOCK(m) ? "a socket"
+                      : "not a regular file";
 }
 
 int pk_input_open(const char *path, long long max_bytes, char *err, size_t errlen)

@@ -82,7 +82,7 @@ typedef struct raw_mesh {
     size_t nn, ncap, nt, tcap;
     long long *ntag;
     double *x;
-    long long *t;     /* [nt][4] node tags */
+    long long *t; /* [nt][4] node tags */
     int32_t *region;
 } raw_mesh;
 
@@ -172,8 +172,8 @@ static int raw_to_mesh(raw_mesh *w, const char *path, pk_mesh *m, char *err, siz
         for (int k = 0; k < 4; k++) {
             long long tag = w->t[4 * e + (size_t)k];
             if (tag < 0 || tag > tmax || map[tag] < 0) {
-                snprintf(err, errlen, "%s: tet %zu refers to node %lld, which is not defined",
-                         path, e, tag);
+                snprintf(err, errlen, "%s: tet %zu refers to node %lld, which is not defined", path,
+                         e, tag);
                 free(map);
                 pk_mesh_free(m);
                 return -1;
@@ -373,7 +373,8 @@ int pk_mesh_read_msh(const char *path, size_t max_tets, pk_mesh *m, char *err, s
                              : msh41_elements(&r, &w, max_tets, err, errlen);
             have_elems = 1;
         } else if (name[0] != '$') {
-            snprintf(err, errlen, "%s:%ld: unexpected \"%s\" between sections", path, r.line + 1, name);
+            snprintf(err, errlen, "%s:%ld: unexpected \"%s\" between sections", path, r.line + 1,
+                     name);
             goto out;
         }
         if (bad || msh_skip_section(&r, name, err, errlen))
@@ -419,8 +420,10 @@ int pk_mesh_read_tetgen(const char *path, size_t max_tets, pk_mesh *m, char *err
         goto out;
     }
     if (nattr < 0 || nattr > MAX_ATTRS || nbm < 0 || nbm > 1) {
-        snprintf(err, errlen, "%s: %lld attributes and %lld boundary markers per node (at most %d "
-                 "and 1)", fn, nattr, nbm, MAX_ATTRS);
+        snprintf(err, errlen,
+                 "%s: %lld attributes and %lld boundary markers per node (at most %d "
+                 "and 1)",
+                 fn, nattr, nbm, MAX_ATTRS);
         goto out;
     }
     for (long long i = 0; i < n; i++) {
@@ -567,13 +570,15 @@ int pk_mesh_from_json(json_t *j, size_t max_tets, pk_mesh *m, pk_mesh_report *re
     int rc;
     if (file) {
         int gmsh = is_gmsh(file, err, errlen);
-        rc = gmsh < 0    ? -1
-             : gmsh == 1 ? pk_mesh_read_msh(file, max_tets, m, err, errlen)
-                         : pk_mesh_read_tetgen(file, max_tets, m, err, errlen);
+        rc = gmsh < 0   ? -1
+            : gmsh == 1 ? pk_mesh_read_msh(file, max_tets, m, err, errlen)
+                        : pk_mesh_read_tetgen(file, max_tets, m, err, errlen);
         if (rc != 0 && gmsh == 2 && !ends_with(file, ".node") && !ends_with(file, ".ele") &&
             strstr(err, ".node: cannot open")) /* e.g. an upload that is no mesh */
-            snprintf(err, errlen, "%s: neither a Gmsh MSH file (no $MeshFormat at the start) nor "
-                     "the base name of a TetGen .node/.ele pair", file);
+            snprintf(err, errlen,
+                     "%s: neither a Gmsh MSH file (no $MeshFormat at the start) nor "
+                     "the base name of a TetGen .node/.ele pair",
+                     file);
     } else {
         if (max_tets && json_array_size(json_object_get(j, "tets")) > max_tets) {
             snprintf(err, errlen, "the mesh has %zu tets, over the limit of %zu",

@@ -79,8 +79,8 @@ static int grading_from_json(json_t *g, pk_grading *out, int *default_discrete,
                 char ptr[64];
                 snprintf(ptr, sizeof ptr, "/grading/passing/%zu", i);
                 pk_schema_errors_add(errs, ptr, "nonDecreasing",
-                                     "cumulative %% passing must not decrease (%g after %g)",
-                                     pc[i], pc[i - 1]);
+                                     "cumulative %% passing must not decrease (%g after %g)", pc[i],
+                                     pc[i - 1]);
                 return -1;
             }
         }
@@ -131,8 +131,9 @@ static int grading_from_json(json_t *g, pk_grading *out, int *default_discrete,
                 }
         }
         if (mass && vol) {
-            pk_schema_errors_add(errs, "/grading/classes", "consistent",
-                                 "use either volume_percent or mass_percent+density for all classes");
+            pk_schema_errors_add(
+                errs, "/grading/classes", "consistent",
+                "use either volume_percent or mass_percent+density for all classes");
             return -1;
         }
         if (!(total > 0)) {
@@ -240,7 +241,7 @@ static int grows_until_jammed(const pk_pack_job *job)
 {
     const pk_edmd_options *o = &job->opt.edmd;
     return !strcmp(job->algorithm, "edmd") && o->prm.until == PK_EDMD_UNTIL_JAMMED &&
-           o->prm.growth == PK_EDMD_GROW_RELATIVE && !o->maximize_delta_d;
+        o->prm.growth == PK_EDMD_GROW_RELATIVE && !o->maximize_delta_d;
 }
 
 static void check_periodic_jamming(const pk_pack_job *job, const pk_pack_plan *plan,
@@ -257,12 +258,13 @@ static void check_periodic_jamming(const pk_pack_job *job, const pk_pack_plan *p
         char ptr[64];
         snprintf(ptr, sizeof ptr, "/domain/box/size/%d", k);
         double need = pow((plan->d_max + job->delta_d) / (0.5 * job->box.L[k]), dim);
-        pk_schema_errors_add(errs, ptr, "periodicJamming",
-                             "until jammed the grains may grow to fill the box: the largest could "
-                             "reach d = %.4g, over half the periodic edge %g (minimum image); needs "
-                             "φ at the target sizes > %.3g (got %.3g): more grains, a walled axis "
-                             "or until: target",
-                             reach, job->box.L[k], need, phi_s);
+        pk_schema_errors_add(
+            errs, ptr, "periodicJamming",
+            "until jammed the grains may grow to fill the box: the largest could "
+            "reach d = %.4g, over half the periodic edge %g (minimum image); needs "
+            "φ at the target sizes > %.3g (got %.3g): more grains, a walled axis "
+            "or until: target",
+            reach, job->box.L[k], need, phi_s);
         return;
     }
 }
@@ -333,15 +335,16 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
         mean_measure = n1 > 0 ? 1.0 / n1 : 0; /* unit resolved measure holds n1 grains */
     }
     if (!(mean_measure > 0)) { /* material is left (keep > 0): the count overflowed */
-        pk_schema_errors_add(errs, "/d_min", "maxParticles",
-                             "the grading above d_min = %g holds too many grains to count: raise d_min",
-                             job->d_min);
+        pk_schema_errors_add(
+            errs, "/d_min", "maxParticles",
+            "the grading above d_min = %g holds too many grains to count: raise d_min", job->d_min);
         return errs->n - before;
     }
     if (job->count) {
         plan->expected_n = (double)job->count;
         if (job->has_phi) /* Meier: absolute size set by the packing */
-            plan->scale = pow(plan->phi_resolved * V / ((double)job->count * mean_measure), 1.0 / dim);
+            plan->scale =
+                pow(plan->phi_resolved * V / ((double)job->count * mean_measure), 1.0 / dim);
         else {
             plan->phi_resolved = (double)job->count * mean_measure / V;
             plan->phi_mix = plan->phi_resolved / keep;
@@ -390,8 +393,8 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
         double phi_shell = plan->phi_resolved * widened * pow(1 + job->delta_d / plan->d_max, dim);
         if (!(phi_shell < 1) && !grows_until_jammed(job)) {
             const char *ptr = plan->phi_resolved < 1 && job->delta_d > 0 ? "/delta_d"
-                              : job->count && !job->has_phi         ? "/count"
-                                                                    : "/phi/value";
+                : job->count && !job->has_phi                            ? "/count"
+                                                                         : "/phi/value";
             pk_schema_errors_add(errs, ptr, "resolvedBelow1",
                                  "the grains would fill φ = %.4g of the box (%.4g with their gaps "
                                  "Δd): must be < 1",

@@ -22,37 +22,37 @@ typedef struct pk_pack_job {
     int dim;
     pk_box box;
     char unit[8];
-    pk_grading grading;          /* the whole curve, before the cut at d_min */
-    int sampling;                /* "sampling": -1 not given, 0 continuous, 1 discrete */
-    int discrete;                /* 1 = one diameter per class (Meier) */
-    double d_min;                /* cut-off diameter (0 = none) */
+    pk_grading grading;            /* the whole curve, before the cut at d_min */
+    int sampling;                  /* "sampling": -1 not given, 0 continuous, 1 discrete */
+    int discrete;                  /* 1 = one diameter per class (Meier) */
+    double d_min;                  /* cut-off diameter (0 = none) */
     double fuller_q, fuller_d_max; /* "grading": {"type": "fuller"} */
     int has_phi, phi_is_mix;
-    double phi;                  /* target value as given */
-    size_t count;                /* 0 = not given */
+    double phi;   /* target value as given */
+    size_t count; /* 0 = not given */
     double delta_d;
-    char algorithm[16];          /* placer name, see pack_placer.h */
-    pk_placer_options opt;       /* the placer's options (its table, pack_placer.h) */
-    json_t *mesh;                /* borrowed "domain": {"mesh"} of the inputs, or NULL */
+    char algorithm[16];    /* placer name, see pack_placer.h */
+    pk_placer_options opt; /* the placer's options (its table, pack_placer.h) */
+    json_t *mesh;          /* borrowed "domain": {"mesh"} of the inputs, or NULL */
     uint64_t seed;
     size_t max_particles;
-    double wall_time_s;          /* 0 = none */
-    int service;                 /* 1: checked for a request to the daemon (check_ctx.h): the
+    double wall_time_s; /* 0 = none */
+    int service;        /* 1: checked for a request to the daemon (check_ctx.h): the
                                   * placer's check opens no file and builds no mesh */
-    int prepare;                 /* 1: the placer's check keeps what it built for the run
+    int prepare;        /* 1: the placer's check keeps what it built for the run
                                   * (plan.prepared: tetfill's mesh, read and built once) */
 } pk_pack_job;
 
 /* What the job implies before anything is drawn. */
 typedef struct pk_pack_plan {
-    pk_grading resolved;         /* grading cut at d_min */
-    double mass_cut;             /* F_m(d_min): mass share not modelled (Eq. 14) */
-    double phi_mix;              /* φ_M target (Eq. 15) */
-    double phi_resolved;         /* φ_eff target (Eqs. 16–17) */
-    double expected_n;           /* expected number of grains */
-    double scale;                /* expected size scale (count + phi), else 1 */
-    double d_max;                /* largest diameter after scaling */
-    void *prepared;              /* the placer's, when job.prepare (pk_placer.release) */
+    pk_grading resolved; /* grading cut at d_min */
+    double mass_cut;     /* F_m(d_min): mass share not modelled (Eq. 14) */
+    double phi_mix;      /* φ_M target (Eq. 15) */
+    double phi_resolved; /* φ_eff target (Eqs. 16–17) */
+    double expected_n;   /* expected number of grains */
+    double scale;        /* expected size scale (count + phi), else 1 */
+    double d_max;        /* largest diameter after scaling */
+    void *prepared;      /* the placer's, when job.prepare (pk_placer.release) */
 } pk_pack_plan;
 
 /* The options of the job itself (pack_job.c); each placer has its own. */

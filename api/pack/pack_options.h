@@ -15,14 +15,14 @@ typedef struct pk_rsa_options {
 } pk_rsa_options;
 
 typedef struct pk_edmd_options {
-    pk_edmd_params prm;        /* the engine's knobs (preset: pk_edmd_params_default); delta
+    pk_edmd_params prm;   /* the engine's knobs (preset: pk_edmd_params_default); delta
                                 * NAN = chosen from the drawn sizes (pk_edmd_start_delta) */
-    int maximize_delta_d;      /* "maximize": "delta_d" (implies growth shell, until jammed) */
-    int wall_gap_none;         /* "wall_gap": "none" */
+    int maximize_delta_d; /* "maximize": "delta_d" (implies growth shell, until jammed) */
+    int wall_gap_none;    /* "wall_gap": "none" */
 } pk_edmd_options;
 
 typedef struct pk_tetfill_options {
-    pk_tetfill_params prm;     /* the filler's knobs (preset: pk_tetfill_defaults) */
+    pk_tetfill_params prm;      /* the filler's knobs (preset: pk_tetfill_defaults) */
     double r_min, r_max, ratio; /* 0 = not given (the radii rule of the placer) */
     size_t max_tets;
 } pk_tetfill_options;

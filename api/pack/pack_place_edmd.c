@@ -86,12 +86,14 @@ static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, void **
     if (prm.growth == PK_EDMD_GROW_SHELL && prm.start_zero)
         pk_schema_errors_add(errs, "/edmd/start", "consistent",
                              "shell growth starts from an RSA configuration (start: rsa)");
-    if (prm.growth == PK_EDMD_GROW_SHELL && prm.until == PK_EDMD_UNTIL_TARGET && !(job->delta_d > 0))
+    if (prm.growth == PK_EDMD_GROW_SHELL && prm.until == PK_EDMD_UNTIL_TARGET &&
+        !(job->delta_d > 0))
         pk_schema_errors_add(errs, "/delta_d", "consistent",
                              "shell growth to a target needs delta_d > 0 (or maximize: delta_d)");
     if (job->opt.edmd.wall_gap_none && !(job->delta_d > 0))
-        pk_schema_errors_add(errs, "/edmd/wall_gap", "consistent",
-                             "wall_gap none lets the shell reach delta_d/2 into the walls: needs delta_d > 0");
+        pk_schema_errors_add(
+            errs, "/edmd/wall_gap", "consistent",
+            "wall_gap none lets the shell reach delta_d/2 into the walls: needs delta_d > 0");
     if (prm.rule == PK_EDMD_RULE_MEIER && !prm.equal_masses)
         pk_schema_errors_add(errs, "/edmd/collision_rule", "consistent",
                              "Meier's Eq. (9) is an equal-mass rule: use masses: equal");
@@ -146,16 +148,20 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
         if (rs.reason == PK_STOP_CANCELLED || rs.reason == PK_STOP_WALL_TIME) {
             for (size_t i = 0; i < p->n; i++)
                 p->r[i] *= prm.delta; /* the start's sizes: the grains as they were placed */
-            *st = (pk_place_stats){.reason = rs.reason, .placed = rs.placed,
-                                   .requested = sz->n, .seconds = rs.seconds,
-                                   .short_delta_d = 1, .audit_delta_d = gap};
+            *st = (pk_place_stats){.reason = rs.reason,
+                                   .placed = rs.placed,
+                                   .requested = sz->n,
+                                   .seconds = rs.seconds,
+                                   .short_delta_d = 1,
+                                   .audit_delta_d = gap};
             return 0;
         }
         if (rs.placed < sz->n && !delta_default) {
-            snprintf(err, errlen,
-                     "RSA start placed only %zu of %zu grains at delta = %g: lower edmd.delta or use "
-                     "start: zero",
-                     rs.placed, sz->n, prm.delta);
+            snprintf(
+                err, errlen,
+                "RSA start placed only %zu of %zu grains at delta = %g: lower edmd.delta or use "
+                "start: zero",
+                rs.placed, sz->n, prm.delta);
             return -1;
         }
         if (rs.placed < sz->n)
@@ -190,25 +196,30 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     /* the monitor's wall limit counts from the job's start (pk_monitor_start),
      * so it covers the RSA start too */
     int run_rc = pk_edmd_run_shell_in_walls(&job->box, w, p, &prm, mon, &es);
-    if (run_rc != 0 && ck.resume && !ck.resumed) { /* a snapshot that does not fit: from the start */
-        snprintf(cf.err, sizeof cf.err, "checkpoint %s does not fit this job; started anew", cf.path);
+    if (run_rc != 0 && ck.resume &&
+        !ck.resumed) { /* a snapshot that does not fit: from the start */
+        snprintf(cf.err, sizeof cf.err, "checkpoint %s does not fit this job; started anew",
+                 cf.path);
         loaded = -1;
         ck.resume = NULL;
         run_rc = pk_edmd_run_shell_in_walls(&job->box, w, p, &prm, mon, &es);
     }
     pk_edmd_snapshot_free(&snap);
     if (run_rc != 0) {
-        snprintf(err, errlen, "EDMD failed (bad parameters, periodic box too small or out of memory)");
+        snprintf(err, errlen,
+                 "EDMD failed (bad parameters, periodic box too small or out of memory)");
         return -1;
     }
     /* a run that reached its end needs no checkpoint; a stopped one (cancel,
      * wall time) keeps it for the next attempt */
-    if (cf.path && (es.reason == PK_STOP_COMPLETE || es.reason == PK_STOP_JAMMED ||
-                    es.reason == PK_STOP_STALLED))
+    if (cf.path &&
+        (es.reason == PK_STOP_COMPLETE || es.reason == PK_STOP_JAMMED ||
+         es.reason == PK_STOP_STALLED))
         remove(cf.path);
     /* the shell short of the job's Δd (jammed, stalled, out of time): the
      * packing is kept, audited at the Δd reached and says so */
-    const int dd_short = prm.growth == PK_EDMD_GROW_SHELL && es.delta_d < job->delta_d * (1 - 1e-12);
+    const int dd_short =
+        prm.growth == PK_EDMD_GROW_SHELL && es.delta_d < job->delta_d * (1 - 1e-12);
     pk_contact_stats cs;
     /* contact: gap within tol·(r_i + r_j) of Δd, tol from the final
      * reduced pressure (pk_contact_tolerance) */
@@ -217,16 +228,19 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
         snprintf(err, errlen, "out of memory in the contact analysis");
         return -1;
     }
-    *st = (pk_place_stats){.reason = es.reason, .placed = p->n, .requested = sz->n,
-                           .seconds = es.seconds, .walls_touch = w > 0};
+    *st = (pk_place_stats){.reason = es.reason,
+                           .placed = p->n,
+                           .requested = sz->n,
+                           .seconds = es.seconds,
+                           .walls_touch = w > 0};
     if (prm.until == PK_EDMD_UNTIL_JAMMED) {
         /* "jammed" when the pressure test held, or the Δφ test the job
          * chose; a stall below the pressure target, or max_events, is said */
         int jam_ok = es.criterion == PK_EDMD_CRIT_PRESSURE ||
-                     es.criterion == PK_EDMD_CRIT_DELTA_PHI ||
-                     (es.criterion == PK_EDMD_CRIT_STALL && es.pressure >= prm.p_max);
-        if (!jam_ok && (es.criterion == PK_EDMD_CRIT_STALL ||
-                        es.criterion == PK_EDMD_CRIT_MAX_EVENTS))
+            es.criterion == PK_EDMD_CRIT_DELTA_PHI ||
+            (es.criterion == PK_EDMD_CRIT_STALL && es.pressure >= prm.p_max);
+        if (!jam_ok &&
+            (es.criterion == PK_EDMD_CRIT_STALL || es.criterion == PK_EDMD_CRIT_MAX_EVENTS))
             snprintf(st->warning, sizeof st->warning,
                      "EDMD stopped on %s at reduced pressure %.3g, below "
                      "jamming.reduced_pressure %.3g: the packing (phi %.6f) is not proven jammed",
@@ -242,7 +256,8 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
             snprintf(st->warning, sizeof st->warning,
                      "EDMD reached reduced pressure %.3g but no grain has dim + 1 contacts at "
                      "tolerance %.3g (no rigid backbone, phi %.6f): lower growth_rate or "
-                     "jamming.rate_factor", es.pressure, ctol, es.phi);
+                     "jamming.rate_factor",
+                     es.pressure, ctol, es.phi);
         }
         st->goal_reached = jam_ok && es.reason == PK_STOP_JAMMED;
     }
@@ -264,13 +279,14 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
         json_object_set_new(obs, "jammed", json_boolean(st->goal_reached));
     }
     json_object_set_new(obs, "collision_rule",
-                        json_string(prm.rule == PK_EDMD_RULE_MEIER  ? "meier"
-                                    : prm.rule == PK_EDMD_RULE_LIFT ? "lift"
-                                                                    : "elastic"));
+                        json_string(prm.rule == PK_EDMD_RULE_MEIER      ? "meier"
+                                        : prm.rule == PK_EDMD_RULE_LIFT ? "lift"
+                                                                        : "elastic"));
     json_object_set_new(obs, "kinetic_energy_ratio", json_real(es.kinetic_ratio));
     if (isfinite(es.phi_jam_estimate))
         json_object_set_new(obs, "phi_jamming_estimate", json_real(es.phi_jam_estimate));
-    json_object_set_new(obs, "termination_criterion", json_string(pk_edmd_criterion_name(es.criterion)));
+    json_object_set_new(obs, "termination_criterion",
+                        json_string(pk_edmd_criterion_name(es.criterion)));
     json_object_set_new(obs, "delta_d_reached", json_real(es.delta_d));
     json_object_set_new(obs, "wall_gap_guaranteed", json_real(fmax(0.5 * es.delta_d - w, 0)));
     json_object_set_new(obs, "start", json_string(prm.start_zero ? "zero" : "rsa"));
@@ -282,7 +298,8 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     if (cf.path) {
         json_object_set_new(obs, "resumed", json_boolean(ck.resumed));
         if (ck.resumed) {
-            json_object_set_new(obs, "resumed_from_events", json_integer((json_int_t)ck.resumed_events));
+            json_object_set_new(obs, "resumed_from_events",
+                                json_integer((json_int_t)ck.resumed_events));
             json_object_set_new(obs, "resumed_from_time", json_real(ck.resumed_time));
         }
         json_object_set_new(obs, "checkpoints_saved", json_integer(ck.saved));

@@ -5,8 +5,7 @@
 #include "pack_placer.h"
 
 static int place_rsa(const pk_pack_job *job, const pk_pack_plan *plan, const pk_sizes *sz,
-                     pk_monitor *mon, pk_particles *p, pk_place_stats *st, char *err,
-                     size_t errlen)
+                     pk_monitor *mon, pk_particles *p, pk_place_stats *st, char *err, size_t errlen)
 {
     (void)plan;
     pk_rsa_params prm = {.delta_d = job->delta_d,
@@ -18,11 +17,11 @@ static int place_rsa(const pk_pack_job *job, const pk_pack_plan *plan, const pk_
         snprintf(err, errlen, "RSA placement failed (%s)", pk_stop_reason_name(rs.reason));
         return -1;
     }
-    *st = (pk_place_stats){.reason = rs.reason, .placed = rs.placed, .requested = rs.requested,
-                           .seconds = rs.seconds};
+    *st = (pk_place_stats){
+        .reason = rs.reason, .placed = rs.placed, .requested = rs.requested, .seconds = rs.seconds};
     st->obs = json_pack("{s:I,s:f,s:I}", "draws", (json_int_t)rs.draws, "draws_per_grain",
-                        rs.placed ? (double)rs.draws / (double)rs.placed : 0.0,
-                        "max_failed_draws", (json_int_t)prm.max_failed_draws);
+                        rs.placed ? (double)rs.draws / (double)rs.placed : 0.0, "max_failed_draws",
+                        (json_int_t)prm.max_failed_draws);
     return 0;
 }
 

@@ -19,14 +19,15 @@
 typedef struct tetfill_setup {
     pk_mesh mesh;
     pk_mesh_report rep;
-    double origin[3];          /* mesh frame = particle frame + origin */
+    double origin[3]; /* mesh frame = particle frame + origin */
     pk_tetfill_params prm;
 } tetfill_setup;
 
 static void preset(void *dst) { pk_tetfill_defaults(&((pk_tetfill_options *)dst)->prm); }
 
 _Static_assert(sizeof(pk_tetfill_contact_rule) == sizeof(int), "named values are stored as int");
-static const char *const contact_names[] = {"tangent", "touching", NULL}; /* pk_tetfill_contact_rule */
+static const char *const contact_names[] = {"tangent", "touching",
+                                            NULL}; /* pk_tetfill_contact_rule */
 #define F(m) PK_OPT_FIELD(pk_tetfill_options, m)
 static const pk_option tetfill_rows[] = {
     {"/tetfill/r_min", PK_OPT_NUMBER, F(r_min), PK_OPT_IMPLICIT},
@@ -34,7 +35,8 @@ static const pk_option tetfill_rows[] = {
     {"/tetfill/ratio", PK_OPT_NUMBER, F(ratio), PK_OPT_IMPLICIT},
     {"/tetfill/epsilon", PK_OPT_NUMBER, F(prm.eps), PK_OPT_PRESET},
     {"/tetfill/z_min", PK_OPT_INTEGER, F(prm.z_min), PK_OPT_PRESET, .lo = 2, .hi = 4},
-    {"/tetfill/contact_rule", PK_OPT_ENUM, F(prm.contact_rule), PK_OPT_PRESET, .names = contact_names},
+    {"/tetfill/contact_rule", PK_OPT_ENUM, F(prm.contact_rule), PK_OPT_PRESET,
+     .names = contact_names},
     {"/tetfill/vertex_weight", PK_OPT_NUMBER, F(prm.vertex_weight), PK_OPT_PRESET},
     {"/tetfill/loose", PK_OPT_BOOL, F(prm.skip_tet_loci), PK_OPT_PRESET},
     {"/tetfill/densify", PK_OPT_BOOL, F(prm.densify), PK_OPT_PRESET},
@@ -96,7 +98,8 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
         *rule = "radii";
         *ptr = "/tetfill";
         if (radii(o, S->mesh.edge_mean, &prm->r_min, &prm->r_max) != 0) {
-            snprintf(err, errlen, "give r_min and r_max, or the ratio R (with r_min, r_max, or "
+            snprintf(err, errlen,
+                     "give r_min and r_max, or the ratio R (with r_min, r_max, or "
                      "alone: r̄ = mean edge / 8), with r_max >= r_min");
             pk_mesh_free(&S->mesh);
             return -1;
@@ -106,7 +109,8 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
         double ratio = S->mesh.edge_mean / (0.5 * (prm->r_min + prm->r_max));
         if (ratio < 4 || ratio > 16) {
             *rule = "meshScale";
-            snprintf(err, errlen, "the mesh's mean edge (%.4g) is %.3g mean radii; Jerier's method "
+            snprintf(err, errlen,
+                     "the mesh's mean edge (%.4g) is %.3g mean radii; Jerier's method "
                      "needs about 8 (between 4 and 16): remesh, or give the ratio R alone",
                      S->mesh.edge_mean, ratio);
             pk_mesh_free(&S->mesh);
@@ -116,13 +120,15 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
         *ptr = "/tetfill";
         *rule = "radii";
         if (radii(o, 0, &prm->r_min, &prm->r_max) != 0) {
-            snprintf(err, errlen, "a box domain needs r_min or r_max (with r_max or ratio), "
+            snprintf(err, errlen,
+                     "a box domain needs r_min or r_max (with r_max or ratio), "
                      "r_max >= r_min");
             return -1;
         }
         double lmin = fmin(job->box.L[0], fmin(job->box.L[1], job->box.L[2]));
         if (!(2 * prm->r_max <= lmin)) {
-            snprintf(err, errlen, "r_max = %g: the largest sphere must fit in the box (2 r_max <= %g)",
+            snprintf(err, errlen,
+                     "r_max = %g: the largest sphere must fit in the box (2 r_max <= %g)",
                      prm->r_max, lmin);
             return -1;
         }
@@ -147,7 +153,6 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
     prm->max_spheres = job->max_particles;
     return 0;
 }
-
 
 static json_t *ints_json(const int64_t *v, size_t n)
 {
@@ -183,8 +188,7 @@ static json_t *observables(const tetfill_setup *S, const pk_tetfill_stats *ts,
     json_object_set_new(o, "phi_geometric", json_real(ts->phi_geometric));
     json_object_set_new(o, "coordination_geometric", json_real(ts->geometric.z));
     json_object_set_new(o, "coordination_tangent_geometric", json_real(ts->geometric.z_tangent));
-    json_object_set_new(o, "coordination_touching_geometric",
-                        json_real(ts->geometric.z_touching));
+    json_object_set_new(o, "coordination_touching_geometric", json_real(ts->geometric.z_touching));
     json_object_set_new(o, "densify_passes", json_integer(ts->passes));
     json_object_set_new(o, "loci", json_integer((json_int_t)ts->loci));
     json_object_set_new(o, "solves", json_integer((json_int_t)ts->solves));
@@ -309,11 +313,16 @@ static int place_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, const
             free_setup(S);
         return -1;
     }
-    *st = (pk_place_stats){.reason = ts.reason, .placed = p->n, .requested = job->count,
-                           .seconds = ts.seconds, .has_domain = 1,
+    *st = (pk_place_stats){.reason = ts.reason,
+                           .placed = p->n,
+                           .requested = job->count,
+                           .seconds = ts.seconds,
+                           .has_domain = 1,
                            .domain_measure = S->mesh.volume,
-                           .overlap_tol = S->prm.eps * S->prm.r_min, .extra = S,
-                           .write_extra = write_mesh, .free_extra = own ? free_setup : NULL};
+                           .overlap_tol = S->prm.eps * S->prm.r_min,
+                           .extra = S,
+                           .write_extra = write_mesh,
+                           .free_extra = own ? free_setup : NULL};
     st->domain_box.dim = 3;
     for (int k = 0; k < 3; k++)
         st->domain_box.L[k] = S->mesh.hi[k];

@@ -25,24 +25,24 @@ typedef struct pk_place_stats {
     pk_stop_reason reason;
     size_t placed, requested;
     double seconds;
-    json_t *obs;          /* algorithm-specific observables (new reference) or NULL */
+    json_t *obs; /* algorithm-specific observables (new reference) or NULL */
     /* Placers that fill their own domain (tetfill: a mesh) report it here:
      * the box written to the file and audited, and its true measure. */
     int has_domain;
     pk_box domain_box;
     double domain_measure;
-    double overlap_tol;   /* overlaps the placer allows by design (0 = hard grains) */
-    int walls_touch;      /* 1: Δd between grains only, grains may touch the walls
+    double overlap_tol; /* overlaps the placer allows by design (0 = hard grains) */
+    int walls_touch;    /* 1: Δd between grains only, grains may touch the walls
                            * (edmd "wall_gap": "none", Titscher §6.3); 0: walls ≥ Δd/2 */
-    int goal_reached;     /* 1: the stop reason is what the job asked for (edmd
+    int goal_reached;   /* 1: the stop reason is what the job asked for (edmd
                            * "until": "jammed" and jammed at its own test: the reduced
                            * pressure, or the Δφ test the job chose), though not
                            * PK_STOP_COMPLETE */
-    int short_delta_d;    /* 1: the placer could not reach the job's Δd (edmd shell
+    int short_delta_d;  /* 1: the placer could not reach the job's Δd (edmd shell
                            * growth): the result is audited at audit_delta_d, the gap
                            * it guarantees, and the placer's warning says so */
     double audit_delta_d;
-    char warning[512];    /* a placer's own "stopped short" sentence, or "" */
+    char warning[512]; /* a placer's own "stopped short" sentence, or "" */
     /* Bulk datasets too large for obs (e.g. the mesh): written under
      * /observables/<algorithm>/ by write_extra, released by free_extra. */
     void *extra;
@@ -51,8 +51,8 @@ typedef struct pk_place_stats {
 } pk_place_stats;
 
 typedef struct pk_placer {
-    const char *name;     /* the "algorithm" value */
-    int own_sizes;        /* 1 = the placer makes its own sizes: no grading, no size draw */
+    const char *name; /* the "algorithm" value */
+    int own_sizes;    /* 1 = the placer makes its own sizes: no grading, no size draw */
     const pk_option_table *options; /* fills job->opt (pack_options.h), or NULL */
     /* Semantic checks of the placer's own inputs (schema already passed);
      * may be NULL.  With job->prepare it may leave in *prepared what it built

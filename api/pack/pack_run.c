@@ -14,8 +14,7 @@
 #include "core/base/rng.h"
 
 /* Draw the grain sizes the plan asks for (random stream 0 of the seed). */
-static int draw_sizes(const pk_pack_job *job, const pk_pack_plan *plan, pk_sizes *sz,
-                      double *scale)
+static int draw_sizes(const pk_pack_job *job, const pk_pack_plan *plan, pk_sizes *sz, double *scale)
 {
     *scale = 1;
     pk_rng rng;
@@ -31,7 +30,8 @@ static int draw_sizes(const pk_pack_job *job, const pk_pack_plan *plan, pk_sizes
     } else if (job->count) {
         rc = pk_sample_by_count(g, job->dim, job->count, &rng, sz);
     } else {
-        rc = pk_sample_by_measure(g, job->dim, plan->phi_resolved * V, &rng, job->max_particles, sz);
+        rc =
+            pk_sample_by_measure(g, job->dim, plan->phi_resolved * V, &rng, job->max_particles, sz);
     }
     if (rc != 0)
         return -1;
@@ -59,8 +59,8 @@ static size_t grains_outside_walls(const pk_box *b, const pk_particles *p, doubl
     size_t n = 0;
     for (size_t i = 0; i < p->n; i++)
         for (int k = 0; k < b->dim; k++)
-            if (!b->periodic[k] && (p->x[3 * i + k] - p->r[i] < -tol ||
-                                    b->L[k] - p->x[3 * i + k] - p->r[i] < -tol)) {
+            if (!b->periodic[k] &&
+                (p->x[3 * i + k] - p->r[i] < -tol || b->L[k] - p->x[3 * i + k] - p->r[i] < -tol)) {
                 n++;
                 break;
             }
@@ -68,10 +68,10 @@ static size_t grains_outside_walls(const pk_box *b, const pk_particles *p, doubl
 }
 
 static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const char *job_json,
-                        const pk_box *box, double V, const pk_particles *p, const pk_sizes *sz, double scale,
-                        const pk_place_stats *st, const pk_gap_report *gap, double t_sizes,
-                        double t_audit, const char *out_path, json_t *summary, char *err,
-                        size_t errlen)
+                        const pk_box *box, double V, const pk_particles *p, const pk_sizes *sz,
+                        double scale, const pk_place_stats *st, const pk_gap_report *gap,
+                        double t_sizes, double t_audit, const char *out_path, json_t *summary,
+                        char *err, size_t errlen)
 {
     pk_h5 *h = pk_h5_create(out_path, err, errlen);
     if (!h)
@@ -101,7 +101,8 @@ static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const 
     if (st->write_extra)
         rc |= st->write_extra(h, job->algorithm, st->extra);
     rc |= pk_h5_obs_double(h, "smallest_gap", gap->min_gap, u);
-    rc |= pk_h5_obs_double(h, "smallest_wall_gap", isinf(gap->min_wall_gap) ? -1 : gap->min_wall_gap, u);
+    rc |= pk_h5_obs_double(h, "smallest_wall_gap",
+                           isinf(gap->min_wall_gap) ? -1 : gap->min_wall_gap, u);
     rc |= pk_h5_obs_int(h, "pairs_below_delta_d", (int64_t)gap->pairs_below);
     rc |= pk_h5_obs_int(h, "grains_below_wall_gap", (int64_t)gap->walls_below);
     rc |= pk_h5_obs_double(h, "timing/sizes_s", t_sizes, "s");
@@ -117,8 +118,10 @@ static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const 
     int64_t *n_placed = calloc((size_t)nc + 1, sizeof *n_placed);
     int64_t *n_drawn = calloc((size_t)nc + 1, sizeof *n_drawn);
     double *sieve = calloc((size_t)nc + 2, sizeof *sieve);
-    double *pass_t = calloc((size_t)nc + 2, sizeof *pass_t), *pass_a = calloc((size_t)nc + 2, sizeof *pass_a);
-    if (!lo || !hi || !tgt || !ach || !exp_n || !n_placed || !n_drawn || !sieve || !pass_t || !pass_a) {
+    double *pass_t = calloc((size_t)nc + 2, sizeof *pass_t),
+           *pass_a = calloc((size_t)nc + 2, sizeof *pass_a);
+    if (!lo || !hi || !tgt || !ach || !exp_n || !n_placed || !n_drawn || !sieve || !pass_t ||
+        !pass_a) {
         rc = -1;
         goto done;
     }
@@ -168,9 +171,10 @@ static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const 
 
     json_t *cls = json_array();
     for (int c = 0; c < nc; c++)
-        json_array_append_new(cls, json_pack("{s:f,s:f,s:I,s:f,s:f}", "d_lo", lo[c], "d_hi", hi[c],
-                                             "placed", (json_int_t)n_placed[c], "target_fraction",
-                                             tgt[c], "achieved_fraction", ach[c]));
+        json_array_append_new(cls,
+                              json_pack("{s:f,s:f,s:I,s:f,s:f}", "d_lo", lo[c], "d_hi", hi[c],
+                                        "placed", (json_int_t)n_placed[c], "target_fraction",
+                                        tgt[c], "achieved_fraction", ach[c]));
     json_object_set_new(summary, "classes", cls);
 done:
     free(lo);
@@ -268,7 +272,8 @@ int pk_pack_run(const void *task, int threads, const char *job_json, const char 
     json_object_set_new(sum, "process", json_string("pack"));
     json_object_set_new(sum, "algorithm", json_string(job.algorithm));
     json_object_set_new(sum, "termination_reason", json_string(pk_stop_reason_name(st.reason)));
-    json_object_set_new(sum, "complete", json_false()); /* here in the listing; pk_pack_verdict sets it */
+    json_object_set_new(sum, "complete",
+                        json_false()); /* here in the listing; pk_pack_verdict sets it */
     json_object_set_new(sum, "count_placed", json_integer((json_int_t)st.placed));
     json_object_set_new(sum, "count_requested", json_integer((json_int_t)st.requested));
     json_object_set_new(sum, "count_expected", json_real(plan.expected_n));
@@ -285,8 +290,8 @@ int pk_pack_run(const void *task, int threads, const char *job_json, const char 
     if (st.overlap_tol > 0)
         json_object_set_new(sum, "overlap_tolerance", json_real(st.overlap_tol));
     pk_pack_verdict(&job, &plan, &st, &p, &gap, pk_particles_solid_measure(&p) / V, audit_dd, sum);
-    int rc = write_result(&job, &plan, job_json, &box, V, &p, &sz, scale, &st, &gap, t_sizes, t_audit,
-                          out_path, sum, err, errlen);
+    int rc = write_result(&job, &plan, job_json, &box, V, &p, &sz, scale, &st, &gap, t_sizes,
+                          t_audit, out_path, sum, err, errlen);
     pk_sizes_free(&sz);
     pk_particles_free(&p);
     if (st.free_extra)

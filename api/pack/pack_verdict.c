@@ -31,16 +31,18 @@ void pk_pack_verdict(const pk_pack_job *job, const pk_pack_plan *plan, const pk_
         pk_verdict_fail(summary, "non-finite numbers in the result (grain %zu of %zu, φ %g)", bad,
                         p->n, phi);
     if (gap->pairs_below || gap->walls_below)
-        pk_verdict_fail(summary,
-                        "the gap audit found %zu pairs closer than Δd = %g (smallest gap %g) and "
-                        "%zu grains beyond their wall clearance: the packing breaks its own contract",
-                        gap->pairs_below, delta_d, gap->min_gap, gap->walls_below);
+        pk_verdict_fail(
+            summary,
+            "the gap audit found %zu pairs closer than Δd = %g (smallest gap %g) and "
+            "%zu grains beyond their wall clearance: the packing breaks its own contract",
+            gap->pairs_below, delta_d, gap->min_gap, gap->walls_below);
     switch (st->reason) {
     case PK_STOP_WALL_TIME:
-        pk_verdict_fail(summary,
-                        "ran out of wall time (limits.wall_time_s = %g s): %zu of %zu grains placed, "
-                        "φ %.4g of the target %.4g",
-                        job->wall_time_s, st->placed, st->requested, phi, plan->phi_resolved);
+        pk_verdict_fail(
+            summary,
+            "ran out of wall time (limits.wall_time_s = %g s): %zu of %zu grains placed, "
+            "φ %.4g of the target %.4g",
+            job->wall_time_s, st->placed, st->requested, phi, plan->phi_resolved);
         break;
     case PK_STOP_CANCELLED:
         pk_verdict_fail(summary, "cancelled: %zu of %zu grains placed, φ %.4g of the target %.4g",
@@ -57,7 +59,8 @@ void pk_pack_verdict(const pk_pack_job *job, const pk_pack_plan *plan, const pk_
             pk_verdict_warn(summary,
                             "saturated: φ %.4g reached of the target %.4g (%s stopped: %s), %zu of "
                             "%zu grains placed",
-                            phi, plan->phi_resolved, job->algorithm, why, st->placed, st->requested);
+                            phi, plan->phi_resolved, job->algorithm, why, st->placed,
+                            st->requested);
         else if (!done) /* tetfill to a φ target: no count asked */
             pk_verdict_warn(summary,
                             "saturated: φ %.4g reached of the target %.4g (%s stopped: %s), %zu "

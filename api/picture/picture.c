@@ -50,8 +50,10 @@ int pk_picture_write_set(const char *h5_path, const char *dir, char *err, size_t
         const char *file;
         pk_picture_kind kind;
         int svg;
-    } set[] = {{"picture.png", PK_PICTURE_PACKING, 0}, {"picture.svg", PK_PICTURE_PACKING, 1},
-               {"grading.png", PK_PICTURE_GRADING, 0}, {"grading.svg", PK_PICTURE_GRADING, 1}};
+    } set[] = {{"picture.png", PK_PICTURE_PACKING, 0},
+               {"picture.svg", PK_PICTURE_PACKING, 1},
+               {"grading.png", PK_PICTURE_GRADING, 0},
+               {"grading.svg", PK_PICTURE_GRADING, 1}};
     int drawn = 0, failed = 0;
     char path[4096], e[512];
     for (size_t i = 0; i < sizeof set / sizeof *set; i++) {

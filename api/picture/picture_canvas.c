@@ -22,7 +22,8 @@ int pk_canvas_open(pk_canvas *c, const char *path, double width, double height, 
     if (ends_with(path, ".png"))
         c->png = 1;
     else if (!ends_with(path, ".svg")) {
-        snprintf(err, errlen, "%s: the picture's format comes from its extension, .svg or .png", path);
+        snprintf(err, errlen, "%s: the picture's format comes from its extension, .svg or .png",
+                 path);
         return -1;
     }
     size_t n = strlen(path) + 32;
@@ -34,8 +35,9 @@ int pk_canvas_open(pk_canvas *c, const char *path, double width, double height, 
         return -1;
     }
     snprintf(c->tmp, n, "%s.tmp.%ld", path, (long)getpid());
-    c->surface = c->png ? cairo_image_surface_create(CAIRO_FORMAT_RGB24, (int)ceil(width), (int)ceil(height))
-                        : cairo_svg_surface_create(c->tmp, width, height);
+    c->surface = c->png
+        ? cairo_image_surface_create(CAIRO_FORMAT_RGB24, (int)ceil(width), (int)ceil(height))
+        : cairo_svg_surface_create(c->tmp, width, height);
     if (cairo_surface_status(c->surface) != CAIRO_STATUS_SUCCESS) {
         snprintf(err, errlen, "cannot create %s: %s", c->tmp,
                  cairo_status_to_string(cairo_surface_status(c->surface)));
@@ -91,8 +93,10 @@ void pk_canvas_abort(pk_canvas *c)
 void pk_canvas_class_colour(cairo_t *cr, int species, int classes, double shade)
 {
     /* viridis at 5 stops, interpolated */
-    static const double stop[5][3] = {{0.267, 0.005, 0.329}, {0.231, 0.322, 0.545},
-                                      {0.129, 0.569, 0.549}, {0.369, 0.788, 0.384},
+    static const double stop[5][3] = {{0.267, 0.005, 0.329},
+                                      {0.231, 0.322, 0.545},
+                                      {0.129, 0.569, 0.549},
+                                      {0.369, 0.788, 0.384},
                                       {0.993, 0.906, 0.144}};
     double t = classes > 1 ? (double)species / (double)(classes - 1) : 0.5;
     t = t < 0 ? 0 : t > 1 ? 1 : t;

@@ -9,7 +9,7 @@
 typedef struct pk_canvas {
     cairo_surface_t *surface;
     cairo_t *cr;
-    int png;              /* 1: PNG written at finish; 0: SVG streamed to tmp */
+    int png; /* 1: PNG written at finish; 0: SVG streamed to tmp */
     char *tmp, *path;
 } pk_canvas;
 

@@ -158,7 +158,8 @@ int pk_picture_grading(const char *h5_path, const char *out_path, char *err, siz
     char text[160];
     double phi_mix = json_number_value(json_object_get(obs, "phi_mix"));
     double phi_eff = json_number_value(json_object_get(obs, "phi_resolved"));
-    snprintf(text, sizeof text, "phi_M = %.2f %%, phi_eff = %.2f %% (grains finer than d_min are left to the matrix)",
+    snprintf(text, sizeof text,
+             "phi_M = %.2f %%, phi_eff = %.2f %% (grains finer than d_min are left to the matrix)",
              100 * phi_mix, 100 * phi_eff);
     cairo_set_source_rgb(c.cr, 0, 0, 0);
     pk_canvas_text(c.cr, LEFT, TOP / 2, 0, 0.5, 13, text);

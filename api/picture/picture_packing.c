@@ -8,7 +8,7 @@
 #include "picture_canvas.h"
 #include "picture_internal.h"
 
-#define PANEL 720.0   /* the longer box side, in pt/px */
+#define PANEL 720.0 /* the longer box side, in pt/px */
 #define MARGIN 36.0
 
 typedef struct frame {

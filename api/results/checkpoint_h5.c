@@ -48,7 +48,8 @@ char *pk_ckpt_read_string(hid_t f, const char *name)
     if (d < 0)
         return NULL;
     hid_t t = H5Dget_type(d);
-    size_t len = t >= 0 && H5Tget_class(t) == H5T_STRING && !H5Tis_variable_str(t) ? H5Tget_size(t) : 0;
+    size_t len =
+        t >= 0 && H5Tget_class(t) == H5T_STRING && !H5Tis_variable_str(t) ? H5Tget_size(t) : 0;
     char *s = len ? malloc(len + 1) : NULL;
     if (s && H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, s) >= 0) {
         s[len] = 0;
@@ -75,8 +76,9 @@ hid_t pk_ckpt_open(const char *path, const char *digest, int *absent, char *err,
     }
     char *dg = pk_ckpt_read_string(f, "digest");
     if (!dg || strcmp(dg, digest) != 0) {
-        snprintf(err, errlen, dg ? "checkpoint %s belongs to another job or packd version"
-                                 : "checkpoint %s is incomplete",
+        snprintf(err, errlen,
+                 dg ? "checkpoint %s belongs to another job or packd version"
+                    : "checkpoint %s is incomplete",
                  path);
         free(dg);
         H5Fclose(f);

@@ -38,16 +38,18 @@ static json_t *read_dataset(hid_t d, size_t max_array)
     } else if ((cls == H5T_FLOAT || cls == H5T_INTEGER) && rank <= 1 && total <= max_array) {
         int is_int = cls == H5T_INTEGER;
         void *buf = malloc((size_t)(total ? total : 1) * 8);
-        if (buf && H5Dread(d, is_int ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL,
-                           H5P_DEFAULT, buf) >= 0) {
+        if (buf &&
+            H5Dread(d, is_int ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT,
+                    buf) >= 0) {
             if (rank == 0) {
                 out = is_int ? json_integer((json_int_t)((long long *)buf)[0])
                              : json_real(((double *)buf)[0]);
             } else {
                 out = json_array();
                 for (hsize_t i = 0; i < total; i++)
-                    json_array_append_new(out, is_int ? json_integer((json_int_t)((long long *)buf)[i])
-                                                      : json_real(((double *)buf)[i]));
+                    json_array_append_new(out,
+                                          is_int ? json_integer((json_int_t)((long long *)buf)[i])
+                                                 : json_real(((double *)buf)[i]));
             }
         }
         free(buf);
@@ -139,9 +141,9 @@ json_t *pk_h5_inspect(const char *path, size_t max_array, char *err, size_t errl
     char stored[65], computed[65];
     if (pk_result_digest_stored(path, stored) == 0) {
         json_object_set_new(out, "result_digest", json_string(stored));
-        json_object_set_new(out, "result_digest_verified",
-                            json_boolean(pk_result_digest_file(path, computed) == 0 &&
-                                         !strcmp(stored, computed)));
+        json_object_set_new(
+            out, "result_digest_verified",
+            json_boolean(pk_result_digest_file(path, computed) == 0 && !strcmp(stored, computed)));
     }
     return out;
 }

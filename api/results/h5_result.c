@@ -20,9 +20,9 @@
 
 struct pk_h5 {
     hid_t file;
-    hid_t obs;            /* /observables */
-    hid_t lcpl;           /* link creation: intermediate groups */
-    int fd;               /* the temporary file, written at commit */
+    hid_t obs;  /* /observables */
+    hid_t lcpl; /* link creation: intermediate groups */
+    int fd;     /* the temporary file, written at commit */
     char *path, *tmp;
 };
 
@@ -301,8 +301,7 @@ int pk_h5_obs_json(pk_h5 *h, const char *prefix, json_t *obj)
     const char *key;
     json_t *v;
     int rc = 0;
-    json_object_foreach(obj, key, v)
-    {
+    json_object_foreach (obj, key, v) {
         char name[256];
         snprintf(name, sizeof name, "%s/%s", prefix, key);
         if (json_is_integer(v))
@@ -319,8 +318,7 @@ int pk_h5_obs_json(pk_h5 *h, const char *prefix, json_t *obj)
             size_t n = json_array_size(v), i;
             int all_int = 1, all_num = 1;
             json_t *e;
-            json_array_foreach(v, i, e)
-            {
+            json_array_foreach (v, i, e) {
                 all_int &= json_is_integer(e);
                 all_num &= json_is_number(e);
             }
@@ -330,14 +328,16 @@ int pk_h5_obs_json(pk_h5 *h, const char *prefix, json_t *obj)
                 int64_t *a = malloc((n ? n : 1) * sizeof *a);
                 if (!a)
                     return -1;
-                json_array_foreach(v, i, e) a[i] = (int64_t)json_integer_value(e);
+                json_array_foreach (v, i, e)
+                    a[i] = (int64_t)json_integer_value(e);
                 rc |= pk_h5_obs_ints(h, name, a, n);
                 free(a);
             } else {
                 double *a = malloc((n ? n : 1) * sizeof *a);
                 if (!a)
                     return -1;
-                json_array_foreach(v, i, e) a[i] = json_number_value(e);
+                json_array_foreach (v, i, e)
+                    a[i] = json_number_value(e);
                 rc |= pk_h5_obs_doubles(h, name, a, n, NULL);
                 free(a);
             }
@@ -387,7 +387,9 @@ static void write_result_digest(pk_h5 *h)
     hid_t g;
     H5E_BEGIN_TRY
     {
-        g = pk_result_digest_compute(h->file, hex) == 0 ? H5Gopen2(h->file, "parameters", H5P_DEFAULT) : -1;
+        g = pk_result_digest_compute(h->file, hex) == 0
+            ? H5Gopen2(h->file, "parameters", H5P_DEFAULT)
+            : -1;
     }
     H5E_END_TRY
     if (g < 0)
@@ -479,7 +481,7 @@ static int dataset_dims(hid_t d, int rank, hsize_t *dims)
 {
     hid_t s = d >= 0 ? H5Dget_space(d) : -1;
     int ok = s >= 0 && H5Sget_simple_extent_ndims(s) == rank &&
-             H5Sget_simple_extent_dims(s, dims, NULL) == rank;
+        H5Sget_simple_extent_dims(s, dims, NULL) == rank;
     if (s >= 0)
         H5Sclose(s);
     return ok ? 0 : -1;
@@ -556,8 +558,9 @@ int pk_h5_read_particles(const char *path, pk_box *b, pk_particles *p, char *err
     struct stat st;
     char fdpath[64];
     snprintf(fdpath, sizeof fdpath, "/proc/self/fd/%d", fd);
-    hid_t f = fstat(fd, &st) == 0 ? H5Fopen(access(fdpath, R_OK) == 0 ? fdpath : path,
-                                            H5F_ACC_RDONLY, H5P_DEFAULT) : -1;
+    hid_t f = fstat(fd, &st) == 0
+        ? H5Fopen(access(fdpath, R_OK) == 0 ? fdpath : path, H5F_ACC_RDONLY, H5P_DEFAULT)
+        : -1;
     close(fd);
     if (f < 0) {
         snprintf(err, errlen, "cannot open %s as HDF5", path);
@@ -598,8 +601,10 @@ int pk_h5_read_particles(const char *path, pk_box *b, pk_particles *p, char *err
                 p->x[3 * i + (size_t)k] = k < dim ? pos[i * (size_t)dim + (size_t)k] : 0.0;
         rc = 0;
     } else {
-        snprintf(err, errlen, "%s: cannot read grain datasets (radius [N], position [N][%d], "
-                 "species [N])", path, dim);
+        snprintf(err, errlen,
+                 "%s: cannot read grain datasets (radius [N], position [N][%d], "
+                 "species [N])",
+                 path, dim);
         pk_particles_free(p);
     }
     free(pos);

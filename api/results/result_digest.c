@@ -33,7 +33,8 @@ static int feed_dataset(pk_sha256 *ctx, hid_t file, const char *path, hid_t mem_
     hssize_t n = s >= 0 ? H5Sget_simple_extent_npoints(s) : -1;
     size_t size = H5Tget_size(mem_type);
     void *buf = n >= 0 ? malloc((size_t)(n ? n : 1) * size) : NULL;
-    int rc = buf && (n == 0 || H5Dread(d, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0) ? 0 : -1;
+    int rc =
+        buf && (n == 0 || H5Dread(d, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0) ? 0 : -1;
     if (rc == 0)
         rc = feed(ctx, path, buf, (uint64_t)n * size);
     free(buf);

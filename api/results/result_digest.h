@@ -11,9 +11,9 @@
 
 #include <hdf5.h>
 
-#define PK_RESULT_DIGEST_METHOD                                                                  \
-    "sha256: for each of /parameters/job (UTF-8 text), /particles/grains/box/edges, position, " \
-    "radius (IEEE float64 LE), species (int32 LE): its name, 0, its byte length (uint64 LE), "  \
+#define PK_RESULT_DIGEST_METHOD                                                                    \
+    "sha256: for each of /parameters/job (UTF-8 text), /particles/grains/box/edges, position, "    \
+    "radius (IEEE float64 LE), species (int32 LE): its name, 0, its byte length (uint64 LE), "     \
     "its bytes"
 
 /* The digest of an open file (result in memory or on disk): 0, or -1 when

@@ -77,8 +77,8 @@ static int has_ids(const char *h5_path)
     if (f < 0)
         return 0;
     int yes = H5Lexists(f, "/particles", H5P_DEFAULT) > 0 &&
-              H5Lexists(f, "/particles/grains", H5P_DEFAULT) > 0 &&
-              H5Lexists(f, "/particles/grains/id", H5P_DEFAULT) > 0;
+        H5Lexists(f, "/particles/grains", H5P_DEFAULT) > 0 &&
+        H5Lexists(f, "/particles/grains/id", H5P_DEFAULT) > 0;
     H5Fclose(f);
     return yes;
 }
@@ -114,15 +114,20 @@ int pk_xdmf_write(const char *h5_path, const char *h5_ref, const char *xdmf_path
             "<Xdmf Version=\"3.0\">\n"
             "  <Domain>\n"
             "    <Grid Name=\"grains\" GridType=\"Uniform\">\n"
-            "      <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" NodesPerElement=\"1\">\n",
+            "      <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
+            "NodesPerElement=\"1\">\n",
             ref, n);
     /* the Xdmf3 reader makes no cells without the connectivity (0..N-1) */
     if (has_ids(h5_path)) {
-        fprintf(f, "        <DataItem Dimensions=\"%zu 1\" NumberType=\"Int\" Precision=\"8\" "
-                   "Format=\"HDF\">%s:/particles/grains/id</DataItem>\n", n, ref);
+        fprintf(f,
+                "        <DataItem Dimensions=\"%zu 1\" NumberType=\"Int\" Precision=\"8\" "
+                "Format=\"HDF\">%s:/particles/grains/id</DataItem>\n",
+                n, ref);
     } else {
-        fprintf(f, "        <DataItem Dimensions=\"%zu 1\" NumberType=\"Int\" Precision=\"8\" "
-                   "Format=\"XML\">", n);
+        fprintf(f,
+                "        <DataItem Dimensions=\"%zu 1\" NumberType=\"Int\" Precision=\"8\" "
+                "Format=\"XML\">",
+                n);
         for (size_t i = 0; i < n; i++)
             fprintf(f, i % 16 == 15 ? "%zu\n" : "%zu ", i);
         fprintf(f, "</DataItem>\n");
@@ -130,13 +135,16 @@ int pk_xdmf_write(const char *h5_path, const char *h5_ref, const char *xdmf_path
     fprintf(f,
             "      </Topology>\n"
             "      <Geometry GeometryType=\"%s\">\n"
-            "        <DataItem Dimensions=\"%zu %d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/particles/grains/position</DataItem>\n"
+            "        <DataItem Dimensions=\"%zu %d\" NumberType=\"Float\" Precision=\"8\" "
+            "Format=\"HDF\">%s:/particles/grains/position</DataItem>\n"
             "      </Geometry>\n"
             "      <Attribute Name=\"radius\" AttributeType=\"Scalar\" Center=\"Node\">\n"
-            "        <DataItem Dimensions=\"%zu\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/particles/grains/radius</DataItem>\n"
+            "        <DataItem Dimensions=\"%zu\" NumberType=\"Float\" Precision=\"8\" "
+            "Format=\"HDF\">%s:/particles/grains/radius</DataItem>\n"
             "      </Attribute>\n"
             "      <Attribute Name=\"species\" AttributeType=\"Scalar\" Center=\"Node\">\n"
-            "        <DataItem Dimensions=\"%zu\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">%s:/particles/grains/species</DataItem>\n"
+            "        <DataItem Dimensions=\"%zu\" NumberType=\"Int\" Precision=\"4\" "
+            "Format=\"HDF\">%s:/particles/grains/species</DataItem>\n"
             "      </Attribute>\n"
             "    </Grid>\n"
             "  </Domain>\n"

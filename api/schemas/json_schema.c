@@ -43,8 +43,8 @@ static void copy_trunc(char *dst, size_t cap, const char *src)
     dst[n] = '\0';
 }
 
-static int errors_addv(pk_schema_errors *e, const char *pointer, const char *rule,
-                       const char *fmt, va_list ap)
+static int errors_addv(pk_schema_errors *e, const char *pointer, const char *rule, const char *fmt,
+                       va_list ap)
 {
     if (!e)
         return 0;
@@ -82,8 +82,9 @@ json_t *pk_schema_errors_json(const pk_schema_errors *e)
         return arr;
     for (size_t i = 0; i < e->n; i++) {
         const pk_schema_error *x = &e->items[i];
-        json_array_append_new(arr, json_pack("{s:s, s:s, s:s}", "pointer", x->pointer,
-                                             "rule", x->rule, "message", x->message));
+        json_array_append_new(arr,
+                              json_pack("{s:s, s:s, s:s}", "pointer", x->pointer, "rule", x->rule,
+                                        "message", x->message));
     }
     return arr;
 }
@@ -181,8 +182,7 @@ static int values_equal(json_t *a, json_t *b)
             return 0;
         const char *k;
         json_t *va;
-        json_object_foreach(a, k, va)
-        {
+        json_object_foreach (a, k, va) {
             json_t *vb = json_object_get(b, k);
             if (!vb || !values_equal(va, vb))
                 return 0;
@@ -338,7 +338,8 @@ static void validate(vctx *c, json_t *schema, json_t *inst);
 /* A keyword handler: the schema object s holding the keyword, its value v,
  * the instance.  Not every handler needs every argument. */
 #define UNUSED __attribute__((unused))
-#define KW(name) static void name(UNUSED vctx *c, UNUSED json_t *s, UNUSED json_t *v, UNUSED json_t *inst)
+#define KW(name)                                                                                   \
+    static void name(UNUSED vctx *c, UNUSED json_t *s, UNUSED json_t *v, UNUSED json_t *inst)
 
 /* Evaluate `schema` without reporting: returns 1 if the instance fails.
  * Schema bugs met on the way are still reported. */
@@ -409,8 +410,8 @@ static int decode_token(char *t)
 
 /* Resolve `ref` from document `root`: returns the target and sets *root_out to
  * the document it lives in, or NULL with a reason in why[]. */
-static json_t *resolve_ref(vctx *c, const char *ref, json_t *root, json_t **root_out,
-                           char *why, size_t whylen)
+static json_t *resolve_ref(vctx *c, const char *ref, json_t *root, json_t **root_out, char *why,
+                           size_t whylen)
 {
     char dummy[8] = "";
     if (!why) {
@@ -528,13 +529,20 @@ KW(kw_ref)
 /* 1 match, 0 no match, -1 unknown type name. */
 static int type_matches(const char *t, const json_t *v)
 {
-    if (!strcmp(t, "object")) return json_is_object(v);
-    if (!strcmp(t, "array")) return json_is_array(v);
-    if (!strcmp(t, "string")) return json_is_string(v);
-    if (!strcmp(t, "number")) return json_is_number(v);
-    if (!strcmp(t, "integer")) return is_integral(v);
-    if (!strcmp(t, "boolean")) return json_is_boolean(v);
-    if (!strcmp(t, "null")) return json_is_null(v);
+    if (!strcmp(t, "object"))
+        return json_is_object(v);
+    if (!strcmp(t, "array"))
+        return json_is_array(v);
+    if (!strcmp(t, "string"))
+        return json_is_string(v);
+    if (!strcmp(t, "number"))
+        return json_is_number(v);
+    if (!strcmp(t, "integer"))
+        return is_integral(v);
+    if (!strcmp(t, "boolean"))
+        return json_is_boolean(v);
+    if (!strcmp(t, "null"))
+        return json_is_null(v);
     return -1;
 }
 
@@ -559,8 +567,7 @@ KW(kw_type)
     json_t *t;
     int any = 0;
     char list[160] = "";
-    json_array_foreach(v, i, t)
-    {
+    json_array_foreach (v, i, t) {
         if (!json_is_string(t) || type_matches(json_string_value(t), inst) < 0) {
             err(c, "schema", "invalid schema: bad entry in \"type\"");
             return;
@@ -584,10 +591,11 @@ KW(kw_enum)
     }
     size_t i;
     json_t *e;
-    json_array_foreach(v, i, e) if (values_equal(e, inst)) return;
+    json_array_foreach (v, i, e)
+        if (values_equal(e, inst))
+            return;
     char list[200] = "", r[96], got[96];
-    json_array_foreach(v, i, e)
-    {
+    json_array_foreach (v, i, e) {
         size_t l = strlen(list);
         render(e, r, sizeof r);
         if (l + strlen(r) + 8 >= sizeof list) {
@@ -622,8 +630,7 @@ KW(kw_properties)
         return;
     const char *k;
     json_t *sub;
-    json_object_foreach(v, k, sub)
-    {
+    json_object_foreach (v, k, sub) {
         if (full(c))
             return;
         json_t *iv = json_object_get(inst, k);
@@ -641,7 +648,9 @@ static int string_array(const json_t *v)
         return 0;
     size_t i;
     json_t *e;
-    json_array_foreach(v, i, e) if (!json_is_string(e)) return 0;
+    json_array_foreach (v, i, e)
+        if (!json_is_string(e))
+            return 0;
     return 1;
 }
 
@@ -655,8 +664,7 @@ KW(kw_required)
         return;
     size_t i;
     json_t *e;
-    json_array_foreach(v, i, e)
-    {
+    json_array_foreach (v, i, e) {
         if (!json_object_get(inst, json_string_value(e)))
             err(c, "required", "missing required property \"%s\"", json_string_value(e));
     }
@@ -675,8 +683,7 @@ KW(kw_additional)
         props = NULL;
     const char *k;
     json_t *iv;
-    json_object_foreach(inst, k, iv)
-    {
+    json_object_foreach (inst, k, iv) {
         if (full(c))
             return;
         if (props && json_object_get(props, k))
@@ -687,8 +694,7 @@ KW(kw_additional)
             const char *pk;
             json_t *pv;
             if (props) {
-                json_object_foreach(props, pk, pv)
-                {
+                json_object_foreach (props, pk, pv) {
                     size_t l = strlen(allowed);
                     if (l + strlen(pk) + 8 >= sizeof allowed) {
                         snprintf(allowed + l, sizeof allowed - l, ", ...");
@@ -706,8 +712,7 @@ KW(kw_additional)
     }
 }
 
-static void count_kw(vctx *c, json_t *v, json_t *inst, const char *kw, int is_min,
-                     int want_array)
+static void count_kw(vctx *c, json_t *v, json_t *inst, const char *kw, int is_min, int want_array)
 {
     size_t lim;
     if (!get_count(v, &lim)) {
@@ -724,14 +729,8 @@ static void count_kw(vctx *c, json_t *v, json_t *inst, const char *kw, int is_mi
         err(c, kw, "must have at most %zu %s (got %zu)", lim, what, n);
 }
 
-KW(kw_minProperties)
-{
-    count_kw(c, v, inst, "minProperties", 1, 0);
-}
-KW(kw_maxProperties)
-{
-    count_kw(c, v, inst, "maxProperties", 0, 0);
-}
+KW(kw_minProperties) { count_kw(c, v, inst, "minProperties", 1, 0); }
+KW(kw_maxProperties) { count_kw(c, v, inst, "maxProperties", 0, 0); }
 
 KW(kw_dependentRequired)
 {
@@ -739,7 +738,9 @@ KW(kw_dependentRequired)
     json_t *deps;
     int ok = json_is_object(v);
     if (ok)
-        json_object_foreach(v, k, deps) if (!string_array(deps)) ok = 0;
+        json_object_foreach (v, k, deps)
+            if (!string_array(deps))
+                ok = 0;
     if (!ok) {
         err(c, "schema",
             "invalid schema: \"dependentRequired\" must map names to arrays of strings");
@@ -747,14 +748,12 @@ KW(kw_dependentRequired)
     }
     if (!json_is_object(inst))
         return;
-    json_object_foreach(v, k, deps)
-    {
+    json_object_foreach (v, k, deps) {
         if (!json_object_get(inst, k))
             continue;
         size_t i;
         json_t *d;
-        json_array_foreach(deps, i, d)
-        {
+        json_array_foreach (deps, i, d) {
             if (!json_object_get(inst, json_string_value(d)))
                 err(c, "dependentRequired", "property \"%s\" requires property \"%s\"", k,
                     json_string_value(d));
@@ -806,14 +805,8 @@ KW(kw_prefixItems)
     }
 }
 
-KW(kw_minItems)
-{
-    count_kw(c, v, inst, "minItems", 1, 1);
-}
-KW(kw_maxItems)
-{
-    count_kw(c, v, inst, "maxItems", 0, 1);
-}
+KW(kw_minItems) { count_kw(c, v, inst, "minItems", 1, 1); }
+KW(kw_maxItems) { count_kw(c, v, inst, "maxItems", 0, 1); }
 
 KW(kw_uniqueItems)
 {
@@ -848,8 +841,7 @@ static void num_kw(vctx *c, json_t *v, json_t *inst, const char *kw, const char 
     if (!json_is_number(inst))
         return;
     int cmp = num_cmp(inst, v);
-    if ((cmp < 0 && fails_if_cmp_lt) || (cmp == 0 && fails_if_eq) ||
-        (cmp > 0 && fails_if_cmp_gt)) {
+    if ((cmp < 0 && fails_if_cmp_lt) || (cmp == 0 && fails_if_eq) || (cmp > 0 && fails_if_cmp_gt)) {
         char want[64], got[64];
         render(v, want, sizeof want);
         render(inst, got, sizeof got);
@@ -857,22 +849,10 @@ static void num_kw(vctx *c, json_t *v, json_t *inst, const char *kw, const char 
     }
 }
 
-KW(kw_minimum)
-{
-    num_kw(c, v, inst, "minimum", ">=", 1, 0, 0);
-}
-KW(kw_maximum)
-{
-    num_kw(c, v, inst, "maximum", "<=", 0, 0, 1);
-}
-KW(kw_exclusiveMinimum)
-{
-    num_kw(c, v, inst, "exclusiveMinimum", ">", 1, 1, 0);
-}
-KW(kw_exclusiveMaximum)
-{
-    num_kw(c, v, inst, "exclusiveMaximum", "<", 0, 1, 1);
-}
+KW(kw_minimum) { num_kw(c, v, inst, "minimum", ">=", 1, 0, 0); }
+KW(kw_maximum) { num_kw(c, v, inst, "maximum", "<=", 0, 0, 1); }
+KW(kw_exclusiveMinimum) { num_kw(c, v, inst, "exclusiveMinimum", ">", 1, 1, 0); }
+KW(kw_exclusiveMaximum) { num_kw(c, v, inst, "exclusiveMaximum", "<", 0, 1, 1); }
 
 KW(kw_multipleOf)
 {
@@ -1035,8 +1015,7 @@ KW(kw_pattern)
         return;
     }
     if (!r->ok) {
-        err(c, "schema", "invalid schema: bad pattern \"%s\": %s", json_string_value(v),
-            r->why);
+        err(c, "schema", "invalid schema: bad pattern \"%s\": %s", json_string_value(v), r->why);
         return;
     }
     if (!json_is_string(inst))
@@ -1056,7 +1035,9 @@ static int schema_array(vctx *c, json_t *v, const char *kw)
     size_t i;
     json_t *e;
     if (ok)
-        json_array_foreach(v, i, e) if (!is_schema(e)) ok = 0;
+        json_array_foreach (v, i, e)
+            if (!is_schema(e))
+                ok = 0;
     if (!ok)
         err(c, "schema", "invalid schema: \"%s\" must be a non-empty array of schemas", kw);
     return ok;
@@ -1068,8 +1049,7 @@ KW(kw_allOf)
         return;
     size_t i;
     json_t *e;
-    json_array_foreach(v, i, e)
-    {
+    json_array_foreach (v, i, e) {
         if (full(c))
             return;
         validate(c, e, inst);
@@ -1086,8 +1066,7 @@ static void collect_consts(vctx *c, json_t *s, json_t *root, json_t *out, int de
     const char *k;
     json_t *p;
     if (json_is_object(props)) {
-        json_object_foreach(props, k, p)
-        {
+        json_object_foreach (props, k, p) {
             if (!json_is_object(p) || json_object_get(out, k))
                 continue;
             json_t *cv = json_object_get(p, "const");
@@ -1109,7 +1088,8 @@ static void collect_consts(vctx *c, json_t *s, json_t *root, json_t *out, int de
     size_t i;
     json_t *e;
     if (json_is_array(all))
-        json_array_foreach(all, i, e) collect_consts(c, e, root, out, depth + 1);
+        json_array_foreach (all, i, e)
+            collect_consts(c, e, root, out, depth + 1);
 }
 
 /* Does the branch's "type" (through $ref and allOf) accept the instance?
@@ -1126,8 +1106,9 @@ static int branch_type_ok(vctx *c, json_t *s, json_t *root, json_t *inst, int de
         size_t i;
         json_t *x;
         res = 0;
-        json_array_foreach(t, i, x) if (json_is_string(x) &&
-                                        type_matches(json_string_value(x), inst) == 1) res = 1;
+        json_array_foreach (t, i, x)
+            if (json_is_string(x) && type_matches(json_string_value(x), inst) == 1)
+                res = 1;
     }
     if (res == 0)
         return 0;
@@ -1145,8 +1126,7 @@ static int branch_type_ok(vctx *c, json_t *s, json_t *root, json_t *inst, int de
     size_t i;
     json_t *e;
     if (json_is_array(all)) {
-        json_array_foreach(all, i, e)
-        {
+        json_array_foreach (all, i, e) {
             int r = branch_type_ok(c, e, root, inst, depth + 1);
             if (r == 0)
                 return 0;
@@ -1160,8 +1140,7 @@ static int branch_type_ok(vctx *c, json_t *s, json_t *root, json_t *inst, int de
 /* anyOf/oneOf matched nothing: if a discriminator-like const property selects
  * exactly one branch, report that branch's errors; otherwise one summary
  * error, naming the expected tag values when every branch has one. */
-static void report_no_match(vctx *c, json_t *v, json_t *inst, const char *kw,
-                            const char *summary)
+static void report_no_match(vctx *c, json_t *v, json_t *inst, const char *kw, const char *summary)
 {
     size_t n = json_array_size(v);
     char suffix[256] = "";
@@ -1173,14 +1152,14 @@ static void report_no_match(vctx *c, json_t *v, json_t *inst, const char *kw,
             collect_consts(c, json_array_get(v, b), c->root, maps[b], 0);
             const char *k;
             json_t *cv;
-            json_object_foreach(maps[b], k, cv) json_object_set(names, k, json_true());
+            json_object_foreach (maps[b], k, cv)
+                json_object_set(names, k, json_true());
         }
         const char *k;
         json_t *unused;
         long chosen = -1;
         const char *tag_all = NULL; /* a property every branch has a const for */
-        json_object_foreach(names, k, unused)
-        {
+        json_object_foreach (names, k, unused) {
             json_t *iv = json_object_get(inst, k);
             size_t nconst = 0, nmatch = 0, which = 0;
             for (size_t b = 0; b < n; b++) {
@@ -1260,13 +1239,14 @@ KW(kw_anyOf)
         return;
     size_t i;
     json_t *e;
-    json_array_foreach(v, i, e) if (!trial(c, e, inst)) return;
+    json_array_foreach (v, i, e)
+        if (!trial(c, e, inst))
+            return;
     /* anyOf of bare {"required": [...]} branches ("give phi or count"):
      * name the alternatives instead of counting them. */
     char alts[200] = "";
     int only_required = 1;
-    json_array_foreach(v, i, e)
-    {
+    json_array_foreach (v, i, e) {
         json_t *req = json_object_get(e, "required");
         if (!json_is_object(e) || json_object_size(e) != 1 || !json_is_array(req)) {
             only_required = 0;
@@ -1276,8 +1256,7 @@ KW(kw_anyOf)
         json_t *name;
         size_t len = strlen(alts);
         snprintf(alts + len, sizeof alts - len, "%s", i ? " or " : "");
-        json_array_foreach(req, k, name)
-        {
+        json_array_foreach (req, k, name) {
             len = strlen(alts);
             snprintf(alts + len, sizeof alts - len, "%s\"%s\"", k ? "+" : "",
                      json_is_string(name) ? json_string_value(name) : "?");
@@ -1299,7 +1278,9 @@ KW(kw_oneOf)
         return;
     size_t i, matched = 0;
     json_t *e;
-    json_array_foreach(v, i, e) if (!trial(c, e, inst)) matched++;
+    json_array_foreach (v, i, e)
+        if (!trial(c, e, inst))
+            matched++;
     if (matched == 1)
         return;
     char summary[96];
@@ -1422,8 +1403,7 @@ static void validate(vctx *c, json_t *schema, json_t *inst)
     c->depth++;
     const char *k;
     json_t *v;
-    json_object_foreach(schema, k, v)
-    {
+    json_object_foreach (schema, k, v) {
         if (full(c))
             break;
         size_t i, nk = sizeof keywords / sizeof keywords[0];
@@ -1483,8 +1463,8 @@ static void embedded_init(void)
     if (!embedded_parsed)
         return;
     for (size_t i = 0; i < n; i++)
-        embedded_parsed[i] = json_loadb(pk_embedded_schemas[i].text,
-                                        pk_embedded_schemas[i].len, 0, NULL);
+        embedded_parsed[i] =
+            json_loadb(pk_embedded_schemas[i].text, pk_embedded_schemas[i].len, 0, NULL);
     embedded_count = n;
 }
 

@@ -25,9 +25,9 @@
 #define PK_SCHEMA_MAX_DEPTH 64
 
 typedef struct pk_schema_error {
-    char pointer[256];   /* e.g. "/grading/sizes/3" */
-    char rule[32];       /* e.g. "minimum", "required", "type" */
-    char message[256];   /* e.g. "must be >= 0 (got -1)" */
+    char pointer[256]; /* e.g. "/grading/sizes/3" */
+    char rule[32];     /* e.g. "minimum", "required", "type" */
+    char message[256]; /* e.g. "must be >= 0 (got -1)" */
 } pk_schema_error;
 
 typedef struct pk_schema_errors {

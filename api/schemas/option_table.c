@@ -37,19 +37,11 @@ static void put_int(void *field, size_t size, long long x)
 static void put_default(const pk_option *o, char *field)
 {
     switch (o->type) {
-    case PK_OPT_NUMBER:
-        memcpy(field, &o->dflt, sizeof o->dflt);
-        break;
-    case PK_OPT_INTEGER:
-        put_int(field, o->size, (long long)o->dflt);
-        break;
+    case PK_OPT_NUMBER: memcpy(field, &o->dflt, sizeof o->dflt); break;
+    case PK_OPT_INTEGER: put_int(field, o->size, (long long)o->dflt); break;
     case PK_OPT_BOOL:
-    case PK_OPT_ENUM:
-        put_int(field, sizeof(int), (long long)o->dflt);
-        break;
-    case PK_OPT_STRING:
-        snprintf(field, o->size, "%s", o->sdefault ? o->sdefault : "");
-        break;
+    case PK_OPT_ENUM: put_int(field, sizeof(int), (long long)o->dflt); break;
+    case PK_OPT_STRING: snprintf(field, o->size, "%s", o->sdefault ? o->sdefault : ""); break;
     }
 }
 
@@ -161,8 +153,7 @@ json_t *pk_option_default_json(const pk_option *o, const void *filled)
         memcpy(&i, field, sizeof i);
         return o->type == PK_OPT_BOOL ? json_boolean(i) : json_string(o->names[i]);
     }
-    case PK_OPT_STRING:
-        return json_string(field);
+    case PK_OPT_STRING: return json_string(field);
     }
     return NULL;
 }

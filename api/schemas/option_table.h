@@ -28,9 +28,9 @@ typedef enum pk_opt_default {
 } pk_opt_default;
 
 typedef struct pk_option {
-    const char *pointer;      /* JSON pointer from the object the table reads, "/edmd/skin" */
+    const char *pointer; /* JSON pointer from the object the table reads, "/edmd/skin" */
     pk_opt_type type;
-    size_t off, size;         /* destination field (PK_OPT_FIELD) */
+    size_t off, size; /* destination field (PK_OPT_FIELD) */
     pk_opt_default how;
     double dflt;              /* NUMBER, INTEGER, BOOL (0/1), ENUM (index into names) */
     const char *sdefault;     /* STRING */
@@ -39,15 +39,18 @@ typedef struct pk_option {
 } pk_option;
 
 typedef struct pk_option_table {
-    const char *schema;       /* the embedded schema the pointers live in */
+    const char *schema; /* the embedded schema the pointers live in */
     const pk_option *rows;
     size_t n;
-    size_t size;              /* of the struct filled */
+    size_t size;               /* of the struct filled */
     void (*preset)(void *dst); /* or NULL: run before the rows (PK_OPT_PRESET rows keep it) */
 } pk_option_table;
 
 #define PK_OPT_FIELD(T, m) .off = offsetof(T, m), .size = sizeof(((T *)0)->m)
-#define PK_OPT_TABLE(schema, T, rows, preset) {schema, rows, sizeof rows / sizeof *rows, sizeof(T), preset}
+#define PK_OPT_TABLE(schema, T, rows, preset)                                                      \
+    {                                                                                              \
+        schema, rows, sizeof rows / sizeof *rows, sizeof(T), preset                                \
+    }
 
 /* The value at a JSON pointer ("/a/b", "" = root) of plain object keys, or NULL. */
 json_t *pk_json_at(json_t *root, const char *pointer);

@@ -6,8 +6,8 @@
 #include <stddef.h>
 
 typedef struct pk_embedded_schema {
-    const char *name;   /* base file name, e.g. "pack.inputs.schema.json" */
-    const char *text;   /* file content, NUL-terminated */
+    const char *name; /* base file name, e.g. "pack.inputs.schema.json" */
+    const char *text; /* file content, NUL-terminated */
     size_t len;
 } pk_embedded_schema;
 

@@ -18,10 +18,7 @@
  * of one; the ICV is per thread, so each thread that calls in sets its own
  * — a few ns).  The numbers do not change (the same operations, in one
  * thread). */
-static void serial_regions(void)
-{
-    omp_set_max_active_levels(0);
-}
+static void serial_regions(void) { omp_set_max_active_levels(0); }
 
 struct pk_sparse_factor {
     cholmod_common c;
@@ -35,7 +32,7 @@ struct pk_sparse_ctx {
     cholmod_common c;
     cholmod_factor *L; /* NULL: none yet */
     size_t n, nnz;
-    int *p, *i;        /* n + 1 column pointers, nnz row indices (packed, sorted) */
+    int *p, *i; /* n + 1 column pointers, nnz row indices (packed, sorted) */
 };
 
 /* |d| below this share of the largest pivot counts as zero (singular). */
@@ -61,7 +58,8 @@ static void classify_pivots(const double *d, size_t ncol, size_t n, pk_sparse_in
     info->min_abs_pivot = ncol ? dmin : 0;
     info->max_abs_pivot = dmax;
     info->status = info->nzero ? PK_SPARSE_SINGULAR
-                               : info->nneg ? PK_SPARSE_INDEFINITE : PK_SPARSE_OK;
+        : info->nneg           ? PK_SPARSE_INDEFINITE
+                               : PK_SPARSE_OK;
 }
 
 /* The pivots of a supernodal LLᵀ factor: L_jj² from each supernode's dense
@@ -105,8 +103,8 @@ static int same_pattern(const pk_sparse_ctx *ctx, const cholmod_sparse *S)
     const int *p = S->p;
     size_t n = S->ncol, nnz = (size_t)p[n];
     return ctx->L && n == ctx->n && nnz == ctx->nnz &&
-           memcmp(p, ctx->p, (n + 1) * sizeof *p) == 0 &&
-           memcmp(S->i, ctx->i, nnz * sizeof *ctx->i) == 0;
+        memcmp(p, ctx->p, (n + 1) * sizeof *p) == 0 &&
+        memcmp(S->i, ctx->i, nnz * sizeof *ctx->i) == 0;
 }
 
 /* ctx's analysis := S's (0), or none (-1). */
@@ -178,7 +176,8 @@ static pk_sparse_factor *factor_any(pk_sparse_ctx *ctx, const pk_sparse_sym *A, 
     f->c.print = 0;
     f->c.error_handler = NULL;
     f->n = A->n;
-    cholmod_triplet *T = cholmod_allocate_triplet(A->n, A->n, A->nnz ? A->nnz : 1, 1, CHOLMOD_REAL, &f->c);
+    cholmod_triplet *T =
+        cholmod_allocate_triplet(A->n, A->n, A->nnz ? A->nnz : 1, 1, CHOLMOD_REAL, &f->c);
     cholmod_sparse *S = NULL;
     if (!T)
         goto fail;

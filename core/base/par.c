@@ -5,7 +5,8 @@
 void pk_par_range(size_t n, int t, int nt, size_t align, size_t *lo, size_t *hi)
 {
     size_t units = (n + align - 1) / align; /* whole groups of align items */
-    size_t a = units * (size_t)t / (size_t)nt * align, b = units * (size_t)(t + 1) / (size_t)nt * align;
+    size_t a = units * (size_t)t / (size_t)nt * align,
+           b = units * (size_t)(t + 1) / (size_t)nt * align;
     *lo = a < n ? a : n;
     *hi = b < n ? b : n;
 }
@@ -18,10 +19,7 @@ pk_par *pk_par_new(int nthreads)
     return NULL;
 }
 
-void pk_par_free(pk_par *p)
-{
-    (void)p;
-}
+void pk_par_free(pk_par *p) { (void)p; }
 
 int pk_par_threads(const pk_par *p)
 {
@@ -61,13 +59,13 @@ struct pk_par {
     int nt;
     void (*fn)(void *ctx, int t, int nt); /* the job: written before claim is reset */
     void *ctx;
-    atomic_uint gen;      /* job counter: a worker looks for parts when it changes */
+    atomic_uint gen;        /* job counter: a worker looks for parts when it changes */
     _Atomic uint64_t claim; /* the job's parts << 32 | the next part to claim: one
                                word, so a claim always sees its own job's count */
-    atomic_int done;      /* parts finished by the workers */
-    atomic_int sleepers;  /* workers blocked (or about to) on cnd */
+    atomic_int done;        /* parts finished by the workers */
+    atomic_int sleepers;    /* workers blocked (or about to) on cnd */
     atomic_int stop;
-    atomic_flag busy;     /* a job is running: nested/concurrent runs go serial */
+    atomic_flag busy; /* a job is running: nested/concurrent runs go serial */
     mtx_t mtx;
     cnd_t cnd;
     thrd_t thr[PK_PAR_MAX];
@@ -218,10 +216,7 @@ void pk_par_free(pk_par *p)
     free(p);
 }
 
-int pk_par_threads(const pk_par *p)
-{
-    return p ? p->nt : 1;
-}
+int pk_par_threads(const pk_par *p) { return p ? p->nt : 1; }
 
 /* nparts parts on p; when p is busy (a nested or concurrent run) or NULL,
  * serial_parts (nparts, or 1: pk_par_run) on the caller instead. */

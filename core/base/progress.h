@@ -13,25 +13,25 @@
 #include <stddef.h>
 
 typedef struct pk_progress {
-    const char *stage;     /* "sizes", "rsa", "edmd", ... */
-    double fraction;       /* 0..1 of the stage, or <0 when unknown */
-    double phi;            /* current solid fraction (resolved), <0 if n/a */
-    size_t done;           /* items finished (particles placed, events, ...) */
-    size_t total;          /* items planned, 0 if unknown */
-    double elapsed_s;      /* wall time since the stage began */
-    double eta_s;          /* estimated seconds left, <0 if unknown */
-    const char *message;   /* optional short text, may be NULL */
+    const char *stage;   /* "sizes", "rsa", "edmd", ... */
+    double fraction;     /* 0..1 of the stage, or <0 when unknown */
+    double phi;          /* current solid fraction (resolved), <0 if n/a */
+    size_t done;         /* items finished (particles placed, events, ...) */
+    size_t total;        /* items planned, 0 if unknown */
+    double elapsed_s;    /* wall time since the stage began */
+    double eta_s;        /* estimated seconds left, <0 if unknown */
+    const char *message; /* optional short text, may be NULL */
 } pk_progress;
 
 /* Return non-zero from the callback to request cancellation. */
 typedef int (*pk_progress_fn)(const pk_progress *p, void *ctx);
 
 typedef struct pk_monitor {
-    pk_progress_fn fn;                 /* may be NULL */
+    pk_progress_fn fn; /* may be NULL */
     void *ctx;
-    volatile sig_atomic_t *cancel;     /* may be NULL; non-zero = stop now */
-    double interval_s;                 /* min wall time between callbacks (default 0.5) */
-    double wall_limit_s;               /* 0 = none; exceeded => stop with reason.  Set it
+    volatile sig_atomic_t *cancel; /* may be NULL; non-zero = stop now */
+    double interval_s;             /* min wall time between callbacks (default 0.5) */
+    double wall_limit_s;           /* 0 = none; exceeded => stop with reason.  Set it
                                         * with pk_monitor_start: it counts from there */
     /* private */
     double t_start, t_last, t_job;

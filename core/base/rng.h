@@ -7,7 +7,9 @@
 
 #include <stdint.h>
 
-typedef struct { uint64_t s[4]; } pk_rng;
+typedef struct {
+    uint64_t s[4];
+} pk_rng;
 
 void pk_rng_seed(pk_rng *g, uint64_t seed, uint64_t stream);
 /* Next 64 random bits.  Inline: hot loops (RSA's batched draws) call it
@@ -29,7 +31,10 @@ static inline uint64_t pk_rng_next(pk_rng *g)
 }
 
 /* Uniform in [0,1) with 53 random bits. */
-static inline double pk_rng_uniform(pk_rng *g) { return (double)(pk_rng_next(g) >> 11) * 0x1.0p-53; }
+static inline double pk_rng_uniform(pk_rng *g)
+{
+    return (double)(pk_rng_next(g) >> 11) * 0x1.0p-53;
+}
 /* Uniform in [a,b). */
 double pk_rng_range(pk_rng *g, double a, double b);
 /* Standard normal (Box–Muller, no cached second value: stream stays simple). */

@@ -22,20 +22,20 @@ void pk_sparse_sym_free(pk_sparse_sym *A);
 void pk_sparse_sym_mv(const pk_sparse_sym *A, const double *x, double *y);
 
 typedef enum pk_sparse_status {
-    PK_SPARSE_OK = 0,          /* positive definite */
-    PK_SPARSE_INDEFINITE,      /* negative pivots (inertia reported) */
-    PK_SPARSE_SINGULAR,        /* zero pivot(s) */
-    PK_SPARSE_FAILED,          /* memory or library error */
-    PK_SPARSE_NOT_PD           /* not positive definite, inertia not computed (factor_pd) */
+    PK_SPARSE_OK = 0,     /* positive definite */
+    PK_SPARSE_INDEFINITE, /* negative pivots (inertia reported) */
+    PK_SPARSE_SINGULAR,   /* zero pivot(s) */
+    PK_SPARSE_FAILED,     /* memory or library error */
+    PK_SPARSE_NOT_PD      /* not positive definite, inertia not computed (factor_pd) */
 } pk_sparse_status;
 
 const char *pk_sparse_status_name(pk_sparse_status s);
 
 typedef struct pk_sparse_info {
     pk_sparse_status status;
-    size_t npos, nneg, nzero;  /* inertia of the LDLᵀ pivots */
+    size_t npos, nneg, nzero; /* inertia of the LDLᵀ pivots */
     double min_abs_pivot, max_abs_pivot;
-    int reused_analysis;       /* factor_pd_ctx: 1 = the context's analysis was used */
+    int reused_analysis; /* factor_pd_ctx: 1 = the context's analysis was used */
 } pk_sparse_info;
 
 typedef struct pk_sparse_factor pk_sparse_factor; /* solver-owned */
@@ -44,7 +44,7 @@ typedef struct pk_sparse_factor pk_sparse_factor; /* solver-owned */
  * it keeps the last symbolic analysis (fill-reducing ordering, supernodes)
  * and reuses it when the next matrix has the same pattern — the same
  * ordering gives the same numbers, bit for bit. */
-typedef struct pk_sparse_ctx pk_sparse_ctx;        /* solver-owned */
+typedef struct pk_sparse_ctx pk_sparse_ctx; /* solver-owned */
 
 typedef struct pk_sparse_solver {
     const char *name;
@@ -61,7 +61,7 @@ typedef struct pk_sparse_solver {
      * its analysis replaces the context's.  The factor outlives ctx. */
     pk_sparse_factor *(*factor_pd_ctx)(pk_sparse_ctx *ctx, const pk_sparse_sym *A,
                                        pk_sparse_info *info);
-    pk_sparse_ctx *(*ctx_new)(void);    /* NULL on failure (then use factor_pd) */
+    pk_sparse_ctx *(*ctx_new)(void);      /* NULL on failure (then use factor_pd) */
     void (*ctx_free)(pk_sparse_ctx *ctx); /* NULL-safe */
     /* X = A⁻¹B, B and X column-major n × nrhs.  0 / -1. */
     int (*solve)(pk_sparse_factor *f, size_t nrhs, const double *B, double *X);

@@ -24,8 +24,8 @@
 
 typedef struct pk_dem_geom {
     int dim;
-    int periodic;        /* 1 = minimum image across the reference box L */
-    double L[3];         /* reference box edges (periodic only) */
+    int periodic; /* 1 = minimum image across the reference box L */
+    double L[3];  /* reference box edges (periodic only) */
     double F[9], Finv[9];
 } pk_dem_geom;
 
@@ -38,11 +38,11 @@ void pk_dem_branch(const pk_dem_geom *g, const double *xi, const double *xj, dou
 
 typedef struct pk_dem_pairs {
     size_t n, cap;
-    int32_t *i, *j;      /* candidate pairs, i < j */
-    double *l;           /* [n][3] branch vector x_j − x_i (min image) */
-    double *len;         /* |l| */
-    double *eps;         /* overlap; contact iff eps >= 0 */
-    double *xb;          /* [np][3] positions at the last build (skin test) */
+    int32_t *i, *j; /* candidate pairs, i < j */
+    double *l;      /* [n][3] branch vector x_j − x_i (min image) */
+    double *len;    /* |l| */
+    double *eps;    /* overlap; contact iff eps >= 0 */
+    double *xb;     /* [np][3] positions at the last build (skin test) */
     size_t np;
     double skin;
     /* Pair-specific stiffness (E_n,ij of (4.3)): when kclass != NULL, pair
@@ -54,7 +54,7 @@ typedef struct pk_dem_pairs {
     const double *kmat;
     size_t nclass;
     double kref;
-    double *kf;          /* [n] per-candidate factor, NULL when uniform */
+    double *kf; /* [n] per-candidate factor, NULL when uniform */
     /* The periodic image of each candidate, fixed at the build: while the
      * grains stay within skin/2 of their build positions and F̄ is the same,
      * a candidate's minimum image cannot change (pk_dem_pairs_build), so the
@@ -74,13 +74,13 @@ typedef struct pk_dem_pairs {
      * bit for bit — f, the count, l, |l|, ε, energy, S — for any number of
      * threads (dem_eval_par.c).  The fields below are its own: */
     pk_par *par;
-    double *fa;          /* [n][dim] force on i of each candidate, 0 when not in contact */
-    int32_t *ord;        /* per part P of the grains, its grains k with candidates
+    double *fa;   /* [n][dim] force on i of each candidate, 0 when not in contact */
+    int32_t *ord; /* per part P of the grains, its grains k with candidates
                             j = k by their number: ord[bofs[P] .. bofs[P+1]) */
     int32_t *bofs;
-    int32_t *jofs, *jq;  /* ord[m]'s candidates with j = ord[m], pair order:
+    int32_t *jofs, *jq; /* ord[m]'s candidates with j = ord[m], pair order:
                             jq[jofs[m] .. jofs[m+1]) */
-    int32_t *iofs;       /* k's own run of candidates: [iofs[k], iofs[k+1]) */
+    int32_t *iofs;      /* k's own run of candidates: [iofs[k], iofs[k+1]) */
     size_t csr_n, csr_np, csr_pcap, csr_gcap;
     int csr_state, csr_dim, csr_parts; /* state 0 to build, 1 built, −1 the list is
                                           not in build order: serial */

@@ -9,11 +9,11 @@
 /* Forces are scattered with the sum on i kept in registers while the pairs
  * of one i follow each other (the build lists them by i): the read-modify-
  * write chain through f[i] was the latency bound of the loop. */
-#define FLUSH_I(dim_)                                                                          \
-    do {                                                                                       \
-        if (f && icur != SIZE_MAX)                                                             \
-            for (int a_ = 0; a_ < (dim_); a_++)                                                \
-                f[3 * icur + a_] += fi[a_];                                                    \
+#define FLUSH_I(dim_)                                                                              \
+    do {                                                                                           \
+        if (f && icur != SIZE_MAX)                                                                 \
+            for (int a_ = 0; a_ < (dim_); a_++)                                                    \
+                f[3 * icur + a_] += fi[a_];                                                        \
     } while (0)
 
 /* The block geometry: l ([n][3]), |l| and ε of the candidates from p0 on,
@@ -67,11 +67,11 @@ int pk_dem_scalar_only = 0;
  * are bit-identical to the scalar loop (tests/unit/test_dem_lanes.c).
  * keep = 0 (block buffers, pk_dem_eval_forces): only l's two components
  * are stored for the lanes (the force pass reads nothing else of them). */
-__attribute__((target("avx2"))) static size_t geom_2d_lanes4(const pk_dem_pairs *c,
-                                                             const double *x, const double *r,
-                                                             double E, size_t p0, size_t pe,
-                                                             geom_out o, int32_t *idx, double *tq,
-                                                             const int per, const int keep)
+__attribute__((target("avx2"))) static size_t geom_2d_lanes4(const pk_dem_pairs *c, const double *x,
+                                                             const double *r, double E, size_t p0,
+                                                             size_t pe, geom_out o, int32_t *idx,
+                                                             double *tq, const int per,
+                                                             const int keep)
 {
     const double *kf = c->kf, *sh = c->sh;
     const __m256d EV = _mm256_set1_pd(E);
@@ -108,10 +108,9 @@ __attribute__((target("avx2"))) static size_t geom_2d_lanes4(const pk_dem_pairs 
             lp[2] = lp[5] = lp[8] = lp[11] = 0;
         const __m256d len =
             _mm256_sqrt_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)));
-        const __m256d eps = _mm256_sub_pd(
-            _mm256_add_pd(_mm256_setr_pd(r[i0], r[i1], r[i2], r[i3]),
-                          _mm256_setr_pd(r[j0], r[j1], r[j2], r[j3])),
-            len);
+        const __m256d eps = _mm256_sub_pd(_mm256_add_pd(_mm256_setr_pd(r[i0], r[i1], r[i2], r[i3]),
+                                                        _mm256_setr_pd(r[j0], r[j1], r[j2], r[j3])),
+                                          len);
         if (keep) {
             _mm256_storeu_pd(&o.len[p - p0], len);
             _mm256_storeu_pd(&o.eps[p - p0], eps);
@@ -136,10 +135,7 @@ __attribute__((target("avx2"))) static size_t geom_2d_lanes4(const pk_dem_pairs 
     return nc;
 }
 
-static int geom_lanes4_ok(void)
-{
-    return __builtin_cpu_supports("avx2") && !pk_dem_scalar_only;
-}
+static int geom_lanes4_ok(void) { return __builtin_cpu_supports("avx2") && !pk_dem_scalar_only; }
 #endif
 
 int pk_dem_lanes_available(void)
@@ -172,11 +168,10 @@ int pk_dem_lanes_available(void)
 #if defined(__GNUC__)
 __attribute__((always_inline)) /* one copy per call below: the flags constants */
 #endif
-static inline size_t eval_2d_loop(pk_dem_pairs *c, const pk_dem_geom *g, const double *x,
-                                  const double *r, double E, double *f, double *phi_out,
-                                  double S[9], size_t pa, size_t pb, const int per,
-                                  const int want_phi, const int want_S, const int lanes,
-                                  const int keep, const int split)
+static inline size_t
+eval_2d_loop(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r, double E,
+             double *f, double *phi_out, double S[9], size_t pa, size_t pb, const int per,
+             const int want_phi, const int want_S, const int lanes, const int keep, const int split)
 {
     const double *kf = c->kf;
     const int32_t *pi = c->i, *pj = c->j;
@@ -188,8 +183,8 @@ static inline size_t eval_2d_loop(pk_dem_pairs *c, const pk_dem_geom *g, const d
     double bl[3 * EVAL_BLOCK], blen[EVAL_BLOCK], beps[EVAL_BLOCK]; /* keep = 0: L1-resident */
     for (size_t p0 = pa; p0 < pb; p0 += EVAL_BLOCK) {
         size_t pe = pb - p0 < EVAL_BLOCK ? pb : p0 + EVAL_BLOCK, m = pe - p0;
-        const geom_out o = keep ? (geom_out){&c->l[3 * p0], &c->len[p0], &c->eps[p0]}
-                                : (geom_out){bl, blen, beps};
+        const geom_out o =
+            keep ? (geom_out){&c->l[3 * p0], &c->len[p0], &c->eps[p0]} : (geom_out){bl, blen, beps};
 #ifdef HAVE_GEOM_LANES4
         if (lanes)
             nc += m = geom_2d_lanes4(c, x, r, E, p0, pe, o, idx, tq, per, keep);
@@ -212,7 +207,7 @@ static inline size_t eval_2d_loop(pk_dem_pairs *c, const pk_dem_geom *g, const d
             double t = lanes ? tq[q] : (kf ? E * kf[p] : E) * o.eps[b] / o.len[b]; /* (4.8) */
             if (want_phi) {
                 double k = kf ? E * kf[p] : E, eps = o.eps[b]; /* pk_dem_pair_E */
-                phi += 0.5 * k * eps * eps;                   /* (4.3) */
+                phi += 0.5 * k * eps * eps;                    /* (4.3) */
             }
             double fa0 = -t * d0, fa1 = -t * d1;
             if (f) {
@@ -314,9 +309,8 @@ static size_t pair_forces_3d(pk_dem_pairs *c, const pk_dem_geom *g, const double
 }
 
 /* 2D: eval_2d; 3D: the generic loop (the same sums in the same order). */
-size_t pk_dem_eval_serial(pk_dem_pairs *c, const pk_dem_geom *g, const double *x,
-                          const double *r, double E, double *f, double *energy, double S[9],
-                          int keep)
+size_t pk_dem_eval_serial(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
+                          double E, double *f, double *energy, double S[9], int keep)
 {
     const int dim = g->dim;
     if (dim == 2)

@@ -217,12 +217,12 @@ typedef struct par_job {
     const double *x, *r;
     double E;
     double *f, *energy, *S;
-    int keep;                 /* pk_dem_eval_part's keep */
-    int nparts, chains;       /* parts of each phase; 1: walk the energy/S chains */
-    atomic_size_t nc;         /* contacts */
-    atomic_int next;          /* phase A's next part to claim */
+    int keep;           /* pk_dem_eval_part's keep */
+    int nparts, chains; /* parts of each phase; 1: walk the energy/S chains */
+    atomic_size_t nc;   /* contacts */
+    atomic_int next;    /* phase A's next part to claim */
     atomic_int chain_taken;
-    atomic_int done[MAX_PARTS]; /* phase A's parts finished */
+    atomic_int done[MAX_PARTS];  /* phase A's parts finished */
     atomic_int taken[MAX_PARTS]; /* phase B's parts claimed */
 } par_job;
 

@@ -6,10 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-int pk_fric_law_active(const pk_fric_law *law)
-{
-    return law && (law->tan_rho > 0 || law->h > 0);
-}
+int pk_fric_law_active(const pk_fric_law *law) { return law && (law->tan_rho > 0 || law->h > 0); }
 
 int pk_fric_return_map(const pk_fric_law *law, double fn, double gamma, double gamma_pl_n,
                        double alpha_n, pk_fric_point *out)
@@ -23,7 +20,7 @@ int pk_fric_return_map(const pk_fric_law *law, double fn, double gamma, double g
     out->dlambda = 0;
     if (Y < c) /* stick; Table 7.1 slips on Y >= c */
         return 0;
-    double sg = ftr >= 0 ? 1 : -1; /* sgn(0) := +1 */
+    double sg = ftr >= 0 ? 1 : -1;  /* sgn(0) := +1 */
     double dl = (Y - c) / (Et + h); /* (7.16) */
     out->dlambda = dl;
     out->gamma_pl = gamma_pl_n + dl * sg; /* (7.17), erratum of (7.12) */
@@ -217,8 +214,10 @@ double pk_dem_fric_gershgorin(const pk_dem_pairs *c, const pk_fric_ctx *fc, size
     return m;
 }
 
-
-typedef struct { uint64_t key; double g, gpl, al; } hist_row;
+typedef struct {
+    uint64_t key;
+    double g, gpl, al;
+} hist_row;
 
 static int cmp_row(const void *a, const void *b)
 {

@@ -33,9 +33,9 @@
 #include "dem_contact.h"
 
 typedef struct pk_fric_law {
-    double E_t;      /* tangential stiffness (> 0), thesis E_t = ϑ E_n */
-    double tan_rho;  /* friction coefficient tan ρ (>= 0) */
-    double h;        /* hardening modulus of the friction limit (>= 0) */
+    double E_t;     /* tangential stiffness (> 0), thesis E_t = ϑ E_n */
+    double tan_rho; /* friction coefficient tan ρ (>= 0) */
+    double h;       /* hardening modulus of the friction limit (>= 0) */
 } pk_fric_law;
 
 /* 1 when the law can carry a tangential force (tan ρ > 0 or h > 0). */
@@ -70,16 +70,16 @@ void pk_fric_pairs_free(pk_fric_pairs *w);
 
 typedef struct pk_fric_ctx {
     const pk_fric_law *law;
-    pk_dem_geom g_n;              /* geometry at the committed F̄ⁿ */
-    const double *x_n, *u_n;      /* committed centres, committed r_i θ_i */
-    const pk_fric_hist *hist_n;   /* committed history */
-    pk_fric_pairs w;              /* per-pair scratch / results */
+    pk_dem_geom g_n;            /* geometry at the committed F̄ⁿ */
+    const double *x_n, *u_n;    /* committed centres, committed r_i θ_i */
+    const pk_fric_hist *hist_n; /* committed history */
+    pk_fric_pairs w;            /* per-pair scratch / results */
 } pk_fric_ctx;
 
 typedef struct pk_fric_totals {
-    double energy;        /* Φ_t (7.6) summed over contacts */
-    double dissipation;   /* Σ Δλ f_n tan ρ (7.13, one step) */
-    size_t sliding;       /* contacts on the yield surface */
+    double energy;      /* Φ_t (7.6) summed over contacts */
+    double dissipation; /* Σ Δλ f_n tan ρ (7.13, one step) */
+    size_t sliding;     /* contacts on the yield surface */
 } pk_fric_totals;
 
 /* Tangential part at (x, u).  Call after pk_dem_eval on the same c and x

@@ -17,9 +17,8 @@ void pk_dem_pairs_fit_images(pk_dem_pairs *c, const pk_dem_geom *g, const double
 /* dem_eval_loops.c: the serial evaluation of every candidate (f, when not
  * NULL, zeroed by the caller; S zeroed).  keep = 0 only for the forces
  * alone: the 2D lanes may leave c->l, len, eps as they were. */
-size_t pk_dem_eval_serial(pk_dem_pairs *c, const pk_dem_geom *g, const double *x,
-                          const double *r, double E, double *f, double *energy, double S[9],
-                          int keep);
+size_t pk_dem_eval_serial(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
+                          double E, double *f, double *energy, double S[9], int keep);
 
 /* dem_eval_loops.c: phase A of the threaded evaluation over candidates
  * [pa, pb) (whole runs of i): the serial loop's geometry, each candidate's

@@ -16,8 +16,7 @@ void pk_dem_kblocks_free(pk_dem_kblocks *kb)
     memset(kb, 0, sizeof *kb);
 }
 
-int pk_dem_kblocks_build(pk_dem_kblocks *kb, const pk_dem_pairs *c, double E,
-                         const uint8_t *mask)
+int pk_dem_kblocks_build(pk_dem_kblocks *kb, const pk_dem_pairs *c, double E, const uint8_t *mask)
 {
     pk_dem_kblocks_free(kb);
     size_t cap = c->n ? c->n : 1;

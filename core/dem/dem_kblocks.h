@@ -15,14 +15,13 @@
 typedef struct pk_dem_kblocks {
     size_t n;
     int32_t *i, *j;
-    uint8_t *side;       /* bit 0: i in the mask, bit 1: j in the mask */
-    double *l;           /* [n][3] branch vectors */
+    uint8_t *side; /* bit 0: i in the mask, bit 1: j in the mask */
+    double *l;     /* [n][3] branch vectors */
     double *a, *b;
 } pk_dem_kblocks;
 
 /* From the contacts of the last pk_dem_eval on c.  0 / -1 (memory). */
-int pk_dem_kblocks_build(pk_dem_kblocks *kb, const pk_dem_pairs *c, double E,
-                         const uint8_t *mask);
+int pk_dem_kblocks_build(pk_dem_kblocks *kb, const pk_dem_pairs *c, double E, const uint8_t *mask);
 
 /* out = K v on the masked particles (v read there only, out 0 elsewhere),
  * = pk_dem_kv(c, dim, np, E, mask, v, out) at the build. */

@@ -149,7 +149,7 @@ static void pair_shifts(pk_dem_pairs *c, const pk_dem_geom *g, const double *x)
 static int shifts_match(const pk_dem_pairs *c, const pk_dem_geom *g)
 {
     return c->sh_ok && c->sh_dim == g->dim && c->sh_periodic == g->periodic &&
-           memcmp(c->sh_F, g->F, sizeof c->sh_F) == 0 && memcmp(c->sh_L, g->L, sizeof c->sh_L) == 0;
+        memcmp(c->sh_F, g->F, sizeof c->sh_F) == 0 && memcmp(c->sh_L, g->L, sizeof c->sh_L) == 0;
 }
 
 void pk_dem_pairs_fit_images(pk_dem_pairs *c, const pk_dem_geom *g, const double *x)

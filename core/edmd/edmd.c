@@ -447,12 +447,13 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
     double gam_now = resume ? L.growth_rate : prm->growth_rate;
     int slowed = (resume && L.slowed) || !(prm->jam_rate_factor > 0 && prm->jam_rate_factor < 1);
     const int stall_auto = isnan(prm->stall_growth);
-    uint64_t next_check = st->events + c_win, hist_stride = L.hist_stride, hist_count = L.hist_count;
+    uint64_t next_check = st->events + c_win, hist_stride = L.hist_stride,
+             hist_count = L.hist_count;
     uint64_t stall_ev = st->events;
     uint64_t last_rebase = st->events, rebase_win = REBASE_WINDOWS * (uint64_t)s->n;
     const uint64_t resort_win = s->n >= RESORT_MIN_N ? RESORT_WINDOWS * (uint64_t)s->n : 0;
     uint64_t next_resort = st->events + resort_win;
-    double t_base = L.t_base;    /* absolute time of the re-based origin t = 0 */
+    double t_base = L.t_base; /* absolute time of the re-based origin t = 0 */
     double stall_acc = 0, phi_prev = phi_sim(s, 0), pressure = L.pressure;
     pk_progress pr = {.stage = "edmd", .fraction = L.fraction, .phi = phi_true(s, 0), .eta_s = -1};
     char msg[160];
@@ -535,8 +536,8 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
             double stall_growth = prm->stall_growth;
             if (stall_auto)
                 stall_growth = prm->until == PK_EDMD_UNTIL_JAMMED
-                                   ? fmin(1e-12, 1e-2 * gam_now / fmax(pressure, 1))
-                                   : 1e-12;
+                    ? fmin(1e-12, 1e-2 * gam_now / fmax(pressure, 1))
+                    : 1e-12;
             if (stall_acc * gam_now < stall_growth) {
                 crit = PK_EDMD_CRIT_STALL;
                 break;
@@ -552,7 +553,9 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
             pr.done = (size_t)st->events;
             if (isfinite(t_stop)) {
                 pr.fraction = fmin(1, (t_base + s->t) / t_stop);
-                pr.eta_s = pr.fraction > 0 ? (pk_wall_seconds() - w0) * (1 - pr.fraction) / pr.fraction : -1;
+                pr.eta_s = pr.fraction > 0
+                    ? (pk_wall_seconds() - w0) * (1 - pr.fraction) / pr.fraction
+                    : -1;
             } else { /* until jammed: the reduced pressure on its way to p_max, on a log scale */
                 double f = pressure > 1 && prm->p_max > 1 ? log(pressure) / log(prm->p_max) : 0;
                 if (prm->max_events)
@@ -619,8 +622,8 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
                 rebase(s);
                 st->rebases++;
                 last_rebase = st->events;
-                edmd_ckpt_loop now = {t_base, K0, pressure, pr.fraction, hist_stride, hist_count,
-                                      gam_now, slowed};
+                edmd_ckpt_loop now = {t_base,      K0,         pressure, pr.fraction,
+                                      hist_stride, hist_count, gam_now,  slowed};
                 edmd_checkpoint_take(s, perm, st, &now, ckpt);
             }
         }

@@ -32,12 +32,12 @@ typedef enum pk_edmd_growth {
     /* d_i(t) = d_i·s(t), s' = γ, d_i the FINAL diameter: size ratios exact (Meier,
      * Titscher §6.2; Titscher's γ of Eq. 30 is relative to δ·d_i, i.e. ours/δ) */
     PK_EDMD_GROW_RELATIVE = 0,
-    PK_EDMD_GROW_SHELL         /* true radii fixed, the Δd/2 shell grows at γ·d̄/2 (Titscher §6.3/6.4) */
+    PK_EDMD_GROW_SHELL /* true radii fixed, the Δd/2 shell grows at γ·d̄/2 (Titscher §6.3/6.4) */
 } pk_edmd_growth;
 
 typedef enum pk_edmd_until {
-    PK_EDMD_UNTIL_TARGET = 0,  /* stop exactly at the target (φ, sizes or Δd) */
-    PK_EDMD_UNTIL_JAMMED       /* grow on until a jamming criterion holds */
+    PK_EDMD_UNTIL_TARGET = 0, /* stop exactly at the target (φ, sizes or Δd) */
+    PK_EDMD_UNTIL_JAMMED      /* grow on until a jamming criterion holds */
 } pk_edmd_until;
 
 /* Pair collision rules.  w = normal separation speed of the centres,
@@ -65,36 +65,43 @@ typedef enum pk_edmd_rule {
 typedef struct pk_edmd_params {
     pk_edmd_growth growth;
     pk_edmd_until until;
-    int start_zero;            /* 1: radii from 0 at random positions (Meier); 0: positions given */
-    double delta;              /* start size fraction δ (relative growth from given positions) */
-    double phi_target;         /* >0: relative growth stops when φ(true radii) = this */
-    double delta_d;            /* minimum surface gap Δd (shell Δd/2); SHELL+TARGET grows it to this */
-    double growth_rate;        /* γ: d(diameter)/dt of a mean grain over the rms speed per axis */
-    double p_max;              /* reduced pressure criterion (e.g. 1e12) */
-    double jam_rate_factor;    /* until jammed: the growth rate × this once p > 10^3 (1 = constant) */
-    double dphi_crit;          /* Meier Eq. 3.11: Δφ over c events below this => jammed (0 = off) */
-    uint64_t dphi_events;      /* c (0 = number of grains) */
-    double stall_growth;       /* stall: relative size growth γ·Δt over the window below this;
+    int start_zero;     /* 1: radii from 0 at random positions (Meier); 0: positions given */
+    double delta;       /* start size fraction δ (relative growth from given positions) */
+    double phi_target;  /* >0: relative growth stops when φ(true radii) = this */
+    double delta_d;     /* minimum surface gap Δd (shell Δd/2); SHELL+TARGET grows it to this */
+    double growth_rate; /* γ: d(diameter)/dt of a mean grain over the rms speed per axis */
+    double p_max;       /* reduced pressure criterion (e.g. 1e12) */
+    double jam_rate_factor; /* until jammed: the growth rate × this once p > 10^3 (1 = constant) */
+    double dphi_crit;       /* Meier Eq. 3.11: Δφ over c events below this => jammed (0 = off) */
+    uint64_t dphi_events;   /* c (0 = number of grains) */
+    double stall_growth;    /* stall: relative size growth γ·Δt over the window below this;
                                 * NAN = the default: 1e-12, and until jammed also below
                                 * 1e-2·γ/p of the window's pressure p (a packing at p grows
                                 * ~γ/p per window: the stall never preempts the pressure stop) */
-    uint64_t stall_events;     /* window of the stall detector (Titscher: 1000; at least N) */
-    pk_edmd_rule rule;         /* pair collision rule */
-    int rescale;               /* 1: hold the kinetic energy near its start value */
-    double rescale_tol;        /* rescale when K leaves [K0/(1+tol), K0(1+tol)] */
-    double skin;               /* neighbour-list skin as a fraction of a radius */
-    int equal_masses;          /* 1: m_i = 1 (Meier); 0: m_i ∝ final volume */
-    uint64_t max_events;       /* 0 = unlimited */
-    uint64_t seed;             /* velocities: stream 2; zero-start positions: stream 3 */
-    struct pk_edmd_checkpoint *checkpoint; /* snapshots / resume (core/edmd/edmd_checkpoint.h); NULL = none */
+    uint64_t stall_events;  /* window of the stall detector (Titscher: 1000; at least N) */
+    pk_edmd_rule rule;      /* pair collision rule */
+    int rescale;            /* 1: hold the kinetic energy near its start value */
+    double rescale_tol;     /* rescale when K leaves [K0/(1+tol), K0(1+tol)] */
+    double skin;            /* neighbour-list skin as a fraction of a radius */
+    int equal_masses;       /* 1: m_i = 1 (Meier); 0: m_i ∝ final volume */
+    uint64_t max_events;    /* 0 = unlimited */
+    uint64_t seed;          /* velocities: stream 2; zero-start positions: stream 3 */
+    struct pk_edmd_checkpoint
+        *checkpoint; /* snapshots / resume (core/edmd/edmd_checkpoint.h); NULL = none */
 } pk_edmd_params;
 
 /* Defaults documented in docs/job-format.md. */
 void pk_edmd_params_default(pk_edmd_params *prm);
 
 typedef enum pk_edmd_criterion {
-    PK_EDMD_CRIT_NONE = 0, PK_EDMD_CRIT_TARGET, PK_EDMD_CRIT_PRESSURE, PK_EDMD_CRIT_DELTA_PHI,
-    PK_EDMD_CRIT_STALL, PK_EDMD_CRIT_MAX_EVENTS, PK_EDMD_CRIT_CANCEL, PK_EDMD_CRIT_WALL_TIME,
+    PK_EDMD_CRIT_NONE = 0,
+    PK_EDMD_CRIT_TARGET,
+    PK_EDMD_CRIT_PRESSURE,
+    PK_EDMD_CRIT_DELTA_PHI,
+    PK_EDMD_CRIT_STALL,
+    PK_EDMD_CRIT_MAX_EVENTS,
+    PK_EDMD_CRIT_CANCEL,
+    PK_EDMD_CRIT_WALL_TIME,
     PK_EDMD_CRIT_ERROR
 } pk_edmd_criterion;
 const char *pk_edmd_criterion_name(pk_edmd_criterion c);
@@ -104,20 +111,20 @@ const char *pk_edmd_criterion_name(pk_edmd_criterion c);
 typedef struct pk_edmd_stats {
     pk_stop_reason reason;
     pk_edmd_criterion criterion;
-    double phi;                 /* φ of the true radii at the stop */
-    double phi_sim;             /* φ of the simulated (shell) radii */
-    double pressure;            /* reduced pressure of the last window (Eq. spec §3.7) */
-    double phi_jam_estimate;    /* φ/(1 − d/p) */
-    double delta_d;             /* gap guaranteed at the stop (2 h) */
-    double t_stop, t_end;       /* simulated times (unit d̄/u) */
+    double phi;              /* φ of the true radii at the stop */
+    double phi_sim;          /* φ of the simulated (shell) radii */
+    double pressure;         /* reduced pressure of the last window (Eq. spec §3.7) */
+    double phi_jam_estimate; /* φ/(1 − d/p) */
+    double delta_d;          /* gap guaranteed at the stop (2 h) */
+    double t_stop, t_end;    /* simulated times (unit d̄/u) */
     double seconds;
     uint64_t events, pair, wall, nlist, invalid, rescales, rebases, overlaps;
-    uint64_t growth_changes;    /* growth-rate reductions of the jamming schedule */
-    uint64_t resorts;           /* renumberings along the Z-order (large N) */
-    uint64_t second;            /* invalid events replaced by their runner-up (no prediction) */
-    double max_overlap_rel;     /* largest overlap seen by the predictor, relative to R */
-    double kinetic_ratio;       /* K/K0 at the stop (grows without rescaling) */
-    size_t nhist;               /* φ(t) history: events, time, φ, p */
+    uint64_t growth_changes; /* growth-rate reductions of the jamming schedule */
+    uint64_t resorts;        /* renumberings along the Z-order (large N) */
+    uint64_t second;         /* invalid events replaced by their runner-up (no prediction) */
+    double max_overlap_rel;  /* largest overlap seen by the predictor, relative to R */
+    double kinetic_ratio;    /* K/K0 at the stop (grows without rescaling) */
+    size_t nhist;            /* φ(t) history: events, time, φ, p */
     double hist_events[PK_EDMD_HIST_MAX], hist_t[PK_EDMD_HIST_MAX];
     double hist_phi[PK_EDMD_HIST_MAX], hist_p[PK_EDMD_HIST_MAX];
 } pk_edmd_stats;
@@ -134,8 +141,8 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
  * the RSA positions.  Returns 0 and the RSA stats; rs->placed < n when RSA
  * could not place all of them. */
 int pk_edmd_start_rsa(const pk_box *b, const double *d, const int32_t *species, size_t n,
-                      double delta, double delta_d, uint64_t seed, pk_monitor *mon,
-                      pk_particles *p, pk_rsa_stats *rs);
+                      double delta, double delta_d, uint64_t seed, pk_monitor *mon, pk_particles *p,
+                      pk_rsa_stats *rs);
 
 /* The default RSA start of relative growth (Titscher §6.2, Kansal): RSA
  * fills PK_EDMD_START_PHI of the box, well below its saturation (3D equal
@@ -158,12 +165,10 @@ double pk_edmd_start_delta(int dim, const double *d, size_t n, double delta_d, d
 
 /* Time τ ≥ 0 until |Δp + Δv τ| = R + G τ (spec §3.3a, cancellation-free
  * roots); INFINITY if never.  *overlap set to 1 when C < −1e-9 R².  dim 2/3. */
-double pk_edmd_pair_time(const double dp[3], const double dv[3], double R, double G,
-                         int *overlap);
+double pk_edmd_pair_time(const double dp[3], const double dv[3], double R, double G, int *overlap);
 
 /* Time until |q + v τ| + ρ0 + g τ = σ (the grain leaves its bounding sphere
  * of radius σ centred at q = 0); INFINITY if never. */
-double pk_edmd_exit_time(const double q[3], const double v[3], double rho0, double g,
-                         double sigma);
+double pk_edmd_exit_time(const double q[3], const double v[3], double rho0, double g, double sigma);
 
 #endif

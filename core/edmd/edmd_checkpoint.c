@@ -65,14 +65,20 @@ void edmd_checkpoint_take(const edmd_state *s, const size_t *perm, const pk_edmd
     snap.scal[PK_EDMD_SNAP_MAX_OVERLAP] = s->max_overlap_rel;
     snap.scal[PK_EDMD_SNAP_FRACTION] = l->fraction;
     snap.scal[PK_EDMD_SNAP_GROWTH_RATE] = l->growth_rate;
-    const uint64_t cnt[PK_EDMD_SNAP_NCNT] = {
-        [PK_EDMD_SNAP_EVENTS] = st->events, [PK_EDMD_SNAP_PAIR] = st->pair,
-        [PK_EDMD_SNAP_WALL] = st->wall, [PK_EDMD_SNAP_NLIST] = st->nlist,
-        [PK_EDMD_SNAP_INVALID] = st->invalid, [PK_EDMD_SNAP_RESCALES] = st->rescales,
-        [PK_EDMD_SNAP_REBASES] = st->rebases, [PK_EDMD_SNAP_OVERLAPS] = s->n_overlap,
-        [PK_EDMD_SNAP_RESORTS] = st->resorts, [PK_EDMD_SNAP_SECOND] = st->second,
-        [PK_EDMD_SNAP_HIST_STRIDE] = l->hist_stride, [PK_EDMD_SNAP_HIST_COUNT] = l->hist_count,
-        [PK_EDMD_SNAP_SLOWED] = (uint64_t)l->slowed, [PK_EDMD_SNAP_GROWTH_CHANGES] = st->growth_changes};
+    const uint64_t cnt[PK_EDMD_SNAP_NCNT] = {[PK_EDMD_SNAP_EVENTS] = st->events,
+                                             [PK_EDMD_SNAP_PAIR] = st->pair,
+                                             [PK_EDMD_SNAP_WALL] = st->wall,
+                                             [PK_EDMD_SNAP_NLIST] = st->nlist,
+                                             [PK_EDMD_SNAP_INVALID] = st->invalid,
+                                             [PK_EDMD_SNAP_RESCALES] = st->rescales,
+                                             [PK_EDMD_SNAP_REBASES] = st->rebases,
+                                             [PK_EDMD_SNAP_OVERLAPS] = s->n_overlap,
+                                             [PK_EDMD_SNAP_RESORTS] = st->resorts,
+                                             [PK_EDMD_SNAP_SECOND] = st->second,
+                                             [PK_EDMD_SNAP_HIST_STRIDE] = l->hist_stride,
+                                             [PK_EDMD_SNAP_HIST_COUNT] = l->hist_count,
+                                             [PK_EDMD_SNAP_SLOWED] = (uint64_t)l->slowed,
+                                             [PK_EDMD_SNAP_GROWTH_CHANGES] = st->growth_changes};
     for (int k = 0; k < PK_EDMD_SNAP_NCNT; k++)
         snap.cnt[k] = (int64_t)cnt[k];
     snap.nhist = st->nhist;

@@ -20,24 +20,42 @@
 
 /* scal[] members */
 enum {
-    PK_EDMD_SNAP_T_BASE, PK_EDMD_SNAP_H0, PK_EDMD_SNAP_H1, PK_EDMD_SNAP_K0,
-    PK_EDMD_SNAP_PRESSURE, PK_EDMD_SNAP_SKIN_SCALE, PK_EDMD_SNAP_MAX_OVERLAP,
-    PK_EDMD_SNAP_FRACTION, PK_EDMD_SNAP_GROWTH_RATE, PK_EDMD_SNAP_NSCAL
+    PK_EDMD_SNAP_T_BASE,
+    PK_EDMD_SNAP_H0,
+    PK_EDMD_SNAP_H1,
+    PK_EDMD_SNAP_K0,
+    PK_EDMD_SNAP_PRESSURE,
+    PK_EDMD_SNAP_SKIN_SCALE,
+    PK_EDMD_SNAP_MAX_OVERLAP,
+    PK_EDMD_SNAP_FRACTION,
+    PK_EDMD_SNAP_GROWTH_RATE,
+    PK_EDMD_SNAP_NSCAL
 };
 /* cnt[] members */
 enum {
-    PK_EDMD_SNAP_EVENTS, PK_EDMD_SNAP_PAIR, PK_EDMD_SNAP_WALL, PK_EDMD_SNAP_NLIST,
-    PK_EDMD_SNAP_INVALID, PK_EDMD_SNAP_RESCALES, PK_EDMD_SNAP_REBASES, PK_EDMD_SNAP_OVERLAPS,
-    PK_EDMD_SNAP_RESORTS, PK_EDMD_SNAP_SECOND, PK_EDMD_SNAP_HIST_STRIDE, PK_EDMD_SNAP_HIST_COUNT,
-    PK_EDMD_SNAP_SLOWED, PK_EDMD_SNAP_GROWTH_CHANGES, PK_EDMD_SNAP_NCNT
+    PK_EDMD_SNAP_EVENTS,
+    PK_EDMD_SNAP_PAIR,
+    PK_EDMD_SNAP_WALL,
+    PK_EDMD_SNAP_NLIST,
+    PK_EDMD_SNAP_INVALID,
+    PK_EDMD_SNAP_RESCALES,
+    PK_EDMD_SNAP_REBASES,
+    PK_EDMD_SNAP_OVERLAPS,
+    PK_EDMD_SNAP_RESORTS,
+    PK_EDMD_SNAP_SECOND,
+    PK_EDMD_SNAP_HIST_STRIDE,
+    PK_EDMD_SNAP_HIST_COUNT,
+    PK_EDMD_SNAP_SLOWED,
+    PK_EDMD_SNAP_GROWTH_CHANGES,
+    PK_EDMD_SNAP_NCNT
 };
 #define PK_EDMD_SNAP_KIN 8 /* p[3], a, v[3], g per grain */
 
 typedef struct pk_edmd_snapshot {
     size_t n;
     int dim;
-    double *kin;                 /* [n][PK_EDMD_SNAP_KIN] in engine order */
-    int64_t *perm;               /* [n] engine index -> the caller's grain */
+    double *kin;   /* [n][PK_EDMD_SNAP_KIN] in engine order */
+    int64_t *perm; /* [n] engine index -> the caller's grain */
     double scal[PK_EDMD_SNAP_NSCAL];
     int64_t cnt[PK_EDMD_SNAP_NCNT];
     size_t nhist;
@@ -46,16 +64,16 @@ typedef struct pk_edmd_snapshot {
 
 /* What a run does with snapshots (pk_edmd_params.checkpoint; NULL = none). */
 typedef struct pk_edmd_checkpoint {
-    double interval_s;           /* wall seconds between snapshots (<= 0: none) */
+    double interval_s; /* wall seconds between snapshots (<= 0: none) */
     /* Called with each snapshot; its return value is only counted (a full
      * disk must not stop the run). */
     int (*save)(const pk_edmd_snapshot *snap, void *ctx);
     void *ctx;
     const pk_edmd_snapshot *resume; /* continue from here (NULL: from the start) */
     /* out */
-    int resumed;                 /* 1: the run continued from resume */
-    uint64_t resumed_events;     /* events done before the resume */
-    double resumed_time;         /* simulated time reached before it */
+    int resumed;             /* 1: the run continued from resume */
+    uint64_t resumed_events; /* events done before the resume */
+    double resumed_time;     /* simulated time reached before it */
     unsigned saved, save_failures;
     /* private */
     double last_s;
@@ -71,8 +89,8 @@ struct edmd_state;
 typedef struct edmd_ckpt_loop {
     double t_base, K0, pressure, fraction;
     uint64_t hist_stride, hist_count;
-    double growth_rate;          /* the run's current γ (slowed near jamming) */
-    int slowed;                  /* the jamming slowdown has been applied */
+    double growth_rate; /* the run's current γ (slowed near jamming) */
+    int slowed;         /* the jamming slowdown has been applied */
 } edmd_ckpt_loop;
 
 /* 1 when a snapshot is due (its interval has passed since the last one or

@@ -12,10 +12,10 @@
 #include "core/space/particles.h"
 
 typedef struct pk_contact_stats {
-    size_t contacts;          /* pairs in contact */
+    size_t contacts; /* pairs in contact */
     size_t rattlers;
-    double rattler_fraction;  /* rattlers / n */
-    double mean_contacts;     /* mean contact number z of the non-rattlers (0 if all rattle) */
+    double rattler_fraction; /* rattlers / n */
+    double mean_contacts;    /* mean contact number z of the non-rattlers (0 if all rattle) */
 } pk_contact_stats;
 
 /* Contact tolerance (relative to r_i + r_j) for a packing at reduced

@@ -26,10 +26,7 @@
 
 /* Free entries a slot gets beyond its list: a few gained neighbours before
  * the list moves to the pool's end. */
-static uint32_t slot_cap(uint32_t n)
-{
-    return n + n / 4 + 4;
-}
+static uint32_t slot_cap(uint32_t n) { return n + n / 4 + 4; }
 
 /* Room for extra more entries at the pool's end: compacts the slots in
  * grain order when at least half the pool is dead (abandoned slots), grows
@@ -132,8 +129,8 @@ static int store_new(edmd_state *s, size_t i, uint32_t n)
 typedef struct visit_ctx {
     edmd_state *s;
     int32_t self;
-    uint32_t n;               /* entries in s->nl_new */
-    uint32_t tag;             /* rebuilds: mark of i's old neighbours; tag + 1: kept */
+    uint32_t n;   /* entries in s->nl_new */
+    uint32_t tag; /* rebuilds: mark of i's old neighbours; tag + 1: kept */
     int failed;
 } visit_ctx;
 
@@ -249,7 +246,7 @@ int edmd_nlist_rebuild(edmd_state *s, size_t i)
         c.failed = 1;
     else
         pk_ugrid_query(&s->ugrid, &s->bs, &s->bs.x[3 * i], s->bs.r[i], visit_rebuild, &c);
-    old = s->nl_pool + s->nl[i].off; /* the pushes may have moved the slots */
+    old = s->nl_pool + s->nl[i].off;          /* the pushes may have moved the slots */
     for (uint32_t q = 0; q < s->nl[i].n; q++) /* lost neighbours */
         if (s->nl_mark[old[q]] == tag)
             drop(s, (size_t)old[q], (int32_t)i);

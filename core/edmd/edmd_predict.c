@@ -13,7 +13,7 @@
 static inline double pair_root(double A, double B, double C, double bound)
 {
     if (C > 0) {
-        if (A < 0) {                 /* growth outruns the relative speed: one positive root */
+        if (A < 0) { /* growth outruns the relative speed: one positive root */
             double sq = sqrt(B * B - A * C);
             return B < 0 ? C / (-B + sq) : (B + sq) / -A;
         }
@@ -26,7 +26,7 @@ static inline double pair_root(double A, double B, double C, double bound)
     }
     /* touching or overlapping by round-off */
     if (B < 0)
-        return 0;                    /* gap shrinking: collide now */
+        return 0; /* gap shrinking: collide now */
     if (A < 0) {
         const double D = B * B - A * C;
         return (B + sqrt(D > 0 ? D : 0)) / -A;
@@ -34,8 +34,7 @@ static inline double pair_root(double A, double B, double C, double bound)
     return INFINITY;
 }
 
-double pk_edmd_pair_time(const double dp[3], const double dv[3], double R, double G,
-                         int *overlap)
+double pk_edmd_pair_time(const double dp[3], const double dv[3], double R, double G, int *overlap)
 {
     double A = dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2] - G * G;
     double B = dp[0] * dv[0] + dp[1] * dv[1] + dp[2] * dv[2] - R * G;
@@ -45,8 +44,7 @@ double pk_edmd_pair_time(const double dp[3], const double dv[3], double R, doubl
     return pair_root(A, B, C, INFINITY);
 }
 
-double pk_edmd_exit_time(const double q[3], const double v[3], double rho0, double g,
-                         double sigma)
+double pk_edmd_exit_time(const double q[3], const double v[3], double rho0, double g, double sigma)
 {
     double S0 = sigma - rho0;
     double A = v[0] * v[0] + v[1] * v[1] + v[2] * v[2] - g * g;
@@ -57,10 +55,10 @@ double pk_edmd_exit_time(const double q[3], const double v[3], double rho0, doub
     const double D = B * B - A * C; /* >= 0 inside (C < 0, A >= 0); round-off aside */
     double sq = sqrt(D > 0 ? D : 0);
     if (B >= 0)
-        return C / -(B + sq);        /* C < 0: positive, no cancellation (+inf at rest, g = 0) */
+        return C / -(B + sq); /* C < 0: positive, no cancellation (+inf at rest, g = 0) */
     if (A > 0)
         return (-B + sq) / A;
-    return 0;                        /* B < 0 with A <= 0 is impossible inside; rebuild now */
+    return 0; /* B < 0 with A <= 0 is impossible inside; rebuild now */
 }
 
 /* Earliest wall contact of i from now; code = 2k + side. */
@@ -174,17 +172,17 @@ static inline void pair_one(edmd_state *s, pred *pr, const self *c, size_t j)
  * neighbours' columns p0..p2, v0..v2, ra, rg and the grain's broadcast terms
  * (X, V, L, I, RI, GI, T, VM) to R, B, dd, C, A and the discriminant D.
  * One text for the 4- and 8-lane loops. */
-#define LANE_TERMS(VT)                                                                         \
-    VT d0 = X0 - (p0 + v0 * T), d1 = X1 - (p1 + v1 * T), d2 = X2 - (p2 + v2 * T);            \
-    d0 -= L0 * ((d0 * I0 + VM) - VM);                                                          \
-    d1 -= L1 * ((d1 * I1 + VM) - VM);                                                          \
-    d2 -= L2 * ((d2 * I2 + VM) - VM);                                                          \
-    const VT dv0 = V0 - v0, dv1 = V1 - v1, dv2 = V2 - v2;                                      \
-    const VT R = RI + ra + rg * T, G = GI + rg;                                                \
-    const VT B = d0 * dv0 + d1 * dv1 + d2 * dv2 - R * G;                                       \
-    const VT dd = d0 * d0 + d1 * d1 + d2 * d2;                                                 \
-    const VT C = dd - R * R;                                                                   \
-    const VT A = dv0 * dv0 + dv1 * dv1 + dv2 * dv2 - G * G;                                    \
+#define LANE_TERMS(VT)                                                                             \
+    VT d0 = X0 - (p0 + v0 * T), d1 = X1 - (p1 + v1 * T), d2 = X2 - (p2 + v2 * T);                  \
+    d0 -= L0 * ((d0 * I0 + VM) - VM);                                                              \
+    d1 -= L1 * ((d1 * I1 + VM) - VM);                                                              \
+    d2 -= L2 * ((d2 * I2 + VM) - VM);                                                              \
+    const VT dv0 = V0 - v0, dv1 = V1 - v1, dv2 = V2 - v2;                                          \
+    const VT R = RI + ra + rg * T, G = GI + rg;                                                    \
+    const VT B = d0 * dv0 + d1 * dv1 + d2 * dv2 - R * G;                                           \
+    const VT dd = d0 * d0 + d1 * d1 + d2 * d2;                                                     \
+    const VT C = dd - R * R;                                                                       \
+    const VT A = dv0 * dv0 + dv1 * dv1 + dv2 * dv2 - G * G;                                        \
     const VT D = B * B - A * C
 
 /* The lanes in `lanes` that the vector tests did not dismiss, in ascending
@@ -242,7 +240,7 @@ __attribute__((target("avx2"))) static void pair_lanes4(edmd_state *s, pred *pr,
         if (q + 4 > nq) {
             const uint32_t left = nq - q; /* 1..3 */
             lanes = (1 << left) - 1;
-            tail[0] = tail[3] = nb[q];    /* nb[q + l] for l < left, else nb[q] */
+            tail[0] = tail[3] = nb[q]; /* nb[q + l] for l < left, else nb[q] */
             tail[1] = nb[q + (left > 1)];
             tail[2] = nb[q + 2 * (left > 2)];
             ix = tail;
@@ -263,12 +261,16 @@ __attribute__((target("avx2"))) static void pair_lanes4(edmd_state *s, pred *pr,
                   Wc = _mm256_load_pd(kc->v), Wd = _mm256_load_pd(kd->v);
         v4d lo = _mm256_unpacklo_pd(Pa, Pb), hi = _mm256_unpackhi_pd(Pa, Pb);
         v4d lo2 = _mm256_unpacklo_pd(Pc, Pd), hi2 = _mm256_unpackhi_pd(Pc, Pd);
-        const v4d p0 = _mm256_permute2f128_pd(lo, lo2, 0x20), p2 = _mm256_permute2f128_pd(lo, lo2, 0x31);
-        const v4d p1 = _mm256_permute2f128_pd(hi, hi2, 0x20), ra = _mm256_permute2f128_pd(hi, hi2, 0x31);
+        const v4d p0 = _mm256_permute2f128_pd(lo, lo2, 0x20),
+                  p2 = _mm256_permute2f128_pd(lo, lo2, 0x31);
+        const v4d p1 = _mm256_permute2f128_pd(hi, hi2, 0x20),
+                  ra = _mm256_permute2f128_pd(hi, hi2, 0x31);
         lo = _mm256_unpacklo_pd(Wa, Wb), hi = _mm256_unpackhi_pd(Wa, Wb);
         lo2 = _mm256_unpacklo_pd(Wc, Wd), hi2 = _mm256_unpackhi_pd(Wc, Wd);
-        const v4d v0 = _mm256_permute2f128_pd(lo, lo2, 0x20), v2 = _mm256_permute2f128_pd(lo, lo2, 0x31);
-        const v4d v1 = _mm256_permute2f128_pd(hi, hi2, 0x20), rg = _mm256_permute2f128_pd(hi, hi2, 0x31);
+        const v4d v0 = _mm256_permute2f128_pd(lo, lo2, 0x20),
+                  v2 = _mm256_permute2f128_pd(lo, lo2, 0x31);
+        const v4d v1 = _mm256_permute2f128_pd(hi, hi2, 0x20),
+                  rg = _mm256_permute2f128_pd(hi, hi2, 0x31);
         LANE_TERMS(v4d);
         const v4d BOUND = _mm256_set1_pd(pr->second);
         /* common lanes: gap open, A >= 0, approaching; pair_root dismisses
@@ -287,8 +289,8 @@ __attribute__((target("avx2"))) static void pair_lanes4(edmd_state *s, pred *pr,
         if (m_hit)
             tau = C / (-B + _mm256_sqrt_pd(_mm256_max_pd(D, ZERO)));
         lane_offers(s, pr, ix, (unsigned)(m_hit | m_other), (unsigned)m_hit, (const double *)&tau,
-                    (const double *)&A, (const double *)&B, (const double *)&C,
-                    (const double *)&R, (const double *)&dd);
+                    (const double *)&A, (const double *)&B, (const double *)&C, (const double *)&R,
+                    (const double *)&dd);
     }
 }
 
@@ -307,8 +309,8 @@ __attribute__((target("avx2"))) static void pair_lanes4(edmd_state *s, pred *pr,
  * 5–6 1.04–1.09; docs/perf/edmd.md). */
 #define LANES8_MIN 7
 __attribute__((target("avx512f"))) static uint32_t pair_lanes8(edmd_state *s, pred *pr,
-                                                               const self *c,
-                                                               const int32_t *nb, uint32_t nq)
+                                                               const self *c, const int32_t *nb,
+                                                               uint32_t nq)
 {
     typedef double v8d __attribute__((vector_size(64)));
     const edmd_kin *K = s->k;
@@ -366,11 +368,11 @@ __attribute__((target("avx512f"))) static uint32_t pair_lanes8(edmd_state *s, pr
         const __mmask8 grow_slower = _mm512_cmp_pd_mask(A, ZERO, _CMP_GE_OQ);
         const __mmask8 common = _mm512_cmp_pd_mask(C, ZERO, _CMP_GT_OQ) & grow_slower;
         const __mmask8 hit = common & _mm512_cmp_pd_mask(B, ZERO, _CMP_LT_OQ) &
-                             _mm512_cmp_pd_mask(C, -TWO * B * BOUND, _CMP_LT_OQ) &
-                             _mm512_cmp_pd_mask(D, ZERO, _CMP_GE_OQ);
+            _mm512_cmp_pd_mask(C, -TWO * B * BOUND, _CMP_LT_OQ) &
+            _mm512_cmp_pd_mask(D, ZERO, _CMP_GE_OQ);
         const __mmask8 parting = _mm512_cmp_pd_mask(C, ZERO, _CMP_LE_OQ) &
-                                 _mm512_cmp_pd_mask(B, ZERO, _CMP_GE_OQ) & grow_slower &
-                                 _mm512_cmp_pd_mask(C, NEG_TOL * R * R, _CMP_GE_OQ);
+            _mm512_cmp_pd_mask(B, ZERO, _CMP_GE_OQ) & grow_slower &
+            _mm512_cmp_pd_mask(C, NEG_TOL * R * R, _CMP_GE_OQ);
         const unsigned m_hit = hit & lanes, m_other = ~(unsigned)(common | parting) & lanes;
         if (!(m_hit | m_other))
             continue;
@@ -378,18 +380,15 @@ __attribute__((target("avx512f"))) static uint32_t pair_lanes8(edmd_state *s, pr
         if (m_hit)
             tau = C / (-B + _mm512_sqrt_pd(_mm512_max_pd(D, ZERO)));
         lane_offers(s, pr, ix, (unsigned)(m_hit | m_other), (unsigned)m_hit, (const double *)&tau,
-                    (const double *)&A, (const double *)&B, (const double *)&C,
-                    (const double *)&R, (const double *)&dd);
+                    (const double *)&A, (const double *)&B, (const double *)&C, (const double *)&R,
+                    (const double *)&dd);
     }
     return q;
 }
 
 /* (no cached flag: workers may predict in several threads; the builtin
  * reads the CPU model libgcc filled in at start-up) */
-static int lanes4_ok(void)
-{
-    return __builtin_cpu_supports("avx2") && !edmd_scalar_only;
-}
+static int lanes4_ok(void) { return __builtin_cpu_supports("avx2") && !edmd_scalar_only; }
 
 static int lanes8_ok(void)
 {

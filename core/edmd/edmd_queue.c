@@ -350,7 +350,7 @@ void edmd_queue_update(edmd_state *s, size_t i)
     const double t = s->ev[i].t;
     int64_t sl = slot_of(q, t);
     if (sl < q->cur)
-        sl = q->cur; /* (never: events lie ahead of the clock) */
+        sl = q->cur;                             /* (never: events lie ahead of the clock) */
     if (q->where[i] == Q_HEAP && sl == q->cur) { /* re-keyed in the heap */
         const size_t k = (size_t)q->hpos[i];
         const double old = q->heap[k].t;

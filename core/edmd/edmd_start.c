@@ -32,14 +32,14 @@ void pk_edmd_params_default(pk_edmd_params *prm)
 
 const char *pk_edmd_criterion_name(pk_edmd_criterion c)
 {
-    static const char *names[] = {"none",  "target",     "pressure",  "delta_phi", "stall",
+    static const char *names[] = {"none",       "target",    "pressure",  "delta_phi", "stall",
                                   "max_events", "cancelled", "wall_time", "error"};
     return (unsigned)c < sizeof names / sizeof *names ? names[c] : "unknown";
 }
 
 int pk_edmd_start_rsa(const pk_box *b, const double *d, const int32_t *species, size_t n,
-                      double delta, double delta_d, uint64_t seed, pk_monitor *mon,
-                      pk_particles *p, pk_rsa_stats *rs)
+                      double delta, double delta_d, uint64_t seed, pk_monitor *mon, pk_particles *p,
+                      pk_rsa_stats *rs)
 {
     if (!(delta > 0) || delta > 1)
         return -1;

@@ -22,9 +22,9 @@ enum { EDMD_EV_NONE = -1, EDMD_EV_NLIST = -2, EDMD_EV_WALL0 = -3 };
  * every collision with the unchanged neighbours (a changed one re-predicted
  * with this grain in its list), so it is taken without a new prediction. */
 typedef struct edmd_event {
-    double t, t2;             /* event times; t2 = +inf when there is no second */
-    int32_t with, with2;      /* EDMD_EV_* or the partner grain */
-    uint32_t stamp, stamp2;   /* partner's ncoll at prediction time */
+    double t, t2;           /* event times; t2 = +inf when there is no second */
+    int32_t with, with2;    /* EDMD_EV_* or the partner grain */
+    uint32_t stamp, stamp2; /* partner's ncoll at prediction time */
 } edmd_event;
 _Static_assert(sizeof(edmd_event) == 32, "two events per cache line");
 
@@ -39,16 +39,17 @@ typedef struct edmd_nlist {
 } edmd_nlist;
 
 typedef struct edmd_kin {
-    double p[3];              /* position at t = 0 of the current flight */
-    double a;                 /* simulated radius at t = 0 */
-    double v[3];              /* velocity (0 beyond dim) */
-    double g;                 /* radius growth rate */
+    double p[3]; /* position at t = 0 of the current flight */
+    double a;    /* simulated radius at t = 0 */
+    double v[3]; /* velocity (0 beyond dim) */
+    double g;    /* radius growth rate */
 } edmd_kin;
-_Static_assert(sizeof(edmd_kin) == 64, "one cache line per grain (aligned_alloc needs a multiple of 64)");
+_Static_assert(sizeof(edmd_kin) == 64,
+               "one cache line per grain (aligned_alloc needs a multiple of 64)");
 
 typedef struct edmd_hnode {
-    double t;                 /* event time (copy of ev_t[i]) */
-    int32_t i;                /* particle */
+    double t;  /* event time (copy of ev_t[i]) */
+    int32_t i; /* particle */
 } edmd_hnode;
 _Static_assert(sizeof(edmd_hnode) == 16, "four heap nodes per cache line");
 
@@ -58,64 +59,64 @@ _Static_assert(sizeof(edmd_hnode) == 16, "four heap nodes per cache line");
  * next slots up to lap_end in unsorted bucket lists (bucket = slot mod nb),
  * later ones in an overflow list, redistributed when a lap starts. */
 typedef struct edmd_queue {
-    double T0, inv_w;         /* slot origin and 1/width */
-    int64_t cur;              /* current slot: its events are in the heap */
-    int64_t lap_end;          /* first slot not in the buckets (<= cur + nb) */
-    uint32_t nb, mask;        /* buckets: a power of two */
-    int32_t *head;            /* [nb + 1] first grain of each bucket's list; [nb]: overflow */
-    uint64_t *occ;            /* [nb / 64] bucket holds a grain */
-    int32_t *nxt, *prv;       /* [n] list links (-1: none) */
-    int32_t *where;           /* [n] bucket, or EDMD_Q_HEAP / EDMD_Q_OVER */
-    int64_t *slot;            /* [n] slot at insertion */
-    edmd_hnode *heap;         /* current slot's events (4-ary, heap_mem + 3) */
+    double T0, inv_w;   /* slot origin and 1/width */
+    int64_t cur;        /* current slot: its events are in the heap */
+    int64_t lap_end;    /* first slot not in the buckets (<= cur + nb) */
+    uint32_t nb, mask;  /* buckets: a power of two */
+    int32_t *head;      /* [nb + 1] first grain of each bucket's list; [nb]: overflow */
+    uint64_t *occ;      /* [nb / 64] bucket holds a grain */
+    int32_t *nxt, *prv; /* [n] list links (-1: none) */
+    int32_t *where;     /* [n] bucket, or EDMD_Q_HEAP / EDMD_Q_OVER */
+    int64_t *slot;      /* [n] slot at insertion */
+    edmd_hnode *heap;   /* current slot's events (4-ary, heap_mem + 3) */
     edmd_hnode *heap_mem;
-    int32_t *hpos;            /* [n] node in the heap */
+    int32_t *hpos; /* [n] node in the heap */
     size_t hn;
-    double *sample;           /* scratch of the width estimate */
+    double *sample; /* scratch of the width estimate */
 } edmd_queue;
 
 typedef struct edmd_state {
     pk_box box;
-    double Lp[3], inv_Lp[3];  /* L and 1/L on periodic axes, 0 otherwise (pk_min_image3) */
+    double Lp[3], inv_Lp[3]; /* L and 1/L on periodic axes, 0 otherwise (pk_min_image3) */
     int dim;
-    int walled;               /* some axis < dim has walls */
+    int walled; /* some axis < dim has walls */
     size_t n;
     /* kinematics */
-    edmd_kin *k;              /* [n], 64-byte aligned */
-    double *m;                /* mass */
-    double h0, h1;            /* shell h(t) = h0 + h1 t */
-    double t;                 /* current time (re-based) */
-    double eps_v;             /* extra separation speed (spec §3.4) */
-    pk_edmd_rule rule;        /* pair (and wall) collision rule */
+    edmd_kin *k;       /* [n], 64-byte aligned */
+    double *m;         /* mass */
+    double h0, h1;     /* shell h(t) = h0 + h1 t */
+    double t;          /* current time (re-based) */
+    double eps_v;      /* extra separation speed (spec §3.4) */
+    pk_edmd_rule rule; /* pair (and wall) collision rule */
     /* events: one (and a runner-up) per particle, 32-byte aligned */
     edmd_event *ev;
-    uint32_t *ncoll;          /* velocity changes of each particle (validity counter) */
+    uint32_t *ncoll; /* velocity changes of each particle (validity counter) */
     edmd_queue q;
     /* neighbour lists */
-    edmd_nlist *nl;           /* [n] slots in nl_pool */
-    int32_t *nl_pool;         /* every list, in slots */
-    size_t nl_used, nl_size;  /* pool entries handed out / allocated */
-    size_t nl_live;           /* Σ cap of the slots in use (the rest is dead) */
-    int32_t *nl_new;          /* the list being rebuilt, before it goes in a slot */
+    edmd_nlist *nl;          /* [n] slots in nl_pool */
+    int32_t *nl_pool;        /* every list, in slots */
+    size_t nl_used, nl_size; /* pool entries handed out / allocated */
+    size_t nl_live;          /* Σ cap of the slots in use (the rest is dead) */
+    int32_t *nl_new;         /* the list being rebuilt, before it goes in a slot */
     uint32_t nl_new_cap;
-    uint32_t *nl_mark;        /* [n] rebuild marks (edmd_nlist_rebuild) */
+    uint32_t *nl_mark; /* [n] rebuild marks (edmd_nlist_rebuild) */
     uint32_t nl_tag;
-    pk_particles bs;          /* bounding spheres: centre c_i, radius σ_i */
-    pk_ugrid ugrid;           /* cells of the bounding spheres */
-    double *skin;             /* per-particle skin s_i (at low pressure) */
-    double skin_scale;        /* skins shrink with the cages as the pressure rises */
-    double *rref;             /* radius at the reference time (target size) */
-    uint32_t *ncoll_nl;       /* ncoll[i] at i's last list build (ballistic test) */
+    pk_particles bs;    /* bounding spheres: centre c_i, radius σ_i */
+    pk_ugrid ugrid;     /* cells of the bounding spheres */
+    double *skin;       /* per-particle skin s_i (at low pressure) */
+    double skin_scale;  /* skins shrink with the cages as the pressure rises */
+    double *rref;       /* radius at the reference time (target size) */
+    uint32_t *ncoll_nl; /* ncoll[i] at i's last list build (ballistic test) */
     /* physics accumulators */
-    double K;                 /* kinetic energy ½Σm v² */
-    double virial;            /* Σ σ J over particle collisions in the window */
-    double kint;              /* ∫K dt over the window */
+    double K;      /* kinetic energy ½Σm v² */
+    double virial; /* Σ σ J over particle collisions in the window */
+    double kint;   /* ∫K dt over the window */
     uint64_t n_overlap;
     /* the run's monitor, ticked inside full list builds (~1 s at 10⁶ grains);
      * NULL during the start-up build */
     pk_monitor *mon;
     pk_progress *pr;
-    int stop;                 /* what the monitor said: 1 cancelled, 2 wall limit */
+    int stop; /* what the monitor said: 1 cancelled, 2 wall limit */
     double max_overlap_rel;
 } edmd_state;
 
@@ -177,8 +178,7 @@ static inline void edmd_sync_pos(edmd_state *s, size_t i, double x[3])
      * branches; same results as the per-axis loop (docs/perf/edmd.md) */
     edmd_kin *k = &s->k[i];
     const double t = s->t;
-    const double x0 = k->p[0] + k->v[0] * t, x1 = k->p[1] + k->v[1] * t,
-                 x2 = k->p[2] + k->v[2] * t;
+    const double x0 = k->p[0] + k->v[0] * t, x1 = k->p[1] + k->v[1] * t, x2 = k->p[2] + k->v[2] * t;
     x[0] = x0;
     x[1] = x1;
     x[2] = x2;
@@ -201,29 +201,29 @@ static inline void edmd_sync(edmd_state *s, size_t i)
 }
 
 /* edmd_predict.c */
-void edmd_predict(edmd_state *s, size_t i);            /* refresh i's event and heap slot */
+void edmd_predict(edmd_state *s, size_t i); /* refresh i's event and heap slot */
 /* Start loading the records of i's neighbours (before a collision: both
  * grains' predictions then find them in cache). */
 void edmd_prefetch_list(const edmd_state *s, size_t i);
 /* Test hook: 1 = the neighbour loop runs scalar even where AVX2 lanes are
  * available (the lanes must give bit-identical events). */
 extern int edmd_scalar_only;
-int edmd_lanes_available(void);                        /* AVX2 lanes in use now */
+int edmd_lanes_available(void);  /* AVX2 lanes in use now */
 extern int edmd_lanes4_only;     /* 1: the AVX2 loop even where AVX-512 is there */
 int edmd_lanes8_available(void); /* AVX-512 lanes in use now */
 double edmd_wall_time(const edmd_state *s, size_t i, int *code);
 
 /* edmd_collide.c */
-double edmd_collide_pair(edmd_state *s, size_t i, size_t j);   /* returns σ·J */
+double edmd_collide_pair(edmd_state *s, size_t i, size_t j); /* returns σ·J */
 void edmd_collide_wall(edmd_state *s, size_t i, int code);
 
 /* edmd_queue.c */
-int edmd_queue_alloc(edmd_state *s, size_t n);         /* 0 or -1 */
+int edmd_queue_alloc(edmd_state *s, size_t n); /* 0 or -1 */
 void edmd_queue_free(edmd_state *s);
-void edmd_queue_init(edmd_state *s);                   /* every ev[i] anew (slots sized here) */
-size_t edmd_queue_top(edmd_state *s);                  /* the grain of the earliest event */
-void edmd_queue_update(edmd_state *s, size_t i);       /* after ev[i].t changed */
-void edmd_queue_shift(edmd_state *s, double dt);       /* all times −= dt */
+void edmd_queue_init(edmd_state *s);             /* every ev[i] anew (slots sized here) */
+size_t edmd_queue_top(edmd_state *s);            /* the grain of the earliest event */
+void edmd_queue_update(edmd_state *s, size_t i); /* after ev[i].t changed */
+void edmd_queue_shift(edmd_state *s, double dt); /* all times −= dt */
 
 /* edmd_order.c: perm[k] = index of the k-th grain along a Z-order curve of
  * cells of edge h.  0 or -1 (out of memory). */

@@ -52,8 +52,8 @@ unsigned pk_homog_audit_step(const pk_homog_rve *rve, const pk_homog_opts *o,
     double Finv[9];
     int inv = pk_m3_inv(s->F, Finv) != 0;
     int fin = inv && all_finite(s->x, 3 * s->n) && (!s->u || all_finite(s->u, s->n)) &&
-              all_finite(st->P, 9) && all_finite(st->sigma, 9) && isfinite(st->energy) &&
-              isfinite(st->energy_t) && isfinite(st->dissipation) && isfinite(st->J);
+        all_finite(st->P, 9) && all_finite(st->sigma, 9) && isfinite(st->energy) &&
+        isfinite(st->energy_t) && isfinite(st->dissipation) && isfinite(st->J);
     if (!fin)
         a->failed |= PK_AUDIT_NOT_FINITE;
     for (size_t i = 0; inv && i < rve->n; i++) {
@@ -78,15 +78,16 @@ void pk_homog_audit_describe(const pk_homog_audit *a, const pk_homog_step *st, c
 {
     size_t n = 0;
     buf[0] = 0;
-#define ADD(...)                                                                                  \
-    do {                                                                                          \
-        if (n < len)                                                                              \
-            n += (size_t)snprintf(buf + n, len - n, __VA_ARGS__);                                 \
+#define ADD(...)                                                                                   \
+    do {                                                                                           \
+        if (n < len)                                                                               \
+            n += (size_t)snprintf(buf + n, len - n, __VA_ARGS__);                                  \
     } while (0)
     if (a->failed & PK_AUDIT_NOT_CONVERGED)
         ADD("%sthe relaxation did not converge (stop %s after %zu iterations, residual %.3g = "
-            "%.3g × its target %.3g)", n ? "; " : "", pk_dr_stop_name(st->dr.stop),
-            st->dr.iterations, st->dr.f, a->residual_ratio, a->target);
+            "%.3g × its target %.3g)",
+            n ? "; " : "", pk_dr_stop_name(st->dr.stop), st->dr.iterations, st->dr.f,
+            a->residual_ratio, a->target);
     if (a->failed & PK_AUDIT_UNBALANCED)
         ADD("%sthe free grains are not in equilibrium (|f| %.3g = %.3g × the target)",
             n ? "; " : "", st->free_force, a->balance_ratio);
@@ -97,6 +98,7 @@ void pk_homog_audit_describe(const pk_homog_audit *a, const pk_homog_step *st, c
         ADD("%snon-finite stresses, energies or positions", n ? "; " : "");
     if (a->failed & PK_AUDIT_OVERLAP)
         ADD("%sthe largest overlap is %.3g × the smaller radius (bound %g: a centre inside its "
-            "neighbour)", n ? "; " : "", a->overlap_ratio, PK_AUDIT_OVERLAP_MAX);
+            "neighbour)",
+            n ? "; " : "", a->overlap_ratio, PK_AUDIT_OVERLAP_MAX);
 #undef ADD
 }

@@ -35,13 +35,13 @@ enum {
 };
 
 typedef struct pk_homog_audit {
-    double target;          /* the relaxation's residual target */
-    double residual_ratio;  /* final |f| / target (0: nothing to relax) */
-    double balance_ratio;   /* recomputed |f_free| / target */
-    double escape;          /* largest excursion of a centre beyond its cell, / its radius */
-    size_t outside;         /* grains beyond their cell */
-    double overlap_ratio;   /* max ε / min(r_i, r_j) */
-    unsigned failed;        /* PK_AUDIT_* bits; 0 = passed */
+    double target;         /* the relaxation's residual target */
+    double residual_ratio; /* final |f| / target (0: nothing to relax) */
+    double balance_ratio;  /* recomputed |f_free| / target */
+    double escape;         /* largest excursion of a centre beyond its cell, / its radius */
+    size_t outside;        /* grains beyond their cell */
+    double overlap_ratio;  /* max ε / min(r_i, r_j) */
+    unsigned failed;       /* PK_AUDIT_* bits; 0 = passed */
 } pk_homog_audit;
 
 /* Audit the step st whose relaxed state is s (its x and F).  Returns a->failed. */

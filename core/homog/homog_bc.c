@@ -182,8 +182,8 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     uint8_t *rat = malloc(n ? n : 1);
     pk_dem_pairs c = {0};
     pk_homog_pairs_setup(&c, rve, o);
-    pk_fric_ctx fc = {.law = o->friction, .x_n = committed->x, .u_n = committed->u,
-                      .hist_n = &committed->hist};
+    pk_fric_ctx fc = {
+        .law = o->friction, .x_n = committed->x, .u_n = committed->u, .hist_n = &committed->hist};
     pk_fric_totals ftot = {0};
     int rc = 0;
     if (!is_free || !f || !rat) {
@@ -215,7 +215,8 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     double phi;
     out->contacts = pk_dem_eval(&c, &g, trial->x, rve->r, n, o->E_n, f, &phi, S);
     if (o->friction) { /* tangential forces (7.19) in f and S; σ̄ by (7.26) */
-        if (pk_dem_fric_eval(&c, &fc, trial->x, trial->u, rve->r, n, o->E_n, f, NULL, S, &ftot) != 0 ||
+        if (pk_dem_fric_eval(&c, &fc, trial->x, trial->u, rve->r, n, o->E_n, f, NULL, S, &ftot) !=
+                0 ||
             pk_fric_hist_collect(&c, &fc, &trial->hist) != 0) {
             rc = -1;
             goto done;

@@ -28,16 +28,16 @@
 
 typedef struct pk_homog_state {
     size_t n;
-    double F[9];          /* F̄ of this state */
-    double *x;            /* [n][3] spatial centres */
+    double F[9]; /* F̄ of this state */
+    double *x;   /* [n][3] spatial centres */
     size_t ncontact;
-    uint64_t *keys;       /* sorted contact keys (i << 32 | j), i < j */
-    double *u;            /* [n] rotations as r_i θ_i (friction; 0 otherwise) */
-    pk_fric_hist hist;    /* per-contact slip history (friction) */
+    uint64_t *keys;    /* sorted contact keys (i << 32 | j), i < j */
+    double *u;         /* [n] rotations as r_i θ_i (friction; 0 otherwise) */
+    pk_fric_hist hist; /* per-contact slip history (friction) */
 } pk_homog_state;
 
 typedef struct pk_homog_opts {
-    double E_n;           /* normal contact stiffness (4.3) */
+    double E_n; /* normal contact stiffness (4.3) */
     /* Pair-specific normal stiffness (E_n,ij of (4.3)) by species: an
      * n_species × n_species symmetric matrix of absolute stiffnesses, row
      * major; NULL = E_n for every pair.  Every RVE species must be < n_species. */
@@ -66,20 +66,20 @@ void pk_homog_pairs_setup(pk_dem_pairs *c, const pk_homog_rve *rve, const pk_hom
 
 typedef struct pk_homog_step {
     double F[9], P[9], sigma[9], sigma_skew[9];
-    double P_reaction[9];      /* (5.16)/(5.19); = P for periodic */
-    double reaction_defect;    /* |P_reaction − P| / max(|P|, tiny) */
+    double P_reaction[9];   /* (5.16)/(5.19); = P for periodic */
+    double reaction_defect; /* |P_reaction − P| / max(|P|, tiny) */
     double J;
-    double energy;             /* Φ_n (4.7) */
-    double energy_density;     /* Φ̄ = Φ_n / V (5.1) */
-    double energy_t;           /* Φ_t (7.6), friction */
-    double dissipation;        /* Σ Δλ f_n tan ρ of this step (7.13), friction */
-    size_t sliding;            /* contacts on the Coulomb limit, friction */
-    double sum_force;          /* |Σ_i f_i| (global equilibrium) */
-    double free_force;         /* |(f_i)_free| at the final state, recomputed (the audit) */
-    double max_overlap_ratio;  /* max ε_ij / min(r_i, r_j) (spec H3) */
+    double energy;            /* Φ_n (4.7) */
+    double energy_density;    /* Φ̄ = Φ_n / V (5.1) */
+    double energy_t;          /* Φ_t (7.6), friction */
+    double dissipation;       /* Σ Δλ f_n tan ρ of this step (7.13), friction */
+    size_t sliding;           /* contacts on the Coulomb limit, friction */
+    double sum_force;         /* |Σ_i f_i| (global equilibrium) */
+    double free_force;        /* |(f_i)_free| at the final state, recomputed (the audit) */
+    double max_overlap_ratio; /* max ε_ij / min(r_i, r_j) (spec H3) */
     size_t contacts, formed, broken, rattlers;
-    double coordination;       /* 2·contacts / particles */
-    pk_dr_stats dr;            /* DR part (all of it without Newton) */
+    double coordination; /* 2·contacts / particles */
+    pk_dr_stats dr;      /* DR part (all of it without Newton) */
     int used_newton;
     pk_newton_stats newton;
 } pk_homog_step;

@@ -46,8 +46,8 @@ double pk_tridiag_min_eig(const double *a, const double *b, int m)
 /* The masked dot product with dim a constant (2 or 3): the axis loop
  * unrolled, the same operations in the same order (it runs on every DR
  * iteration for the residual and in every Lanczos step). */
-static inline double dot_mask_loop(const double *u, const double *v, const uint8_t *mask,
-                                   size_t np, const int dim)
+static inline double dot_mask_loop(const double *u, const double *v, const uint8_t *mask, size_t np,
+                                   const int dim)
 {
     double s = 0;
     for (size_t i = 0; i < np; i++)
@@ -109,7 +109,7 @@ double pk_homog_lanczos_min(const pk_dem_pairs *c, int dim, size_t np, double E,
     double *w = calloc(3 * np, sizeof *w);
     double *al = calloc((size_t)steps + 1, sizeof *al), *be = calloc((size_t)steps + 1, sizeof *be);
     size_t *dof = malloc(ndof * sizeof *dof); /* the masked entries, in order */
-    pk_dem_kblocks kb = {0}; /* K once for the `steps` products */
+    pk_dem_kblocks kb = {0};                  /* K once for the `steps` products */
     if (!q || !qp || !w || !al || !be || !dof || pk_dem_kblocks_build(&kb, c, E, mask) != 0) {
         free(q), free(qp), free(w), free(al), free(be), free(dof);
         return NAN;

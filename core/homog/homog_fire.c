@@ -12,8 +12,8 @@
  * slower on the near-jamming 10⁴ bench steps (docs/perf/homog.md). */
 pk_fire_params pk_fire_params_default(void)
 {
-    pk_fire_params p = {.n_min = 5, .f_inc = 1.1, .f_dec = 0.5, .alpha0 = 0.1, .f_alpha = 0.99,
-                        .dt_scale = 1.0};
+    pk_fire_params p = {
+        .n_min = 5, .f_inc = 1.1, .f_dec = 0.5, .alpha0 = 0.1, .f_alpha = 0.99, .dt_scale = 1.0};
     return p;
 }
 
@@ -22,8 +22,8 @@ pk_fire_params pk_fire_params_default(void)
 #define DT_MIN_SHARE 0.02
 
 /* v ← v + Δt f on the free grains (v = 0 after a restart); returns |v|². */
-static double velocity_step(double *v, const double *f, const uint8_t *is_free, size_t np,
-                            int dim, double dt)
+static double velocity_step(double *v, const double *f, const uint8_t *is_free, size_t np, int dim,
+                            double dt)
 {
     double vv = 0;
     for (size_t i = 0; i < np; i++)

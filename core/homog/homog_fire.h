@@ -21,12 +21,12 @@
 #include "homog_relax.h"
 
 typedef struct pk_fire_params {
-    size_t n_min;     /* uphill-free steps before Δt grows (5) */
-    double f_inc;     /* Δt growth (1.1) */
-    double f_dec;     /* Δt cut on an uphill step (0.5) */
-    double alpha0;    /* mixing at (re)start (0.1) */
-    double f_alpha;   /* mixing decay (0.99) */
-    double dt_scale;  /* Δt_max / (2/√λ_max) */
+    size_t n_min;    /* uphill-free steps before Δt grows (5) */
+    double f_inc;    /* Δt growth (1.1) */
+    double f_dec;    /* Δt cut on an uphill step (0.5) */
+    double alpha0;   /* mixing at (re)start (0.1) */
+    double f_alpha;  /* mixing decay (0.99) */
+    double dt_scale; /* Δt_max / (2/√λ_max) */
 } pk_fire_params;
 
 /* The standard parameters of Bitzek et al. and the measured dt_scale. */

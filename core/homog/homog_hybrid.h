@@ -44,7 +44,7 @@ typedef struct newton_run {
  * fire_after-th attempt point that is not solved DR stops there (hook
  * result 2) for FIRE to go on. */
 typedef struct attempt_ctx {
-    newton_run sy;     /* sy.s.c = the attempts' own pair list */
+    newton_run sy; /* sy.s.c = the attempts' own pair list */
     newton_work *w;
     double target;
     size_t *budget;
@@ -57,8 +57,8 @@ typedef struct attempt_ctx {
 
 /* One Newton phase from x (w->f, *phi, *fn describe x on entry and on exit);
  * see homog_newton.c.  Returns 0, -1 (memory), -2 (box), 1 (cancelled). */
-int pk_hybrid_newton_phase(const newton_run *sy, newton_work *w, double *x, double *phi,
-                           double *fn, double target, size_t stall, int shift, size_t *budget,
+int pk_hybrid_newton_phase(const newton_run *sy, newton_work *w, double *x, double *phi, double *fn,
+                           double target, size_t stall, int shift, size_t *budget,
                            pk_newton_stats *ns, pk_dr_stats *st);
 
 /* The threshold of the next attempt after one at *at. */
@@ -79,8 +79,8 @@ void pk_hybrid_fire_merge(pk_dr_stats *st, const pk_dr_stats *fs, const pk_dr_pa
  * hook stops DR (hook->fn returned 2; not when hook->poll did): *fire_after
  * = 0 and *in_fire = 1 as FIRE begins, *st_dr = DR's statistics at its end. */
 int pk_hybrid_relax_then_fire(const newton_run *sy, double *x, double target, pk_dr_hook *hook,
-                              size_t *fire_after, int *in_fire, pk_dr_stats *st,
-                              pk_dr_stats *st_dr, pk_newton_stats *ns);
+                              size_t *fire_after, int *in_fire, pk_dr_stats *st, pk_dr_stats *st_dr,
+                              pk_newton_stats *ns);
 
 /* How the hybrid makes its attempts: the first phase's stall count, the
  * unsolved attempt points before FIRE, the first threshold, the creep. */
@@ -93,7 +93,7 @@ typedef struct pk_hybrid_plan {
 /* One step of the hybrid: its problem, work, the attempts' own pair list,
  * and what the prologue found at the start point. */
 typedef struct pk_hybrid {
-    newton_run sy;           /* sy.s.c: the caller's pair list */
+    newton_run sy; /* sy.s.c: the caller's pair list */
     newton_work w;
     pk_dem_pairs c2;         /* the attempts' */
     double phi0, f0, target; /* at the start point (w.f: its forces) */
@@ -103,9 +103,9 @@ typedef struct pk_hybrid {
 /* The prologue: ns and st cleared, the pair list built and evaluated at x,
  * the work arrays, the DOF numbering, f⁰ and the target.  0, -1 (memory),
  * -2 (box); pk_hybrid_end is due in every case. */
-int pk_hybrid_begin(pk_hybrid *h, const pk_dem_system *s, const double *x,
-                    const pk_dr_params *prm, const pk_newton_opts *no, pk_monitor *mon,
-                    pk_dr_stats *st, pk_newton_stats *ns);
+int pk_hybrid_begin(pk_hybrid *h, const pk_dem_system *s, const double *x, const pk_dr_params *prm,
+                    const pk_newton_opts *no, pk_monitor *mon, pk_dr_stats *st,
+                    pk_newton_stats *ns);
 /* The serial step after the prologue: the Newton phase from x, then DR (and
  * FIRE) with the attempts. */
 int pk_hybrid_step(pk_hybrid *h, double *x, pk_dr_stats *st, pk_newton_stats *ns);

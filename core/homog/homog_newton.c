@@ -260,8 +260,8 @@ static pk_sparse_factor *factor_block(const newton_run *sy, newton_work *w, doub
  * *budget factorisations at most (decremented).
  * Returns 0, -1 (memory), -2 (box), 1 (cancelled: st->stop set). */
 int pk_hybrid_newton_phase(const newton_run *sy, newton_work *w, double *x, double *phi, double *fn,
-                        double target, size_t stall, int shift, size_t *budget,
-                        pk_newton_stats *ns, pk_dr_stats *st)
+                           double target, size_t stall, int shift, size_t *budget,
+                           pk_newton_stats *ns, pk_dr_stats *st)
 {
     pk_dem_pairs *c = sy->s.c;
     const pk_dem_geom *g = sy->s.g;
@@ -271,7 +271,7 @@ int pk_hybrid_newton_phase(const newton_run *sy, newton_work *w, double *x, doub
     double best = *fn, mu = 0, mu_used = 0;
     const double f_entry = *fn; /* no shift once the residual rose above it */
     size_t since_best = 0;
-    int stable_start = 0; /* the block was positive definite at the entry point */
+    int stable_start = 0;     /* the block was positive definite at the entry point */
     int raises = 0, hold = 0; /* hold: keep μ at the next positive definite factorisation */
     int rises = 0;            /* of the residual between factorisation points (attempts) */
     ns->exit = PK_NEWTON_CAP;
@@ -318,7 +318,7 @@ int pk_hybrid_newton_phase(const newton_run *sy, newton_work *w, double *x, doub
         double f_window = *fn;
         size_t window_start = 0;
         int failed_first = 0, rc = 0;
-        for (size_t inner = 0; inner < MAX_INNER && *fn > target; inner++) {
+        for (size_t inner = 0; inner<MAX_INNER && * fn> target; inner++) {
             if (qn_direction(&w->mem, sy->solver, fac, w->g, w->qv, w->d) != 0) {
                 rc = -1;
                 break;
@@ -374,8 +374,8 @@ int pk_hybrid_newton_phase(const newton_run *sy, newton_work *w, double *x, doub
                 ns->cuts++;
                 /* Φ(t) ≈ Φ + t·gd + c t² through Φ(s): its minimiser over s */
                 cut_by = lin > ENERGY_ROUNDOFF * fabs(*phi)
-                             ? fmax(CUT_MIN, fmin(CUT_MAX, 0.5 * lin / (phit - *phi + lin)))
-                             : CUT_MAX;
+                    ? fmax(CUT_MIN, fmin(CUT_MAX, 0.5 * lin / (phit - *phi + lin)))
+                    : CUT_MAX;
             }
             if (rc != 0)
                 break;
@@ -406,8 +406,8 @@ int pk_hybrid_newton_phase(const newton_run *sy, newton_work *w, double *x, doub
                 break;
             }
             if (sy->mon) {
-                pk_progress pr = {.stage = "newton", .fraction = -1, .phi = -1, .eta_s = -1,
-                                  .done = ns->steps};
+                pk_progress pr = {
+                    .stage = "newton", .fraction = -1, .phi = -1, .eta_s = -1, .done = ns->steps};
                 int t = pk_monitor_tick(sy->mon, &pr, 0);
                 if (t) {
                     st->stop = t == 1 ? PK_DR_CANCELLED : PK_DR_WALL_TIME;
@@ -419,7 +419,8 @@ int pk_hybrid_newton_phase(const newton_run *sy, newton_work *w, double *x, doub
         sy->solver->release(fac);
         if (rc != 0)
             return rc;
-        rc = eval_at(c, g, x, sy->s.r, np, E, sy->prm, w->f, phi); /* contacts of the current point */
+        rc = eval_at(c, g, x, sy->s.r, np, E, sy->prm, w->f,
+                     phi); /* contacts of the current point */
         if (rc != 0)
             return rc;
         if (failed_first) {
@@ -478,8 +479,8 @@ int pk_hybrid_attempt_from(attempt_ctx *a, double *xn, double *fres)
     double fn = sqrt(pk_homog_dot_mask(w->f, w->f, a->sy.s.is_free, np, dim));
     a->ns->attempts++;
     pk_dr_stop keep = a->st->stop;
-    rc = pk_hybrid_newton_phase(&a->sy, w, xn, &phi, &fn, a->target, ATTEMPT_STALL, 1, a->budget, a->ns,
-                      a->st);
+    rc = pk_hybrid_newton_phase(&a->sy, w, xn, &phi, &fn, a->target, ATTEMPT_STALL, 1, a->budget,
+                                a->ns, a->st);
     if (rc < 0)
         return rc;
     if (rc == 1) { /* cancelled: the relaxation's monitor sees it within 64 iterations */
@@ -530,7 +531,7 @@ pk_dr_params pk_hybrid_fire_params(const pk_dr_params *prm, double target, const
 
 /* st (DR's statistics) with FIRE's fs after it added, and its end. */
 void pk_hybrid_fire_merge(pk_dr_stats *st, const pk_dr_stats *fs, const pk_dr_params *prm,
-                       pk_newton_stats *ns)
+                          pk_newton_stats *ns)
 {
     st->iterations += fs->iterations;
     ns->fire_iterations = fs->iterations;
@@ -538,9 +539,9 @@ void pk_hybrid_fire_merge(pk_dr_stats *st, const pk_dr_stats *fs, const pk_dr_pa
     st->f = fs->f;
     st->dt = fs->dt;
     st->gamma = 0;
-    st->stop = !pk_dr_stop_ok(fs->stop)       ? fs->stop
-               : fs->f <= prm->tol * st->f0 ? PK_DR_CONVERGED
-                                             : PK_DR_CONVERGED_ABS;
+    st->stop = !pk_dr_stop_ok(fs->stop) ? fs->stop
+        : fs->f <= prm->tol * st->f0    ? PK_DR_CONVERGED
+                                        : PK_DR_CONVERGED_ABS;
 }
 
 /* FIRE from DR's point after a failed attempt (the attempts go on from
@@ -561,8 +562,8 @@ static int fire_on(const newton_run *sy, double *x, double target, pk_dr_hook *h
 /* DR, then FIRE (homog_hybrid.h): the path the serial step and the
  * speculative runner share. */
 int pk_hybrid_relax_then_fire(const newton_run *sy, double *x, double target, pk_dr_hook *hook,
-                              size_t *fire_after, int *in_fire, pk_dr_stats *st,
-                              pk_dr_stats *st_dr, pk_newton_stats *ns)
+                              size_t *fire_after, int *in_fire, pk_dr_stats *st, pk_dr_stats *st_dr,
+                              pk_newton_stats *ns)
 {
     int rc = pk_homog_relax_hooked(&sy->s, x, sy->prm, hook, sy->mon, st);
     *st_dr = *st;
@@ -575,9 +576,8 @@ int pk_hybrid_relax_then_fire(const newton_run *sy, double *x, double target, pk
     return rc;
 }
 
-int pk_hybrid_begin(pk_hybrid *h, const pk_dem_system *s, const double *x,
-                    const pk_dr_params *prm, const pk_newton_opts *no, pk_monitor *mon,
-                    pk_dr_stats *st, pk_newton_stats *ns)
+int pk_hybrid_begin(pk_hybrid *h, const pk_dem_system *s, const double *x, const pk_dr_params *prm,
+                    const pk_newton_opts *no, pk_monitor *mon, pk_dr_stats *st, pk_newton_stats *ns)
 {
     pk_dem_pairs *c = s->c;
     const int dim = s->g->dim;
@@ -653,8 +653,10 @@ int pk_hybrid_step(pk_hybrid *h, double *x, pk_dr_stats *st, pk_newton_stats *ns
     memcpy(x, h->w.x0, 3 * np * sizeof *x);
     attempt_ctx a = {*sy, &h->w, target, &h->budget, ns, st, FIRE_AFTER, 0};
     a.sy.s.c = &h->c2;
-    pk_dr_hook hook = {.fn = newton_attempt, .ctx = &a,
-                       .at = HANDOVER * f0 > target ? HANDOVER * f0 : 0, .crawl = CRAWL};
+    pk_dr_hook hook = {.fn = newton_attempt,
+                       .ctx = &a,
+                       .at = HANDOVER * f0 > target ? HANDOVER * f0 : 0,
+                       .crawl = CRAWL};
     pk_dr_stats st_dr;
     int in_fire = 0;
     rc = pk_hybrid_relax_then_fire(sy, x, target, &hook, &a.fire_after, &in_fire, st, &st_dr, ns);
@@ -665,8 +667,7 @@ int pk_hybrid_step(pk_hybrid *h, double *x, pk_dr_stats *st, pk_newton_stats *ns
 }
 
 int pk_homog_newton(const pk_dem_system *s, double *x, const pk_dr_params *prm,
-                    const pk_newton_opts *no, pk_monitor *mon, pk_dr_stats *st,
-                    pk_newton_stats *ns)
+                    const pk_newton_opts *no, pk_monitor *mon, pk_dr_stats *st, pk_newton_stats *ns)
 {
     pk_hybrid h;
     int rc = pk_hybrid_begin(&h, s, x, prm, no, mon, st, ns);

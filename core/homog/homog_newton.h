@@ -35,23 +35,23 @@
 #include "homog_relax.h"
 
 typedef enum pk_newton_exit {
-    PK_NEWTON_CONVERGED = 0,     /* the last Newton phase converged (after DR or not) */
-    PK_NEWTON_BLOCK_NOT_PD,      /* exact block not positive definite (instability) → DR */
-    PK_NEWTON_LINE_SEARCH,       /* no descent along a fresh Newton direction → DR */
-    PK_NEWTON_CAP,               /* factorisation budget spent → DR to the end */
-    PK_NEWTON_STALLED            /* residual not halved over the stall count → DR */
+    PK_NEWTON_CONVERGED = 0, /* the last Newton phase converged (after DR or not) */
+    PK_NEWTON_BLOCK_NOT_PD,  /* exact block not positive definite (instability) → DR */
+    PK_NEWTON_LINE_SEARCH,   /* no descent along a fresh Newton direction → DR */
+    PK_NEWTON_CAP,           /* factorisation budget spent → DR to the end */
+    PK_NEWTON_STALLED        /* residual not halved over the stall count → DR */
 } pk_newton_exit;
 
 const char *pk_newton_exit_name(pk_newton_exit e);
 
 typedef struct pk_newton_stats {
-    size_t iterations;           /* factorisations of the stiffness */
-    size_t reused;               /* of them, those that reused the context's analysis */
-    size_t steps, cuts;          /* quasi-Newton steps, line-search halvings */
-    size_t attempts;             /* Newton attempts from DR's points */
-    size_t shifts;               /* Levenberg–Marquardt shift raises in those attempts */
-    size_t fire_iterations;      /* of the relaxation's iterations, those FIRE made */
-    pk_newton_exit exit;         /* of the last Newton phase */
+    size_t iterations;      /* factorisations of the stiffness */
+    size_t reused;          /* of them, those that reused the context's analysis */
+    size_t steps, cuts;     /* quasi-Newton steps, line-search halvings */
+    size_t attempts;        /* Newton attempts from DR's points */
+    size_t shifts;          /* Levenberg–Marquardt shift raises in those attempts */
+    size_t fire_iterations; /* of the relaxation's iterations, those FIRE made */
+    pk_newton_exit exit;    /* of the last Newton phase */
 } pk_newton_stats;
 
 /* The sparse solver a solve factorises with. */

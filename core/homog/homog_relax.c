@@ -42,7 +42,7 @@ typedef struct relax_run {
     const pk_dem_system *s;
     pk_fric_ctx *fc; /* NULL: frictionless */
     int fric_active;
-    int lanczos;     /* Lanczos steps of an estimate */
+    int lanczos; /* Lanczos steps of an estimate */
     uint8_t *rat, *mask;
     double *work;
 } relax_run;
@@ -281,8 +281,8 @@ int pk_relax_move_acc(double *x, double *v, const double *f, const uint8_t *is_f
                     : move(x, v, f, is_free, np, dim, cf, c->xb, lim2, 0, NULL);
 }
 
-int pk_relax_move(double *x, double *v, const double *f, const uint8_t *is_free, size_t np,
-                  int dim, pk_relax_coef cf, const pk_dem_pairs *c)
+int pk_relax_move(double *x, double *v, const double *f, const uint8_t *is_free, size_t np, int dim,
+                  pk_relax_coef cf, const pk_dem_pairs *c)
 {
     return pk_relax_move_acc(x, v, f, is_free, np, dim, cf, c, NULL);
 }
@@ -317,9 +317,10 @@ int pk_relax_iteration_end(pk_dr_stats *st, const pk_dr_params *prm, double targ
     }
     if (hook)
         hook->f_peak = fmax(hook->f_peak, st->f);
-    if (hook && (st->f <= hook->at ||
-                 (hook->crawl && hook->last && st->iterations >= hook->last + hook->crawl &&
-                  hook->f_peak <= hook->f_last))) {
+    if (hook &&
+        (st->f <= hook->at ||
+         (hook->crawl && hook->last && st->iterations >= hook->last + hook->crawl &&
+          hook->f_peak <= hook->f_last))) {
         hook->last = st->iterations; /* >= 1 */
         hook->f_last = hook->f_peak = st->f;
         double fh = st->f;
@@ -368,8 +369,7 @@ int pk_relax_settled(pk_dr_stats *st, const pk_dr_params *prm, int nothing_moves
 }
 
 static int relax(const pk_dem_system *sy, double *x, const pk_dr_params *prm, pk_fric_ctx *fc,
-                 double *u, pk_dr_hook *hook, pk_monitor *mon, pk_dr_stats *st,
-                 pk_fric_totals *tot)
+                 double *u, pk_dr_hook *hook, pk_monitor *mon, pk_dr_stats *st, pk_fric_totals *tot)
 {
     pk_dem_pairs *c = sy->c;
     const pk_dem_geom *g = sy->g;
@@ -386,7 +386,8 @@ static int relax(const pk_dem_system *sy, double *x, const pk_dr_params *prm, pk
     double *work = malloc(4 * (np ? np : 1) * sizeof *work);
     double *gu = calloc(np ? np : 1, sizeof *gu), *vu = calloc(np ? np : 1, sizeof *vu);
     uint8_t *rat = malloc(np ? np : 1), *mask = malloc(np ? np : 1);
-    relax_run sys = {sy, fc, fc && pk_fric_law_active(fc->law), prm->lanczos_steps, rat, mask, work};
+    relax_run sys = {sy,   fc,  fc && pk_fric_law_active(fc->law), prm->lanczos_steps, rat,
+                     mask, work};
     if (!f || !v || !work || !gu || !vu || !rat || !mask || forces(&sys, x, u, f, gu, tot) != 0) {
         rc = -1;
         goto out;
@@ -496,9 +497,8 @@ int pk_homog_relax_hooked(const pk_dem_system *s, double *x, const pk_dr_params 
     return relax(s, x, prm, NULL, NULL, hook, mon, st, NULL);
 }
 
-int pk_homog_relax_fric(const pk_dem_system *s, double *x, const pk_dr_params *prm,
-                        pk_fric_ctx *fc, double *u, pk_monitor *mon, pk_dr_stats *st,
-                        pk_fric_totals *tot)
+int pk_homog_relax_fric(const pk_dem_system *s, double *x, const pk_dr_params *prm, pk_fric_ctx *fc,
+                        double *u, pk_monitor *mon, pk_dr_stats *st, pk_fric_totals *tot)
 {
     return relax(s, x, prm, fc, u, NULL, mon, st, tot);
 }

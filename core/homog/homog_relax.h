@@ -17,13 +17,13 @@
 #include "homog_system.h"
 
 typedef enum pk_dr_stop {
-    PK_DR_CONVERGED = 0,     /* relative tolerance met */
-    PK_DR_CONVERGED_ABS,     /* absolute floor met (incl. nothing to relax) */
-    PK_DR_NOT_NEEDED,        /* no free particle (Taylor) */
+    PK_DR_CONVERGED = 0, /* relative tolerance met */
+    PK_DR_CONVERGED_ABS, /* absolute floor met (incl. nothing to relax) */
+    PK_DR_NOT_NEEDED,    /* no free particle (Taylor) */
     PK_DR_MAX_ITER,
     PK_DR_CANCELLED,
     PK_DR_WALL_TIME,
-    PK_DR_HANDED_OVER        /* a hook stopped the relaxation to go on otherwise (internal) */
+    PK_DR_HANDED_OVER /* a hook stopped the relaxation to go on otherwise (internal) */
 } pk_dr_stop;
 
 const char *pk_dr_stop_name(pk_dr_stop s);
@@ -31,8 +31,8 @@ const char *pk_dr_stop_name(pk_dr_stop s);
 int pk_dr_stop_ok(pk_dr_stop s);
 
 typedef struct pk_dr_params {
-    double tol;           /* relative, (4.42); thesis 1e-8 */
-    double abs_floor;     /* absolute force floor */
+    double tol;       /* relative, (4.42); thesis 1e-8 */
+    double abs_floor; /* absolute force floor */
     size_t max_iter;
     int lanczos_steps;    /* for the initial λ_min (e.g. 40) */
     size_t refresh;       /* iterations between estimate refreshes (e.g. 200) */
@@ -44,11 +44,11 @@ typedef struct pk_dr_params {
 typedef struct pk_dr_stats {
     pk_dr_stop stop;
     size_t iterations, rebuilds, refreshes;
-    double f0, f;            /* |f⁰|, final |f| (free DOFs) */
-    double dt, gamma;        /* last parameters used */
+    double f0, f;     /* |f⁰|, final |f| (free DOFs) */
+    double dt, gamma; /* last parameters used */
     double lambda_min, lambda_max;
-    int clamped;             /* λ_min <= 0 was clamped (indefinite or no jammed grain) */
-    size_t rattlers;         /* at the last refresh */
+    int clamped;     /* λ_min <= 0 was clamped (indefinite or no jammed grain) */
+    size_t rattlers; /* at the last refresh */
 } pk_dr_stats;
 
 /* Relax x (the entries of particles with s->is_free[i]) at fixed geometry
@@ -80,9 +80,9 @@ typedef struct pk_dr_hook {
      * attempts on a second thread).  It must be cheap. */
     int (*poll)(void *ctx);
     /* the relaxation's book-keeping (zero at the start) */
-    size_t last;   /* iteration of the last call (counted from 1; 0: not called yet) */
-    double f_last; /* |f| at the last call */
-    double f_peak; /* the largest |f| since */
+    size_t last;                /* iteration of the last call (counted from 1; 0: not called yet) */
+    double f_last;              /* |f| at the last call */
+    double f_peak;              /* the largest |f| since */
     const pk_dr_stats *running; /* during a call: the relaxation's statistics so far */
 } pk_dr_hook;
 
@@ -108,8 +108,8 @@ int pk_relax_settled(pk_dr_stats *st, const pk_dr_params *prm, int nothing_moves
 typedef struct pk_relax_coef {
     double dt, cv, cf;
 } pk_relax_coef;
-int pk_relax_move(double *x, double *v, const double *f, const uint8_t *is_free, size_t np,
-                  int dim, pk_relax_coef cf, const pk_dem_pairs *c);
+int pk_relax_move(double *x, double *v, const double *f, const uint8_t *is_free, size_t np, int dim,
+                  pk_relax_coef cf, const pk_dem_pairs *c);
 /* The same move, and acc[0] += v·v, acc[1] += v·f with the new v (each
  * axis summed apart, then the axes in order: the same bits in the SSE2 and
  * the generic loop); acc NULL: pk_relax_move. */
@@ -156,8 +156,7 @@ int pk_homog_relax_hooked(const pk_dem_system *s, double *x, const pk_dr_params 
  * (frictional) force.  An inactive law (tan ρ = h = 0) carries no tangential
  * force and leaves the frictionless iteration unchanged.  tot (may be NULL)
  * gets the tangential totals at the final state. */
-int pk_homog_relax_fric(const pk_dem_system *s, double *x, const pk_dr_params *prm,
-                        pk_fric_ctx *fc, double *u, pk_monitor *mon, pk_dr_stats *st,
-                        pk_fric_totals *tot);
+int pk_homog_relax_fric(const pk_dem_system *s, double *x, const pk_dr_params *prm, pk_fric_ctx *fc,
+                        double *u, pk_monitor *mon, pk_dr_stats *st, pk_fric_totals *tot);
 
 #endif

@@ -71,7 +71,8 @@ static int build_periodic(const pk_box *b, const pk_particles *p, double f, pk_h
 {
     for (int k = 0; k < b->dim; k++)
         if (!b->periodic[k]) {
-            snprintf(err, errlen, "periodic boundary conditions need a packing periodic on every axis");
+            snprintf(err, errlen,
+                     "periodic boundary conditions need a packing periodic on every axis");
             return -1;
         }
     if (rve_alloc(rve, p->n ? p->n : 1) != 0) {
@@ -145,8 +146,8 @@ static int build_unfolded(const pk_box *b, const pk_particles *p, double f, pk_h
     return 0;
 }
 
-int pk_homog_rve_build(const pk_box *b, const pk_particles *p, pk_homog_bc bc,
-                       double radius_factor, pk_homog_rve *rve, char *err, size_t errlen)
+int pk_homog_rve_build(const pk_box *b, const pk_particles *p, pk_homog_bc bc, double radius_factor,
+                       pk_homog_rve *rve, char *err, size_t errlen)
 {
     memset(rve, 0, sizeof *rve);
     if (!(radius_factor >= 1) || !isfinite(radius_factor)) {

@@ -22,11 +22,7 @@
 #include "core/space/box.h"
 #include "core/space/particles.h"
 
-typedef enum pk_homog_bc {
-    PK_BC_TAYLOR = 0,
-    PK_BC_RESTRICTED_TAYLOR,
-    PK_BC_PERIODIC
-} pk_homog_bc;
+typedef enum pk_homog_bc { PK_BC_TAYLOR = 0, PK_BC_RESTRICTED_TAYLOR, PK_BC_PERIODIC } pk_homog_bc;
 
 const char *pk_homog_bc_name(pk_homog_bc bc);
 
@@ -34,21 +30,21 @@ typedef struct pk_homog_rve {
     int dim;
     pk_homog_bc bc;
     size_t n;
-    double *X;          /* [n][3] reference centres */
-    double *r;          /* [n] radii (after any inflation) */
-    int32_t *grain;     /* [n] index of the source grain */
-    int32_t *species;   /* [n] species (size class) of the source grain: selects E_n,ij */
-    uint8_t *fixed;     /* [n] 1 = position prescribed, x = F̄X */
-    uint8_t *hull;      /* [n] 1 = in the boundary set 𝓑 */
-    int periodic;       /* contacts by minimum image across L */
+    double *X;        /* [n][3] reference centres */
+    double *r;        /* [n] radii (after any inflation) */
+    int32_t *grain;   /* [n] index of the source grain */
+    int32_t *species; /* [n] species (size class) of the source grain: selects E_n,ij */
+    uint8_t *fixed;   /* [n] 1 = position prescribed, x = F̄X */
+    uint8_t *hull;    /* [n] 1 = in the boundary set 𝓑 */
+    int periodic;     /* contacts by minimum image across L */
     double L[3];
-    double V;           /* undeformed RVE measure */
+    double V; /* undeformed RVE measure */
 } pk_homog_rve;
 
 /* Build the RVE from a packing.  radius_factor (>= 1) inflates every radius
  * (initial-state policy).  0 on success; -1 with a message in err. */
-int pk_homog_rve_build(const pk_box *b, const pk_particles *p, pk_homog_bc bc,
-                       double radius_factor, pk_homog_rve *rve, char *err, size_t errlen);
+int pk_homog_rve_build(const pk_box *b, const pk_particles *p, pk_homog_bc bc, double radius_factor,
+                       pk_homog_rve *rve, char *err, size_t errlen);
 
 void pk_homog_rve_free(pk_homog_rve *rve);
 

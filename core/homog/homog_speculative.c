@@ -46,17 +46,17 @@ typedef struct spec {
     size_t n, cap, done; /* points queued, room, finished (in order) */
     int closed;          /* no more points: the relaxation has ended */
     int worker_done;
-    int worker_rc;       /* < 0: the worker's error */
-    atomic_int stop;     /* the worker solved the step or failed: the relaxation stops */
-    atomic_int abort;    /* the relaxation was cancelled or failed: the worker stops */
-    size_t solved;       /* 1 + the index of the point solved; 0: none */
-    attempt_ctx *a;      /* the worker's: its own pair list, work, budget, statistics */
+    int worker_rc;         /* < 0: the worker's error */
+    atomic_int stop;       /* the worker solved the step or failed: the relaxation stops */
+    atomic_int abort;      /* the relaxation was cancelled or failed: the worker stops */
+    size_t solved;         /* 1 + the index of the point solved; 0: none */
+    attempt_ctx *a;        /* the worker's: its own pair list, work, budget, statistics */
     const pk_dem_pairs *c; /* the relaxation's pair list */
     pk_dr_hook *hook;
-    size_t points;       /* attempt points so far (fire_after) */
+    size_t points; /* attempt points so far (fire_after) */
     size_t fire_after;
-    int fire;            /* the relaxation is FIRE */
-    double phi0, f0;     /* the first phase's start (w->f holds its forces) */
+    int fire;        /* the relaxation is FIRE */
+    double phi0, f0; /* the first phase's start (w->f holds its forces) */
     size_t stall_first;
     double target;
 } spec;
@@ -262,7 +262,11 @@ static int speculative(pk_hybrid *h, double *x, const pk_hybrid_plan *plan, pk_d
         pk_dem_eval(c2, sy->s.g, x, sy->s.r, np, sy->s.E, NULL, NULL, NULL);
     pk_newton_stats nsw = *ns;
     pk_dr_stats stw = {0}, st_dr = {0};
-    spec s = {.f0 = f0, .phi0 = phi0, .target = target, .c = c, .fire_after = plan->fire_after,
+    spec s = {.f0 = f0,
+              .phi0 = phi0,
+              .target = target,
+              .c = c,
+              .fire_after = plan->fire_after,
               .stall_first = plan->stall_first};
     atomic_init(&s.stop, 0);
     atomic_init(&s.abort, 0);
@@ -271,8 +275,8 @@ static int speculative(pk_hybrid *h, double *x, const pk_hybrid_plan *plan, pk_d
     a.sy.mon = NULL; /* the relaxation ticks the monitor; the worker stops on s.abort */
     a.sy.abort = &s.abort;
     s.a = &a;
-    pk_dr_hook hook = {.fn = spec_hook, .ctx = &s, .poll = spec_poll, .at = plan->at,
-                       .crawl = plan->crawl};
+    pk_dr_hook hook = {
+        .fn = spec_hook, .ctx = &s, .poll = spec_poll, .at = plan->at, .crawl = plan->crawl};
     s.hook = &hook;
     spec_point *first = rc == 0 ? point_new(np, x, NULL) : NULL;
     if (rc != 0 || !first) {
@@ -298,8 +302,8 @@ static int speculative(pk_hybrid *h, double *x, const pk_hybrid_plan *plan, pk_d
             point_free(first);
         rc = -1;
     } else {
-        rc = pk_hybrid_relax_then_fire(sy, x, target, &hook, &s.fire_after, &s.fire, st, &st_dr,
-                                       ns);
+        rc =
+            pk_hybrid_relax_then_fire(sy, x, target, &hook, &s.fire_after, &s.fire, st, &st_dr, ns);
         /* the points queued are the serial hybrid's all the same (it made
          * them before the end the relaxation reached alone) — unless this
          * was a cancel or an error */

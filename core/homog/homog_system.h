@@ -11,9 +11,9 @@
 #include "core/dem/dem_contact.h"
 
 typedef struct pk_dem_system {
-    pk_dem_pairs *c;        /* the candidate pair list, (re)built by the solvers as needed */
-    const pk_dem_geom *g;   /* the box under F̄ */
-    const double *r;        /* radii [np] */
+    pk_dem_pairs *c;      /* the candidate pair list, (re)built by the solvers as needed */
+    const pk_dem_geom *g; /* the box under F̄ */
+    const double *r;      /* radii [np] */
     size_t np;
     double E;               /* normal contact stiffness E_n (4.3) */
     const uint8_t *is_free; /* [np] 1: the grain relaxes, 0: prescribed (4.24)/(4.27) */

@@ -121,7 +121,8 @@ int pk_homog_tangent(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_h
                     double s2 = 0; /* (Bᵀ K⁻¹ B)_IJ */
                     for (size_t k = 0; k < nd; k++)
                         s2 += Bm[(size_t)I * nd + k] * Y[(size_t)J * nd + k];
-                    A[(3 * a + b) * 9 + 3 * cc + d] = (AFF[(3 * a + b) * 9 + 3 * cc + d] - s2) / rve->V;
+                    A[(3 * a + b) * 9 + 3 * cc + d] =
+                        (AFF[(3 * a + b) * 9 + 3 * cc + d] - s2) / rve->V;
                 }
 done:
     if (fac)

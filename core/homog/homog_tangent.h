@@ -19,8 +19,8 @@
 #include "core/base/sparse.h"
 
 typedef struct pk_tangent_info {
-    pk_sparse_info block;      /* factorisation of K_II (status OK when no free DOF) */
-    size_t free_dofs;          /* size of K_II */
+    pk_sparse_info block; /* factorisation of K_II (status OK when no free DOF) */
+    size_t free_dofs;     /* size of K_II */
     size_t jammed_contacts;
     double seconds;
 } pk_tangent_info;

@@ -53,7 +53,7 @@ void pk_mesh_translate(pk_mesh *m, const double off[3])
 static double det3(const double *a, const double *b, const double *c)
 {
     return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-           a[2] * (b[0] * c[1] - b[1] * c[0]);
+        a[2] * (b[0] * c[1] - b[1] * c[0]);
 }
 
 double pk_mesh_tet_volume(const pk_mesh *m, size_t e)
@@ -157,10 +157,10 @@ static void *alloc_records(size_t n, size_t size, const char *what, char *err, s
 }
 
 typedef struct face_rec {
-    int32_t key[3];  /* sorted node indices */
+    int32_t key[3]; /* sorted node indices */
     int32_t tet;
-    int8_t local;    /* opposite local node */
-    int8_t parity;   /* orientation of the outward face relative to the sorted key */
+    int8_t local;  /* opposite local node */
+    int8_t parity; /* orientation of the outward face relative to the sorted key */
 } face_rec;
 
 static int cmp_face(const void *a, const void *b)
@@ -214,15 +214,19 @@ static int build_faces(pk_mesh *m, char *err, size_t errlen)
         if (j - i == 1)
             nb++;
         else if (j - i == 2 && f[i].parity == f[i + 1].parity) {
-            snprintf(err, errlen, "tets %d and %d overlap: both lie on the same side of face "
-                     "(%d, %d, %d)", (int)f[i].tet, (int)f[i + 1].tet, (int)f[i].key[0],
-                     (int)f[i].key[1], (int)f[i].key[2]);
+            snprintf(err, errlen,
+                     "tets %d and %d overlap: both lie on the same side of face "
+                     "(%d, %d, %d)",
+                     (int)f[i].tet, (int)f[i + 1].tet, (int)f[i].key[0], (int)f[i].key[1],
+                     (int)f[i].key[2]);
             free(f);
             return -1;
         } else if (j - i > 2) {
-            snprintf(err, errlen, "non-manifold mesh: face (%d, %d, %d) is shared by %zu tets "
-                     "(tets %d, %d, %d, ...)", (int)f[i].key[0], (int)f[i].key[1],
-                     (int)f[i].key[2], j - i, (int)f[i].tet, (int)f[i + 1].tet, (int)f[i + 2].tet);
+            snprintf(err, errlen,
+                     "non-manifold mesh: face (%d, %d, %d) is shared by %zu tets "
+                     "(tets %d, %d, %d, ...)",
+                     (int)f[i].key[0], (int)f[i].key[1], (int)f[i].key[2], j - i, (int)f[i].tet,
+                     (int)f[i + 1].tet, (int)f[i + 2].tet);
             free(f);
             return -1;
         }
@@ -287,9 +291,9 @@ int pk_mesh_faces(const pk_mesh *m, int32_t **faces, size_t *nface)
 }
 
 typedef struct edge_rec {
-    uint64_t key;     /* (min << 32) | max */
+    uint64_t key; /* (min << 32) | max */
     int32_t face;
-    int8_t dir;       /* +1 if the face runs min → max */
+    int8_t dir; /* +1 if the face runs min → max */
 } edge_rec;
 
 static int cmp_edge(const void *a, const void *b)
@@ -326,15 +330,18 @@ static int check_boundary(const pk_mesh *m, char *err, size_t errlen)
         int a = (int)(r[i].key >> 32), b = (int)(r[i].key & 0xffffffffu);
         int32_t f = r[i].face;
         if (j - i == 1) {
-            snprintf(err, errlen, "non-conforming mesh or open boundary: edge (%d, %d) of boundary "
-                     "face (%d, %d, %d) of tet %d has no matching face", a, b,
-                     (int)m->bface[3 * (size_t)f], (int)m->bface[3 * (size_t)f + 1],
+            snprintf(err, errlen,
+                     "non-conforming mesh or open boundary: edge (%d, %d) of boundary "
+                     "face (%d, %d, %d) of tet %d has no matching face",
+                     a, b, (int)m->bface[3 * (size_t)f], (int)m->bface[3 * (size_t)f + 1],
                      (int)m->bface[3 * (size_t)f + 2], (int)m->bface_tet[f]);
             rc = -1;
         } else if (j - i > 2 || r[i].dir == r[i + 1].dir) {
-            snprintf(err, errlen, "non-manifold or non-conforming boundary: edge (%d, %d) is shared by %zu boundary "
-                     "faces (tets %d and %d)", a, b, j - i, (int)m->bface_tet[r[i].face],
-                     (int)m->bface_tet[r[i + 1].face]);
+            snprintf(
+                err, errlen,
+                "non-manifold or non-conforming boundary: edge (%d, %d) is shared by %zu boundary "
+                "faces (tets %d and %d)",
+                a, b, j - i, (int)m->bface_tet[r[i].face], (int)m->bface_tet[r[i + 1].face]);
             rc = -1;
         }
         i = j;

@@ -15,23 +15,23 @@
 
 typedef struct pk_mesh {
     size_t nnode, ntet;
-    double *x;          /* [nnode][3] */
-    int32_t *t;         /* [ntet][4], positive orientation after the check */
-    int32_t *region;    /* [ntet] region id */
+    double *x;       /* [nnode][3] */
+    int32_t *t;      /* [ntet][4], positive orientation after the check */
+    int32_t *region; /* [ntet] region id */
     /* filled by pk_mesh_check */
     size_t nbface;
-    int32_t *bface;     /* [nbface][3] boundary faces, right-hand normal points outward */
-    int32_t *bface_tet; /* [nbface] the tet each boundary face belongs to */
-    double volume;      /* total volume */
-    double edge_mean;   /* mean length over unique edges */
-    double lo[3], hi[3];/* bounding box */
+    int32_t *bface;      /* [nbface][3] boundary faces, right-hand normal points outward */
+    int32_t *bface_tet;  /* [nbface] the tet each boundary face belongs to */
+    double volume;       /* total volume */
+    double edge_mean;    /* mean length over unique edges */
+    double lo[3], hi[3]; /* bounding box */
 } pk_mesh;
 
 typedef struct pk_mesh_report {
-    size_t reoriented;      /* inverted tets whose orientation was flipped */
-    size_t slivers;         /* tets with quality below the sliver threshold */
-    size_t first_sliver;    /* index of the first sliver (SIZE_MAX if none) */
-    double min_quality;     /* smallest tet quality (1 = regular tet) */
+    size_t reoriented;   /* inverted tets whose orientation was flipped */
+    size_t slivers;      /* tets with quality below the sliver threshold */
+    size_t first_sliver; /* index of the first sliver (SIZE_MAX if none) */
+    double min_quality;  /* smallest tet quality (1 = regular tet) */
 } pk_mesh_report;
 
 /* Quality below which a tet is called a sliver: q = 6√2·V / ℓ_rms³ (1 for a

@@ -60,7 +60,8 @@ int pk_mesh_box(pk_mesh *m, const double L[3], double h, size_t max_tets, char *
             }
     /* Kuhn split: one tet per axis permutation, along the path
      * (0,0,0) → e_a → e_a + e_b → (1,1,1). */
-    static const int perm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    static const int perm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                   {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
     size_t e = 0;
     for (int64_t k = 0; k < n[2]; k++)
         for (int64_t j = 0; j < n[1]; j++)

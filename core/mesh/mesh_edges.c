@@ -23,7 +23,8 @@ int pk_mesh_edges(const pk_mesh *m, pk_mesh_edge_list *el)
     for (size_t e = 0; e < m->ntet; e++)
         for (int i = 0; i < 4; i++)
             for (int j = i + 1; j < 4; j++) {
-                uint32_t a = (uint32_t)m->t[4 * e + (size_t)i], b = (uint32_t)m->t[4 * e + (size_t)j];
+                uint32_t a = (uint32_t)m->t[4 * e + (size_t)i],
+                         b = (uint32_t)m->t[4 * e + (size_t)j];
                 key[c++] = a < b ? ((uint64_t)a << 32 | b) : ((uint64_t)b << 32 | a);
             }
     qsort(key, nk, sizeof *key, cmp_u64);

@@ -10,7 +10,7 @@
 
 typedef struct pk_mesh_edge_list {
     size_t n;
-    int32_t *v;   /* [n][2], v[2i] < v[2i+1], sorted */
+    int32_t *v; /* [n][2], v[2i] < v[2i+1], sorted */
 } pk_mesh_edge_list;
 
 int pk_mesh_edges(const pk_mesh *m, pk_mesh_edge_list *el);

@@ -6,7 +6,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-static double dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static double dot(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
 static void sub(const double *a, const double *b, double *o)
 {
     for (int k = 0; k < 3; k++)
@@ -118,7 +121,8 @@ int pk_mesh_locator_init(pk_mesh_locator *L, const pk_mesh *m)
         return -1;
     }
     for (size_t f = 0; f < m->nbface; f++) {
-        const double *a = &m->x[3 * (size_t)m->bface[3 * f]], *b = &m->x[3 * (size_t)m->bface[3 * f + 1]],
+        const double *a = &m->x[3 * (size_t)m->bface[3 * f]],
+                     *b = &m->x[3 * (size_t)m->bface[3 * f + 1]],
                      *c = &m->x[3 * (size_t)m->bface[3 * f + 2]];
         double u[3], w[3], *n = &L->fn[3 * f];
         sub(b, a, u);
@@ -168,7 +172,8 @@ static int visit_tet(size_t e, const double dx[PK_MAXDIM], double dist2, void *v
         sub(c->x, a, w);
         /* volume of (face, x) on the inner side: x inside ⇔ all four >= 0 */
         double s = -(u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-                     u[2] * (v[0] * w[1] - v[1] * w[0])) / 6;
+                     u[2] * (v[0] * w[1] - v[1] * w[0])) /
+            6;
         if (s < -1e-12 * V)
             return 0;
     }
@@ -194,7 +199,8 @@ typedef struct near_ctx {
 static void face_closest(const pk_mesh_locator *L, size_t f, const double *x, double q[3])
 {
     const pk_mesh *m = L->m;
-    pk_closest_on_triangle(x, &m->x[3 * (size_t)m->bface[3 * f]], &m->x[3 * (size_t)m->bface[3 * f + 1]],
+    pk_closest_on_triangle(x, &m->x[3 * (size_t)m->bface[3 * f]],
+                           &m->x[3 * (size_t)m->bface[3 * f + 1]],
                            &m->x[3 * (size_t)m->bface[3 * f + 2]], q);
 }
 

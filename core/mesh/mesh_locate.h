@@ -14,10 +14,10 @@
 
 typedef struct pk_mesh_locator {
     const pk_mesh *m;
-    pk_box box;              /* [0, hi] padded, walls */
-    pk_particles tb, fb;     /* bounding spheres of tets and boundary faces */
+    pk_box box;          /* [0, hi] padded, walls */
+    pk_particles tb, fb; /* bounding spheres of tets and boundary faces */
     pk_grid tg, fg;
-    double *fn;              /* [nbface][3] outward unit normals */
+    double *fn; /* [nbface][3] outward unit normals */
 } pk_mesh_locator;
 
 int pk_mesh_locator_init(pk_mesh_locator *L, const pk_mesh *m);

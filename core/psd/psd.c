@@ -25,7 +25,8 @@ static _Thread_local char psd_err[256] = "no error";
 #if defined(__GNUC__)
 __attribute__((format(printf, 1, 2)))
 #endif
-static void set_err(const char *fmt, ...)
+static void
+set_err(const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -76,7 +77,9 @@ static double law_cdf(double s, double a, double b, double d)
  * generalised), with the per-class constants precomputed for the draw loops.
  * u <= 1/2 is inverted from d_lo, u > 1/2 from d_hi, so neither tail loses
  * relative precision (1 − u is exact for u in [1/2, 1]). */
-typedef struct { double a, b, s, e_lo, e_hi; } law_sampler;
+typedef struct {
+    double a, b, s, e_lo, e_hi;
+} law_sampler;
 
 static law_sampler law_prepare(double s, double a, double b)
 {
@@ -216,7 +219,9 @@ int pk_grading_from_sieve(pk_grading *g, const double *sizes, const double *pass
     return 0;
 }
 
-typedef struct { double d, v; } dv_pair;
+typedef struct {
+    double d, v;
+} dv_pair;
 
 static int cmp_dv_desc(const void *pa, const void *pb)
 {
@@ -249,8 +254,7 @@ int pk_grading_from_classes(pk_grading *g, const double *d, const double *share,
         double v = share[i];
         if (density) {
             if (!isfinite(density[i]) || !(density[i] > 0.0)) {
-                set_err("class density at index %d must be finite and > 0 (got %g)", i,
-                        density[i]);
+                set_err("class density at index %d must be finite and > 0 (got %g)", i, density[i]);
                 return -1;
             }
             v /= density[i];
@@ -287,8 +291,8 @@ int pk_grading_from_fuller(pk_grading *g, double q, double d_max, double d_floor
         return -1;
     }
     if (!isfinite(d_max) || !isfinite(d_floor) || !(d_floor > 0.0) || !(d_floor < d_max)) {
-        set_err("Fuller curve needs finite 0 < d_floor < d_max (got d_floor %g, d_max %g)",
-                d_floor, d_max);
+        set_err("Fuller curve needs finite 0 < d_floor < d_max (got d_floor %g, d_max %g)", d_floor,
+                d_max);
         return -1;
     }
     memset(g, 0, sizeof *g);
@@ -310,14 +314,10 @@ static const struct {
     int n;
     double p[8];
 } din_presets[] = {
-    {"A8", 6, {5, 14, 21, 36, 61, 100}},
-    {"B8", 6, {11, 26, 42, 57, 74, 100}},
-    {"C8", 6, {21, 39, 57, 71, 85, 100}},
-    {"A16", 7, {3, 8, 12, 21, 36, 60, 100}},
-    {"B16", 7, {8, 20, 32, 42, 56, 76, 100}},
-    {"C16", 7, {18, 34, 49, 62, 74, 88, 100}},
-    {"A32", 8, {2, 5, 8, 14, 23, 38, 62, 100}},
-    {"B32", 8, {8, 18, 28, 37, 47, 62, 80, 100}},
+    {"A8", 6, {5, 14, 21, 36, 61, 100}},           {"B8", 6, {11, 26, 42, 57, 74, 100}},
+    {"C8", 6, {21, 39, 57, 71, 85, 100}},          {"A16", 7, {3, 8, 12, 21, 36, 60, 100}},
+    {"B16", 7, {8, 20, 32, 42, 56, 76, 100}},      {"C16", 7, {18, 34, 49, 62, 74, 88, 100}},
+    {"A32", 8, {2, 5, 8, 14, 23, 38, 62, 100}},    {"B32", 8, {8, 18, 28, 37, 47, 62, 80, 100}},
     {"C32", 8, {15, 29, 42, 53, 65, 77, 89, 100}},
 };
 
@@ -437,10 +437,7 @@ int pk_grading_truncate(pk_grading *g, double d_min)
 
 /* ---------------------------------------------------- in-class sampling */
 
-static int class_args_ok(const pk_size_class *c, int dim)
-{
-    return dim_ok(dim) && class_ok(c, 0);
-}
+static int class_args_ok(const pk_size_class *c, int dim) { return dim_ok(dim) && class_ok(c, 0); }
 
 double pk_class_number_cdf(const pk_size_class *c, int dim, double d)
 {
@@ -519,7 +516,10 @@ void pk_sizes_free(pk_sizes *s)
     s->n = 0;
 }
 
-typedef struct { double d; int32_t sp; } grain;
+typedef struct {
+    double d;
+    int32_t sp;
+} grain;
 
 static int cmp_grain_desc(const void *pa, const void *pb)
 {
@@ -529,7 +529,10 @@ static int cmp_grain_desc(const void *pa, const void *pb)
     return (a->sp > b->sp) - (a->sp < b->sp);
 }
 
-typedef struct { grain *g; size_t n, cap; } grain_buf;
+typedef struct {
+    grain *g;
+    size_t n, cap;
+} grain_buf;
 
 static int gb_push(grain_buf *b, double d, int32_t sp)
 {
@@ -585,8 +588,8 @@ static void sizes_clear(pk_sizes *out)
     }
 }
 
-int pk_sample_by_measure(const pk_grading *g, int dim, double resolved_measure,
-                         pk_rng *rng, size_t max_n, pk_sizes *out)
+int pk_sample_by_measure(const pk_grading *g, int dim, double resolved_measure, pk_rng *rng,
+                         size_t max_n, pk_sizes *out)
 {
     if (!out) {
         set_err("sample by measure: out is NULL");
@@ -627,8 +630,8 @@ int pk_sample_by_measure(const pk_grading *g, int dim, double resolved_measure,
                 free(b.g);
                 set_err("sample by measure: more than max_n = %zu grains needed "
                         "(expected about %.0f)",
-                        max_n, resolved_measure / msum *
-                                   pk_grading_expected_count(g, dim, 1.0, NULL));
+                        max_n,
+                        resolved_measure / msum * pk_grading_expected_count(g, dim, 1.0, NULL));
                 return -1;
             }
             double d = law_draw(&w, pk_rng_uniform(rng));

@@ -24,16 +24,16 @@
 #define PK_PSD_MAX_CLASSES 256
 
 typedef struct pk_size_class {
-    double d_lo, d_hi;       /* class bounds, d_lo < d_hi (continuous mode) */
-    double d_rep;            /* representative diameter (discrete mode): Meier's lower sieve */
-    double mass_fraction;    /* share of the *whole* curve's mass, 0..1 */
-    double beta;             /* in-class mass CDF exponent (0 = log-linear) */
+    double d_lo, d_hi;    /* class bounds, d_lo < d_hi (continuous mode) */
+    double d_rep;         /* representative diameter (discrete mode): Meier's lower sieve */
+    double mass_fraction; /* share of the *whole* curve's mass, 0..1 */
+    double beta;          /* in-class mass CDF exponent (0 = log-linear) */
 } pk_size_class;
 
 typedef struct pk_grading {
     int nclass;
-    pk_size_class cls[PK_PSD_MAX_CLASSES];  /* coarse → fine */
-    double mass_below;       /* fraction of the whole curve finer than the finest class (not modelled) */
+    pk_size_class cls[PK_PSD_MAX_CLASSES]; /* coarse → fine */
+    double mass_below; /* fraction of the whole curve finer than the finest class (not modelled) */
 } pk_grading;
 
 /* Error text for the last failing call of this module (static, thread-local
@@ -96,13 +96,14 @@ double pk_class_expected_count(const pk_size_class *c, int dim, double measure);
 
 /* Expected total count when the whole curve (before truncation) has solid
  * measure `total_measure` = φ_M·V.  counts[] (may be NULL) receives per-class values. */
-double pk_grading_expected_count(const pk_grading *g, int dim, double total_measure, double *counts);
+double pk_grading_expected_count(const pk_grading *g, int dim, double total_measure,
+                                 double *counts);
 
 /* Sizes drawn for a packing. */
 typedef struct pk_sizes {
     size_t n;
-    double *d;          /* diameters, sorted descending (largest first) */
-    int32_t *species;   /* class index of each grain */
+    double *d;        /* diameters, sorted descending (largest first) */
+    int32_t *species; /* class index of each grain */
 } pk_sizes;
 
 void pk_sizes_free(pk_sizes *s);
@@ -111,8 +112,8 @@ void pk_sizes_free(pk_sizes *s);
  * the resolved solid measure reaches `resolved_measure` (= φ_eff·V) split by
  * class mass; the overshoot of each class is taken off the next.
  * max_n bounds memory (returns -1 if exceeded). */
-int pk_sample_by_measure(const pk_grading *g, int dim, double resolved_measure,
-                         pk_rng *rng, size_t max_n, pk_sizes *out);
+int pk_sample_by_measure(const pk_grading *g, int dim, double resolved_measure, pk_rng *rng,
+                         size_t max_n, pk_sizes *out);
 
 /* Exactly n grains: class chosen by expected number share, size by Eq. (10). */
 int pk_sample_by_count(const pk_grading *g, int dim, size_t n, pk_rng *rng, pk_sizes *out);

@@ -29,10 +29,10 @@
 typedef struct segment {
     pk_rsa_vox vox;
     int on;
-    int covering;        /* placed grains mark their exclusion zones */
-    int unstored;        /* a segment grain went to the grid instead of a voxel */
-    size_t first;        /* grains first.. (in `out`) are stored in vox, not yet in the grid */
-    double retry_below;  /* no new build is tried while r >= retry_below */
+    int covering;       /* placed grains mark their exclusion zones */
+    int unstored;       /* a segment grain went to the grid instead of a voxel */
+    size_t first;       /* grains first.. (in `out`) are stored in vox, not yet in the grid */
+    double retry_below; /* no new build is tried while r >= retry_below */
     uint64_t win_draws, win_placed;
 } segment;
 
@@ -40,8 +40,7 @@ typedef struct segment {
  * segments, then this segment's in voxel order (neighbouring marks share
  * cache lines).  Marks are optional for correctness (a bit left set only
  * costs a draw), so a cancel request may cut this short. */
-static void start_covering(segment *sg, const pk_particles *out, pk_monitor *mon,
-                           pk_progress *pg)
+static void start_covering(segment *sg, const pk_particles *out, pk_monitor *mon, pk_progress *pg)
 {
     sg->covering = 1;
     size_t upto = sg->unstored ? out->n : sg->first;
@@ -61,8 +60,8 @@ static void start_covering(segment *sg, const pk_particles *out, pk_monitor *mon
 
 /* Build the voxel set for grain i onwards (all bits set; the placed grains
  * mark their zones once start_covering runs). */
-static void begin_segment(segment *sg, const pk_box *b, const double *diameters, size_t i,
-                          size_t n, double gap, const pk_particles *out)
+static void begin_segment(segment *sg, const pk_box *b, const double *diameters, size_t i, size_t n,
+                          double gap, const pk_particles *out)
 {
     double r = 0.5 * diameters[i];
     double r_valid = fmax(0.5 * diameters[n - 1], r / SEGMENT_RATIO);
@@ -107,8 +106,7 @@ static int leave_segment(void *ctx)
 }
 
 int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *species, size_t n,
-                 const pk_rsa_params *prm, pk_monitor *mon, pk_particles *out,
-                 pk_rsa_stats *st)
+                 const pk_rsa_params *prm, pk_monitor *mon, pk_particles *out, pk_rsa_stats *st)
 {
     pk_rsa_stats local = {0};
     if (!st)
@@ -146,9 +144,18 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
     segment sg = {.on = 0, .retry_below = prm->draws == PK_RSA_DRAWS_PLAIN ? 0 : INFINITY};
     size_t no_batch_below = prm->test.one_at_a_time ? SIZE_MAX : 0;
     segment_exit flush = {&sg, &grid, out};
-    const pk_rsa_batch_env env = {.b = b, .prm = prm, .grid = &grid, .rng = &rng, .mon = mon,
-                                  .pg = &pg, .box_measure = box_measure, .solid = &solid,
-                                  .out = out, .st = st, .enter = leave_segment, .ctx = &flush};
+    const pk_rsa_batch_env env = {.b = b,
+                                  .prm = prm,
+                                  .grid = &grid,
+                                  .rng = &rng,
+                                  .mon = mon,
+                                  .pg = &pg,
+                                  .box_measure = box_measure,
+                                  .solid = &solid,
+                                  .out = out,
+                                  .st = st,
+                                  .enter = leave_segment,
+                                  .ctx = &flush};
     for (size_t i = 0; i < n; i++) {
         double r = 0.5 * diameters[i];
         /* Draw range per axis: walls keep the grain Δd/2 away (spec §2.1). */
@@ -211,7 +218,7 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
                     if (!b->periodic[k] && (x[k] < lo[k] || x[k] > lo[k] + span[k]))
                         ok = 0;
                 ok = ok && !pk_rsa_vox_overlaps(&sg.vox, x, r) &&
-                     !pk_grid_overlaps(&grid, out, x, r);
+                    !pk_grid_overlaps(&grid, out, x, r);
             } else {
                 for (int k = 0; k < b->dim; k++)
                     x[k] = lo[k] + span[k] * pk_rng_uniform(&rng);

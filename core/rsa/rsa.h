@@ -26,19 +26,19 @@
  * differ in how many draws a grain costs, hence in what a given N^F reaches,
  * and in the packing a seed gives. */
 typedef enum pk_rsa_draws {
-    PK_RSA_DRAWS_OPEN = 0,       /* "open" (default): late in a run, draws come from the
+    PK_RSA_DRAWS_OPEN = 0, /* "open" (default): late in a run, draws come from the
                                     space not yet known to be excluded (rsa_voxels.h; runs
                                     of equal grains: batch/README.md); a run whose open
                                     space is used up stops as PK_STOP_SATURATED */
-    PK_RSA_DRAWS_PLAIN           /* "plain": uniform over the whole draw range all along,
+    PK_RSA_DRAWS_PLAIN     /* "plain": uniform over the whole draw range all along,
                                     Titscher's loop draw for draw (runs of equal grains
                                     are batched with the same outcome bit for bit) */
 } pk_rsa_draws;
 
 typedef struct pk_rsa_params {
-    double delta_d;              /* minimum surface gap Δd (>= 0) */
-    uint64_t max_failed_draws;   /* N^F (e.g. 1e6) */
-    uint64_t seed;               /* positions use stream 1 of this seed */
+    double delta_d;            /* minimum surface gap Δd (>= 0) */
+    uint64_t max_failed_draws; /* N^F (e.g. 1e6) */
+    uint64_t seed;             /* positions use stream 1 of this seed */
     pk_rsa_draws draws;
     struct {                     /* test and bench overrides; all 0 in jobs */
         int one_at_a_time;       /* 1: runs of equal grains are not batched either */
@@ -50,7 +50,7 @@ typedef struct pk_rsa_params {
 typedef struct pk_rsa_stats {
     pk_stop_reason reason;
     size_t placed, requested;
-    uint64_t draws;              /* all position draws */
+    uint64_t draws; /* all position draws */
     double seconds;
 } pk_rsa_stats;
 
@@ -60,7 +60,6 @@ typedef struct pk_rsa_stats {
  * run ended cleanly (whatever the reason; see stats->reason), -1 on bad input
  * or allocation failure. */
 int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *species, size_t n,
-                 const pk_rsa_params *prm, pk_monitor *mon, pk_particles *out,
-                 pk_rsa_stats *stats);
+                 const pk_rsa_params *prm, pk_monitor *mon, pk_particles *out, pk_rsa_stats *stats);
 
 #endif

@@ -111,10 +111,7 @@ void pk_rsa_vox_free(pk_rsa_vox *v)
 
 /* Periodic image of an unwrapped index: the ranges scanned here reach at most
  * one period beyond the lattice (reach < L/2), so no division is needed. */
-static inline int64_t image_of(int64_t i, int64_t n)
-{
-    return i < 0 ? -1 : (i >= n ? 1 : 0);
-}
+static inline int64_t image_of(int64_t i, int64_t n) { return i < 0 ? -1 : (i >= n ? 1 : 0); }
 
 /* Index range [*lo, *hi] of voxels along axis k meeting [a, c]; walled axes
  * are clipped to the lattice, periodic ones stay unwrapped. */

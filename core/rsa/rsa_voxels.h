@@ -38,25 +38,25 @@
  * record so a draw, the overlap test and the cover read the same lines. */
 typedef struct pk_rsa_cell {
     double x[3], r;
-    uint64_t mask;              /* sub-voxels not yet known covered, bit (z·sub+y)·sub+x */
+    uint64_t mask; /* sub-voxels not yet known covered, bit (z·sub+y)·sub+x */
 } pk_rsa_cell;
 
 typedef struct pk_rsa_vox {
     pk_box box;
-    double org[PK_MAXDIM];      /* lattice origin per axis */
-    double e[PK_MAXDIM];        /* voxel edge per axis */
+    double org[PK_MAXDIM]; /* lattice origin per axis */
+    double e[PK_MAXDIM];   /* voxel edge per axis */
     double inv_e[PK_MAXDIM];
-    int64_t n[PK_MAXDIM];       /* voxels per axis (1 on unused axes) */
+    int64_t n[PK_MAXDIM]; /* voxels per axis (1 on unused axes) */
     uint64_t nvox;
-    double r_valid;             /* set valid for grains with r >= r_valid */
-    double r_top;               /* largest grain stored */
-    double gap;                 /* Δd */
-    double margin;              /* absolute safety margin of the cover test */
-    int sub;                    /* sub-voxels per axis and voxel (sub^dim = 64) */
-    double se[PK_MAXDIM];       /* sub-voxel edge per axis */
-    pk_rsa_cell *cell;          /* [nvox] */
-    uint32_t *slot;             /* index in `active`, UINT32_MAX once removed */
-    uint32_t *active;           /* active voxel ids */
+    double r_valid;       /* set valid for grains with r >= r_valid */
+    double r_top;         /* largest grain stored */
+    double gap;           /* Δd */
+    double margin;        /* absolute safety margin of the cover test */
+    int sub;              /* sub-voxels per axis and voxel (sub^dim = 64) */
+    double se[PK_MAXDIM]; /* sub-voxel edge per axis */
+    pk_rsa_cell *cell;    /* [nvox] */
+    uint32_t *slot;       /* index in `active`, UINT32_MAX once removed */
+    uint32_t *active;     /* active voxel ids */
     uint64_t nactive;
 } pk_rsa_vox;
 

@@ -8,9 +8,9 @@
 #define PK_MAXDIM 3
 
 typedef struct pk_box {
-    int dim;                     /* 2 or 3 */
-    double L[PK_MAXDIM];         /* edge lengths */
-    bool periodic[PK_MAXDIM];    /* true = periodic axis, false = walls at 0 and L */
+    int dim;                  /* 2 or 3 */
+    double L[PK_MAXDIM];      /* edge lengths */
+    bool periodic[PK_MAXDIM]; /* true = periodic axis, false = walls at 0 and L */
 } pk_box;
 
 /* Area (2D) or volume (3D). */

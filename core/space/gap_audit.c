@@ -26,21 +26,21 @@
 #define MAX_LEVELS 40
 
 typedef struct level_grid {
-    double edge[PK_MAXDIM];   /* cell edge per axis (L_k / n_k) */
-    int64_t n[PK_MAXDIM];     /* cells per axis (1 on unused axes) */
-    size_t *start;            /* [ncell + 1] CSR: grains of cell c are ids[start[c] .. start[c+1]) */
+    double edge[PK_MAXDIM]; /* cell edge per axis (L_k / n_k) */
+    int64_t n[PK_MAXDIM];   /* cells per axis (1 on unused axes) */
+    size_t *start;          /* [ncell + 1] CSR: grains of cell c are ids[start[c] .. start[c+1]) */
     size_t *ids;
-    double *q;                /* [count][4] centre and radius of ids[s], in the same (cell)
+    double *q;    /* [count][4] centre and radius of ids[s], in the same (cell)
                                  order: a cell's candidates are contiguous in memory */
-    size_t count;             /* grains in the level */
+    size_t count; /* grains in the level */
 } level_grid;
 
 typedef struct audit {
     const pk_box *b;
     const pk_particles *p;
     int nlevel;
-    double r_up[MAX_LEVELS];  /* radius bound of level L: r_max / 2^L */
-    int *level;               /* [n] level of each grain */
+    double r_up[MAX_LEVELS]; /* radius bound of level L: r_max / 2^L */
+    int *level;              /* [n] level of each grain */
     level_grid g[MAX_LEVELS];
 } audit;
 
@@ -71,7 +71,7 @@ static int64_t cell_of(const level_grid *G, const pk_box *b, int k, double x)
 static uint64_t cell_index(const level_grid *G, const int64_t *c)
 {
     return ((uint64_t)c[2] * (uint64_t)G->n[1] + (uint64_t)c[1]) * (uint64_t)G->n[0] +
-           (uint64_t)c[0];
+        (uint64_t)c[0];
 }
 
 /* The grains in (level, cell) order: keys base_l + cell (32 bits: at most
@@ -286,8 +286,8 @@ static void pass(const audit *A, double h, double required, double tol, pk_gap_r
 int pk_gap_audit(const pk_box *b, const pk_particles *p, double required, double tol,
                  double horizon, pk_gap_report *rep)
 {
-    *rep = (pk_gap_report){.min_gap = horizon, .min_pair = {SIZE_MAX, SIZE_MAX},
-                           .min_wall_gap = INFINITY};
+    *rep = (pk_gap_report){
+        .min_gap = horizon, .min_pair = {SIZE_MAX, SIZE_MAX}, .min_wall_gap = INFINITY};
     const int dim = b->dim;
     double rmax = 0, rmin = INFINITY;
     for (size_t i = 0; i < p->n; i++) {

@@ -12,12 +12,12 @@
 #include "particles.h"
 
 typedef struct pk_gap_report {
-    double min_gap;          /* smallest surface gap over pairs closer than `horizon` (else = horizon) */
-    size_t min_pair[2];      /* the pair that has it (or SIZE_MAX) */
-    double min_wall_gap;     /* smallest grain–wall clearance over walled axes (INFINITY if none) */
-    size_t pairs_below;      /* pairs with gap < required - tol */
-    size_t walls_below;      /* grains with wall clearance < required/2 - tol */
-    size_t pairs_checked;    /* pairs closer than the last pass's horizon (gap_audit.c) */
+    double min_gap;     /* smallest surface gap over pairs closer than `horizon` (else = horizon) */
+    size_t min_pair[2]; /* the pair that has it (or SIZE_MAX) */
+    double min_wall_gap;  /* smallest grain–wall clearance over walled axes (INFINITY if none) */
+    size_t pairs_below;   /* pairs with gap < required - tol */
+    size_t walls_below;   /* grains with wall clearance < required/2 - tol */
+    size_t pairs_checked; /* pairs closer than the last pass's horizon (gap_audit.c) */
 } pk_gap_report;
 
 /* required: Δd; tol: absolute tolerance for the "below" counts; horizon:

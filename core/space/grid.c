@@ -234,16 +234,16 @@ static inline int scan(const pk_grid *g, const pk_particles *p, const double *x,
         }
         /* a wrapped cell coordinate: the division only off [0, n) (two of
          * them per cell are most of a 2D query's time; docs/perf/space.md) */
-#define WRAPPED(c_, k_)                                                                        \
-    (wrap[k_] && ((c_) < 0 || (c_) >= lv->ncell[k_])                                          \
-         ? (((c_) % lv->ncell[k_]) + lv->ncell[k_]) % lv->ncell[k_]                             \
+#define WRAPPED(c_, k_)                                                                            \
+    (wrap[k_] && ((c_) < 0 || (c_) >= lv->ncell[k_])                                               \
+         ? (((c_) % lv->ncell[k_]) + lv->ncell[k_]) % lv->ncell[k_]                                \
          : (c_))
         for (int64_t cz = lo[2]; cz <= hi[2]; cz++) {
             int64_t iz = WRAPPED(cz, 2);
             for (int64_t cy = lo[1]; cy <= hi[1]; cy++) {
                 int64_t iy = WRAPPED(cy, 1);
-                uint64_t base = ((uint64_t)iz * (uint64_t)lv->ncell[1] + (uint64_t)iy) *
-                                (uint64_t)lv->ncell[0];
+                uint64_t base =
+                    ((uint64_t)iz * (uint64_t)lv->ncell[1] + (uint64_t)iy) * (uint64_t)lv->ncell[0];
                 for (int64_t cx = lo[0]; cx <= hi[0]; cx++) {
                     int64_t ix = WRAPPED(cx, 0);
                     uint64_t lin = base + (uint64_t)ix;

@@ -26,24 +26,24 @@
 #define PK_GRID_MAX_LEVELS 24
 
 typedef struct pk_grid_level {
-    double h[PK_MAXDIM];        /* cell edge per axis */
-    int64_t ncell[PK_MAXDIM];   /* cells per axis */
-    double r_hi;                /* radii in this level are <= r_hi */
-    size_t count;               /* grains registered */
-    uint64_t mask;              /* nbucket - 1 (nbucket a power of two) */
-    int32_t *head;              /* [nbucket] first grain of each bucket, -1 = empty */
+    double h[PK_MAXDIM];      /* cell edge per axis */
+    int64_t ncell[PK_MAXDIM]; /* cells per axis */
+    double r_hi;              /* radii in this level are <= r_hi */
+    size_t count;             /* grains registered */
+    uint64_t mask;            /* nbucket - 1 (nbucket a power of two) */
+    int32_t *head;            /* [nbucket] first grain of each bucket, -1 = empty */
 } pk_grid_level;
 
 typedef struct pk_grid {
     pk_box box;
-    double gap;                 /* contact distance is r_i + r_j + gap */
-    double r_top;               /* radius bound of level 0 */
+    double gap;   /* contact distance is r_i + r_j + gap */
+    double r_top; /* radius bound of level 0 */
     int nlevel;
     pk_grid_level lv[PK_GRID_MAX_LEVELS];
-    size_t cap;                 /* per-grain arrays sized for indices < cap */
-    int32_t *next;              /* bucket chain */
-    uint64_t *cell;             /* linear cell index of each registered grain */
-    int8_t *level;              /* level of each grain, -1 = not registered */
+    size_t cap;     /* per-grain arrays sized for indices < cap */
+    int32_t *next;  /* bucket chain */
+    uint64_t *cell; /* linear cell index of each registered grain */
+    int8_t *level;  /* level of each grain, -1 = not registered */
 } pk_grid;
 
 /* r_min..r_max: radius range of the grains to be registered (r_max > 0);
@@ -64,8 +64,8 @@ int pk_grid_update(pk_grid *g, const pk_particles *p, size_t i);
  * non-zero to stop the query; pk_grid_query then returns that value. */
 typedef int (*pk_grid_visit)(size_t j, const double dx[PK_MAXDIM], double dist2, void *ctx);
 
-int pk_grid_query(const pk_grid *g, const pk_particles *p, const double x[PK_MAXDIM],
-                  double r, double extra, pk_grid_visit fn, void *ctx);
+int pk_grid_query(const pk_grid *g, const pk_particles *p, const double x[PK_MAXDIM], double r,
+                  double extra, pk_grid_visit fn, void *ctx);
 
 /* Fast path for RSA: 1 if a registered grain j has |x_j - x| < r + r_j + gap. */
 int pk_grid_overlaps(const pk_grid *g, const pk_particles *p, const double x[PK_MAXDIM], double r);

@@ -36,7 +36,8 @@ int pk_ugrid_cover_init(pk_ugrid *g, const size_t *count, size_t n)
     int ncovered = 0;
     for (int l = 0; l < busiest; l++) { /* balls of bounded size, entries O(n) */
         const double cells = ball_cells(g, ldexp(g->r_top, -l) + g->cov_r);
-        g->covered[l] = cells <= COVER_BALL_CELLS && (double)count[l] * cells <= 8.0 * (double)n + 65536;
+        g->covered[l] =
+            cells <= COVER_BALL_CELLS && (double)count[l] * cells <= 8.0 * (double)n + 65536;
         ncovered += g->covered[l];
     }
     if (ncovered == 0)
@@ -304,8 +305,8 @@ void pk_ugrid_cover_remove(pk_ugrid *g, size_t j)
 }
 
 /* The grains ids[0..n) within r + r_j of x (minimum image), as scan_cells. */
-static int cover_test(const pk_ugrid *g, const pk_particles *p, const double x[PK_MAXDIM],
-                      double r, const int32_t *ids, uint32_t n, pk_grid_visit fn, void *ctx)
+static int cover_test(const pk_ugrid *g, const pk_particles *p, const double x[PK_MAXDIM], double r,
+                      const int32_t *ids, uint32_t n, pk_grid_visit fn, void *ctx)
 {
     const double M = 6755399441055744.0; /* pk_min_image3 */
     for (uint32_t q = 0; q < n; q++) {
@@ -335,8 +336,9 @@ int pk_ugrid_cover_query(const pk_ugrid *g, const pk_particles *p, const double 
     const pk_ugrid_level *lv = &g->lv[g->cov_level];
     int32_t u[PK_MAXDIM] = {0, 0, 0};
     for (int k = 0; k < g->box.dim; k++)
-        u[k] = g->box.periodic[k] ? ug_wrap_index((int64_t)ug_fast_floor(x[k] * lv->inv_h[k]), lv->n[k])
-                                  : ug_coord(lv, k, x[k]);
+        u[k] = g->box.periodic[k]
+            ? ug_wrap_index((int64_t)ug_fast_floor(x[k] * lv->inv_h[k]), lv->n[k])
+            : ug_coord(lv, k, x[k]);
     const pk_ugrid_cover *cell =
         &g->cov[((size_t)u[2] * (size_t)lv->n[1] + (size_t)u[1]) * (size_t)lv->n[0] + (size_t)u[0]];
     int stop = cover_test(g, p, x, r, cell->ids, cell->n, fn, ctx);

@@ -144,8 +144,8 @@ int pk_ugrid_insert(pk_ugrid *g, const pk_particles *p, size_t i)
     g->level[i] = (int8_t)l;
     if (p->r[i] > lv->r_max)
         lv->r_max = p->r[i];
-    if (g->covered[l] && (move ? pk_ugrid_cover_move(g, i, x, p->r[i])
-                               : pk_ugrid_cover_add(g, i, x, p->r[i])) != 0)
+    if (g->covered[l] &&
+        (move ? pk_ugrid_cover_move(g, i, x, p->r[i]) : pk_ugrid_cover_add(g, i, x, p->r[i])) != 0)
         return -1;
     return 0;
 }
@@ -231,8 +231,8 @@ static int query_level(const pk_ugrid *g, const pk_ugrid_level *lv, const pk_par
         lo[k] = ug_wrap_index((int64_t)flo, n);
         cnt[k] = (int32_t)(fhi - flo) + 1;
     }
-    const qctx q = {g->next, p->x, p->r, x[0], x[1], x[2], r,
-                    g->L[0], g->L[1], g->L[2], g->inv_L[0], g->inv_L[1], g->inv_L[2], fn, ctx};
+    const qctx q = {g->next, p->x,    p->r,        x[0],        x[1],        x[2], r,  g->L[0],
+                    g->L[1], g->L[2], g->inv_L[0], g->inv_L[1], g->inv_L[2], fn,   ctx};
     const int32_t nx = lv->n[0], ny = lv->n[1], nz = lv->n[2];
     /* x cells: [lo, e1) then, past the periodic seam, [0, e2) */
     const int32_t e1 = lo[0] + cnt[0] <= nx ? lo[0] + cnt[0] : nx, e2 = lo[0] + cnt[0] - e1;
@@ -241,7 +241,8 @@ static int query_level(const pk_ugrid *g, const pk_ugrid_level *lv, const pk_par
         int32_t iy = lo[1];
         for (int32_t cy = 0; cy < cnt[1]; cy++, iy = iy + 1 == ny ? 0 : iy + 1) {
             const int32_t *row = &lv->head[((size_t)iz * (size_t)ny + (size_t)iy) * (size_t)nx];
-            int stop = images ? scan_cells(&q, row, lo[0], e1, 1) : scan_cells(&q, row, lo[0], e1, 0);
+            int stop =
+                images ? scan_cells(&q, row, lo[0], e1, 1) : scan_cells(&q, row, lo[0], e1, 0);
             if (!stop && e2 > 0)
                 stop = scan_cells(&q, row, 0, e2, 1);
             if (stop)

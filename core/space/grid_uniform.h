@@ -36,10 +36,10 @@
 #define PK_UGRID_CELLS_PER_GRAIN 8
 
 typedef struct pk_ugrid_level {
-    double inv_h[PK_MAXDIM];    /* 1 / cell edge */
-    int32_t n[PK_MAXDIM];       /* cells per axis (1 beyond dim) */
-    int32_t *head;              /* first grain of each cell, -1 = empty */
-    double r_max;               /* largest radius registered here (never lowered) */
+    double inv_h[PK_MAXDIM]; /* 1 / cell edge */
+    int32_t n[PK_MAXDIM];    /* cells per axis (1 beyond dim) */
+    int32_t *head;           /* first grain of each cell, -1 = empty */
+    double r_max;            /* largest radius registered here (never lowered) */
 } pk_ugrid_level;
 
 /* A cover cell: the coarse grains whose balls r_j + cov_r touch it. */
@@ -50,9 +50,9 @@ typedef struct pk_ugrid_cover {
 
 typedef struct pk_ugrid {
     pk_box box;
-    double L[PK_MAXDIM];        /* box edges on periodic axes, 0 otherwise */
-    double inv_L[PK_MAXDIM];    /* 1/L on periodic axes, 0 otherwise */
-    double r_top;               /* level l holds radii in (r_top/2^(l+1), r_top/2^l] */
+    double L[PK_MAXDIM];     /* box edges on periodic axes, 0 otherwise */
+    double inv_L[PK_MAXDIM]; /* 1/L on periodic axes, 0 otherwise */
+    double r_top;            /* level l holds radii in (r_top/2^(l+1), r_top/2^l] */
     int nlevel;
     pk_ugrid_level lv[PK_UGRID_MAX_LEVELS];
     int32_t *next, *prev, *cell; /* per grain; cell -1 = not registered */
@@ -66,14 +66,14 @@ typedef struct pk_ugrid {
      * most populated). */
     double cov_r;
     int8_t covered[PK_UGRID_MAX_LEVELS];
-    int cov_level;              /* whose cell geometry the cover uses */
-    pk_ugrid_cover *cov;        /* cells */
-    pk_ugrid_cover cov_big;     /* grains grown past a bounded ball: tested by every cover query */
-    double *cov_ball;           /* per grain: centre and radius it is listed with (0: not; < 0: in cov_big) */
-    size_t cov_nmax;            /* most cells along an axis */
-    int64_t *cov_off;           /* scratch of the cover walks: 3 × 3 × cov_nmax cell offsets
+    int cov_level;          /* whose cell geometry the cover uses */
+    pk_ugrid_cover *cov;    /* cells */
+    pk_ugrid_cover cov_big; /* grains grown past a bounded ball: tested by every cover query */
+    double *cov_ball; /* per grain: centre and radius it is listed with (0: not; < 0: in cov_big) */
+    size_t cov_nmax;  /* most cells along an axis */
+    int64_t *cov_off; /* scratch of the cover walks: 3 × 3 × cov_nmax cell offsets
                                  * (two balls and their union) */
-    double *cov_e2;             /* and 4 × 3 × cov_nmax squared slab distances (two balls,
+    double *cov_e2;   /* and 4 × 3 × cov_nmax squared slab distances (two balls,
                                  * and each over the union) */
 } pk_ugrid;
 

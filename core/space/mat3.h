@@ -16,7 +16,7 @@ static inline void pk_m3_vec(const double A[9], const double x[3], double y[3])
 static inline double pk_m3_det(const double A[9])
 {
     return A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) +
-           A[2] * (A[3] * A[7] - A[4] * A[6]);
+        A[2] * (A[3] * A[7] - A[4] * A[6]);
 }
 
 /* B = A^{-1}; returns det(A) (B untouched when det == 0). */
@@ -57,7 +57,8 @@ static inline double pk_m3_sigma_min(const double F[9], int dim)
     }
     double q = (C[0] + C[4] + C[8]) / 3;
     double p1 = C[1] * C[1] + C[2] * C[2] + C[5] * C[5];
-    double p2 = (C[0] - q) * (C[0] - q) + (C[4] - q) * (C[4] - q) + (C[8] - q) * (C[8] - q) + 2 * p1;
+    double p2 =
+        (C[0] - q) * (C[0] - q) + (C[4] - q) * (C[4] - q) + (C[8] - q) * (C[8] - q) + 2 * p1;
     double p = sqrt(p2 / 6);
     if (!(p > 0))
         return sqrt(fmax(0, q));

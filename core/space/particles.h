@@ -9,12 +9,12 @@
 #include <stdint.h>
 
 typedef struct pk_particles {
-    int dim;           /* 2 or 3 */
-    size_t n;          /* particles in use */
-    size_t cap;        /* allocated */
-    double *x;         /* [cap][3] centres */
-    double *r;         /* [cap] radii */
-    int32_t *species;  /* [cap] size-class index (0 = coarsest) */
+    int dim;          /* 2 or 3 */
+    size_t n;         /* particles in use */
+    size_t cap;       /* allocated */
+    double *x;        /* [cap][3] centres */
+    double *r;        /* [cap] radii */
+    int32_t *species; /* [cap] size-class index (0 = coarsest) */
 } pk_particles;
 
 /* 0 on success, -1 on allocation failure.  Starts empty with capacity cap. */

@@ -12,23 +12,28 @@
 #include "core/base/rng.h"
 #include "tetfill_tangent.h"
 
-#define MAX_NB 16      /* neighbours list capacity (spheres + planes) */
-#define MAX_PLANES 3   /* boundary planes offered as virtual spheres per locus */
+#define MAX_NB 16    /* neighbours list capacity (spheres + planes) */
+#define MAX_PLANES 3 /* boundary planes offered as virtual spheres per locus */
 #ifndef TETFILL_RETIRE
 #define TETFILL_RETIRE 16 /* failed visits in a row that retire a tet from step 7b */
 #endif
 
 void pk_tetfill_defaults(pk_tetfill_params *prm)
 {
-    *prm = (pk_tetfill_params){.eps = 1e-4, .z_min = 3, .contact_rule = PK_TETFILL_CONTACT_TANGENT,
-                               .vertex_weight = 0.5, .densify = 1, .neighbours = 8,
-                               .max_combos = 30, .max_passes = 1000};
+    *prm = (pk_tetfill_params){.eps = 1e-4,
+                               .z_min = 3,
+                               .contact_rule = PK_TETFILL_CONTACT_TANGENT,
+                               .vertex_weight = 0.5,
+                               .densify = 1,
+                               .neighbours = 8,
+                               .max_combos = 30,
+                               .max_passes = 1000};
 }
 
 typedef struct nb_sphere {
-    double s;          /* surface distance to the locus */
+    double s; /* surface distance to the locus */
     double c[3], r;
-    int virt;          /* 1 = virtual sphere standing for a boundary plane */
+    int virt; /* 1 = virtual sphere standing for a boundary plane */
 } nb_sphere;
 
 typedef struct filler {
@@ -36,17 +41,17 @@ typedef struct filler {
     const pk_tetfill_params *prm;
     pk_mesh_locator L;
     pk_particles *p;
-    size_t first;        /* p's grains before this run (not ours) */
+    size_t first; /* p's grains before this run (not ours) */
     pk_grid g;
     pk_rng rng;
-    double tau;          /* contact tolerance (query reach) */
-    double zgap;         /* a gap <= zgap is a contact in the z_min test */
-    double Rv;           /* virtual sphere radius */
+    double tau;  /* contact tolerance (query reach) */
+    double zgap; /* a gap <= zgap is a contact in the z_min test */
+    double Rv;   /* virtual sphere radius */
     double V, solid;
     pk_monitor *mon;
     pk_progress prog;
     pk_tetfill_stats *st;
-    int stop;            /* 0 go, 1 target reached, 2 cancelled/time/limit */
+    int stop; /* 0 go, 1 target reached, 2 cancelled/time/limit */
     /* scratch for the acceptance query */
     double *nd, *nr;
     size_t nn, ncap;
@@ -74,8 +79,8 @@ static int tick(filler *F, int force)
     F->prog.done = F->p->n - F->first;
     F->prog.phi = F->solid / F->V;
     F->prog.fraction = F->prm->phi_target > 0 ? fmin(1, F->prog.phi / F->prm->phi_target)
-                       : F->prm->n_target ? fmin(1, (double)F->prog.done / (double)F->prm->n_target)
-                                          : -1;
+        : F->prm->n_target ? fmin(1, (double)F->prog.done / (double)F->prm->n_target)
+                           : -1;
     int rc = pk_monitor_tick(F->mon, &F->prog, force);
     if (rc) {
         F->stop = 2;
@@ -382,8 +387,7 @@ static int try_locus(filler *F, const double q[3], int void_only)
                     int nroot;
                     F->st->solves++;
                     if (pk_tangent_sphere(cc, rr, PK_TETFILL_TANGENT_TOL * prm->r_min, x, r,
-                                          &nroot) ==
-                        PK_TANGENT_SINGULAR) {
+                                          &nroot) == PK_TANGENT_SINGULAR) {
                         F->st->singular++;
                         continue;
                     }

@@ -72,19 +72,19 @@ typedef enum pk_tetfill_contact_rule {
 
 typedef struct pk_tetfill_params {
     double r_min, r_max;
-    double eps;              /* maximum overlap rate ε: δ_max = ε r_min */
-    int z_min;               /* minimum contacts of an inserted sphere (2, 3, 4) */
+    double eps;                           /* maximum overlap rate ε: δ_max = ε r_min */
+    int z_min;                            /* minimum contacts of an inserted sphere (2, 3, 4) */
     pk_tetfill_contact_rule contact_rule; /* the contact of the z_min test */
-    double phi_target;       /* stop at this solid fraction (0 = none) */
-    size_t n_target;         /* stop at this many spheres (0 = none) */
-    uint64_t seed;           /* loci order and random radii: streams 0, 1 */
-    double vertex_weight;    /* step 6 locus = centroid + w (node − centroid) */
-    int skip_tet_loci;       /* skip steps 5–6 (Jerier's loose packings) */
-    int densify;             /* run step 7b */
-    int neighbours;          /* nearest spheres combined per locus (4..12) */
-    int max_combos;          /* four-sphere sets tried per locus */
-    int max_passes;          /* densification passes */
-    size_t max_spheres;      /* hard limit (0 = none) */
+    double phi_target;                    /* stop at this solid fraction (0 = none) */
+    size_t n_target;                      /* stop at this many spheres (0 = none) */
+    uint64_t seed;                        /* loci order and random radii: streams 0, 1 */
+    double vertex_weight;                 /* step 6 locus = centroid + w (node − centroid) */
+    int skip_tet_loci;                    /* skip steps 5–6 (Jerier's loose packings) */
+    int densify;                          /* run step 7b */
+    int neighbours;                       /* nearest spheres combined per locus (4..12) */
+    int max_combos;                       /* four-sphere sets tried per locus */
+    int max_passes;                       /* densification passes */
+    size_t max_spheres;                   /* hard limit (0 = none) */
 } pk_tetfill_params;
 
 /* Defaults: ε = 1e-4 (YADE), z_min = 3, contact rule tangent, w = 0.5,
@@ -94,13 +94,13 @@ void pk_tetfill_defaults(pk_tetfill_params *prm);
 
 typedef struct pk_tetfill_stats {
     pk_stop_reason reason;
-    size_t n_direct;         /* after steps 2–3 and overlap reduction */
-    size_t n_trimmed;        /* removed at the boundary (7a) */
-    size_t n_geometric;      /* after steps 4–6 */
-    double phi_geometric;    /* solid fraction after steps 4–6 */
+    size_t n_direct;            /* after steps 2–3 and overlap reduction */
+    size_t n_trimmed;           /* removed at the boundary (7a) */
+    size_t n_geometric;         /* after steps 4–6 */
+    double phi_geometric;       /* solid fraction after steps 4–6 */
     pk_tetfill_coord geometric; /* coordination after steps 1–6 (before 7b) */
     size_t n_final;
-    double phi;              /* final solid fraction (Σ V_i / V_mesh) */
+    double phi; /* final solid fraction (Σ V_i / V_mesh) */
     size_t loci, solves, singular, accepted, accepted_three;
     int passes;
     double seconds, seconds_geometric;

@@ -19,12 +19,14 @@ void pk_sym3_eigenvalues(const double a[9], double ev[3])
         ev[1] = a[4];
         ev[2] = a[8];
     } else {
-        double p2 = (a[0] - q) * (a[0] - q) + (a[4] - q) * (a[4] - q) + (a[8] - q) * (a[8] - q) + 2 * p1;
+        double p2 =
+            (a[0] - q) * (a[0] - q) + (a[4] - q) * (a[4] - q) + (a[8] - q) * (a[8] - q) + 2 * p1;
         double p = sqrt(p2 / 6), b[9];
         for (int i = 0; i < 9; i++)
             b[i] = (a[i] - (i % 4 == 0 ? q : 0)) / p;
         double r = (b[0] * (b[4] * b[8] - b[5] * b[7]) - b[1] * (b[3] * b[8] - b[5] * b[6]) +
-                    b[2] * (b[3] * b[7] - b[4] * b[6])) / 2;
+                    b[2] * (b[3] * b[7] - b[4] * b[6])) /
+            2;
         double phi = r <= -1 ? M_PI / 3 : r >= 1 ? 0 : acos(r) / 3;
         ev[2] = q + 2 * p * cos(phi);
         ev[0] = q + 2 * p * cos(phi + 2 * M_PI / 3);
@@ -42,8 +44,8 @@ void pk_sym3_eigenvalues(const double a[9], double ev[3])
 int pk_tetfill_contact_kind(double gap, double r_min, double eps)
 {
     return (gap <= fmax(eps, 1e-9) * r_min ? PK_CONTACT_TOL : 0) |
-           (gap <= PK_TETFILL_TANGENT_TOL * r_min ? PK_CONTACT_TANGENT : 0) |
-           (gap <= 0 ? PK_CONTACT_TOUCHING : 0);
+        (gap <= PK_TETFILL_TANGENT_TOL * r_min ? PK_CONTACT_TANGENT : 0) |
+        (gap <= 0 ? PK_CONTACT_TOUCHING : 0);
 }
 
 typedef struct coord_ctx {

@@ -25,8 +25,8 @@
 #include "core/mesh/mesh.h"
 #include "core/space/particles.h"
 
-#define PK_TETFILL_ZHIST 16   /* coordination histogram bins 0..15 (last: >= 15) */
-#define PK_TETFILL_THIST 32   /* spheres-per-tet histogram bins 0..31 (last: >= 31) */
+#define PK_TETFILL_ZHIST 16         /* coordination histogram bins 0..15 (last: >= 15) */
+#define PK_TETFILL_THIST 32         /* spheres-per-tet histogram bins 0..31 (last: >= 31) */
 #define PK_TETFILL_TANGENT_TOL 1e-9 /* tangency residual bound / r_min (tetfill.c) */
 
 /* Which of the three contact definitions a pair with this gap meets. */
@@ -41,26 +41,26 @@ typedef struct pk_tetfill_coord {
 
 typedef struct pk_tetfill_measures {
     size_t n;
-    double overlap_max;        /* largest overlap / r_min (0 if none) */
-    double overlap_mean;       /* mean overlap / r_min over overlapping pairs */
-    size_t pairs_overlapping, pairs_over_bound;   /* bound: ε r_min (1 + 1e-9) */
+    double overlap_max;                         /* largest overlap / r_min (0 if none) */
+    double overlap_mean;                        /* mean overlap / r_min over overlapping pairs */
+    size_t pairs_overlapping, pairs_over_bound; /* bound: ε r_min (1 + 1e-9) */
     size_t contacts;
-    double z_mean;             /* 2 N_c / N */
-    size_t contacts_tangent;   /* pairs with gap <= PK_TETFILL_TANGENT_TOL r_min */
-    double z_tangent;          /* 2 N_c / N with those */
-    size_t contacts_touching;  /* pairs with gap <= 0 exactly (no tolerance) */
-    double z_touching;         /* 2 N_c / N with those: the count of Jerier's
+    double z_mean;            /* 2 N_c / N */
+    size_t contacts_tangent;  /* pairs with gap <= PK_TETFILL_TANGENT_TOL r_min */
+    double z_tangent;         /* 2 N_c / N with those */
+    size_t contacts_touching; /* pairs with gap <= 0 exactly (no tolerance) */
+    double z_touching;        /* 2 N_c / N with those: the count of Jerier's
                                 * SpherePadder (distance <= 0) and of a DEM
                                 * code that detects contacts by overlap; a
                                 * tangency solved in floating point lands on
                                 * either side of 0, so about half count */
     int64_t z_hist[PK_TETFILL_ZHIST];
-    double fabric[9];          /* F_αβ (Eq. 17), row-major */
-    double fabric_eig[3];      /* ascending */
-    double phi;                /* Σ V_i / V_mesh */
+    double fabric[9];     /* F_αβ (Eq. 17), row-major */
+    double fabric_eig[3]; /* ascending */
+    double phi;           /* Σ V_i / V_mesh */
     size_t nregion;
-    int64_t *region_id;        /* [nregion] ascending */
-    double *region_phi;        /* [nregion] Σ V_i (centre in region) / region volume */
+    int64_t *region_id; /* [nregion] ascending */
+    double *region_phi; /* [nregion] Σ V_i (centre in region) / region volume */
     double spheres_per_tet_mean;
     int64_t t_hist[PK_TETFILL_THIST];
     size_t outside;            /* centres in no tet */

@@ -14,8 +14,8 @@
 #define PK_TANGENT_DET_TOL 1e-10
 
 typedef enum pk_tangent_status {
-    PK_TANGENT_OK = 0,        /* roots (possibly none) computed */
-    PK_TANGENT_SINGULAR,      /* det A ≈ 0 relative to ℓ³: coplanar quadruple */
+    PK_TANGENT_OK = 0,   /* roots (possibly none) computed */
+    PK_TANGENT_SINGULAR, /* det A ≈ 0 relative to ℓ³: coplanar quadruple */
 } pk_tangent_status;
 
 /* Positive radii only (a root r <= 0 is a sphere enclosing the four), ordered

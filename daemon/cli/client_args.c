@@ -14,7 +14,8 @@ static const struct command {
     const char *positional; /* NULL: none */
     const char *what;
 } commands[] = {
-    {"submit", SUBMIT, "JOB.json", "submit a job file to a packd service; with --wait follow it and download its result"},
+    {"submit", SUBMIT, "JOB.json",
+     "submit a job file to a packd service; with --wait follow it and download its result"},
     {"jobs", JOBS, NULL, "list the service's jobs, newest first"},
     {"cancel", CANCEL, "ID", "dismiss a job (a running one is stopped)"},
     {"fetch", FETCH, "ID", "download a job's result and verify its SHA-256"},
@@ -23,12 +24,12 @@ static const struct command {
 typedef enum { STR, FLAG } kind;
 
 static const struct option {
-    const char *name;     /* long form, without "--" */
-    const char *alias;    /* short form or NULL */
+    const char *name;  /* long form, without "--" */
+    const char *alias; /* short form or NULL */
     kind kind;
     const char *metavar;
-    const char *env;      /* fallback environment variable or NULL */
-    const char *def;      /* built-in default or NULL */
+    const char *env; /* fallback environment variable or NULL */
+    const char *def; /* built-in default or NULL */
     unsigned cmds;
     size_t off;
     const char *help;
@@ -94,9 +95,11 @@ void pk_client_help(const char *cmd, FILE *f)
         fputc('\n', f);
     }
     if (c->bit & (SUBMIT | FETCH))
-        fprintf(f, "\nexit status: 0 done, 1 rejected (the problem's errors on stderr), 2 transport\n"
-                   "or integrity error (no answer, 5xx, SHA-256 mismatch), 3 the job failed or was\n"
-                   "dismissed (a failed job's partial result is still downloaded with -o), 64 usage.\n");
+        fprintf(
+            f,
+            "\nexit status: 0 done, 1 rejected (the problem's errors on stderr), 2 transport\n"
+            "or integrity error (no answer, 5xx, SHA-256 mismatch), 3 the job failed or was\n"
+            "dismissed (a failed job's partial result is still downloaded with -o), 64 usage.\n");
 }
 
 int pk_client_parse(int argc, char **argv, pk_client_args *a)
@@ -117,7 +120,8 @@ int pk_client_parse(int argc, char **argv, pk_client_args *a)
             }
             *(const char **)((char *)a + o->off) = argv[++i];
         } else if (arg[0] == '-' && arg[1]) {
-            fprintf(stderr, "packd %s: unknown option '%s' (packd %s --help)\n", c->name, arg, c->name);
+            fprintf(stderr, "packd %s: unknown option '%s' (packd %s --help)\n", c->name, arg,
+                    c->name);
             return 64;
         } else if (c->positional && !a->arg) {
             a->arg = arg;
@@ -128,7 +132,8 @@ int pk_client_parse(int argc, char **argv, pk_client_args *a)
         }
     }
     if (c->positional && !a->arg) {
-        fprintf(stderr, "packd %s: missing %s (packd %s --help)\n", c->name, c->positional, c->name);
+        fprintf(stderr, "packd %s: missing %s (packd %s --help)\n", c->name, c->positional,
+                c->name);
         return 64;
     }
     if ((c->bit & FETCH) && !a->output) {

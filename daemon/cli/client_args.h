@@ -7,15 +7,15 @@
 #include <stdio.h>
 
 typedef struct pk_client_args {
-    const char *server;   /* --server, $PACKD_SERVER, http://127.0.0.1:8080 */
-    const char *token;    /* --token, $PACKD_TOKEN */
-    const char *output;   /* -o FILE */
-    const char *status;   /* jobs --status */
-    const char *limit;    /* jobs --limit */
-    int wait;             /* submit --wait (implied by -o) */
-    int json;             /* jobs --json */
-    int quiet;            /* submit/fetch --quiet: no progress line */
-    const char *arg;      /* the positional argument (JOB.json or ID), NULL for jobs */
+    const char *server; /* --server, $PACKD_SERVER, http://127.0.0.1:8080 */
+    const char *token;  /* --token, $PACKD_TOKEN */
+    const char *output; /* -o FILE */
+    const char *status; /* jobs --status */
+    const char *limit;  /* jobs --limit */
+    int wait;           /* submit --wait (implied by -o) */
+    int json;           /* jobs --json */
+    int quiet;          /* submit/fetch --quiet: no progress line */
+    const char *arg;    /* the positional argument (JOB.json or ID), NULL for jobs */
 } pk_client_args;
 
 /* Parse argv (argv[0] is the command name).  Returns 0, or 64 after printing

@@ -31,13 +31,13 @@ json_t *pk_reply_json(const pk_reply *r)
 
 typedef struct sink {
     pk_reply *r;
-    FILE *file;          /* download target, or NULL: collect into r->body */
-    pk_sha256 *md;       /* hash of what goes to file */
+    FILE *file;    /* download target, or NULL: collect into r->body */
+    pk_sha256 *md; /* hash of what goes to file */
     int write_failed;
     /* SSE */
     pk_sse_fn fn;
     void *ctx;
-    char *line;          /* partial line */
+    char *line; /* partial line */
     size_t nline;
     char event[64], id[64];
     char *data;
@@ -259,7 +259,8 @@ int pk_client_download(const pk_client *c, const char *path, const char *file, c
     hex[0] = 0;
     sink s = {.r = r, .file = fopen(file, "wb"), .md = pk_sha256_new()};
     if (!s.file || !s.md) {
-        snprintf(r->error, sizeof r->error, "%s: %s", file, s.file ? "cannot hash" : strerror(errno));
+        snprintf(r->error, sizeof r->error, "%s: %s", file,
+                 s.file ? "cannot hash" : strerror(errno));
         if (s.file)
             fclose(s.file);
         pk_sha256_free(s.md);

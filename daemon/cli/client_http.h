@@ -9,16 +9,16 @@
 #include <stddef.h>
 
 typedef struct pk_client {
-    const char *server;   /* base URL, e.g. http://127.0.0.1:8080 (no trailing slash needed) */
-    const char *token;    /* bearer token or NULL */
+    const char *server; /* base URL, e.g. http://127.0.0.1:8080 (no trailing slash needed) */
+    const char *token;  /* bearer token or NULL */
 } pk_client;
 
 typedef struct pk_reply {
-    long status;              /* HTTP status; 0 when no answer came (transport error) */
-    char *body;               /* the body (NUL-terminated), NULL for downloads */
-    size_t len;               /* bytes received */
-    char sha256_header[65];   /* X-Content-SHA256, "" if absent */
-    char error[512];          /* transport error text when status == 0 */
+    long status;            /* HTTP status; 0 when no answer came (transport error) */
+    char *body;             /* the body (NUL-terminated), NULL for downloads */
+    size_t len;             /* bytes received */
+    char sha256_header[65]; /* X-Content-SHA256, "" if absent */
+    char error[512];        /* transport error text when status == 0 */
 } pk_reply;
 
 void pk_reply_free(pk_reply *r);

@@ -30,16 +30,15 @@ int pk_client_report(const char *cmd, const pk_reply *r)
                 title && detail ? ": " : "", detail ? detail : "");
         size_t i;
         json_t *e;
-        json_array_foreach(json_object_get(p, "errors"), i, e) {
+        json_array_foreach (json_object_get(p, "errors"), i, e) {
             const char *ptr = json_string_value(json_object_get(e, "pointer"));
             const char *rule = json_string_value(json_object_get(e, "rule"));
-            fprintf(stderr, "  %s: %s%s%s%s\n", ptr && *ptr ? ptr : "/",
-                    pk_doc_str(e, "message"), rule ? " (rule " : "",
-                    rule ? rule : "", rule ? ")" : "");
+            fprintf(stderr, "  %s: %s%s%s%s\n", ptr && *ptr ? ptr : "/", pk_doc_str(e, "message"),
+                    rule ? " (rule " : "", rule ? rule : "", rule ? ")" : "");
         }
     } else {
-        fprintf(stderr, "packd %s: HTTP %ld: %.*s\n", cmd, r->status, (int)(r->len > 400 ? 400 : r->len),
-                r->body ? r->body : "");
+        fprintf(stderr, "packd %s: HTTP %ld: %.*s\n", cmd, r->status,
+                (int)(r->len > 400 ? 400 : r->len), r->body ? r->body : "");
     }
     json_decref(p);
     return r->status >= 500 ? 2 : 1;
@@ -58,9 +57,9 @@ typedef struct follow {
     char last_id[64];
     char status[16];
     int percent;
-    char detail[160];    /* from the last progress event */
+    char detail[160]; /* from the last progress event */
     double last_print;
-    int line_open;       /* a \r line is on the terminal */
+    int line_open; /* a \r line is on the terminal */
 } follow;
 
 static double now_s(void)
@@ -117,14 +116,14 @@ static int on_event(const char *event, const char *data, const char *id, void *c
         json_t *done = json_object_get(d, "done"), *total = json_object_get(d, "total");
         if (json_is_number(fr))
             f->percent = (int)(100 * json_number_value(fr));
-        int n = snprintf(f->detail, sizeof f->detail, "%s",
-                         pk_doc_str(d, "stage"));
+        int n = snprintf(f->detail, sizeof f->detail, "%s", pk_doc_str(d, "stage"));
         if (json_is_number(json_object_get(d, "phi")) && n < (int)sizeof f->detail)
             n += snprintf(f->detail + n, sizeof f->detail - n, "  phi %.4f",
                           json_number_value(json_object_get(d, "phi")));
         if (json_is_integer(done) && json_is_integer(total) && n < (int)sizeof f->detail)
-            n += snprintf(f->detail + n, sizeof f->detail - n, "  %lld/%lld",
-                          (long long)json_integer_value(done), (long long)json_integer_value(total));
+            n +=
+                snprintf(f->detail + n, sizeof f->detail - n, "  %lld/%lld",
+                         (long long)json_integer_value(done), (long long)json_integer_value(total));
         if (json_is_number(eta) && n < (int)sizeof f->detail)
             snprintf(f->detail + n, sizeof f->detail - n, "  eta %.0f s", json_number_value(eta));
         show(f, 0);
@@ -170,8 +169,7 @@ json_t *pk_client_wait(const pk_client *c, const char *id, int quiet)
             if (json_is_integer(json_object_get(doc, "progress")))
                 f.percent = (int)json_integer_value(json_object_get(doc, "progress"));
             if (is_final(st)) {
-                snprintf(f.detail, sizeof f.detail, "%s",
-                         pk_doc_str(doc, "message"));
+                snprintf(f.detail, sizeof f.detail, "%s", pk_doc_str(doc, "message"));
                 if (changed || f.tty)
                     show(&f, 1);
                 break;
@@ -220,7 +218,8 @@ static int download_verified(const pk_client *c, const char *href, const char *o
         return rc;
     }
     if (pk_client_verify(hex, declared, r.sha256_header, err, sizeof err) != 0) {
-        fprintf(stderr, "packd fetch: %s: %s (%zu bytes received); file removed\n", href, err, r.len);
+        fprintf(stderr, "packd fetch: %s: %s (%zu bytes received); file removed\n", href, err,
+                r.len);
         pk_reply_free(&r);
         remove(part);
         return 2;
@@ -278,20 +277,23 @@ int pk_client_fetch(const pk_client *c, const char *id, const char *out, json_t 
             fprintf(stderr, "packd fetch: the results document names no result file\n");
             rc = 2;
         } else {
-            rc = download_verified(c, href, out, json_string_value(json_object_get(res, "sha256")), info);
+            rc = download_verified(c, href, out, json_string_value(json_object_get(res, "sha256")),
+                                   info);
         }
         json_t *v = json_object_get(json_object_get(doc, "summary"), "value");
         if (v)
             json_object_set(info, "summary", v);
         if (rc == 0)
-            rc = check_result_digest(out, json_string_value(json_object_get(v, "result_digest")), info);
+            rc = check_result_digest(out, json_string_value(json_object_get(v, "result_digest")),
+                                     info);
     } else if (r.status == 422 && type && strstr(type, "job-failed")) {
         /* the job failed: say why; its partial file is still worth keeping */
         pk_client_report("fetch", &r);
         json_t *part = json_object_get(doc, "partial_result");
         const char *href = json_string_value(json_object_get(part, "href"));
-        if (href && download_verified(c, href, out, json_string_value(json_object_get(part, "sha256")),
-                                      info) == 0)
+        if (href &&
+            download_verified(c, href, out, json_string_value(json_object_get(part, "sha256")),
+                              info) == 0)
             fprintf(stderr, "packd fetch: partial result of the failed job in %s\n", out);
         if (json_object_get(doc, "summary"))
             json_object_set(info, "summary", json_object_get(doc, "summary"));

@@ -16,12 +16,14 @@
 void cmd_backup_help(const char *name, FILE *f)
 {
     (void)name;
-    fprintf(f, "usage: packd backup FILE [--data DIR | --config F]\n"
-               "Copy the service's database (DIR/queue.db; DIR from --data, else the config file's\n"
-               "`data`, else $PACKD_DATA, else ./var) to FILE while the service runs, check the copy\n"
-               "(PRAGMA integrity_check) and print {\"backup\", \"pages\", \"bytes\", \"jobs\", ...}.\n"
-               "Restore: stop the service, copy FILE to DIR/queue.db, remove DIR/queue.db-wal and\n"
-               "DIR/queue.db-shm, start the service.\n");
+    fprintf(
+        f,
+        "usage: packd backup FILE [--data DIR | --config F]\n"
+        "Copy the service's database (DIR/queue.db; DIR from --data, else the config file's\n"
+        "`data`, else $PACKD_DATA, else ./var) to FILE while the service runs, check the copy\n"
+        "(PRAGMA integrity_check) and print {\"backup\", \"pages\", \"bytes\", \"jobs\", ...}.\n"
+        "Restore: stop the service, copy FILE to DIR/queue.db, remove DIR/queue.db-wal and\n"
+        "DIR/queue.db-shm, start the service.\n");
 }
 
 static long long scalar(sqlite3 *db, const char *sql)
@@ -45,7 +47,8 @@ static int copy(sqlite3 *src, sqlite3 *dst, int *pages, char *err, size_t errlen
         return -1;
     }
     int rc, waits = 0;
-    while ((rc = sqlite3_backup_step(b, -1)) == SQLITE_OK || rc == SQLITE_BUSY || rc == SQLITE_LOCKED) {
+    while ((rc = sqlite3_backup_step(b, -1)) == SQLITE_OK || rc == SQLITE_BUSY ||
+           rc == SQLITE_LOCKED) {
         if (rc != SQLITE_OK) {
             if (++waits > 600) /* 30 s */
                 break;
@@ -89,7 +92,8 @@ int cmd_backup(int argc, char **argv)
     /* read-write without create: a WAL database needs its -shm, and a
      * missing database is an error, not a new empty one */
     if (sqlite3_open_v2(src_path, &src, SQLITE_OPEN_READWRITE, NULL) != SQLITE_OK) {
-        fprintf(stderr, "packd backup: %s: %s\n", src_path, src ? sqlite3_errmsg(src) : "cannot open");
+        fprintf(stderr, "packd backup: %s: %s\n", src_path,
+                src ? sqlite3_errmsg(src) : "cannot open");
         goto out;
     }
     sqlite3_busy_timeout(src, 5000);
@@ -114,7 +118,8 @@ int cmd_backup(int argc, char **argv)
         fprintf(stderr, "packd backup: the copy fails its integrity check: %s\n", integrity);
         goto out;
     }
-    long long version = scalar(dst, "PRAGMA user_version"), jobs = scalar(dst, "SELECT count(*) FROM jobs");
+    long long version = scalar(dst, "PRAGMA user_version"),
+              jobs = scalar(dst, "SELECT count(*) FROM jobs");
     sqlite3_close(dst);
     dst = NULL;
     if (rename(tmp, out) != 0) {

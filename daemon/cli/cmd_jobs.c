@@ -40,15 +40,16 @@ int cmd_jobs(int argc, char **argv)
                "MESSAGE");
         size_t i;
         json_t *j;
-        json_array_foreach(json_object_get(doc, "jobs"), i, j)
+        json_array_foreach (json_object_get(doc, "jobs"), i, j)
             printf("%-36s  %-10s  %-10s  %4lld  %-24s  %s\n", pk_doc_str(j, "jobID"),
                    pk_doc_str(j, "processID"), pk_doc_str(j, "status"),
                    (long long)json_integer_value(json_object_get(j, "progress")),
                    pk_doc_str(j, "created"), pk_doc_str(j, "message"));
         json_t *n = json_object_get(doc, "numberMatched");
-        if (json_is_integer(n) && (size_t)json_integer_value(n) > json_array_size(json_object_get(doc, "jobs")))
-            printf("(%zu of %lld jobs; --limit N for more)\n", json_array_size(json_object_get(doc, "jobs")),
-                   (long long)json_integer_value(n));
+        if (json_is_integer(n) &&
+            (size_t)json_integer_value(n) > json_array_size(json_object_get(doc, "jobs")))
+            printf("(%zu of %lld jobs; --limit N for more)\n",
+                   json_array_size(json_object_get(doc, "jobs")), (long long)json_integer_value(n));
     }
     json_decref(doc);
     return 0;

@@ -8,10 +8,11 @@
 
 static int usage(FILE *f)
 {
-    fprintf(f, "usage: packd picture RESULT.h5 -o FILE.svg|FILE.png [--kind packing|grading]\n"
-               "  packing  the grains (2D: as the papers draw them; 3D: mid-plane section and a\n"
-               "           depth-shaded view along -z), coloured by size class (default)\n"
-               "  grading  the grading curve, target against achieved (pack results)\n");
+    fprintf(f,
+            "usage: packd picture RESULT.h5 -o FILE.svg|FILE.png [--kind packing|grading]\n"
+            "  packing  the grains (2D: as the papers draw them; 3D: mid-plane section and a\n"
+            "           depth-shaded view along -z), coloured by size class (default)\n"
+            "  grading  the grading curve, target against achieved (pack results)\n");
     return f == stderr ? 64 : 0;
 }
 

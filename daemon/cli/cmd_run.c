@@ -23,7 +23,7 @@ static void on_signal(int sig)
 }
 
 typedef struct {
-    FILE *out;   /* JSON lines of progress, or NULL */
+    FILE *out; /* JSON lines of progress, or NULL */
 } progress_sink;
 
 /* One JSON object per line: what the daemon relays to its SSE listeners. */
@@ -74,11 +74,12 @@ int cmd_run(int argc, char **argv)
             char *end;
             ckpt_interval = strtod(argv[++i], &end);
             if (*end || !(ckpt_interval > 0 && ckpt_interval <= 1e6)) {
-                fprintf(stderr, "packd run: --checkpoint-interval takes seconds in (0, 1e6], not '%s'\n", argv[i]);
+                fprintf(stderr,
+                        "packd run: --checkpoint-interval takes seconds in (0, 1e6], not '%s'\n",
+                        argv[i]);
                 return 64;
             }
-        }
-        else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
+        } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
             char *end;
             long t = strtol(argv[++i], &end, 10);
             if (*end || t < 1 || t > 64) {
@@ -86,8 +87,7 @@ int cmd_run(int argc, char **argv)
                 return 64;
             }
             threads = (int)t;
-        }
-        else if (!job_path && argv[i][0] != '-')
+        } else if (!job_path && argv[i][0] != '-')
             job_path = argv[i];
         else if (!job_path && !strcmp(argv[i], "-"))
             job_path = argv[i];
@@ -97,8 +97,10 @@ int cmd_run(int argc, char **argv)
         }
     }
     if (!job_path || !out_path) {
-        fprintf(stderr, "usage: packd run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--pictures DIR] [--progress] "
-                        "[--progress-fd N] [--threads N] [--checkpoint FILE [--checkpoint-interval S]]\n");
+        fprintf(
+            stderr,
+            "usage: packd run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--pictures DIR] [--progress] "
+            "[--progress-fd N] [--threads N] [--checkpoint FILE [--checkpoint-interval S]]\n");
         return 64;
     }
     json_t *job = cli_load_json(job_path);
@@ -117,8 +119,8 @@ int cmd_run(int argc, char **argv)
         if (!sink.out)
             fprintf(stderr, "packd run: --progress-fd %d: %s\n", progress_fd, strerror(errno));
     }
-    pk_monitor mon = {.fn = print_progress, .ctx = &sink, .cancel = &cancel_requested,
-                      .interval_s = 0.5};
+    pk_monitor mon = {
+        .fn = print_progress, .ctx = &sink, .cancel = &cancel_requested, .interval_s = 0.5};
     pk_schema_errors errs = {0};
     json_t *summary = NULL;
     char err[1024] = "";

@@ -26,9 +26,11 @@
 
 static int usage(FILE *f)
 {
-    fprintf(f, "usage: packd serve [--config FILE] [--KEY VALUE]...\n"
-               "Settings, lowest precedence first: defaults, config file (--config or $PACKD_CONFIG),\n"
-               "environment PACKD_<KEY>, flags.  Keys (see deploy/packd.conf.example):\n");
+    fprintf(
+        f,
+        "usage: packd serve [--config FILE] [--KEY VALUE]...\n"
+        "Settings, lowest precedence first: defaults, config file (--config or $PACKD_CONFIG),\n"
+        "environment PACKD_<KEY>, flags.  Keys (see deploy/packd.conf.example):\n");
     pk_config_print_keys(f);
     return f == stderr ? 64 : 0;
 }
@@ -50,11 +52,12 @@ static void log_auth(pk_service *svc)
     pk_config cfg = pk_service_config(svc);
     const char *why;
     int on = pk_auth_required(&cfg, &why);
-    pk_log(on ? PK_LOG_INFO : PK_LOG_WARN, on ? "auth is on" : "auth is off", "{s:s,s:s,s:s}", "why", why,
-           "bind", cfg.bind, "trusted_proxy", cfg.trusted_proxy[0] ? cfg.trusted_proxy : "none");
+    pk_log(on ? PK_LOG_INFO : PK_LOG_WARN, on ? "auth is on" : "auth is off", "{s:s,s:s,s:s}",
+           "why", why, "bind", cfg.bind, "trusted_proxy",
+           cfg.trusted_proxy[0] ? cfg.trusted_proxy : "none");
     if (on && pk_tokens_count(svc->tokens) == 0)
-        pk_log(PK_LOG_WARN, "no tokens yet: every request but the public ones gets 401", "{s:s}", "hint",
-               "packd token add NAME --admin --data DATA");
+        pk_log(PK_LOG_WARN, "no tokens yet: every request but the public ones gets 401", "{s:s}",
+               "hint", "packd token add NAME --admin --data DATA");
 }
 
 static void reload(pk_service *svc, int argc, char **argv)
@@ -66,7 +69,8 @@ static void reload(pk_service *svc, int argc, char **argv)
         return;
     }
     pthread_mutex_lock(&svc->mu);
-    if (strcmp(next.bind, svc->cfg.bind) || next.port != svc->cfg.port || strcmp(next.data, svc->cfg.data))
+    if (strcmp(next.bind, svc->cfg.bind) || next.port != svc->cfg.port ||
+        strcmp(next.data, svc->cfg.data))
         pk_log(PK_LOG_WARN, "bind, port and data need a restart; kept", NULL);
     snprintf(next.bind, sizeof next.bind, "%s", svc->cfg.bind);
     next.port = svc->cfg.port;
@@ -77,8 +81,8 @@ static void reload(pk_service *svc, int argc, char **argv)
     pk_supervisor_configure(svc->sup, next.workers, next.max_wall_time_s, next.job_threads);
     pk_supervisor_set_checkpoint_interval(svc->sup, next.checkpoint_interval_s);
     log_auth(svc);
-    pk_log(PK_LOG_INFO, "configuration reloaded", "{s:s,s:i,s:s}", "file", next.config_file, "workers",
-           next.workers, "log_level", pk_log_level_name(next.log_level));
+    pk_log(PK_LOG_INFO, "configuration reloaded", "{s:s,s:i,s:s}", "file", next.config_file,
+           "workers", next.workers, "log_level", pk_log_level_name(next.log_level));
 }
 
 int cmd_serve(int argc, char **argv)
@@ -112,7 +116,8 @@ int cmd_serve(int argc, char **argv)
     snprintf(path, sizeof path, "%s/packd.lock", svc.cfg.data);
     int lock = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0640);
     if (lock < 0 || flock(lock, LOCK_EX | LOCK_NB) != 0) {
-        pk_log(PK_LOG_ERROR, "another packd serve uses this data directory", "{s:s}", "data", svc.cfg.data);
+        pk_log(PK_LOG_ERROR, "another packd serve uses this data directory", "{s:s}", "data",
+               svc.cfg.data);
         return 2;
     }
     char exe[1024];
@@ -148,8 +153,8 @@ int cmd_serve(int argc, char **argv)
     pthread_sigmask(SIG_BLOCK, &set, NULL);
     signal(SIGPIPE, SIG_IGN);
 
-    svc.sup = pk_supervisor_start(svc.q, exe, svc.cfg.data, svc.cfg.workers, svc.cfg.max_wall_time_s,
-                                  svc.cfg.job_threads);
+    svc.sup = pk_supervisor_start(svc.q, exe, svc.cfg.data, svc.cfg.workers,
+                                  svc.cfg.max_wall_time_s, svc.cfg.job_threads);
     if (svc.sup)
         pk_supervisor_set_checkpoint_interval(svc.sup, svc.cfg.checkpoint_interval_s);
     int port = 0;
@@ -162,8 +167,8 @@ int cmd_serve(int argc, char **argv)
         pk_queue_close(svc.q);
         return 2;
     }
-    pk_log(PK_LOG_INFO, "listening", "{s:s,s:i,s:s,s:i,s:s,s:i}", "bind", svc.cfg.bind, "port", port,
-           "data", svc.cfg.data, "workers", svc.cfg.workers, "version", PACKD_VERSION, "pid",
+    pk_log(PK_LOG_INFO, "listening", "{s:s,s:i,s:s,s:i,s:s,s:i}", "bind", svc.cfg.bind, "port",
+           port, "data", svc.cfg.data, "workers", svc.cfg.workers, "version", PACKD_VERSION, "pid",
            (int)getpid());
     log_auth(&svc);
     pk_sd_notify("READY=1"); /* Type=notify: systemd starts dependants now */

@@ -24,7 +24,8 @@ int cmd_submit(int argc, char **argv)
     const char *process = json_string_value(json_object_get(job, "process"));
     json_t *inputs = json_object_get(job, "inputs");
     if (!process || !json_is_object(inputs)) {
-        fprintf(stderr, "packd submit: %s: a job file is {\"process\": \"…\", \"inputs\": {…}}\n", a.arg);
+        fprintf(stderr, "packd submit: %s: a job file is {\"process\": \"…\", \"inputs\": {…}}\n",
+                a.arg);
         json_decref(job);
         return 1;
     }
@@ -76,8 +77,7 @@ int cmd_submit(int argc, char **argv)
         if (frc)
             rc = frc;
     } else if (rc == 3) {
-        fprintf(stderr, "packd submit: job %s %s: %s\n", jid, st,
-                pk_doc_str(fin, "message"));
+        fprintf(stderr, "packd submit: job %s %s: %s\n", jid, st, pk_doc_str(fin, "message"));
     }
     json_decref(fin);
     json_dumpf(out, stdout, JSON_INDENT(2) | JSON_REAL_PRECISION(10));

@@ -22,8 +22,9 @@ static const struct {
      "jobs and reads /metrics.  Clients send it as `Authorization: Bearer TOKEN`; by convention\n"
      "they read it from the environment variable PACKD_TOKEN."},
     {"list", "", "Print each token's name, admin flag, creation and last use (never the token)."},
-    {"revoke", "NAME", "Delete NAME's token: requests with it get 401 from now on.  NAME's jobs stay;\n"
-                       "`packd token add NAME` again gives NAME a new token to them."},
+    {"revoke", "NAME",
+     "Delete NAME's token: requests with it get 401 from now on.  NAME's jobs stay;\n"
+     "`packd token add NAME` again gives NAME a new token to them."},
 };
 
 static int usage(FILE *f, int sub)
@@ -37,7 +38,9 @@ static int usage(FILE *f, int sub)
             fprintf(f, "%s\n", subs[i].help);
     }
     if (sub >= 0)
-        fprintf(f, "The database is DIR/queue.db of `packd serve --data DIR` (same --config, PACKD_DATA).\n");
+        fprintf(f,
+                "The database is DIR/queue.db of `packd serve --data DIR` (same --config, "
+                "PACKD_DATA).\n");
     return f == stderr ? 64 : 0;
 }
 
@@ -57,7 +60,7 @@ static int list(pk_tokens *t)
     printf("%-24s %-5s %-20s %s\n", "NAME", "ADMIN", "CREATED", "LAST_USED");
     size_t i;
     json_t *row;
-    json_array_foreach(a, i, row) {
+    json_array_foreach (a, i, row) {
         char created[32], used[32] = "never";
         iso_time(json_number_value(json_object_get(row, "created")), created, sizeof created);
         json_t *lu = json_object_get(row, "last_used");
@@ -127,7 +130,9 @@ int cmd_token(int argc, char **argv)
             rc = 1;
         } else {
             printf("%s\n", token);
-            fprintf(stderr, "packd token add: %s token for '%s' in %s — shown this once; keep it as PACKD_TOKEN\n",
+            fprintf(stderr,
+                    "packd token add: %s token for '%s' in %s — shown this once; keep it as "
+                    "PACKD_TOKEN\n",
                     admin ? "an admin" : "a", name, path);
         }
     } else if (sub == 1) {

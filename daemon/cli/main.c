@@ -19,24 +19,38 @@ static const struct {
     const char *usage;
     void (*help)(const char *name, FILE *f); /* --help; NULL: the usage line */
 } commands[] = {
-    {"run", cmd_run, "run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--progress] [--progress-fd N]\n"
-                     "                                                    run a job, write its result",
+    {"run", cmd_run,
+     "run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--progress] [--progress-fd N]\n"
+     "                                                    run a job, write its result",
      NULL},
-    {"validate", cmd_validate, "validate JOB.json                                 check a job, print its plan or errors", NULL},
-    {"inspect", cmd_inspect, "inspect OUT.h5 [--full]                          print a result file's summary as JSON", NULL},
-    {"serve", cmd_serve, "serve [--config F] [--bind A] [--port N] [--data DIR] run the job service",
-     cmd_serve_help},
-    {"picture", cmd_picture, "picture OUT.h5 -o FILE.svg|png [--kind packing|grading] draw a result", own_help},
-    {"token", cmd_token, "token add NAME [--admin] | list | revoke NAME [--config F] [--data DIR]\n"
-                         "                                                    the service's bearer tokens", own_help},
-    {"submit", cmd_submit, "submit JOB.json [--server URL] [--token T] [--wait] [-o OUT.h5]\n"
-                           "                                                    submit a job to a service (-o: wait, download, verify)",
+    {"validate", cmd_validate,
+     "validate JOB.json                                 check a job, print its plan or errors",
+     NULL},
+    {"inspect", cmd_inspect,
+     "inspect OUT.h5 [--full]                          print a result file's summary as JSON",
+     NULL},
+    {"serve", cmd_serve,
+     "serve [--config F] [--bind A] [--port N] [--data DIR] run the job service", cmd_serve_help},
+    {"picture", cmd_picture,
+     "picture OUT.h5 -o FILE.svg|png [--kind packing|grading] draw a result", own_help},
+    {"token", cmd_token,
+     "token add NAME [--admin] | list | revoke NAME [--config F] [--data DIR]\n"
+     "                                                    the service's bearer tokens",
+     own_help},
+    {"submit", cmd_submit,
+     "submit JOB.json [--server URL] [--token T] [--wait] [-o OUT.h5]\n"
+     "                                                    submit a job to a service (-o: wait, "
+     "download, verify)",
      pk_client_help},
-    {"jobs", cmd_jobs, "jobs [--server URL] [--status S]            list a service's jobs", pk_client_help},
-    {"cancel", cmd_cancel, "cancel ID [--server URL]                    dismiss a job", pk_client_help},
-    {"fetch", cmd_fetch, "fetch ID -o OUT.h5 [--server URL]           download a result, verify its SHA-256",
+    {"jobs", cmd_jobs, "jobs [--server URL] [--status S]            list a service's jobs",
      pk_client_help},
-    {"backup", cmd_backup, "backup FILE [--data DIR | --config F]       online copy of the service's database",
+    {"cancel", cmd_cancel, "cancel ID [--server URL]                    dismiss a job",
+     pk_client_help},
+    {"fetch", cmd_fetch,
+     "fetch ID -o OUT.h5 [--server URL]           download a result, verify its SHA-256",
+     pk_client_help},
+    {"backup", cmd_backup,
+     "backup FILE [--data DIR | --config F]       online copy of the service's database",
      cmd_backup_help},
 };
 
@@ -52,7 +66,8 @@ static void own_help(const char *name, FILE *f)
 
 static int usage(FILE *f)
 {
-    fprintf(f, "packd %s — dense granular packings and RVE homogenization\n\nusage:\n", PACKD_VERSION);
+    fprintf(f, "packd %s — dense granular packings and RVE homogenization\n\nusage:\n",
+            PACKD_VERSION);
     for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
         fprintf(f, "  packd %s\n", commands[i].usage);
     fprintf(f, "  packd version\n");

@@ -24,15 +24,19 @@ int pk_auth_required(const pk_config *c, const char **why)
     const char *w;
     int on;
     if (c->auth == PK_AUTH_ON) {
-        on = 1, w = "auth = on: every route but /, /conformance, /api and /healthz needs a bearer token";
+        on = 1,
+        w = "auth = on: every route but /, /conformance, /api and /healthz needs a bearer token";
     } else if (c->auth == PK_AUTH_OFF) {
-        on = 0, w = "auth = off: every client that reaches the port may read, submit and dismiss every job";
+        on = 0,
+        w = "auth = off: every client that reaches the port may read, submit and dismiss every job";
     } else if (is_loopback(c->bind)) {
-        on = 0, w = "auth = auto and bind is a loopback address: only this host can connect, and every "
-                    "local user may read, submit and dismiss every job (auth = on to require tokens)";
+        on = 0,
+        w = "auth = auto and bind is a loopback address: only this host can connect, and every "
+            "local user may read, submit and dismiss every job (auth = on to require tokens)";
     } else {
-        on = 1, w = "auth = auto and bind is not a loopback address: every route but /, /conformance, "
-                    "/api and /healthz needs a bearer token";
+        on = 1,
+        w = "auth = auto and bind is not a loopback address: every route but /, /conformance, "
+            "/api and /healthz needs a bearer token";
     }
     if (why)
         *why = w;
@@ -83,7 +87,7 @@ static enum MHD_Result refuse(pk_req *r, unsigned status, const char *type, cons
 static int owner_ok(const char *s)
 {
     size_t n = strlen(s);
-    if (n == 0 || n >= sizeof ((pk_req *)0)->owner)
+    if (n == 0 || n >= sizeof((pk_req *)0)->owner)
         return 0;
     for (size_t i = 0; i < n; i++)
         if (s[i] <= ' ' || s[i] > '~')
@@ -98,12 +102,14 @@ int pk_authorize(pk_req *r, pk_access access, enum MHD_Result *reply)
     peer_address(r, peer, sizeof peer);
     /* X-Packd-Owner only from the configured proxy: anyone else could name any owner. */
     const char *named = cfg.trusted_proxy[0] && !strcmp(peer, cfg.trusted_proxy)
-                            ? pk_header(r, "X-Packd-Owner") : NULL;
+        ? pk_header(r, "X-Packd-Owner")
+        : NULL;
     if (named && !*named)
         named = NULL;
     if (named && !owner_ok(named)) {
-        *reply = pk_send_problem(r, 400, PK_PROBLEM_GENERIC, "Bad Request",
-                                 "X-Packd-Owner: 1 to 127 printable characters without spaces", NULL, 0);
+        *reply =
+            pk_send_problem(r, 400, PK_PROBLEM_GENERIC, "Bad Request",
+                            "X-Packd-Owner: 1 to 127 printable characters without spaces", NULL, 0);
         return 0;
     }
     snprintf(r->owner, sizeof r->owner, "%s", named ? named : peer);
@@ -139,7 +145,8 @@ int pk_authorize(pk_req *r, pk_access access, enum MHD_Result *reply)
         snprintf(r->owner, sizeof r->owner, "%s", name);
     r->admin = admin && !named;
     if (access == PK_ADMIN && !r->admin) {
-        *reply = refuse(r, 403, PK_PROBLEM_PACKD "forbidden", "Forbidden", "this route needs an admin token",
+        *reply = refuse(r, 403, PK_PROBLEM_PACKD "forbidden", "Forbidden",
+                        "this route needs an admin token",
                         "Bearer realm=\"packd\", error=\"insufficient_scope\"");
         return 0;
     }

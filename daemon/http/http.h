@@ -20,7 +20,7 @@
 typedef struct pk_req {
     struct MHD_Connection *conn;
     pk_service *svc;
-    const char *method;        /* HEAD is routed as GET */
+    const char *method; /* HEAD is routed as GET */
     const char *url;
     char seg[PK_MAX_SEGMENTS][160]; /* path segments; a route's '*' captures one */
     int nseg;
@@ -28,17 +28,17 @@ typedef struct pk_req {
     size_t body_len, body_cap;
     int too_large;
     int first_call_done;
-    char owner[128];           /* who asks (auth.c): token name, proxy's X-Packd-Owner or address */
-    int admin;                 /* sees every owner's jobs and uploads */
-    int answered;              /* answered from the headers alone (413, 415): the body is not read */
-    double started;            /* when the headers were complete (pk_queue_now clock) */
+    char owner[128]; /* who asks (auth.c): token name, proxy's X-Packd-Owner or address */
+    int admin;       /* sees every owner's jobs and uploads */
+    int answered;    /* answered from the headers alone (413, 415): the body is not read */
+    double started;  /* when the headers were complete (pk_queue_now clock) */
     /* A request that waits without a thread (http_park.h): once its
      * connection resumes, resume is called instead of the route; wait is
      * its state, freed by wait_free when the request ends. */
     enum MHD_Result (*resume)(struct pk_req *r);
     void *wait;
     void (*wait_free)(void *wait);
-    char sync_job[40];         /* answered synchronously for this job (Prefer: respond-sync):
+    char sync_job[40]; /* answered synchronously for this job (Prefer: respond-sync):
                                   pk_send adds Preference-Applied and Link rel=monitor */
 } pk_req;
 
@@ -49,12 +49,12 @@ typedef enum { PK_PUBLIC, PK_USER, PK_ADMIN } pk_access;
 
 typedef struct pk_route {
     const char *method;
-    const char *pattern;       /* e.g. "/jobs/{*}": a star segment matches any one segment */
+    const char *pattern; /* e.g. "/jobs/{*}": a star segment matches any one segment */
     pk_handler handler;
     pk_access access;
 } pk_route;
 
-extern const pk_route pk_routes[];   /* terminated by {NULL} */
+extern const pk_route pk_routes[]; /* terminated by {NULL} */
 
 /* Start/stop the listener.  Returns NULL with err on failure.  *port gets the
  * bound port (useful with port 0). */

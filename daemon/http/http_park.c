@@ -10,13 +10,13 @@
 
 struct pk_parked {
     struct MHD_Connection *conn;
-    int suspended;             /* MHD_suspend_connection called, not yet resumed */
+    int suspended; /* MHD_suspend_connection called, not yet resumed */
     double wake_at;
     pk_parked *prev, *next;
 };
 
 static struct {
-    pthread_mutex_t mu;        /* guards everything below and every pk_parked */
+    pthread_mutex_t mu; /* guards everything below and every pk_parked */
     pk_parked *head;
     pk_service *svc;
     pthread_t thread;

@@ -23,7 +23,9 @@ static void base_url(pk_req *r, char *out, size_t n)
             len--;
         snprintf(out, n, "%.*s", (int)len, cfg.public_url);
     } else if (host && *host && strlen(host) < 200 &&
-               host[strspn(host, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789.-:[]")] == 0)
+               host[strspn(
+                   host, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789.-:[]")] ==
+                   0)
         snprintf(out, n, "http://%s", host);
     else
         snprintf(out, n, "http://localhost");
@@ -35,8 +37,9 @@ static void absolute_hrefs(json_t *node, const char *base)
     json_t *v;
     size_t i;
     if (json_is_array(node))
-        json_array_foreach(node, i, v) absolute_hrefs(v, base);
-    json_object_foreach(node, key, v) {
+        json_array_foreach (node, i, v)
+            absolute_hrefs(v, base);
+    json_object_foreach (node, key, v) {
         const char *s = json_string_value(v);
         if (!strcmp(key, "href") && s && s[0] == '/') {
             char *abs = malloc(strlen(base) + strlen(s) + 1);
@@ -59,8 +62,9 @@ static void relative_hrefs(json_t *node, const char *base, size_t bl)
     json_t *v;
     size_t i;
     if (json_is_array(node))
-        json_array_foreach(node, i, v) relative_hrefs(v, base, bl);
-    json_object_foreach(node, key, v) {
+        json_array_foreach (node, i, v)
+            relative_hrefs(v, base, bl);
+    json_object_foreach (node, key, v) {
         const char *s = json_string_value(v);
         if (!strcmp(key, "href") && s && !strncmp(s, base, bl) && s[bl] == '/')
             json_object_set_new(node, key, json_string(s + bl));
@@ -229,7 +233,8 @@ enum MHD_Result pk_send_file(pk_req *r, const char *path, const char *ctype, con
     if (fd < 0 || fstat(fd, &st) != 0) {
         if (fd >= 0)
             close(fd);
-        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "the file is gone", NULL, 0);
+        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "the file is gone", NULL,
+                               0);
     }
     char etag[80];
     snprintf(etag, sizeof etag, "\"%s\"", sha256_hex);
@@ -251,7 +256,8 @@ enum MHD_Result pk_send_file(pk_req *r, const char *path, const char *ctype, con
             char cr[64];
             snprintf(cr, sizeof cr, "bytes */%lld", size);
             struct MHD_Response *resp = pk_json_response(
-                pk_problem(416, PK_PROBLEM_GENERIC, "Range Not Satisfiable", range), "application/problem+json");
+                pk_problem(416, PK_PROBLEM_GENERIC, "Range Not Satisfiable", range),
+                "application/problem+json");
             MHD_add_response_header(resp, "Content-Range", cr);
             return pk_send(r, 416, resp);
         }

@@ -74,7 +74,8 @@ static int match(const pk_req *r, const char *pattern)
 static enum MHD_Result dispatch(pk_req *r)
 {
     if (split_path(r, r->url) != 0)
-        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such resource", NULL, 0);
+        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such resource", NULL,
+                               0);
     char allow[128] = "";
     for (const pk_route *rt = pk_routes; rt->method; rt++) {
         if (!match(r, rt->pattern))
@@ -93,11 +94,13 @@ static enum MHD_Result dispatch(pk_req *r)
         }
     }
     if (!allow[0])
-        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such resource", NULL, 0);
+        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such resource", NULL,
+                               0);
     char detail[200];
     snprintf(detail, sizeof detail, "%s is not allowed here; allowed: %s", r->method, allow);
-    struct MHD_Response *resp = pk_json_response(
-        pk_problem(405, PK_PROBLEM_GENERIC, "Method Not Allowed", detail), "application/problem+json");
+    struct MHD_Response *resp =
+        pk_json_response(pk_problem(405, PK_PROBLEM_GENERIC, "Method Not Allowed", detail),
+                         "application/problem+json");
     MHD_add_response_header(resp, "Allow", allow);
     return pk_send(r, 405, resp);
 }
@@ -306,18 +309,15 @@ struct MHD_Daemon *pk_http_start(pk_service *svc, int *port, char *err, size_t e
     unsigned limit = connection_limit(&cfg);
     struct MHD_Daemon *d = MHD_start_daemon(
         MHD_USE_EPOLL_INTERNAL_THREAD | MHD_ALLOW_SUSPEND_RESUME | MHD_USE_ERROR_LOG,
-        (uint16_t)cfg.port, NULL, NULL, on_request, svc,
-        MHD_OPTION_EXTERNAL_LOGGER, mhd_log, NULL,
-        MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr,
-        MHD_OPTION_NOTIFY_COMPLETED, on_completed, NULL,
-        MHD_OPTION_THREAD_POOL_SIZE, (unsigned)cfg.http_threads,
-        MHD_OPTION_CONNECTION_LIMIT, limit,
-        MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)cfg.max_connections_per_ip,
-        MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg.idle_timeout_s,
-        MHD_OPTION_END);
+        (uint16_t)cfg.port, NULL, NULL, on_request, svc, MHD_OPTION_EXTERNAL_LOGGER, mhd_log, NULL,
+        MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr, MHD_OPTION_NOTIFY_COMPLETED, on_completed,
+        NULL, MHD_OPTION_THREAD_POOL_SIZE, (unsigned)cfg.http_threads, MHD_OPTION_CONNECTION_LIMIT,
+        limit, MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)cfg.max_connections_per_ip,
+        MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg.idle_timeout_s, MHD_OPTION_END);
     if (!d) {
         pk_park_stop();
-        snprintf(err, errlen, "cannot listen on %s:%d (in use or not permitted)", cfg.bind, cfg.port);
+        snprintf(err, errlen, "cannot listen on %s:%d (in use or not permitted)", cfg.bind,
+                 cfg.port);
         return NULL;
     }
     const union MHD_DaemonInfo *info = MHD_get_daemon_info(d, MHD_DAEMON_INFO_BIND_PORT);

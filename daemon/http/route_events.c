@@ -25,12 +25,12 @@ typedef struct sse {
     pk_service *svc;
     pk_parked *park;
     char id[37];
-    long long last;        /* last event id sent */
-    long long fetched_at;  /* event sequence of the last fetch that got everything */
-    char *pending;         /* formatted text not yet handed to MHD */
+    long long last;       /* last event id sent */
+    long long fetched_at; /* event sequence of the last fetch that got everything */
+    char *pending;        /* formatted text not yet handed to MHD */
     size_t len, off;
     double last_write;
-    int check_final;       /* a status event (or a keep-alive) since the last look at the job row */
+    int check_final; /* a status event (or a keep-alive) since the last look at the job row */
     int done;
 } sse;
 
@@ -53,7 +53,7 @@ static int job_final(sse *s)
         return 1;
     const char *st = json_string_value(json_object_get(row, "status"));
     int final = strcmp(st, "accepted") && strcmp(st, "running") &&
-                (strcmp(st, "dismissed") || !json_is_null(json_object_get(row, "finished")));
+        (strcmp(st, "dismissed") || !json_is_null(json_object_get(row, "finished")));
     json_decref(row);
     return final;
 }
@@ -64,10 +64,10 @@ static int job_final(sse *s)
 static struct {
     pthread_mutex_t mu;
     char job[37];
-    long long after, seq;   /* the batch: events of job after `after`, read at `seq` */
-    long long last;         /* id of its last event */
+    long long after, seq; /* the batch: events of job after `after`, read at `seq` */
+    long long last;       /* id of its last event */
     size_t got;
-    int status;             /* it holds a status event */
+    int status; /* it holds a status event */
     char *text;
 } batch = {.mu = PTHREAD_MUTEX_INITIALIZER, .seq = -1};
 
@@ -80,7 +80,7 @@ static void read_batch(pk_queue *q, const char *job, long long after, long long 
     json_t *e;
     batch.last = after;
     batch.status = 0;
-    json_array_foreach(ev, i, e) {
+    json_array_foreach (ev, i, e) {
         char *data = json_dumps(json_object_get(e, "data"), JSON_COMPACT | JSON_REAL_PRECISION(10));
         const char *kind = json_string_value(json_object_get(e, "kind"));
         batch.last = json_integer_value(json_object_get(e, "id"));
@@ -193,7 +193,8 @@ enum MHD_Result route_events(pk_req *r)
     s->check_final = 1;
     s->park = pk_park_register(r->conn);
     append(s, "retry: 2000\n\n");
-    struct MHD_Response *resp = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 8192, reader, s, release);
+    struct MHD_Response *resp =
+        MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 8192, reader, s, release);
     MHD_add_response_header(resp, "Content-Type", "text/event-stream");
     MHD_add_response_header(resp, "Cache-Control", "no-cache");
     MHD_add_response_header(resp, "X-Accel-Buffering", "no");

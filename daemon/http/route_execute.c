@@ -26,7 +26,7 @@
 /* A synchronous execute waiting for its job. */
 typedef struct sync_wait {
     char id[37];
-    double deadline;           /* pk_queue_now clock */
+    double deadline; /* pk_queue_now clock */
     pk_parked *park;
     pk_exec_opts opts;
     int replayed;
@@ -80,7 +80,8 @@ static enum MHD_Result sync_check(pk_req *r)
         }
         int gone = !strcmp(st, "dismissed");
         json_decref(row);
-        int parked = gone || pk_queue_now() >= w->deadline ? -1 : pk_park(w->park, seq, w->deadline);
+        int parked =
+            gone || pk_queue_now() >= w->deadline ? -1 : pk_park(w->park, seq, w->deadline);
         if (parked > 0)
             return MHD_YES;
         if (parked < 0) {
@@ -118,7 +119,8 @@ static enum MHD_Result reply_job(pk_req *r, const char *id, int replayed)
 {
     json_t *row = pk_queue_get(r->svc->q, id);
     if (!row)
-        return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error", "job vanished", NULL, 0);
+        return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error", "job vanished",
+                               NULL, 0);
     json_t *info = pk_status_info(row);
     pk_absolute_links(r, info);
     struct MHD_Response *resp = pk_json_response(info, "application/json");
@@ -136,7 +138,8 @@ enum MHD_Result route_execute(pk_req *r)
     pk_service *svc = r->svc;
     const pk_process *p = pk_process_find(r->seg[1]);
     if (!p)
-        return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_PROCESS, "No such process", r->seg[1], NULL, 0);
+        return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_PROCESS, "No such process", r->seg[1],
+                               NULL, 0);
     if (__atomic_load_n(&svc->draining, __ATOMIC_RELAXED))
         return pk_send_problem(r, 503, PK_PROBLEM_PACKD "shutting-down", "Service Unavailable",
                                "the daemon is stopping; submit again shortly", NULL, 10);
@@ -145,8 +148,8 @@ enum MHD_Result route_execute(pk_req *r)
     if (!body) {
         char d[300];
         if (r->body_len)
-            snprintf(d, sizeof d, "the body is not JSON: %s (line %d, column %d)", jerr.text, jerr.line,
-                     jerr.column);
+            snprintf(d, sizeof d, "the body is not JSON: %s (line %d, column %d)", jerr.text,
+                     jerr.line, jerr.column);
         else
             snprintf(d, sizeof d, "the body is empty; expected {\"inputs\": {...}}");
         return pk_send_problem(r, 400, PK_PROBLEM_GENERIC, "Bad Request", d, NULL, 0);
@@ -156,16 +159,18 @@ enum MHD_Result route_execute(pk_req *r)
     char bad_opts[200];
     if (json_is_object(body) && pk_exec_opts_parse(body, &opts, bad_opts, sizeof bad_opts) != 0) {
         json_decref(body);
-        return pk_send_problem(r, 400, PK_PROBLEM_INVALID_INPUT, "Invalid execute request", bad_opts,
-                               NULL, 0);
+        return pk_send_problem(r, 400, PK_PROBLEM_INVALID_INPUT, "Invalid execute request",
+                               bad_opts, NULL, 0);
     }
     if (!json_is_object(body) || !json_is_object(inputs)) {
         pk_exec_opts_free(&opts);
         pk_schema_errors e = {0};
-        pk_schema_errors_add(&e, json_is_object(body) ? "/inputs" : "", json_is_object(body) ? "required" : "type",
+        pk_schema_errors_add(&e, json_is_object(body) ? "/inputs" : "",
+                             json_is_object(body) ? "required" : "type",
                              "the body must be an object with an \"inputs\" object");
         json_decref(body);
-        enum MHD_Result rc = pk_send_problem_doc(r, 400, pk_problem_invalid(400, "malformed execute request", &e), 0);
+        enum MHD_Result rc = pk_send_problem_doc(
+            r, 400, pk_problem_invalid(400, "malformed execute request", &e), 0);
         pk_schema_errors_free(&e);
         return rc;
     }
@@ -173,10 +178,12 @@ enum MHD_Result route_execute(pk_req *r)
     json_t *named = json_object_get(body, "process");
     if (named && !(json_is_string(named) && !strcmp(json_string_value(named), p->id))) {
         pk_schema_errors e = {0};
-        pk_schema_errors_add(&e, "/process", "const", "this is POST /processes/%s/execution", p->id);
+        pk_schema_errors_add(&e, "/process", "const", "this is POST /processes/%s/execution",
+                             p->id);
         json_decref(body);
         pk_exec_opts_free(&opts);
-        enum MHD_Result rc = pk_send_problem_doc(r, 400, pk_problem_invalid(400, "process mismatch", &e), 0);
+        enum MHD_Result rc =
+            pk_send_problem_doc(r, 400, pk_problem_invalid(400, "process mismatch", &e), 0);
         pk_schema_errors_free(&e);
         return rc;
     }
@@ -219,9 +226,13 @@ enum MHD_Result route_execute(pk_req *r)
     free(fp_src);
     pk_owner(r, owner, sizeof owner);
     const char *key = pk_header(r, "Idempotency-Key");
-    pk_submit s = {.process = p->id, .inputs_json = text, .owner = owner,
-                   .idempotency_key = key && *key ? key : NULL, .request_sha256 = fp_src_hash,
-                   .max_queued = cfg.max_queued, .max_queued_per_owner = cfg.max_queued_per_owner};
+    pk_submit s = {.process = p->id,
+                   .inputs_json = text,
+                   .owner = owner,
+                   .idempotency_key = key && *key ? key : NULL,
+                   .request_sha256 = fp_src_hash,
+                   .max_queued = cfg.max_queued,
+                   .max_queued_per_owner = cfg.max_queued_per_owner};
     int rc = pk_queue_submit(svc->q, &s, id);
     free(text);
     if (rc == PK_Q_OK && pk_results_opts_save(r, id, &opts) != 0)
@@ -231,13 +242,14 @@ enum MHD_Result route_execute(pk_req *r)
         pk_exec_opts_free(&opts);
     switch (rc) {
     case PK_Q_OK:
-        pk_log(PK_LOG_INFO, "job accepted", "{s:s,s:s,s:s}", "job", id, "process", p->id, "owner", owner);
+        pk_log(PK_LOG_INFO, "job accepted", "{s:s,s:s,s:s}", "job", id, "process", p->id, "owner",
+               owner);
         pk_supervisor_wake(svc->sup);
         return answer(r, id, 0, &opts);
-    case PK_Q_EXISTING:
-        return answer(r, id, 1, &opts);
+    case PK_Q_EXISTING: return answer(r, id, 1, &opts);
     case PK_Q_KEY_CONFLICT:
-        return pk_send_problem(r, 422, PK_PROBLEM_PACKD "idempotency-key-reused", "Idempotency key reused",
+        return pk_send_problem(r, 422, PK_PROBLEM_PACKD "idempotency-key-reused",
+                               "Idempotency key reused",
                                "this Idempotency-Key was used for a different request",
                                json_pack("{s:s}", "jobID", id), 0);
     case PK_Q_FULL:
@@ -248,8 +260,8 @@ enum MHD_Result route_execute(pk_req *r)
         pk_queue_writable(svc->q, why, sizeof why);
         snprintf(d, sizeof d, "the queue database cannot be written (%s); try again later", why);
         pk_log(PK_LOG_ERROR, "job refused: queue not writable", "{s:s}", "error", why);
-        return pk_send_problem(r, 503, PK_PROBLEM_PACKD "queue-unwritable", "Service Unavailable", d,
-                               NULL, 30);
+        return pk_send_problem(r, 503, PK_PROBLEM_PACKD "queue-unwritable", "Service Unavailable",
+                               d, NULL, 30);
     }
     case PK_Q_OWNER_FULL:
         return pk_send_problem(r, 429, PK_PROBLEM_PACKD "owner-queue-full", "Too many queued jobs",

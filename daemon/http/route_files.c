@@ -69,7 +69,8 @@ enum MHD_Result route_file_get(pk_req *r)
 {
     json_t *f = pk_queue_get_file(r->svc->q, r->seg[1], pk_scope(r));
     if (!f)
-        return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-file", "No such file", r->seg[1], NULL, 0);
+        return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-file", "No such file", r->seg[1],
+                               NULL, 0);
     pk_config cfg = pk_service_config(r->svc);
     char path[1200];
     snprintf(path, sizeof path, "%s/files/%s", cfg.data, r->seg[1]);

@@ -25,9 +25,9 @@
 static const char *const statuses[] = {"accepted", "running", "successful", "failed", "dismissed"};
 
 typedef struct list_query {
-    json_t *status, *process, *type;   /* arrays of the values given, or NULL */
+    json_t *status, *process, *type; /* arrays of the values given, or NULL */
     const char *datetime, *limit, *offset, *min_duration, *max_duration;
-    char bad[240];                     /* the first rule broken */
+    char bad[240]; /* the first rule broken */
 } list_query;
 
 static void add_items(json_t **into, const char *value)
@@ -49,7 +49,8 @@ static void once(list_query *q, const char **slot, const char *key, const char *
     *slot = value ? value : "";
 }
 
-static enum MHD_Result collect(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
+static enum MHD_Result collect(void *cls, enum MHD_ValueKind kind, const char *key,
+                               const char *value)
 {
     list_query *q = cls;
     (void)kind;
@@ -139,18 +140,25 @@ static int parse(list_query *q, pk_job_filter *f, long long *limit, long long *o
         return -1;
     size_t i;
     json_t *v;
-    json_array_foreach(q->status, i, v) if (!known_status(json_string_value(v))) {
-        snprintf(q->bad, sizeof q->bad, "query parameter status: '%s' is not one of accepted, "
-                 "running, successful, failed, dismissed", json_string_value(v));
-        return -1;
-    }
-    json_array_foreach(q->type, i, v) if (strcmp(json_string_value(v), "process") != 0) {
-        snprintf(q->bad, sizeof q->bad, "query parameter type: '%s' is not a job type here "
-                 "(every job is of type process)", json_string_value(v));
-        return -1;
-    }
+    json_array_foreach (q->status, i, v)
+        if (!known_status(json_string_value(v))) {
+            snprintf(q->bad, sizeof q->bad,
+                     "query parameter status: '%s' is not one of accepted, "
+                     "running, successful, failed, dismissed",
+                     json_string_value(v));
+            return -1;
+        }
+    json_array_foreach (q->type, i, v)
+        if (strcmp(json_string_value(v), "process") != 0) {
+            snprintf(q->bad, sizeof q->bad,
+                     "query parameter type: '%s' is not a job type here "
+                     "(every job is of type process)",
+                     json_string_value(v));
+            return -1;
+        }
     if (q->datetime && parse_datetime(q->datetime, f) != 0) {
-        snprintf(q->bad, sizeof q->bad, "query parameter datetime: an RFC 3339 date-time, or an "
+        snprintf(q->bad, sizeof q->bad,
+                 "query parameter datetime: an RFC 3339 date-time, or an "
                  "interval start/end whose open end is '..' or empty (start not after end)");
         return -1;
     }
@@ -166,14 +174,17 @@ static int parse(list_query *q, pk_job_filter *f, long long *limit, long long *o
     }
     f->max_duration = d < 0 ? NAN : (double)d;
     if (integer(q->limit, 1, LIMIT_DEFAULT, limit) != 0) {
-        snprintf(q->bad, sizeof q->bad, "query parameter limit: an integer, 1 or more (at most %d "
-                 "jobs are listed; a larger limit lists that many)", LIMIT_MAX);
+        snprintf(q->bad, sizeof q->bad,
+                 "query parameter limit: an integer, 1 or more (at most %d "
+                 "jobs are listed; a larger limit lists that many)",
+                 LIMIT_MAX);
         return -1;
     }
     if (*limit > LIMIT_MAX)
         *limit = LIMIT_MAX;
     if (integer(q->offset, 0, 0, offset) != 0 || *offset > OFFSET_MAX) {
-        snprintf(q->bad, sizeof q->bad, "query parameter offset: an integer in 0..%lld", OFFSET_MAX);
+        snprintf(q->bad, sizeof q->bad, "query parameter offset: an integer in 0..%lld",
+                 OFFSET_MAX);
         return -1;
     }
     return 0;
@@ -198,7 +209,7 @@ static void put_array(FILE *f, const char *key, json_t *a)
     fprintf(f, "&%s=", key);
     size_t i;
     json_t *v;
-    json_array_foreach(a, i, v) {
+    json_array_foreach (a, i, v) {
         if (i)
             fputc(',', f);
         put_encoded(f, json_string_value(v));
@@ -231,15 +242,16 @@ static char *filters_query(const list_query *q)
     return text;
 }
 
-static void add_link(json_t *links, const char *rel, long long limit, long long offset, const char *qs)
+static void add_link(json_t *links, const char *rel, long long limit, long long offset,
+                     const char *qs)
 {
     size_t n = strlen(qs ? qs : "") + 64;
     char *href = malloc(n);
     if (!href)
         return;
     snprintf(href, n, "/jobs?limit=%lld&offset=%lld%s", limit, offset, qs ? qs : "");
-    json_array_append_new(links, json_pack("{s:s,s:s,s:s}", "href", href, "rel", rel, "type",
-                                           "application/json"));
+    json_array_append_new(
+        links, json_pack("{s:s,s:s,s:s}", "href", href, "rel", rel, "type", "application/json"));
     free(href);
 }
 
@@ -251,7 +263,8 @@ enum MHD_Result route_jobs(pk_req *r)
     long long limit, offset;
     enum MHD_Result rc;
     if (parse(&q, &f, &limit, &offset) != 0) {
-        rc = pk_send_problem(r, 400, PK_PROBLEM_INVALID_INPUT, "Invalid query parameter", q.bad, NULL, 0);
+        rc = pk_send_problem(r, 400, PK_PROBLEM_INVALID_INPUT, "Invalid query parameter", q.bad,
+                             NULL, 0);
         goto out;
     }
     char *st = json_array_size(q.status) ? json_dumps(q.status, JSON_COMPACT) : NULL;
@@ -265,7 +278,8 @@ enum MHD_Result route_jobs(pk_req *r)
     json_t *jobs = json_array();
     size_t i;
     json_t *row;
-    json_array_foreach(rows, i, row) json_array_append_new(jobs, pk_status_info(row));
+    json_array_foreach (rows, i, row)
+        json_array_append_new(jobs, pk_status_info(row));
     json_decref(rows);
     char *qs = filters_query(&q);
     json_t *links = json_array();
@@ -275,10 +289,11 @@ enum MHD_Result route_jobs(pk_req *r)
     if (offset > 0)
         add_link(links, "prev", limit, offset > limit ? offset - limit : 0, qs);
     free(qs);
-    rc = pk_send_json(r, 200,
-                      json_pack("{s:o,s:i,s:I,s:o}", "jobs", jobs, "numberMatched", total,
-                                "numberReturned", (json_int_t)json_array_size(jobs), "links", links),
-                      NULL);
+    rc =
+        pk_send_json(r, 200,
+                     json_pack("{s:o,s:i,s:I,s:o}", "jobs", jobs, "numberMatched", total,
+                               "numberReturned", (json_int_t)json_array_size(jobs), "links", links),
+                     NULL);
 out:
     json_decref(q.status);
     json_decref(q.process);

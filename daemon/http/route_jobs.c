@@ -18,7 +18,8 @@ enum MHD_Result route_job(pk_req *r)
     if (!row)
         return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
     char etag[200];
-    snprintf(etag, sizeof etag, "\"%s-%lld\"", r->seg[1], (long long)json_integer_value(json_object_get(row, "rev")));
+    snprintf(etag, sizeof etag, "\"%s-%lld\"", r->seg[1],
+             (long long)json_integer_value(json_object_get(row, "rev")));
     const char *inm = pk_header(r, "If-None-Match");
     if (inm && strstr(inm, etag)) {
         json_decref(row);

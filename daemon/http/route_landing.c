@@ -13,25 +13,33 @@ enum MHD_Result route_landing(pk_req *r)
 {
     json_t *links = json_array();
     json_array_append_new(links, mklink("/", "self", "application/json", "this document"));
-    json_array_append_new(links, mklink("/api", "service-desc", "application/vnd.oai.openapi+json;version=3.0",
-                                      "the API definition (OpenAPI 3.0)"));
-    json_array_append_new(links, mklink("/conformance", "http://www.opengis.net/def/rel/ogc/1.0/conformance",
-                                      "application/json", "conformance classes implemented"));
-    json_array_append_new(links, mklink("/processes", "http://www.opengis.net/def/rel/ogc/1.0/processes",
-                                      "application/json", "processes"));
-    json_array_append_new(links, mklink("/jobs", "http://www.opengis.net/def/rel/ogc/1.0/job-list",
-                                      "application/json", "jobs"));
-    return pk_send_json(r, 200,
-                        json_pack("{s:s,s:s,s:s,s:o}", "title", "packd job service", "description",
-                                  "Dense random packings of grains from grading curves (OGC API - Processes)",
-                                  "version", PACKD_VERSION, "links", links),
-                        NULL);
+    json_array_append_new(links,
+                          mklink("/api", "service-desc",
+                                 "application/vnd.oai.openapi+json;version=3.0",
+                                 "the API definition (OpenAPI 3.0)"));
+    json_array_append_new(links,
+                          mklink("/conformance",
+                                 "http://www.opengis.net/def/rel/ogc/1.0/conformance",
+                                 "application/json", "conformance classes implemented"));
+    json_array_append_new(links,
+                          mklink("/processes", "http://www.opengis.net/def/rel/ogc/1.0/processes",
+                                 "application/json", "processes"));
+    json_array_append_new(links,
+                          mklink("/jobs", "http://www.opengis.net/def/rel/ogc/1.0/job-list",
+                                 "application/json", "jobs"));
+    return pk_send_json(
+        r, 200,
+        json_pack("{s:s,s:s,s:s,s:o}", "title", "packd job service", "description",
+                  "Dense random packings of grains from grading curves (OGC API - Processes)",
+                  "version", PACKD_VERSION, "links", links),
+        NULL);
 }
 
 enum MHD_Result route_conformance(pk_req *r)
 {
     const char *base = "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/";
-    const char *classes[] = {"core", "json", "oas30", "job-list", "dismiss", "ogc-process-description"};
+    const char *classes[] = {"core",     "json",    "oas30",
+                             "job-list", "dismiss", "ogc-process-description"};
     json_t *a = json_array();
     for (size_t i = 0; i < sizeof classes / sizeof *classes; i++) {
         char uri[160];

@@ -60,7 +60,8 @@ static json_t *finished_job(pk_req *r, json_t *row, int partial_ok, enum MHD_Res
     }
     if (strcmp(st, "successful") != 0) {
         char d[400];
-        snprintf(d, sizeof d, "the job is %s: %s", st, json_string_value(json_object_get(row, "message")));
+        snprintf(d, sizeof d, "the job is %s: %s", st,
+                 json_string_value(json_object_get(row, "message")));
         *rc = pk_send_problem(r, 404, PK_PROBLEM_RESULT_NOT_READY, "Result not ready", d,
                               json_pack("{s:s,s:s}", "jobID", id, "jobStatus", st), 0);
         json_decref(row);
@@ -75,7 +76,9 @@ static int selected(const pk_exec_opts *o, const char *output)
         return 1;
     size_t i;
     json_t *v;
-    json_array_foreach(o->select, i, v) if (!strcmp(json_string_value(v), output)) return 1;
+    json_array_foreach (o->select, i, v)
+        if (!strcmp(json_string_value(v), output))
+            return 1;
     return 0;
 }
 
@@ -97,8 +100,9 @@ static json_t *results_document(pk_req *r, json_t *row, const pk_exec_opts *o)
         job_file(r, id, out->id, path, sizeof path);
         if (out->optional && access(path, R_OK) == 0) {
             snprintf(href, sizeof href, "/jobs/%s/results/%s", id, out->id);
-            json_object_set_new(doc, out->id, json_pack("{s:s,s:s,s:s}", "href", href, "type",
-                                                        out->type, "title", out->title));
+            json_object_set_new(
+                doc, out->id,
+                json_pack("{s:s,s:s,s:s}", "href", href, "type", out->type, "title", out->title));
         }
         if (!selected(o, out->id))
             json_object_del(doc, out->id);
@@ -120,9 +124,12 @@ static enum MHD_Result send_output(pk_req *r, json_t *row, const pk_output *out)
         job_file(r, id, out->id, path, sizeof path);
         if (access(path, R_OK) != 0 || pk_sha256_file_hex(path, hex) != 0) {
             char d[200];
-            snprintf(d, sizeof d, "this job has no such picture (SVG packings are drawn up to %d "
-                     "grains, grading curves for pack results)", PK_PICTURE_SVG_MAX_GRAINS);
-            rc = pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output", d, NULL, 0);
+            snprintf(d, sizeof d,
+                     "this job has no such picture (SVG packings are drawn up to %d "
+                     "grains, grading curves for pack results)",
+                     PK_PICTURE_SVG_MAX_GRAINS);
+            rc = pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output", d,
+                                 NULL, 0);
         } else {
             rc = pk_send_file(r, path, out->type, hex, NULL); /* shown inline */
         }
@@ -142,8 +149,8 @@ static enum MHD_Result send_output(pk_req *r, json_t *row, const pk_output *out)
     } else {
         job_file(r, id, pk_job_file_name(PK_JOB_RESULT), path, sizeof path);
         snprintf(name, sizeof name, "%s.h5", id);
-        rc = pk_send_file(r, path, out->type, json_string_value(json_object_get(row, "result_sha256")),
-                          name);
+        rc = pk_send_file(r, path, out->type,
+                          json_string_value(json_object_get(row, "result_sha256")), name);
     }
     json_decref(row);
     return rc;
@@ -184,7 +191,8 @@ enum MHD_Result route_result_file(pk_req *r)
     if (!out)
         return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output",
                                "outputs: summary, result, xdmf, picture.png, picture.svg, "
-                               "grading.png, grading.svg", NULL, 0);
+                               "grading.png, grading.svg",
+                               NULL, 0);
     json_t *row = pk_job_visible(r, r->seg[1]);
     if (!row)
         return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);

@@ -15,7 +15,7 @@ typedef enum pk_job_file {
     PK_JOB_LOG,        /* worker.log: the worker's stderr */
     PK_JOB_LOCK,       /* worker.lock: flock'd by the worker while it lives */
     PK_JOB_CHECKPOINT, /* checkpoint.h5: kept across attempts, a re-queued job resumes from it */
-    PK_JOB_EXEC_OPTS,  /* execute.json: the request's response/outputs, only when not the defaults */
+    PK_JOB_EXEC_OPTS, /* execute.json: the request's response/outputs, only when not the defaults */
 } pk_job_file;
 
 /* The file's name inside the job directory, e.g. "result.h5". */

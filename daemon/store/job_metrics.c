@@ -42,11 +42,13 @@ json_t *pk_metrics_read(sqlite3 *db)
 {
     json_t *finished = json_object(), *durations = json_object(), *bounds = json_array();
     sqlite3_stmt *st;
-    if (sqlite3_prepare_v2(db, "SELECT le FROM duration_buckets ORDER BY le", -1, &st, NULL) == SQLITE_OK)
+    if (sqlite3_prepare_v2(db, "SELECT le FROM duration_buckets ORDER BY le", -1, &st, NULL) ==
+        SQLITE_OK)
         while (sqlite3_step(st) == SQLITE_ROW)
             json_array_append_new(bounds, bound_json(sqlite3_column_double(st, 0)));
     sqlite3_finalize(st);
-    if (sqlite3_prepare_v2(db, "SELECT process, status, n FROM job_counts", -1, &st, NULL) == SQLITE_OK)
+    if (sqlite3_prepare_v2(db, "SELECT process, status, n FROM job_counts", -1, &st, NULL) ==
+        SQLITE_OK)
         while (sqlite3_step(st) == SQLITE_ROW) {
             const char *p = (const char *)sqlite3_column_text(st, 0);
             json_t *o = json_object_get(finished, p);
@@ -73,9 +75,11 @@ json_t *pk_metrics_read(sqlite3 *db)
             json_array_append_new(json_object_get(o, "n"), json_integer(n));
             json_object_set_new(o, "count",
                                 json_integer(json_integer_value(json_object_get(o, "count")) + n));
-            json_object_set_new(o, "sum", json_real(json_real_value(json_object_get(o, "sum")) +
-                                                    sqlite3_column_double(st, 3)));
+            json_object_set_new(o, "sum",
+                                json_real(json_real_value(json_object_get(o, "sum")) +
+                                          sqlite3_column_double(st, 3)));
         }
     sqlite3_finalize(st);
-    return json_pack("{s:o,s:o,s:o}", "finished", finished, "durations", durations, "bounds", bounds);
+    return json_pack("{s:o,s:o,s:o}", "finished", finished, "durations", durations, "bounds",
+                     bounds);
 }

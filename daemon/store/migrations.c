@@ -7,25 +7,26 @@
 static const char *const steps[] = {
     /* 0 -> 1: jobs, their events (SSE resume), idempotency keys, uploads */
     "CREATE TABLE jobs ("
-    "  seq INTEGER PRIMARY KEY AUTOINCREMENT,"      /* submission order */
+    "  seq INTEGER PRIMARY KEY AUTOINCREMENT," /* submission order */
     "  id TEXT NOT NULL UNIQUE,"
     "  process TEXT NOT NULL,"
-    "  inputs TEXT NOT NULL,"                      /* JSON, as validated */
+    "  inputs TEXT NOT NULL," /* JSON, as validated */
     "  owner TEXT NOT NULL,"
-    "  status TEXT NOT NULL CHECK (status IN ('accepted','running','successful','failed','dismissed')),"
+    "  status TEXT NOT NULL CHECK (status IN "
+    "('accepted','running','successful','failed','dismissed')),"
     "  progress INTEGER NOT NULL DEFAULT 0,"
     "  message TEXT NOT NULL DEFAULT '',"
     "  created REAL NOT NULL, started REAL, finished REAL, updated REAL NOT NULL,"
-    "  attempts INTEGER NOT NULL DEFAULT 0,"       /* worker starts */
+    "  attempts INTEGER NOT NULL DEFAULT 0," /* worker starts */
     "  cancel_requested INTEGER NOT NULL DEFAULT 0,"
     "  worker_pid INTEGER,"
-    "  rev INTEGER NOT NULL DEFAULT 0,"            /* bumped on every change: ETag */
-    "  summary TEXT,"                              /* worker's summary JSON */
+    "  rev INTEGER NOT NULL DEFAULT 0," /* bumped on every change: ETag */
+    "  summary TEXT,"                   /* worker's summary JSON */
     "  result_sha256 TEXT, result_size INTEGER);"
     "CREATE INDEX jobs_by_status ON jobs(status, seq);"
     "CREATE INDEX jobs_by_owner ON jobs(owner, status);"
     "CREATE TABLE events ("
-    "  id INTEGER PRIMARY KEY AUTOINCREMENT,"      /* SSE id */
+    "  id INTEGER PRIMARY KEY AUTOINCREMENT," /* SSE id */
     "  job_id TEXT NOT NULL, kind TEXT NOT NULL, data TEXT NOT NULL, created REAL NOT NULL);"
     "CREATE INDEX events_by_job ON events(job_id, id);"
     "CREATE TABLE idempotency ("
@@ -56,7 +57,7 @@ static const char *const steps[] = {
     "CREATE TABLE duration_buckets (le REAL PRIMARY KEY);"
     "INSERT INTO duration_buckets VALUES (0.1), (0.5), (1), (2), (5), (10), (30), (60), (120),"
     "  (300), (600), (1800), (3600), (7200), (21600), (86400), (9e999);"
-    "CREATE TABLE job_durations ("                 /* per bucket, not cumulative */
+    "CREATE TABLE job_durations (" /* per bucket, not cumulative */
     "  process TEXT NOT NULL, le REAL NOT NULL, n INTEGER NOT NULL, secs REAL NOT NULL,"
     "  PRIMARY KEY (process, le));"
     "INSERT INTO job_counts(process, status, n) SELECT process, status, count(*) FROM jobs"
@@ -129,7 +130,8 @@ sqlite3 *pk_db_open(const char *path, char *err, size_t errlen)
      * daemon's queue and token store, `packd token`, the sqlite3 CLI, backups). */
     sqlite3_busy_timeout(db, 5000);
     char *msg = NULL;
-    if (sqlite3_exec(db, "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL; PRAGMA foreign_keys=ON;",
+    if (sqlite3_exec(db,
+                     "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL; PRAGMA foreign_keys=ON;",
                      NULL, NULL, &msg) != SQLITE_OK ||
         pk_migrate(db, err, errlen) < 0) {
         if (msg)

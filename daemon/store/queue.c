@@ -21,13 +21,12 @@ struct pk_queue {
     pthread_mutex_t mu;
     pthread_mutex_t ev_mu;
     pthread_cond_t ev_cond;
-    long long ev_seq;     /* bumped on every inserted event / state change */
+    long long ev_seq; /* bumped on every inserted event / state change */
     /* The last failed write (disk or database full, I/O error) until a
      * commit succeeds again: /healthz is not ready meanwhile. */
     double write_failed_at, probed_at;
     char write_error[160];
 };
-
 
 double pk_queue_now(void)
 {
@@ -148,16 +147,17 @@ static void notify(pk_queue *q)
 static void add_event(pk_queue *q, const char *id, const char *kind, json_t *data)
 {
     char *text = json_dumps(data, JSON_COMPACT);
-    run(q, prep(q, "INSERT INTO events(job_id, kind, data, created) VALUES (?,?,?,?)", "sssd", id,
-                kind, text ? text : "{}", pk_queue_now()));
+    run(q,
+        prep(q, "INSERT INTO events(job_id, kind, data, created) VALUES (?,?,?,?)", "sssd", id,
+             kind, text ? text : "{}", pk_queue_now()));
     free(text);
 }
 
 /* The "status" event of a job, from its row (after a change). */
 static void add_status_event(pk_queue *q, const char *id)
 {
-    json_t *d = one_row(prep(q, "SELECT status, progress, message, attempts FROM jobs WHERE id=?",
-                             "s", id));
+    json_t *d = one_row(
+        prep(q, "SELECT status, progress, message, attempts FROM jobs WHERE id=?", "s", id));
     if (d) {
         add_event(q, id, "status", d);
         json_decref(d);
@@ -227,8 +227,9 @@ int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37])
         goto out;
     }
     if (s->idempotency_key) {
-        json_t *k = one_row(prep(q, "SELECT request_sha256, job_id FROM idempotency WHERE owner=? AND key=?",
-                                 "ss", s->owner, s->idempotency_key));
+        json_t *k = one_row(
+            prep(q, "SELECT request_sha256, job_id FROM idempotency WHERE owner=? AND key=?", "ss",
+                 s->owner, s->idempotency_key));
         if (k) {
             int same = !strcmp(json_string_value(json_object_get(k, "request_sha256")),
                                s->request_sha256 ? s->request_sha256 : "");
@@ -239,13 +240,15 @@ int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37])
             goto out;
         }
     }
-    if (scalar(q, prep(q, "SELECT count(*) FROM jobs WHERE status='accepted'", NULL)) >= s->max_queued) {
+    if (scalar(q, prep(q, "SELECT count(*) FROM jobs WHERE status='accepted'", NULL)) >=
+        s->max_queued) {
         rollback(q);
         rc = PK_Q_FULL;
         goto out;
     }
-    if (scalar(q, prep(q, "SELECT count(*) FROM jobs WHERE owner=? AND status='accepted'", "s",
-                       s->owner)) >= s->max_queued_per_owner) {
+    if (scalar(q,
+               prep(q, "SELECT count(*) FROM jobs WHERE owner=? AND status='accepted'", "s",
+                    s->owner)) >= s->max_queued_per_owner) {
         rollback(q);
         rc = PK_Q_OWNER_FULL;
         goto out;
@@ -255,13 +258,18 @@ int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37])
         goto out;
     }
     double now = pk_queue_now();
-    if (run(q, prep(q, "INSERT INTO jobs(id, process, inputs, owner, status, message, created, updated)"
-                       " VALUES (?,?,?,?,'accepted','queued',?,?)",
-                    "ssssdd", id, s->process, s->inputs_json, s->owner, now, now)) != 1 ||
+    if (run(q,
+            prep(q,
+                 "INSERT INTO jobs(id, process, inputs, owner, status, message, created, updated)"
+                 " VALUES (?,?,?,?,'accepted','queued',?,?)",
+                 "ssssdd", id, s->process, s->inputs_json, s->owner, now, now)) != 1 ||
         (s->idempotency_key &&
-         run(q, prep(q, "INSERT INTO idempotency(owner, key, request_sha256, job_id, created) VALUES (?,?,?,?,?)",
-                     "ssssd", s->owner, s->idempotency_key, s->request_sha256 ? s->request_sha256 : "",
-                     id, now)) != 1)) {
+         run(q,
+             prep(q,
+                  "INSERT INTO idempotency(owner, key, request_sha256, job_id, created) VALUES "
+                  "(?,?,?,?,?)",
+                  "ssssd", s->owner, s->idempotency_key, s->request_sha256 ? s->request_sha256 : "",
+                  id, now)) != 1)) {
         int code = sqlite3_errcode(q->db);
         if (code == SQLITE_FULL || code == SQLITE_IOERR || code == SQLITE_READONLY) {
             note_write(q, 0);
@@ -280,9 +288,10 @@ out:
     return rc;
 }
 
-#define JOB_COLUMNS "id, process, inputs, owner, status, progress, message, created, started, " \
-                    "finished, updated, attempts, cancel_requested, worker_pid, rev, summary, "  \
-                    "result_sha256, result_size"
+#define JOB_COLUMNS                                                                                \
+    "id, process, inputs, owner, status, progress, message, created, started, "                    \
+    "finished, updated, attempts, cancel_requested, worker_pid, rev, summary, "                    \
+    "result_sha256, result_size"
 
 json_t *pk_queue_get(pk_queue *q, const char *id)
 {
@@ -296,28 +305,31 @@ json_t *pk_queue_list(pk_queue *q, const pk_job_filter *f, int limit, int offset
 {
     /* Arrays are bound as JSON text and unpacked by json_each; a NaN bound
      * as a double is NULL in SQLite, so NAN means "no bound" below. */
-    const char *where =
-        " WHERE (?1 IS NULL OR status IN (SELECT value FROM json_each(?1)))"
-        " AND (?2 IS NULL OR process IN (SELECT value FROM json_each(?2)))"
-        " AND (?5 IS NULL OR owner=?5)"
-        " AND (?6 IS NULL OR created >= ?6) AND (?7 IS NULL OR created < ?7)"
-        " AND ((?8 IS NULL AND ?9 IS NULL) OR (started IS NOT NULL AND"
-        "  (finished IS NOT NULL OR status='running') AND"
-        "  coalesce(finished, ?10) - started BETWEEN coalesce(?8, -1e300) AND coalesce(?9, 1e300)))";
+    const char *where = " WHERE (?1 IS NULL OR status IN (SELECT value FROM json_each(?1)))"
+                        " AND (?2 IS NULL OR process IN (SELECT value FROM json_each(?2)))"
+                        " AND (?5 IS NULL OR owner=?5)"
+                        " AND (?6 IS NULL OR created >= ?6) AND (?7 IS NULL OR created < ?7)"
+                        " AND ((?8 IS NULL AND ?9 IS NULL) OR (started IS NOT NULL AND"
+                        "  (finished IS NOT NULL OR status='running') AND"
+                        "  coalesce(finished, ?10) - started BETWEEN coalesce(?8, -1e300) AND "
+                        "coalesce(?9, 1e300)))";
     char sql[1024];
     double now = pk_queue_now();
     pthread_mutex_lock(&q->mu);
     snprintf(sql, sizeof sql, "SELECT count(*) FROM jobs%s", where);
     if (total)
-        *total = (int)scalar(q, prep(q, sql, "ssiisddddd", f->status_json, f->process_json, 0, 0,
-                                     f->owner, f->created_from, f->created_before, f->min_duration,
-                                     f->max_duration, now));
-    snprintf(sql, sizeof sql,
-             "SELECT id, process, status, progress, message, created, started, finished, updated, rev"
-             " FROM jobs%s ORDER BY seq DESC LIMIT ?3 OFFSET ?4", where);
-    json_t *r = rows(prep(q, sql, "ssiisddddd", f->status_json, f->process_json, limit, offset,
-                          f->owner, f->created_from, f->created_before, f->min_duration,
-                          f->max_duration, now));
+        *total = (int)scalar(q,
+                             prep(q, sql, "ssiisddddd", f->status_json, f->process_json, 0, 0,
+                                  f->owner, f->created_from, f->created_before, f->min_duration,
+                                  f->max_duration, now));
+    snprintf(
+        sql, sizeof sql,
+        "SELECT id, process, status, progress, message, created, started, finished, updated, rev"
+        " FROM jobs%s ORDER BY seq DESC LIMIT ?3 OFFSET ?4",
+        where);
+    json_t *r =
+        rows(prep(q, sql, "ssiisddddd", f->status_json, f->process_json, limit, offset, f->owner,
+                  f->created_from, f->created_before, f->min_duration, f->max_duration, now));
     pthread_mutex_unlock(&q->mu);
     return r;
 }
@@ -328,7 +340,8 @@ json_t *pk_queue_claim(pk_queue *q)
     pthread_mutex_lock(&q->mu);
     if (begin(q) != SQLITE_OK)
         goto out;
-    json_t *next = one_row(prep(q, "SELECT id FROM jobs WHERE status='accepted' ORDER BY seq LIMIT 1", NULL));
+    json_t *next =
+        one_row(prep(q, "SELECT id FROM jobs WHERE status='accepted' ORDER BY seq LIMIT 1", NULL));
     if (!next) {
         rollback(q);
         goto out;
@@ -336,9 +349,11 @@ json_t *pk_queue_claim(pk_queue *q)
     const char *id = json_string_value(json_object_get(next, "id"));
     double now = pk_queue_now();
     /* The status condition makes the claim atomic: a job is running at most once. */
-    if (run(q, prep(q, "UPDATE jobs SET status='running', attempts=attempts+1, started=?, updated=?,"
-                       " message='running', progress=0, rev=rev+1 WHERE id=? AND status='accepted'",
-                    "dds", now, now, id)) == 1) {
+    if (run(q,
+            prep(q,
+                 "UPDATE jobs SET status='running', attempts=attempts+1, started=?, updated=?,"
+                 " message='running', progress=0, rev=rev+1 WHERE id=? AND status='accepted'",
+                 "dds", now, now, id)) == 1) {
         add_status_event(q, id);
         r = one_row(prep(q, "SELECT " JOB_COLUMNS " FROM jobs WHERE id=?", "s", id));
         commit(q);
@@ -365,9 +380,11 @@ void pk_queue_progress(pk_queue *q, const char *id, int percent, json_t *data)
     pthread_mutex_lock(&q->mu);
     const char *msg = json_string_value(json_object_get(data, "message"));
     if (begin(q) == SQLITE_OK) {
-        if (run(q, prep(q, "UPDATE jobs SET progress=?, message=coalesce(?, message), updated=?,"
-                           " rev=rev+1 WHERE id=? AND status='running'",
-                        "isds", percent, msg, pk_queue_now(), id)) == 1)
+        if (run(q,
+                prep(q,
+                     "UPDATE jobs SET progress=?, message=coalesce(?, message), updated=?,"
+                     " rev=rev+1 WHERE id=? AND status='running'",
+                     "isds", percent, msg, pk_queue_now(), id)) == 1)
             add_event(q, id, "progress", data);
         commit(q);
     }
@@ -382,19 +399,23 @@ const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, con
     double now = pk_queue_now();
     pthread_mutex_lock(&q->mu);
     if (begin(q) == SQLITE_OK) {
-        int n = run(q, prep(q, "UPDATE jobs SET status=?, message=?, progress=CASE WHEN ?='successful'"
-                               " THEN 100 ELSE progress END, finished=?, updated=?, summary=?,"
-                               " result_sha256=?, result_size=?, worker_pid=NULL, rev=rev+1"
-                               " WHERE id=? AND status='running'",
-                            "sssddssIs", status, message, status, now, now, summary_json, sha256,
-                            size, id));
+        int n = run(q,
+                    prep(q,
+                         "UPDATE jobs SET status=?, message=?, progress=CASE WHEN ?='successful'"
+                         " THEN 100 ELSE progress END, finished=?, updated=?, summary=?,"
+                         " result_sha256=?, result_size=?, worker_pid=NULL, rev=rev+1"
+                         " WHERE id=? AND status='running'",
+                         "sssddssIs", status, message, status, now, now, summary_json, sha256, size,
+                         id));
         if (n == 1) {
             ended = !strcmp(status, "successful") ? "successful" : "failed";
             pk_metrics_job_ended(q->db, id, ended);
-        } else if (run(q, prep(q, "UPDATE jobs SET finished=?, updated=?, worker_pid=NULL, rev=rev+1,"
-                                  " message='dismissed; worker stopped' WHERE id=? AND"
-                                  " status='dismissed' AND finished IS NULL",
-                               "dds", now, now, id)) != 1) { /* not ours to end */
+        } else if (run(q,
+                       prep(q,
+                            "UPDATE jobs SET finished=?, updated=?, worker_pid=NULL, rev=rev+1,"
+                            " message='dismissed; worker stopped' WHERE id=? AND"
+                            " status='dismissed' AND finished IS NULL",
+                            "dds", now, now, id)) != 1) { /* not ours to end */
             ended = "unchanged";
             commit(q);
             goto out;
@@ -403,8 +424,11 @@ const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, con
         }
         add_status_event(q, id);
         /* History stays small: of the progress events only the last is kept. */
-        run(q, prep(q, "DELETE FROM events WHERE job_id=?1 AND kind='progress' AND id <"
-                       " (SELECT max(id) FROM events WHERE job_id=?1 AND kind='progress')", "s", id));
+        run(q,
+            prep(q,
+                 "DELETE FROM events WHERE job_id=?1 AND kind='progress' AND id <"
+                 " (SELECT max(id) FROM events WHERE job_id=?1 AND kind='progress')",
+                 "s", id));
         commit(q);
     }
 out:
@@ -428,11 +452,17 @@ int pk_queue_dismiss(pk_queue *q, const char *id, char was[16])
     json_decref(r);
     double now = pk_queue_now();
     if (!strcmp(was, "running"))
-        run(q, prep(q, "UPDATE jobs SET status='dismissed', cancel_requested=1, message='dismissed;"
-                       " stopping the worker', updated=?, rev=rev+1 WHERE id=?", "ds", now, id));
+        run(q,
+            prep(q,
+                 "UPDATE jobs SET status='dismissed', cancel_requested=1, message='dismissed;"
+                 " stopping the worker', updated=?, rev=rev+1 WHERE id=?",
+                 "ds", now, id));
     else if (strcmp(was, "dismissed") != 0)
-        run(q, prep(q, "UPDATE jobs SET status='dismissed', message='dismissed', updated=?,"
-                       " finished=coalesce(finished, ?), rev=rev+1 WHERE id=?", "dds", now, now, id));
+        run(q,
+            prep(q,
+                 "UPDATE jobs SET status='dismissed', message='dismissed', updated=?,"
+                 " finished=coalesce(finished, ?), rev=rev+1 WHERE id=?",
+                 "dds", now, now, id));
     if (!strcmp(was, "accepted")) /* a finished job was counted when it ended */
         pk_metrics_job_ended(q->db, id, "dismissed");
     add_status_event(q, id);
@@ -448,8 +478,10 @@ out:
 json_t *pk_queue_cancel_requests(pk_queue *q)
 {
     pthread_mutex_lock(&q->mu);
-    json_t *r = rows(prep(q, "SELECT id, worker_pid FROM jobs WHERE cancel_requested=1 AND"
-                             " finished IS NULL", NULL));
+    json_t *r = rows(prep(q,
+                          "SELECT id, worker_pid FROM jobs WHERE cancel_requested=1 AND"
+                          " finished IS NULL",
+                          NULL));
     pthread_mutex_unlock(&q->mu);
     return r;
 }
@@ -460,28 +492,39 @@ int pk_queue_recover(pk_queue *q, int max_attempts, int *failed)
     *failed = 0;
     pthread_mutex_lock(&q->mu);
     if (begin(q) == SQLITE_OK) {
-        json_t *left = rows(prep(q, "SELECT id, attempts, status FROM jobs WHERE (status='running') OR"
-                                    " (cancel_requested=1 AND finished IS NULL)", NULL));
+        json_t *left = rows(prep(q,
+                                 "SELECT id, attempts, status FROM jobs WHERE (status='running') OR"
+                                 " (cancel_requested=1 AND finished IS NULL)",
+                                 NULL));
         double now = pk_queue_now();
         size_t i;
         json_t *r;
-        json_array_foreach(left, i, r) {
+        json_array_foreach (left, i, r) {
             const char *id = json_string_value(json_object_get(r, "id"));
             if (strcmp(json_string_value(json_object_get(r, "status")), "running") != 0) {
-                run(q, prep(q, "UPDATE jobs SET finished=?, worker_pid=NULL WHERE id=?", "ds", now, id));
+                run(q,
+                    prep(q, "UPDATE jobs SET finished=?, worker_pid=NULL WHERE id=?", "ds", now,
+                         id));
                 pk_metrics_job_ended(q->db, id, "dismissed");
                 continue;
             }
             int attempts = (int)json_integer_value(json_object_get(r, "attempts"));
             if (attempts < max_attempts) {
-                run(q, prep(q, "UPDATE jobs SET status='accepted', worker_pid=NULL, progress=0,"
-                               " message='re-queued after the daemon stopped (attempt ' || attempts || ')',"
-                               " updated=?, rev=rev+1 WHERE id=?", "ds", now, id));
+                run(q,
+                    prep(q,
+                         "UPDATE jobs SET status='accepted', worker_pid=NULL, progress=0,"
+                         " message='re-queued after the daemon stopped (attempt ' || attempts || "
+                         "')',"
+                         " updated=?, rev=rev+1 WHERE id=?",
+                         "ds", now, id));
                 requeued++;
             } else {
-                run(q, prep(q, "UPDATE jobs SET status='failed', worker_pid=NULL, finished=?, updated=?,"
-                               " message='interrupted ' || attempts || ' times by daemon restarts; not"
-                               " retried', rev=rev+1 WHERE id=?", "dds", now, now, id));
+                run(q,
+                    prep(q,
+                         "UPDATE jobs SET status='failed', worker_pid=NULL, finished=?, updated=?,"
+                         " message='interrupted ' || attempts || ' times by daemon restarts; not"
+                         " retried', rev=rev+1 WHERE id=?",
+                         "dds", now, now, id));
                 pk_metrics_job_ended(q->db, id, "failed");
                 (*failed)++;
             }
@@ -498,9 +541,12 @@ void pk_queue_requeue(pk_queue *q, const char *id, const char *why)
 {
     pthread_mutex_lock(&q->mu);
     if (begin(q) == SQLITE_OK) {
-        if (run(q, prep(q, "UPDATE jobs SET status='accepted', attempts=max(attempts-1, 0),"
-                           " worker_pid=NULL, progress=0, message=?, updated=?, rev=rev+1"
-                           " WHERE id=? AND status='running'", "sds", why, pk_queue_now(), id)) == 1)
+        if (run(q,
+                prep(q,
+                     "UPDATE jobs SET status='accepted', attempts=max(attempts-1, 0),"
+                     " worker_pid=NULL, progress=0, message=?, updated=?, rev=rev+1"
+                     " WHERE id=? AND status='running'",
+                     "sds", why, pk_queue_now(), id)) == 1)
             add_status_event(q, id);
         commit(q);
     }
@@ -511,8 +557,10 @@ void pk_queue_requeue(pk_queue *q, const char *id, const char *why)
 json_t *pk_queue_events(pk_queue *q, const char *id, long long after, int limit)
 {
     pthread_mutex_lock(&q->mu);
-    json_t *r = rows(prep(q, "SELECT id, kind, data FROM events WHERE job_id=? AND id>? ORDER BY id"
-                             " LIMIT ?", "sIi", id, after, limit));
+    json_t *r = rows(prep(q,
+                          "SELECT id, kind, data FROM events WHERE job_id=? AND id>? ORDER BY id"
+                          " LIMIT ?",
+                          "sIi", id, after, limit));
     pthread_mutex_unlock(&q->mu);
     return r;
 }
@@ -559,7 +607,7 @@ json_t *pk_queue_stats(pk_queue *q)
         json_object_set_new(jobs, all[i], json_integer(0));
     size_t i;
     json_t *r;
-    json_array_foreach(by, i, r) {
+    json_array_foreach (by, i, r) {
         const char *st = json_string_value(json_object_get(r, "status"));
         json_object_set(jobs, st, json_object_get(r, "n"));
     }
@@ -578,7 +626,8 @@ int pk_queue_writable(pk_queue *q, char *why, size_t n)
     if (q->write_failed_at > 0 && now - q->probed_at >= 1.0) {
         q->probed_at = now;
         if (begin(q) == SQLITE_OK &&
-            sqlite3_exec(q->db, "PRAGMA application_id = 1885889636", NULL, NULL, NULL) == SQLITE_OK)
+            sqlite3_exec(q->db, "PRAGMA application_id = 1885889636", NULL, NULL, NULL) ==
+                SQLITE_OK)
             commit(q);
         else
             rollback(q);
@@ -595,9 +644,11 @@ int pk_queue_add_file(pk_queue *q, const char *id, const char *sha256, long long
                       const char *media_type, const char *owner)
 {
     pthread_mutex_lock(&q->mu);
-    int n = run(q, prep(q, "INSERT OR IGNORE INTO files(id, sha256, size, media_type, owner, created)"
-                           " VALUES (?,?,?,?,?,?)", "ssIssd", id, sha256, size, media_type, owner,
-                        pk_queue_now()));
+    int n = run(q,
+                prep(q,
+                     "INSERT OR IGNORE INTO files(id, sha256, size, media_type, owner, created)"
+                     " VALUES (?,?,?,?,?,?)",
+                     "ssIssd", id, sha256, size, media_type, owner, pk_queue_now()));
     pthread_mutex_unlock(&q->mu);
     return n < 0 ? -1 : 0;
 }
@@ -605,8 +656,10 @@ int pk_queue_add_file(pk_queue *q, const char *id, const char *sha256, long long
 json_t *pk_queue_get_file(pk_queue *q, const char *id, const char *owner)
 {
     pthread_mutex_lock(&q->mu);
-    json_t *r = one_row(prep(q, "SELECT id, sha256, size, media_type, created FROM files WHERE id=?1"
-                                " AND (?2 IS NULL OR owner=?2) LIMIT 1", "ss", id, owner));
+    json_t *r = one_row(prep(q,
+                             "SELECT id, sha256, size, media_type, created FROM files WHERE id=?1"
+                             " AND (?2 IS NULL OR owner=?2) LIMIT 1",
+                             "ss", id, owner));
     pthread_mutex_unlock(&q->mu);
     return r;
 }

@@ -14,12 +14,12 @@
 typedef struct pk_queue pk_queue;
 
 enum {
-    PK_Q_OK = 0,          /* new job created */
-    PK_Q_EXISTING = 1,    /* idempotency key seen with the same request: same job */
-    PK_Q_FULL = -2,       /* max_queued waiting jobs */
-    PK_Q_OWNER_FULL = -3, /* max_queued_per_owner waiting jobs of this owner */
+    PK_Q_OK = 0,            /* new job created */
+    PK_Q_EXISTING = 1,      /* idempotency key seen with the same request: same job */
+    PK_Q_FULL = -2,         /* max_queued waiting jobs */
+    PK_Q_OWNER_FULL = -3,   /* max_queued_per_owner waiting jobs of this owner */
     PK_Q_KEY_CONFLICT = -4, /* idempotency key reused with another request */
-    PK_Q_UNWRITABLE = -5, /* the database takes no writes now (disk full, I/O error) */
+    PK_Q_UNWRITABLE = -5,   /* the database takes no writes now (disk full, I/O error) */
     PK_Q_ERROR = -1,
 };
 
@@ -31,8 +31,8 @@ double pk_queue_now(void);
 
 typedef struct pk_submit {
     const char *process, *inputs_json, *owner;
-    const char *idempotency_key;   /* may be NULL */
-    const char *request_sha256;    /* fingerprint of the request (with a key) */
+    const char *idempotency_key; /* may be NULL */
+    const char *request_sha256;  /* fingerprint of the request (with a key) */
     int max_queued, max_queued_per_owner;
 } pk_submit;
 
@@ -44,13 +44,13 @@ json_t *pk_queue_get(pk_queue *q, const char *id);
 
 /* Which jobs GET /jobs lists (OGC job-list); an absent filter matches all. */
 typedef struct pk_job_filter {
-    const char *status_json;   /* JSON array of statuses (any of them), or NULL */
-    const char *process_json;  /* JSON array of process ids (any of them), or NULL */
-    const char *owner;         /* NULL: every owner's */
-    double created_from, created_before;  /* created in [from, before); NAN: open */
+    const char *status_json;             /* JSON array of statuses (any of them), or NULL */
+    const char *process_json;            /* JSON array of process ids (any of them), or NULL */
+    const char *owner;                   /* NULL: every owner's */
+    double created_from, created_before; /* created in [from, before); NAN: open */
     /* started..finished, or ..now while running; a job without both (never
      * started, or re-queued) has no duration and fails either bound */
-    double min_duration, max_duration;    /* seconds; NAN: none */
+    double min_duration, max_duration; /* seconds; NAN: none */
 } pk_job_filter;
 
 /* Newest first: at most limit rows after offset; *total all that match. */

@@ -100,8 +100,8 @@ int pk_tokens_add(pk_tokens *t, const char *name, int admin, char out[PK_TOKEN_L
     pk_token_hash(out, hex);
     pthread_mutex_lock(&t->mu);
     sqlite3_stmt *st = NULL;
-    int rc = sqlite3_prepare_v2(t->db, "INSERT INTO tokens(name, sha256, admin, created) VALUES (?,?,?,?)",
-                                -1, &st, NULL);
+    int rc = sqlite3_prepare_v2(
+        t->db, "INSERT INTO tokens(name, sha256, admin, created) VALUES (?,?,?,?)", -1, &st, NULL);
     if (rc == SQLITE_OK) {
         sqlite3_bind_text(st, 1, name, -1, SQLITE_TRANSIENT);
         sqlite3_bind_text(st, 2, hex, -1, SQLITE_TRANSIENT);
@@ -125,15 +125,18 @@ json_t *pk_tokens_list(pk_tokens *t)
     json_t *a = json_array();
     pthread_mutex_lock(&t->mu);
     sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(t->db, "SELECT name, admin, created, last_used FROM tokens ORDER BY name",
-                           -1, &st, NULL) == SQLITE_OK)
+    if (sqlite3_prepare_v2(t->db,
+                           "SELECT name, admin, created, last_used FROM tokens ORDER BY name", -1,
+                           &st, NULL) == SQLITE_OK)
         while (sqlite3_step(st) == SQLITE_ROW)
-            json_array_append_new(
-                a, json_pack("{s:s,s:b,s:f,s:o}", "name", (const char *)sqlite3_column_text(st, 0),
-                             "admin", sqlite3_column_int(st, 1), "created", sqlite3_column_double(st, 2),
-                             "last_used", sqlite3_column_type(st, 3) == SQLITE_NULL
-                                              ? json_null()
-                                              : json_real(sqlite3_column_double(st, 3))));
+            json_array_append_new(a,
+                                  json_pack("{s:s,s:b,s:f,s:o}", "name",
+                                            (const char *)sqlite3_column_text(st, 0), "admin",
+                                            sqlite3_column_int(st, 1), "created",
+                                            sqlite3_column_double(st, 2), "last_used",
+                                            sqlite3_column_type(st, 3) == SQLITE_NULL
+                                                ? json_null()
+                                                : json_real(sqlite3_column_double(st, 3))));
     sqlite3_finalize(st);
     pthread_mutex_unlock(&t->mu);
     return a;
@@ -158,7 +161,8 @@ int pk_tokens_revoke(pk_tokens *t, const char *name)
  * token's characters (an attacker cannot choose the hash's prefix). */
 int pk_tokens_verify(pk_tokens *t, const char *token, char name[PK_TOKEN_NAME_MAX], int *admin)
 {
-    if (strncmp(token, PK_TOKEN_PREFIX, strlen(PK_TOKEN_PREFIX)) != 0 || strlen(token) != PK_TOKEN_LEN)
+    if (strncmp(token, PK_TOKEN_PREFIX, strlen(PK_TOKEN_PREFIX)) != 0 ||
+        strlen(token) != PK_TOKEN_LEN)
         return 0;
     char hex[65];
     pk_token_hash(token, hex);
@@ -166,7 +170,8 @@ int pk_tokens_verify(pk_tokens *t, const char *token, char name[PK_TOKEN_NAME_MA
     int rc = -1;
     pthread_mutex_lock(&t->mu);
     sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(t->db, "SELECT name, admin, coalesce(last_used, 0) FROM tokens WHERE sha256=?",
+    if (sqlite3_prepare_v2(t->db,
+                           "SELECT name, admin, coalesce(last_used, 0) FROM tokens WHERE sha256=?",
                            -1, &st, NULL) == SQLITE_OK) {
         sqlite3_bind_text(st, 1, hex, -1, SQLITE_TRANSIENT);
         int s = sqlite3_step(st);
@@ -179,8 +184,9 @@ int pk_tokens_verify(pk_tokens *t, const char *token, char name[PK_TOKEN_NAME_MA
         sqlite3_finalize(st);
         st = NULL;
         /* Best effort: a failed write (busy, disk full) does not refuse the request. */
-        if (stale && sqlite3_prepare_v2(t->db, "UPDATE tokens SET last_used=? WHERE sha256=?", -1, &st,
-                                        NULL) == SQLITE_OK) {
+        if (stale &&
+            sqlite3_prepare_v2(t->db, "UPDATE tokens SET last_used=? WHERE sha256=?", -1, &st,
+                               NULL) == SQLITE_OK) {
             sqlite3_bind_double(st, 1, now);
             sqlite3_bind_text(st, 2, hex, -1, SQLITE_TRANSIENT);
             sqlite3_step(st);

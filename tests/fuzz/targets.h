@@ -162,10 +162,13 @@ static inline void fuzz_h5_rve(const uint8_t *data, size_t size)
 
 /* Sanitizer settings for binaries that run the targets (see h5_rve above);
  * without a sanitizer these hooks are never called. */
-#define FUZZ_SANITIZER_OPTIONS                                                     \
-    const char *__asan_default_options(void);                                      \
-    const char *__asan_default_options(void) { return "allocator_may_return_null=1:max_allocation_size_mb=512"; } \
-    const char *__lsan_default_suppressions(void);                                 \
+#define FUZZ_SANITIZER_OPTIONS                                                                     \
+    const char *__asan_default_options(void);                                                      \
+    const char *__asan_default_options(void)                                                       \
+    {                                                                                              \
+        return "allocator_may_return_null=1:max_allocation_size_mb=512";                           \
+    }                                                                                              \
+    const char *__lsan_default_suppressions(void);                                                 \
     const char *__lsan_default_suppressions(void) { return "leak:libhdf5\n"; }
 
 #endif

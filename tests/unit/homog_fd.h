@@ -14,8 +14,8 @@
  * topology).  h = 1e-6: truncation O(h²) ~ 1e-12 relative, round-off of
  * the relaxation residual ~1e-13 / h → relative error ≪ 1e-6. */
 static inline double fd_tangent_error(fixture *fx, const double F0[9], int dim, const double A[81],
-                               const pk_tangent_info *info, int *skipped, double *asym,
-                               double *An)
+                                      const pk_tangent_info *info, int *skipped, double *asym,
+                                      double *An)
 {
     *An = 0;
     for (int k = 0; k < 81; k++)

@@ -56,7 +56,8 @@ static inline double P_rel_diff(const pk_homog_step *a, const pk_homog_step *b)
 
 /* Jammed periodic packing: n grains, radii in [0.8, 1.2], overlapping at
  * φ_nominal, relaxed to equilibrium (DR tol 1e-12). */
-static inline void make_jammed(int dim, size_t n, double phi, uint64_t seed, pk_box *b, pk_particles *p)
+static inline void make_jammed(int dim, size_t n, double phi, uint64_t seed, pk_box *b,
+                               pk_particles *p)
 {
     pk_rng rng;
     pk_rng_seed(&rng, seed, 0);
@@ -107,8 +108,8 @@ typedef struct fixture {
 } fixture;
 
 /* Committed state after F0 with options o (e.g. a species stiffness). */
-static inline void fixture_make_opts(fixture *fx, const pk_box *b, const pk_particles *p, pk_homog_bc bc,
-                              const double F0[9], const pk_homog_opts *o)
+static inline void fixture_make_opts(fixture *fx, const pk_box *b, const pk_particles *p,
+                                     pk_homog_bc bc, const double F0[9], const pk_homog_opts *o)
 {
     char err[128];
     CHECK(pk_homog_rve_build(b, p, bc, 1.0, &fx->rve, err, sizeof err) == 0);
@@ -119,7 +120,7 @@ static inline void fixture_make_opts(fixture *fx, const pk_box *b, const pk_part
 }
 
 static inline void fixture_make(fixture *fx, const pk_box *b, const pk_particles *p, pk_homog_bc bc,
-                         const double F0[9])
+                                const double F0[9])
 {
     pk_homog_opts o = opts(1.0);
     fixture_make_opts(fx, b, p, bc, F0, &o);

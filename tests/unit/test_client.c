@@ -19,9 +19,12 @@ static void test_verify(void)
     CHECK(pk_client_verify(ABC, ABC, ABC, err, sizeof err) == 0);
     CHECK(pk_client_verify(ABC, ABC, "", err, sizeof err) == 0);
     CHECK(pk_client_verify(ABC, NULL, ABC, err, sizeof err) == 0);
-    CHECK(pk_client_verify(ABC, other, ABC, err, sizeof err) == -1 && strstr(err, "results document"));
-    CHECK(pk_client_verify(ABC, ABC, other, err, sizeof err) == -1 && strstr(err, "X-Content-SHA256"));
-    CHECK(pk_client_verify(ABC, NULL, NULL, err, sizeof err) == -1); /* nothing declared: not verified */
+    CHECK(pk_client_verify(ABC, other, ABC, err, sizeof err) == -1 &&
+          strstr(err, "results document"));
+    CHECK(pk_client_verify(ABC, ABC, other, err, sizeof err) == -1 &&
+          strstr(err, "X-Content-SHA256"));
+    CHECK(pk_client_verify(ABC, NULL, NULL, err, sizeof err) ==
+          -1); /* nothing declared: not verified */
     CHECK(pk_client_verify("", ABC, ABC, err, sizeof err) == -1);
 }
 
@@ -37,7 +40,8 @@ static void test_option_precedence(void)
     setenv("PACKD_TOKEN", "envtok", 1);
     CHECK(pk_client_parse(1, v1, &a) == 0);
     CHECK(!strcmp(a.server, "http://env:1") && !strcmp(a.token, "envtok"));
-    char *v2[] = {"submit", "job.json", "--server", "http://flag:2", "--token", "t", "-o", "x.h5", NULL};
+    char *v2[] = {"submit", "job.json", "--server", "http://flag:2", "--token", "t",
+                  "-o",     "x.h5",     NULL};
     CHECK(pk_client_parse(8, v2, &a) == 0);
     CHECK(!strcmp(a.server, "http://flag:2") && !strcmp(a.token, "t") && a.wait == 1 &&
           !strcmp(a.arg, "job.json"));

@@ -32,8 +32,9 @@ static void test_file(void)
     pk_config c;
     char err[512];
     pk_config_defaults(&c);
-    write_file("# comment\n\nport = 9000   # trailing comment\nbind=0.0.0.0\ndata = \"/srv/packd\"\n"
-               "workers = 4\nmax_wall_time_s = 3600.5\nlog_level = debug\n");
+    write_file(
+        "# comment\n\nport = 9000   # trailing comment\nbind=0.0.0.0\ndata = \"/srv/packd\"\n"
+        "workers = 4\nmax_wall_time_s = 3600.5\nlog_level = debug\n");
     CHECK(pk_config_load_file(&c, path, err, sizeof err) == 0);
     CHECK(c.port == 9000 && !strcmp(c.bind, "0.0.0.0") && !strcmp(c.data, "/srv/packd"));
     CHECK(c.workers == 4 && c.max_wall_time_s == 3600.5 && c.log_level == PK_LOG_DEBUG);
@@ -50,8 +51,8 @@ static void test_file_errors(void)
     CHECK_MSG(strstr(err, ":2:") != NULL, "%s", err);
     write_file("colour = blue\n");
     CHECK(pk_config_load_file(&c, path, err, sizeof err) == -1 && strstr(err, "unknown key"));
-    const char *bad[] = {"port = 70000\n", "port = 80.5\n", "workers = -1\n", "port = 8x\n",
-                         "log_level = loud\n", "max_wall_time_s = nan\n"};
+    const char *bad[] = {"port = 70000\n", "port = 80.5\n",      "workers = -1\n",
+                         "port = 8x\n",    "log_level = loud\n", "max_wall_time_s = nan\n"};
     for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
         write_file(bad[i]);
         CHECK_MSG(pk_config_load_file(&c, path, err, sizeof err) == -1, "%s accepted", bad[i]);
@@ -66,7 +67,8 @@ static void test_precedence(void)
     write_file("port = 9000\nworkers = 2\nmax_queued = 7\n");
     setenv("PACKD_PORT", "9100", 1);
     setenv("PACKD_WORKERS", "3", 1);
-    char *argv[] = {"serve", "--config", path, "--port", "9200", "--max-queued-per-owner", "5", NULL};
+    char *argv[] = {"serve", "--config", path, "--port", "9200", "--max-queued-per-owner",
+                    "5",     NULL};
     CHECK(pk_config_from_args(&c, 7, argv, err, sizeof err) == 0);
     CHECK(c.port == 9200);              /* flag over env over file */
     CHECK(c.workers == 3);              /* env over file */
@@ -105,17 +107,21 @@ static void test_auth_keys(void)
     CHECK(c.auth == PK_AUTH_AUTO && c.trusted_proxy[0] == 0);
     CHECK(!pk_auth_required(&c, NULL)); /* 127.0.0.1: the make run default stays open */
     const char *why = NULL;
-    CHECK(pk_config_set(&c, "bind", "10.1.2.3", err, sizeof err) == 0 && pk_auth_required(&c, &why) && why);
+    CHECK(pk_config_set(&c, "bind", "10.1.2.3", err, sizeof err) == 0 &&
+          pk_auth_required(&c, &why) && why);
     CHECK(pk_config_set(&c, "bind", "0.0.0.0", err, sizeof err) == 0 && pk_auth_required(&c, NULL));
-    CHECK(pk_config_set(&c, "bind", "127.8.0.1", err, sizeof err) == 0 && !pk_auth_required(&c, NULL));
+    CHECK(pk_config_set(&c, "bind", "127.8.0.1", err, sizeof err) == 0 &&
+          !pk_auth_required(&c, NULL));
     CHECK(pk_config_set(&c, "bind", "::1", err, sizeof err) == 0 && !pk_auth_required(&c, NULL));
-    CHECK(pk_config_set(&c, "auth", "on", err, sizeof err) == 0 && c.auth == PK_AUTH_ON && pk_auth_required(&c, NULL));
+    CHECK(pk_config_set(&c, "auth", "on", err, sizeof err) == 0 && c.auth == PK_AUTH_ON &&
+          pk_auth_required(&c, NULL));
     CHECK(pk_config_set(&c, "bind", "0.0.0.0", err, sizeof err) == 0);
     CHECK(pk_config_set(&c, "auth", "off", err, sizeof err) == 0 && !pk_auth_required(&c, NULL));
     CHECK(pk_config_set(&c, "auth", "yes", err, sizeof err) == -1 && strstr(err, "auto on off"));
     CHECK(pk_config_set(&c, "trusted_proxy", "10.0.0.7", err, sizeof err) == 0 &&
           !strcmp(c.trusted_proxy, "10.0.0.7"));
-    CHECK(pk_config_set(&c, "trusted_proxy", "0:0::1", err, sizeof err) == 0 && !strcmp(c.trusted_proxy, "::1"));
+    CHECK(pk_config_set(&c, "trusted_proxy", "0:0::1", err, sizeof err) == 0 &&
+          !strcmp(c.trusted_proxy, "::1"));
     CHECK(pk_config_set(&c, "trusted_proxy", "proxy.lab", err, sizeof err) == -1);
     CHECK(pk_config_set(&c, "trusted_proxy", "10.0.0.256", err, sizeof err) == -1);
     setenv("PACKD_AUTH", "on", 1);

@@ -93,7 +93,7 @@ static size_t move_case(int dim, const bool periodic[3], uint64_t seed)
         if (step == 10)
             p.r[2] = 0.4 * b.L[0]; /* grown past a bounded ball: cov_big */
         if (step == 20)
-            p.r[2] = r2;           /* and back */
+            p.r[2] = r2; /* and back */
         for (size_t i = 0; i < n; i++)
             CHECK(pk_ugrid_insert(&g, &p, i) == 0);
         big_seen += g.cov_big.n;

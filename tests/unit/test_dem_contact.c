@@ -192,8 +192,7 @@ static void test_rattler_cascade(void)
 {
     /* fixed ring A..D around free grain P at the origin; free grain Q sits
      * outside touching P and one fixed grain only. */
-    double x[3 * 7] = {0, 0, 0,   2, 0, 0,  0, 2, 0,  -2, 0, 0,
-                       0, -2, 0,  4, 0, 0,  2, 2, 0};
+    double x[3 * 7] = {0, 0, 0, 2, 0, 0, 0, 2, 0, -2, 0, 0, 0, -2, 0, 4, 0, 0, 2, 2, 0};
     double r[7] = {1.01, 1.01, 1.01, 1.01, 1.01, 1.01, 1.01};
     uint8_t fr[7] = {1, 0, 0, 0, 0, 1, 0}, rat[7];
     pk_dem_geom g;

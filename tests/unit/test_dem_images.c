@@ -74,7 +74,8 @@ static size_t brute_forces(const scene *s, const double *x, const pk_dem_geom *g
             for (int a = -1; a <= 1; a++)
                 for (int b = -1; b <= 1; b++)
                     for (int e = -m3; e <= m3; e++) {
-                        double qs[3] = {q[0] + a * s->L, q[1] + b * s->L, dim == 3 ? q[2] + e * s->L : 0};
+                        double qs[3] = {q[0] + a * s->L, q[1] + b * s->L,
+                                        dim == 3 ? q[2] + e * s->L : 0};
                         double l[3];
                         pk_m3_vec(g->F, qs, l);
                         double len = sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
@@ -107,8 +108,9 @@ static void agree(pk_dem_pairs *c, const scene *s, const double *x, const pk_dem
         err = fmax(err, fabs(f[k] - fb[k]));
         fbig = fmax(fbig, fabs(fb[k]));
     }
-    CHECK_MSG(nc == nb && err <= tol, "dim %d %s (%s): %zu contacts, brute force %zu, max |Δf| %.3g",
-              s->dim, what, pk_dem_scalar_only ? "scalar" : "lanes", nc, nb, err);
+    CHECK_MSG(nc == nb && err <= tol,
+              "dim %d %s (%s): %zu contacts, brute force %zu, max |Δf| %.3g", s->dim, what,
+              pk_dem_scalar_only ? "scalar" : "lanes", nc, nb, err);
     CHECK(nb > 20 && fbig > 0.1); /* a real test: contacts with forces */
     free(f);
     free(fb);

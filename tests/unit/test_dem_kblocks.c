@@ -65,10 +65,7 @@ static void test_kblocks_equal_kv_2d(void)
     check_kv_equal(2, 150, 0.88, 1);
 }
 
-static void test_kblocks_equal_kv_3d(void)
-{
-    check_kv_equal(3, 120, 0.70, 0);
-}
+static void test_kblocks_equal_kv_3d(void) { check_kv_equal(3, 120, 0.70, 0); }
 
 int main(void)
 {

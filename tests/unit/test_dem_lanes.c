@@ -21,10 +21,7 @@ typedef struct outcome {
     double *f, *l, *len, *eps, energy, S[9];
 } outcome;
 
-static void outcome_free(outcome *o)
-{
-    free(o->f), free(o->l), free(o->len), free(o->eps);
-}
+static void outcome_free(outcome *o) { free(o->f), free(o->l), free(o->len), free(o->eps); }
 
 static void *dup(const void *p, size_t bytes)
 {
@@ -39,8 +36,8 @@ static void *dup(const void *p, size_t bytes)
  * geometry in block buffers) with the pair arrays poisoned: the same forces
  * and count (it reads none of them), and pk_dem_eval without outputs puts
  * the same geometry back (pk_relax_geom_refresh). */
-static void eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r,
-                 size_t np, int scalar, outcome *o)
+static void eval(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, const double *r, size_t np,
+                 int scalar, outcome *o)
 {
     pk_dem_scalar_only = scalar;
     double *f2 = malloc(3 * np * sizeof *f2);
@@ -133,7 +130,8 @@ static void test_far_image(void) { same_numbers(1, 0, 1); }
 int main(void)
 {
     if (!pk_dem_lanes_available()) {
-        const char *why = "this CPU has no AVX2: the lanes would be the scalar loop compared with itself";
+        const char *why =
+            "this CPU has no AVX2: the lanes would be the scalar loop compared with itself";
         SKIP(test_periodic_uniform, "%s", why);
         SKIP(test_periodic_classes, "%s", why);
         SKIP(test_open_box, "%s", why);

@@ -83,10 +83,9 @@ static int same(const outcome *s, const outcome *p)
     for (int k = 0; k < 4 && ok; k++)
         ok = s->nc[k] == p->nc[k] && memcmp(s->f[k], p->f[k], 3 * s->np * sizeof(double)) == 0;
     return ok && memcmp(s->l, p->l, 3 * s->n * sizeof(double)) == 0 &&
-           memcmp(s->len, p->len, s->n * sizeof(double)) == 0 &&
-           memcmp(s->eps, p->eps, s->n * sizeof(double)) == 0 &&
-           memcmp(s->energy, p->energy, sizeof s->energy) == 0 &&
-           memcmp(s->S, p->S, sizeof s->S) == 0;
+        memcmp(s->len, p->len, s->n * sizeof(double)) == 0 &&
+        memcmp(s->eps, p->eps, s->n * sizeof(double)) == 0 &&
+        memcmp(s->energy, p->energy, sizeof s->energy) == 0 && memcmp(s->S, p->S, sizeof s->S) == 0;
 }
 
 /* The scene's serial outcome (lanes and scalar), against 1–4 threads; the
@@ -117,8 +116,8 @@ static void compare(pk_dem_pairs *c, const pk_dem_geom *g, const double *x, cons
                     sum[a] += s.f[0][3 * i + a];
                     big = fmax(big, fabs(s.f[0][3 * i + a]));
                 }
-            printf("  %s: %zu grains, %zu candidates, %zu contacts, max |f| %.3g\n", what, np,
-                   c->n, s.nc[0], big);
+            printf("  %s: %zu grains, %zu candidates, %zu contacts, max |f| %.3g\n", what, np, c->n,
+                   s.nc[0], big);
             if (c->n > 100) {
                 CHECK(s.nc[0] > c->n / 10 && s.nc[0] <= c->n);
                 CHECK(big > 0.1);
@@ -140,10 +139,7 @@ typedef struct scene {
     pk_dem_geom g;
 } scene;
 
-static void scene_free(scene *s)
-{
-    free(s->x), free(s->r), free(s->cls);
-}
+static void scene_free(scene *s) { free(s->x), free(s->r), free(s->cls); }
 
 /* np grains at random in a box of edge L (reference frame) under F. */
 static scene random_scene(size_t np, int dim, int periodic, double L, const double F[9],
@@ -216,8 +212,7 @@ static void test_lattice_signed_zeros(void)
 {
     const size_t nx = 60, ny = 50;
     const double ax = 1.9, ay = 2.5;
-    scene s = {.dim = 2,
-               .g = {.dim = 2, .periodic = 1, .L = {nx * ax, ny * ay, 0}}};
+    scene s = {.dim = 2, .g = {.dim = 2, .periodic = 1, .L = {nx * ax, ny * ay, 0}}};
     const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     pk_dem_geom_set_F(&s.g, I);
     s.x = calloc(3 * nx * ny, sizeof *s.x);

@@ -46,8 +46,8 @@ static double cube_edge(int n, double r, double phi)
 /* The common set-up: n grains (radius r, every 4th r4 — r4 = r for equal
  * grains) at the origin (the zero start places them) in a cube of edge L,
  * and the default parameters. */
-static void setup(pk_box *b, pk_particles *p, pk_edmd_params *prm, int dim, double L,
-                  int periodic, int n, double r, double r4)
+static void setup(pk_box *b, pk_particles *p, pk_edmd_params *prm, int dim, double L, int periodic,
+                  int n, double r, double r4)
 {
     box_cube(b, dim, L, periodic);
     pk_particles_init(p, dim, (size_t)n);
@@ -302,7 +302,8 @@ static void test_rsa_start_relative_and_shell(void)
         pk_particles_init(&p, 3, (size_t)n);
         pk_rsa_stats rs;
         double delta = shell ? 1.0 : 0.9, dd = 0.1;
-        CHECK(pk_edmd_start_rsa(&b, d, sp, (size_t)n, delta, shell ? 0 : dd, 5, NULL, &p, &rs) == 0);
+        CHECK(pk_edmd_start_rsa(&b, d, sp, (size_t)n, delta, shell ? 0 : dd, 5, NULL, &p, &rs) ==
+              0);
         CHECK(rs.placed == (size_t)n);
         pk_edmd_params prm;
         pk_edmd_params_default(&prm);
@@ -379,8 +380,8 @@ static void test_renumbering_large_n(void)
     for (int i = 0; i < n; i++)
         CHECK_NEAR(p.r[i] / (i % 4 == 0 ? 0.7 : 0.5), scale, 1e-12 * scale);
     check_no_overlap(&b, &p, 0);
-    printf("  N=%d: events=%llu renumberings=%llu phi=%.6f\n", n,
-           (unsigned long long)st.events, (unsigned long long)st.resorts, st.phi);
+    printf("  N=%d: events=%llu renumberings=%llu phi=%.6f\n", n, (unsigned long long)st.events,
+           (unsigned long long)st.resorts, st.phi);
     pk_particles_free(&p);
     pk_particles_free(&q);
 }

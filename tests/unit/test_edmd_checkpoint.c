@@ -122,7 +122,8 @@ static void test_resume_continues_the_run(void)
     CHECK(overlaps(&b, &p) == 0);
     /* the same grains: radii are the targets scaled alike, species kept */
     for (size_t i = 0; i < p.n; i++)
-        CHECK_MSG(fabs(p.r[i] / (i % 2 ? 0.35 : 0.5) - p.r[0] / 0.5) < 1e-9 && p.species[i] == (int32_t)(i % 2),
+        CHECK_MSG(fabs(p.r[i] / (i % 2 ? 0.35 : 0.5) - p.r[0] / 0.5) < 1e-9 &&
+                      p.species[i] == (int32_t)(i % 2),
                   "grain %zu", i);
     CHECK_NEAR(res.phi, full.phi, 0.01);
     CHECK(res.nhist >= back.nhist);

@@ -114,9 +114,10 @@ static void jam_run(int dim, const double *r, int n, double rate, double dphi, j
     check_no_overlap(&b, &p);
     o->tol = pk_contact_tolerance(dim, o->st.pressure);
     CHECK(pk_contact_stats_compute(&b, &p, 0, o->tol, &o->cs) == 0);
-    printf("  dim=%d n=%d rate=%g %s: phi=%.5f p=%.3g events=%llu z=%.3f rattlers=%.3f (tol %.2g)\n",
-           dim, n, rate, pk_edmd_criterion_name(o->st.criterion), o->st.phi, o->st.pressure,
-           (unsigned long long)o->st.events, o->cs.mean_contacts, o->cs.rattler_fraction, o->tol);
+    printf(
+        "  dim=%d n=%d rate=%g %s: phi=%.5f p=%.3g events=%llu z=%.3f rattlers=%.3f (tol %.2g)\n",
+        dim, n, rate, pk_edmd_criterion_name(o->st.criterion), o->st.phi, o->st.pressure,
+        (unsigned long long)o->st.events, o->cs.mean_contacts, o->cs.rattler_fraction, o->tol);
     pk_particles_free(&p);
 }
 

@@ -30,7 +30,8 @@ static void run(int dim, int n, double ratio, path via, outcome *o)
     pk_particles_init(&o->p, dim, (size_t)n);
     double x[3] = {0, 0, 0};
     for (int i = 0; i < n; i++)
-        pk_particles_push(&o->p, x, 0.5 * (i % 5 == 0 ? ratio : 1 + (ratio - 1) * 0.1 * (i % 3)), 0);
+        pk_particles_push(&o->p, x, 0.5 * (i % 5 == 0 ? ratio : 1 + (ratio - 1) * 0.1 * (i % 3)),
+                          0);
     pk_box b = edmd_fixture_periodic_box(&o->p, 0.5);
     pk_edmd_params prm;
     pk_edmd_params_default(&prm);

@@ -120,8 +120,7 @@ static void test_phi_target_refers_to_box(void)
 
 /* A16 sizes for φ_M in the 80 mm cube (Algorithm 1, as `packd run` draws
  * them) at the RSA start of §6.3: true sizes, Δd = 0. */
-static int a16_start(double phi_mix, uint64_t seed, const pk_box *b, pk_particles *p,
-                     double *keep)
+static int a16_start(double phi_mix, uint64_t seed, const pk_box *b, pk_particles *p, double *keep)
 {
     pk_grading g;
     if (pk_grading_preset(&g, "A16") != 0 || pk_grading_truncate(&g, 2.0) != 0)

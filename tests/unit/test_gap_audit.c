@@ -33,8 +33,8 @@ static double brute_gap(const pk_box *b, const pk_particles *p, size_t i, size_t
 static void brute(const pk_box *b, const pk_particles *p, double required, double tol,
                   double horizon, pk_gap_report *rep)
 {
-    *rep = (pk_gap_report){.min_gap = horizon, .min_pair = {SIZE_MAX, SIZE_MAX},
-                           .min_wall_gap = INFINITY};
+    *rep = (pk_gap_report){
+        .min_gap = horizon, .min_pair = {SIZE_MAX, SIZE_MAX}, .min_wall_gap = INFINITY};
     for (size_t i = 0; i < p->n; i++) {
         for (int k = 0; k < b->dim; k++) {
             if (b->periodic[k])
@@ -88,8 +88,8 @@ static void same(const pk_box *b, const pk_particles *p, double required, double
     pk_gap_report a, e;
     CHECK(pk_gap_audit(b, p, required, tol, horizon, &a) == 0);
     brute(b, p, required, tol, horizon, &e);
-    CHECK_MSG(a.min_gap == e.min_gap, "%s: smallest gap %.17g, brute force %.17g", name,
-              a.min_gap, e.min_gap);
+    CHECK_MSG(a.min_gap == e.min_gap, "%s: smallest gap %.17g, brute force %.17g", name, a.min_gap,
+              e.min_gap);
     CHECK_MSG(a.pairs_below == e.pairs_below, "%s: %zu pairs below, brute force %zu", name,
               a.pairs_below, e.pairs_below);
     CHECK_MSG(a.walls_below == e.walls_below && a.min_wall_gap == e.min_wall_gap,
@@ -140,8 +140,8 @@ static void test_narrow_and_sparse(void)
 {
     /* periodic box narrower than twice the reach: a grain meets several images */
     for (int dim = 2; dim <= 3; dim++) {
-        pk_box b = {.dim = dim, .L = {1.1, 0.9, dim == 3 ? 1.0 : 0},
-                    .periodic = {true, true, true}};
+        pk_box b = {
+            .dim = dim, .L = {1.1, 0.9, dim == 3 ? 1.0 : 0}, .periodic = {true, true, true}};
         pk_particles p;
         scatter(&b, 12, 0.05, 0.3, 0.02, 7 + (uint64_t)dim, &p);
         same(&b, &p, 0.02, 0.3, dim == 2 ? "narrow 2D" : "narrow 3D");

@@ -184,7 +184,8 @@ static size_t cover_case(int dim, const bool periodic[3], uint64_t seed)
 
 static void test_cover_of_coarse_levels(void)
 {
-    bool per[3] = {true, true, true}, mixed[3] = {true, false, true}, walled[3] = {false, false, false};
+    bool per[3] = {true, true, true}, mixed[3] = {true, false, true},
+         walled[3] = {false, false, false};
     size_t big = cover_case(3, per, 11);
     big += cover_case(3, mixed, 12);
     big += cover_case(2, per, 13);

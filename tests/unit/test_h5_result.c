@@ -37,7 +37,8 @@ static void test_round_trip_and_layout(void)
     CHECK(pk_h5_write_parameters(h, "pack", "{\"process\":\"pack\"}", 42) == 0);
     CHECK(pk_h5_obs_double(h, "phi_resolved", 0.5, NULL) == 0);
     CHECK(pk_h5_obs_string(h, "termination_reason", "complete") == 0);
-    json_t *extra = json_pack("{s:i,s:[f,f],s:{s:s}}", "events", 7, "hist", 0.1, 0.2, "sub", "k", "v");
+    json_t *extra =
+        json_pack("{s:i,s:[f,f],s:{s:s}}", "events", 7, "hist", 0.1, 0.2, "sub", "k", "v");
     CHECK(pk_h5_obs_json(h, "edmd", extra) == 0);
     json_decref(extra);
     CHECK(pk_h5_commit(h, err, sizeof err) == 0);

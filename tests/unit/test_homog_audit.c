@@ -45,8 +45,7 @@ static void test_wall_limit_counts_from_the_job(void)
     pk_monitor m3 = {0}; /* a tiny limit does stop the job */
     pk_monitor_start(&m3, 1e-9);
     double t0 = pk_wall_seconds();
-    while (pk_wall_seconds() - t0 < 1e-6) {
-    }
+    while (pk_wall_seconds() - t0 < 1e-6) {}
     CHECK(pk_monitor_tick(&m3, &p, 0) == 2);
 }
 
@@ -92,7 +91,8 @@ static void test_audit_checks(void)
         CHECK(pk_homog_audit_step(&rve, &o, &s, &st, &a) == 0);
         CHECK_NEAR(a.residual_ratio, 0.5, 1e-12);
 
-        st.dr.stop = PK_DR_MAX_ITER; /* a step at max_iter is not converged, whatever its residual */
+        st.dr.stop =
+            PK_DR_MAX_ITER; /* a step at max_iter is not converged, whatever its residual */
         CHECK(pk_homog_audit_step(&rve, &o, &s, &st, &a) == PK_AUDIT_NOT_CONVERGED);
         good_step(&st, &o);
         st.dr.f = 2e-8;

@@ -191,8 +191,8 @@ static void test_stress_is_energy_derivative(void)
                     Fm[3 * a + c] -= h;
                     pk_homog_eval(&fx.rve, &fx.o, &fx.s, Fp, &tr, &sp, NULL);
                     pk_homog_eval(&fx.rve, &fx.o, &fx.s, Fm, &tr, &sm, NULL);
-                    same_topology &= sp.formed == 0 && sp.broken == 0 && sm.formed == 0 &&
-                                     sm.broken == 0;
+                    same_topology &=
+                        sp.formed == 0 && sp.broken == 0 && sm.formed == 0 && sm.broken == 0;
                     double fd = (sp.energy_density - sm.energy_density) / (2 * h);
                     worst = fmax(worst, fabs(fd - fx.st.P[3 * a + c]) / Pn);
                 }

@@ -41,17 +41,11 @@ static void drive(double (*f)(size_t), size_t n, size_t crawl, spy *s)
 }
 
 /* a creep: 0.1 % less per iteration, never rising (0.5 at iteration 693) */
-static double creep(size_t k)
-{
-    return pow(0.999, (double)k);
-}
+static double creep(size_t k) { return pow(0.999, (double)k); }
 
 /* the creep, but 50 iterations after the first call the residual jumps up
  * (an event under way) and creeps down from there, never back to 0.5 */
-static double event(size_t k)
-{
-    return k < 743 ? creep(k) : 4 * creep(k);
-}
+static double event(size_t k) { return k < 743 ? creep(k) : 4 * creep(k); }
 
 static void test_creep_calls_every_crawl_iterations(void)
 {

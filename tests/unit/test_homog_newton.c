@@ -123,8 +123,8 @@ static void test_plastic_step_ends_at_a_minimum(void)
         size_t n;
         double phi, strain;
         uint64_t seed;
-        int climbs;  /* a failed attempt climbs into an instability: no shift */
-        int fire;    /* two attempts fail: FIRE takes over from DR */
+        int climbs; /* a failed attempt climbs into an instability: no shift */
+        int fire;   /* two attempts fail: FIRE takes over from DR */
     } cases[] = {{200, 0.86, 0.01, 2, 0, 0},
                  {200, 0.86, 0.01, 3, 0, 0},
                  {400, 0.88, 0.01, 5, 1, 1},
@@ -167,14 +167,16 @@ static void test_plastic_step_ends_at_a_minimum(void)
         }
         CHECK_MSG(phi[1] <= phi[0] + 1e-12 * phi[0], "hybrid Φ %.15g above DR's %.15g", phi[1],
                   phi[0]);
-        printf("  %zu grains φ %.2f %.1f %% seed %lu: start Φ %.10g; DR %zu it → Φ %.12g; hybrid %zu "
-               "factorisations (%zu shift raises) + %zu DR/FIRE it (%zu FIRE), %zu attempts → Φ %.12g; "
-               "|ΔP|/|P| "
-               "%.1e (%s minimum)\n",
-               cases[s].n, cases[s].phi, 100 * cases[s].strain, (unsigned long)cases[s].seed, phi0,
-               sd.dr.iterations, phi[0], sn.newton.iterations, sn.newton.shifts, sn.dr.iterations,
-               sn.newton.fire_iterations, sn.newton.attempts, phi[1], P_rel_diff(&sd, &sn),
-               fabs(phi[1] - phi[0]) <= 1e-12 * phi[0] ? "same" : "another");
+        printf(
+            "  %zu grains φ %.2f %.1f %% seed %lu: start Φ %.10g; DR %zu it → Φ %.12g; hybrid %zu "
+            "factorisations (%zu shift raises) + %zu DR/FIRE it (%zu FIRE), %zu attempts → Φ "
+            "%.12g; "
+            "|ΔP|/|P| "
+            "%.1e (%s minimum)\n",
+            cases[s].n, cases[s].phi, 100 * cases[s].strain, (unsigned long)cases[s].seed, phi0,
+            sd.dr.iterations, phi[0], sn.newton.iterations, sn.newton.shifts, sn.dr.iterations,
+            sn.newton.fire_iterations, sn.newton.attempts, phi[1], P_rel_diff(&sd, &sn),
+            fabs(phi[1] - phi[0]) <= 1e-12 * phi[0] ? "same" : "another");
         free(x0);
         pk_homog_state_free(&td);
         pk_homog_state_free(&tn);

@@ -21,8 +21,8 @@ static int geometry_is_fresh(relax_problem *pb, const double *x)
     memcpy(le, c->len, n * sizeof *le);
     memcpy(le + n, c->eps, n * sizeof *le);
     pk_dem_eval(c, &pb->g, x, pb->rve.r, pb->rve.n, pb->o.E_n, NULL, NULL, NULL);
-    int same = memcmp(l, c->l, 3 * n * sizeof *l) == 0 &&
-               memcmp(le, c->len, n * sizeof *le) == 0 && memcmp(le + n, c->eps, n * sizeof *le) == 0;
+    int same = memcmp(l, c->l, 3 * n * sizeof *l) == 0 && memcmp(le, c->len, n * sizeof *le) == 0 &&
+        memcmp(le + n, c->eps, n * sizeof *le) == 0;
     free(l), free(le);
     return same;
 }

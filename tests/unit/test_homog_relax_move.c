@@ -64,7 +64,8 @@ static void same_bits(pk_relax_coef cf, int skin_far, int nonfinite, uint64_t se
     state ca = run(x, v, f, is_free, np, cf, &c, 1, &st_c, sa);
     state cb = run(x, v, f, is_free, np, cf, &c, 0, &st_d, sb);
     CHECK(st_c == st_a && st_d == st_a);
-    CHECK(memcmp(ca.x, a.x, 3 * np * sizeof *a.x) == 0 && memcmp(cb.v, a.v, 3 * np * sizeof *a.v) == 0);
+    CHECK(memcmp(ca.x, a.x, 3 * np * sizeof *a.x) == 0 &&
+          memcmp(cb.v, a.v, 3 * np * sizeof *a.v) == 0);
     CHECK(memcmp(sa, sb, sizeof sa) == 0);
     if (!nonfinite) { /* the sums themselves, against a plain loop (added to what acc held;
                         * another order of ~2,000 terms of order 1: 1e-12 relative) */
@@ -85,7 +86,7 @@ static void same_bits(pk_relax_coef cf, int skin_far, int nonfinite, uint64_t se
         kept &= b.x[3 * i + 2] == x[3 * i + 2] && b.v[3 * i + 2] == v[3 * i + 2];
         if (!is_free[i])
             kept &= memcmp(&b.x[3 * i], &x[3 * i], 3 * sizeof *x) == 0 &&
-                    memcmp(&b.v[3 * i], &v[3 * i], 3 * sizeof *v) == 0;
+                memcmp(&b.v[3 * i], &v[3 * i], 3 * sizeof *v) == 0;
     }
     CHECK(kept);
     /* the move did move (a test that cannot pass on a no-op) */

@@ -29,17 +29,16 @@ static void step(const pk_homog_rve *rve, const pk_homog_opts *o, const double F
     pk_par_free(on.par);
 }
 
-static int same_bits(const void *a, const void *b, size_t n)
-{
-    return memcmp(a, b, n) == 0;
-}
+static int same_bits(const void *a, const void *b, size_t n) { return memcmp(a, b, n) == 0; }
 
 /* Every output of step b equal to a's, bit for bit. */
 static void check_same(const pk_homog_rve *rve, const run *a, const run *b, const char *what)
 {
     const pk_homog_step *x = &a->s, *y = &b->s;
-    CHECK_MSG(same_bits(a->t.x, b->t.x, 3 * rve->n * sizeof *a->t.x), "%s: end points differ", what);
-    CHECK_MSG(same_bits(x->P, y->P, sizeof x->P) && same_bits(&x->energy, &y->energy, sizeof x->energy),
+    CHECK_MSG(same_bits(a->t.x, b->t.x, 3 * rve->n * sizeof *a->t.x), "%s: end points differ",
+              what);
+    CHECK_MSG(same_bits(x->P, y->P, sizeof x->P) &&
+                  same_bits(&x->energy, &y->energy, sizeof x->energy),
               "%s: P̄ or Φ differ", what);
     CHECK_MSG(x->dr.iterations == y->dr.iterations && x->dr.rebuilds == y->dr.rebuilds &&
                   x->dr.refreshes == y->dr.refreshes && x->dr.stop == y->dr.stop &&
@@ -58,7 +57,8 @@ static void check_same(const pk_homog_rve *rve, const run *a, const run *b, cons
               "%zu/%zu, FIRE %zu/%zu, exit %d/%d)",
               what, m->iterations, n->iterations, m->steps, n->steps, m->attempts, n->attempts,
               m->fire_iterations, n->fire_iterations, m->exit, n->exit);
-    CHECK_MSG(x->contacts == y->contacts && x->rattlers == y->rattlers, "%s: contacts differ", what);
+    CHECK_MSG(x->contacts == y->contacts && x->rattlers == y->rattlers, "%s: contacts differ",
+              what);
 }
 
 static void jammed(size_t n, double phi, uint64_t seed, pk_particles *p, pk_homog_rve *rve)
@@ -92,9 +92,9 @@ static void test_same_step_as_serial(void)
     } cases[] = {
         {400, 0.90, 0.001, 1, 50, FIRST_PHASE}, /* dense, small step: elastic */
         {200, 0.86, 0.01, 2, 50, FROM_DR},
-        {400, 0.88, 0.01, 5, 50, FROM_FIRE},   /* test_homog_newton's climbing case */
+        {400, 0.88, 0.01, 5, 50, FROM_FIRE}, /* test_homog_newton's climbing case */
         {800, 0.86, 0.01, 1, 50, FROM_FIRE},
-        {400, 0.88, 0.01, 5, 1, ALONE},        /* the budget spent by the first phase */
+        {400, 0.88, 0.01, 5, 1, ALONE}, /* the budget spent by the first phase */
     };
     for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
         pk_particles p;

@@ -13,7 +13,8 @@ static void test_sparse_solver_status(void)
 {
     pk_sparse_sym A = {.n = 3};
     pk_sparse_sym_add(&A, 0, 0, 4), pk_sparse_sym_add(&A, 0, 1, 1), pk_sparse_sym_add(&A, 1, 1, 3);
-    pk_sparse_sym_add(&A, 1, 2, 1), pk_sparse_sym_add(&A, 2, 2, 2), pk_sparse_sym_add(&A, 2, 2, 0.5);
+    pk_sparse_sym_add(&A, 1, 2, 1), pk_sparse_sym_add(&A, 2, 2, 2),
+        pk_sparse_sym_add(&A, 2, 2, 0.5);
     pk_sparse_info info;
     pk_sparse_factor *f = pk_sparse_cholmod.factor(&A, &info);
     CHECK(f && info.status == PK_SPARSE_OK && info.npos == 3);
@@ -70,10 +71,12 @@ static void test_sparse_solver_supernodal(void)
     pk_sparse_info info;
     grid_laplacian(m, 0.01, &A);
     pk_sparse_factor *f = pk_sparse_cholmod.factor(&A, &info);
-    CHECK(f && info.status == PK_SPARSE_OK && info.npos == A.n && info.nneg == 0 && info.nzero == 0);
+    CHECK(f && info.status == PK_SPARSE_OK && info.npos == A.n && info.nneg == 0 &&
+          info.nzero == 0);
     CHECK_MSG(info.min_abs_pivot > 0 && info.max_abs_pivot / info.min_abs_pivot < 8 / 0.01,
               "pivots %g .. %g", info.min_abs_pivot, info.max_abs_pivot);
-    double *b = malloc(A.n * sizeof *b), *x = malloc(A.n * sizeof *x), *Ax = calloc(A.n, sizeof *Ax);
+    double *b = malloc(A.n * sizeof *b), *x = malloc(A.n * sizeof *x),
+           *Ax = calloc(A.n, sizeof *Ax);
     for (size_t k = 0; k < A.n; k++)
         b[k] = sin(0.37 * (double)k) + 0.1;
     CHECK(f && pk_sparse_cholmod.solve(f, 1, b, x) == 0);
@@ -120,13 +123,16 @@ static void test_sparse_solver_pd_only(void)
         grid_laplacian(m, shifts[t], &A);
         pk_sparse_factor *f = pk_sparse_cholmod.factor(&A, &full);
         pk_sparse_factor *g = pk_sparse_cholmod.factor_pd(&A, &pd);
-        CHECK_MSG((full.status == PK_SPARSE_OK) == (pd.status == PK_SPARSE_OK), "shift %g: %s vs %s",
-                  shifts[t], pk_sparse_status_name(full.status), pk_sparse_status_name(pd.status));
+        CHECK_MSG((full.status == PK_SPARSE_OK) == (pd.status == PK_SPARSE_OK),
+                  "shift %g: %s vs %s", shifts[t], pk_sparse_status_name(full.status),
+                  pk_sparse_status_name(pd.status));
         if (t == 0) {
-            double *b = malloc(A.n * sizeof *b), *x = malloc(A.n * sizeof *x), *y = malloc(A.n * sizeof *y);
+            double *b = malloc(A.n * sizeof *b), *x = malloc(A.n * sizeof *x),
+                   *y = malloc(A.n * sizeof *y);
             for (size_t k = 0; k < A.n; k++)
                 b[k] = cos(0.21 * (double)k);
-            CHECK(f && g && pk_sparse_cholmod.solve(f, 1, b, x) == 0 && pk_sparse_cholmod.solve(g, 1, b, y) == 0);
+            CHECK(f && g && pk_sparse_cholmod.solve(f, 1, b, x) == 0 &&
+                  pk_sparse_cholmod.solve(g, 1, b, y) == 0);
             double d = 0, nx = 0;
             for (size_t k = 0; k < A.n; k++)
                 d += (x[k] - y[k]) * (x[k] - y[k]), nx += x[k] * x[k];
@@ -150,11 +156,13 @@ static void test_square_lattice_tangent(void)
         double *X = calloc(3 * n, sizeof *X), *r = malloc(n * sizeof *r);
         uint8_t *fx = malloc(n);
         for (size_t i = 0; i < n; i++) {
-            X[3 * i] = 2.0 * (double)(i % (size_t)m) + 5, X[3 * i + 1] = 2.0 * (double)(i / (size_t)m) - 3;
+            X[3 * i] = 2.0 * (double)(i % (size_t)m) + 5,
+                  X[3 * i + 1] = 2.0 * (double)(i / (size_t)m) - 3;
             r[i] = 1, fx[i] = 1;
         }
         pk_homog_rve rve;
-        pk_homog_rve_from_arrays(2, PK_BC_TAYLOR, n, X, r, fx, 0, NULL, 4.0 * (m - 1) * (m - 1), &rve);
+        pk_homog_rve_from_arrays(2, PK_BC_TAYLOR, n, X, r, fx, 0, NULL, 4.0 * (m - 1) * (m - 1),
+                                 &rve);
         pk_homog_opts o = opts(1);
         o.E_n = 50;
         pk_homog_state s0;
@@ -202,7 +210,8 @@ static void test_tangent_vs_finite_differences(void)
             CHECK_MSG(worst < 1e-6, "dim %d %s: FD rel. error %g", dim,
                       pk_homog_bc_name((pk_homog_bc)bc), worst);
             CHECK_MSG(asym < 1e-12, "major symmetry defect %g", asym);
-            printf("  dim %d %-17s |A| %.4g  FD rel. error %.2e  symmetry %.1e  free dofs %zu  skipped %d\n",
+            printf("  dim %d %-17s |A| %.4g  FD rel. error %.2e  symmetry %.1e  free dofs %zu  "
+                   "skipped %d\n",
                    dim, pk_homog_bc_name((pk_homog_bc)bc), An, worst, asym, info.free_dofs,
                    skipped);
             fixture_free(&fx);
@@ -287,8 +296,8 @@ static void test_newton_matches_dr(void)
                 d = fmax(d, fabs(sd.P[k] - sn.P[k]));
             }
             CHECK_MSG(d <= 1e-8 * Pn, "dim %d bc %d: |ΔP|/|P| = %g", dim, bc, d / Pn);
-            printf("  dim %d %-17s DR %zu it, Newton %zu it (+%zu DR, exit %s), |ΔP|/|P| %.1e\n", dim,
-                   pk_homog_bc_name((pk_homog_bc)bc), sd.dr.iterations, sn.newton.iterations,
+            printf("  dim %d %-17s DR %zu it, Newton %zu it (+%zu DR, exit %s), |ΔP|/|P| %.1e\n",
+                   dim, pk_homog_bc_name((pk_homog_bc)bc), sd.dr.iterations, sn.newton.iterations,
                    sn.dr.iterations, pk_newton_exit_name(sn.newton.exit), d / Pn);
             pk_homog_state_free(&t1);
             pk_homog_state_free(&t2);

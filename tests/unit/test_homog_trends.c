@@ -90,7 +90,8 @@ static void test_periodic_shear_plateau(void)
     for (int c = 0; c < 2; c++) {
         shear_path(PK_BC_PERIODIC, sizes[c], 3 + (uint64_t)c, 0, 0.3, STEPS, sg, g);
         level[c] = mean_ratio(sg, g, STEPS, 0.1, 0.3);
-        double early = mean_ratio(sg, g, STEPS, 0.1, 0.2), late = mean_ratio(sg, g, STEPS, 0.2, 0.3);
+        double early = mean_ratio(sg, g, STEPS, 0.1, 0.2),
+               late = mean_ratio(sg, g, STEPS, 0.2, 0.3);
         printf("  periodic N=%zu: τ/p plateau %.4f (γ 0.1–0.2: %.4f, 0.2–0.3: %.4f)\n", sizes[c],
                level[c], early, late);
         CHECK_MSG(level[c] > 0 && level[c] < 0.2, "N=%zu τ/p = %g", sizes[c], level[c]);

@@ -59,7 +59,8 @@ static void test_open_refuses_special_files(void)
     CHECK(fd >= 0);
     if (fd >= 0)
         close(fd);
-    CHECK(pk_input_open(at("small.txt"), 3, err, sizeof err) < 0 && strstr(err, "over the input limit"));
+    CHECK(pk_input_open(at("small.txt"), 3, err, sizeof err) < 0 &&
+          strstr(err, "over the input limit"));
     alarm(0);
 }
 
@@ -73,7 +74,8 @@ static void test_readers_refuse_special_files(void)
         pk_mesh m;
         pk_mesh_report rep;
         CHECK_MSG(pk_mesh_from_json(j, 0, &m, &rep, err, sizeof err) != 0 &&
-                      strstr(err, "not a regular file"), "%s: %s", files[i], err);
+                      strstr(err, "not a regular file"),
+                  "%s: %s", files[i], err);
         json_decref(j);
         pk_box b;
         pk_particles p;
@@ -90,9 +92,9 @@ static void test_readers_refuse_special_files(void)
 
 static json_t *tetfill(const char *file)
 {
-    return json_pack("{s:i,s:{s:{s:s}},s:s,s:{s:i},s:{s:f,s:s}}", "dim", 3, "domain", "mesh", "file",
-                     file, "algorithm", "tetfill", "tetfill", "ratio", 3, "phi", "value", 0.3,
-                     "refers_to", "resolved");
+    return json_pack("{s:i,s:{s:{s:s}},s:s,s:{s:i},s:{s:f,s:s}}", "dim", 3, "domain", "mesh",
+                     "file", file, "algorithm", "tetfill", "tetfill", "ratio", 3, "phi", "value",
+                     0.3, "refers_to", "resolved");
 }
 
 static void test_service_checks_open_nothing(void)
@@ -163,8 +165,9 @@ static void test_confine(void)
     CHECK(confine(in, "base.node", NULL, NULL) == 0);
     CHECK(confine(in, "link_in.msh", NULL, NULL) == 0);
     /* refused */
-    const char *bad[] = {"../small.txt", at("small.txt"), "/etc/passwd", "out.msh", "zero.msh",
-                         "fifo.msh", "big.msh", "nope.msh", "sub", "bad", "..", "dirlink/x.msh"};
+    const char *bad[] = {"../small.txt", at("small.txt"), "/etc/passwd", "out.msh",
+                         "zero.msh",     "fifo.msh",      "big.msh",     "nope.msh",
+                         "sub",          "bad",           "..",          "dirlink/x.msh"};
     for (size_t i = 0; i < sizeof bad / sizeof *bad; i++)
         CHECK_MSG(confine(in, bad[i], rule, NULL) == 1 && !strcmp(rule, "inputDir"), "%s", bad[i]);
 }
@@ -188,7 +191,7 @@ int main(void)
     put("in/base.node", "4 3 0 0\n");
     put("in/base.ele", "1 4 0\n");
     put("in/bad.node", "4 3 0 0\n");
-    symlink(at("small.txt"), at("in/bad.ele"));  /* the pair's second file leads out */
+    symlink(at("small.txt"), at("in/bad.ele")); /* the pair's second file leads out */
     symlink(at("small.txt"), at("in/out.msh"));
     symlink("/dev/zero", at("in/zero.msh"));
     mkfifo(at("in/fifo.msh"), 0600);

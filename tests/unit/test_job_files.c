@@ -18,8 +18,8 @@ static void test_paths(void)
 
 static void test_names_distinct(void)
 {
-    static const pk_job_file all[] = {PK_JOB_INPUT, PK_JOB_RESULT, PK_JOB_XDMF, PK_JOB_SUMMARY,
-                                      PK_JOB_LOG, PK_JOB_LOCK, PK_JOB_CHECKPOINT};
+    static const pk_job_file all[] = {PK_JOB_INPUT, PK_JOB_RESULT, PK_JOB_XDMF,      PK_JOB_SUMMARY,
+                                      PK_JOB_LOG,   PK_JOB_LOCK,   PK_JOB_CHECKPOINT};
     size_t n = sizeof all / sizeof *all;
     for (size_t i = 0; i < n; i++) {
         CHECK(strlen(pk_job_file_name(all[i])) > 0 && !strchr(pk_job_file_name(all[i]), '/'));

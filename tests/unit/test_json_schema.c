@@ -49,20 +49,20 @@ static int has(const pk_schema_errors *e, const char *ptr, const char *rule, con
     return 0;
 }
 
-#define OK(schema, inst)                                                             \
-    do {                                                                             \
-        size_t n_ = V(&e, schema, inst);                                             \
-        CHECK_MSG(n_ == 0, "%s vs %s: %zu errors", schema, inst, n_);                \
-        if (n_)                                                                      \
-            dump(&e);                                                                \
+#define OK(schema, inst)                                                                           \
+    do {                                                                                           \
+        size_t n_ = V(&e, schema, inst);                                                           \
+        CHECK_MSG(n_ == 0, "%s vs %s: %zu errors", schema, inst, n_);                              \
+        if (n_)                                                                                    \
+            dump(&e);                                                                              \
     } while (0)
 
-#define BAD(schema, inst, ptr, rule, msg)                                            \
-    do {                                                                             \
-        size_t n_ = V(&e, schema, inst);                                             \
-        CHECK_MSG(n_ > 0, "%s vs %s: expected an error", schema, inst);              \
-        CHECK_MSG(has(&e, ptr, rule, msg), "%s vs %s: want [%s] %s ~ %s", schema, inst, \
-                  ptr, rule, msg ? msg : "");                                        \
+#define BAD(schema, inst, ptr, rule, msg)                                                          \
+    do {                                                                                           \
+        size_t n_ = V(&e, schema, inst);                                                           \
+        CHECK_MSG(n_ > 0, "%s vs %s: expected an error", schema, inst);                            \
+        CHECK_MSG(has(&e, ptr, rule, msg), "%s vs %s: want [%s] %s ~ %s", schema, inst, ptr, rule, \
+                  msg ? msg : "");                                                                 \
     } while (0)
 
 static void test_type(void)
@@ -94,7 +94,8 @@ static void test_enum_const(void)
     OK("{\"enum\":[2,3]}", "3");
     OK("{\"enum\":[2,3]}", "3.0");
     BAD("{\"enum\":[2,3]}", "4", "", "enum", "must be one of 2, 3 (got 4)");
-    BAD("{\"enum\":[\"mm\",\"m\"]}", "\"km\"", "", "enum", "must be one of \"mm\", \"m\" (got \"km\")");
+    BAD("{\"enum\":[\"mm\",\"m\"]}", "\"km\"", "", "enum",
+        "must be one of \"mm\", \"m\" (got \"km\")");
     OK("{\"enum\":[{\"a\":[1]}]}", "{\"a\":[1]}");
     OK("{\"const\":\"sieve\"}", "\"sieve\"");
     BAD("{\"const\":\"sieve\"}", "\"laser\"", "", "const", "must be \"sieve\" (got \"laser\")");
@@ -136,8 +137,8 @@ static void test_additional_properties(void)
 static void test_pointer_escaping(void)
 {
     pk_schema_errors e = {0};
-    BAD("{\"additionalProperties\":false}", "{\"a/b~c\":1}", "/a~1b~0c",
-        "additionalProperties", "unknown property \"a/b~c\"");
+    BAD("{\"additionalProperties\":false}", "{\"a/b~c\":1}", "/a~1b~0c", "additionalProperties",
+        "unknown property \"a/b~c\"");
     BAD("{\"properties\":{\"x/y\":{\"properties\":{\"~\":{\"type\":\"string\"}}}}}",
         "{\"x/y\":{\"~\":1}}", "/x~1y/~0", "type", NULL);
     pk_schema_errors_free(&e);
@@ -361,8 +362,9 @@ static void test_not(void)
 static void test_if_then_else(void)
 {
     pk_schema_errors e = {0};
-    const char *s = "{\"if\":{\"properties\":{\"kind\":{\"const\":\"mass\"}},\"required\":[\"kind\"]},"
-                    "\"then\":{\"required\":[\"density\"]},\"else\":{\"required\":[\"volume\"]}}";
+    const char *s =
+        "{\"if\":{\"properties\":{\"kind\":{\"const\":\"mass\"}},\"required\":[\"kind\"]},"
+        "\"then\":{\"required\":[\"density\"]},\"else\":{\"required\":[\"volume\"]}}";
     OK(s, "{\"kind\":\"mass\",\"density\":2.65}");
     OK(s, "{\"kind\":\"vol\",\"volume\":1}");
     BAD(s, "{\"kind\":\"mass\"}", "", "required", "\"density\"");
@@ -591,7 +593,8 @@ static void integer_maxima(json_t *s, const char *name, const char *at, int *n)
     if (json_is_array(s)) {
         size_t i;
         json_t *v;
-        json_array_foreach(s, i, v) integer_maxima(v, name, at, n);
+        json_array_foreach (s, i, v)
+            integer_maxima(v, name, at, n);
         return;
     }
     if (!json_is_object(s))
@@ -604,8 +607,7 @@ static void integer_maxima(json_t *s, const char *name, const char *at, int *n)
     }
     const char *k;
     json_t *v;
-    json_object_foreach(s, k, v)
-    {
+    json_object_foreach (s, k, v) {
         char sub[256];
         snprintf(sub, sizeof sub, "%s/%s", at, k);
         integer_maxima(v, name, sub, n);

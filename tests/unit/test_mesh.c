@@ -36,7 +36,8 @@ static double flux(const pk_mesh *m)
 {
     double s = 0;
     for (size_t f = 0; f < m->nbface; f++) {
-        const double *a = &m->x[3 * (size_t)m->bface[3 * f]], *b = &m->x[3 * (size_t)m->bface[3 * f + 1]],
+        const double *a = &m->x[3 * (size_t)m->bface[3 * f]],
+                     *b = &m->x[3 * (size_t)m->bface[3 * f + 1]],
                      *c = &m->x[3 * (size_t)m->bface[3 * f + 2]];
         double u[3], v[3], n[3], g[3];
         for (int k = 0; k < 3; k++) {
@@ -59,7 +60,7 @@ static void test_box_mesh(void)
     double L[3] = {2, 3, 4};
     CHECK(pk_mesh_box(&m, L, 1, 0, err, sizeof err) == 0);
     CHECK(m.ntet == 6 * 2 * 3 * 4);
-    CHECK_NEAR(m.volume, 24, 1e-12);          /* exact up to round-off */
+    CHECK_NEAR(m.volume, 24, 1e-12);                    /* exact up to round-off */
     CHECK(m.nbface == 2 * 2 * (2 * 3 + 3 * 4 + 2 * 4)); /* two triangles per boundary square */
     CHECK_NEAR(flux(&m), 3 * 24, 1e-9);
     for (size_t e = 0; e < m.ntet; e++)
@@ -149,7 +150,8 @@ static long brute_locate(const pk_mesh *m, const double *p)
                 w[j] = d[3][j] - d[0][j];
             }
             s += fabs(u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-                      u[2] * (v[0] * w[1] - v[1] * w[0])) / 6;
+                      u[2] * (v[0] * w[1] - v[1] * w[0])) /
+                6;
         }
         V = pk_mesh_tet_volume(m, e);
         if (s <= V * (1 + 1e-9))
@@ -163,10 +165,12 @@ static double brute_boundary(const pk_mesh *m, const double *p)
     double best = INFINITY;
     for (size_t f = 0; f < m->nbface; f++) {
         double q[3];
-        pk_closest_on_triangle(p, &m->x[3 * (size_t)m->bface[3 * f]], &m->x[3 * (size_t)m->bface[3 * f + 1]],
+        pk_closest_on_triangle(p, &m->x[3 * (size_t)m->bface[3 * f]],
+                               &m->x[3 * (size_t)m->bface[3 * f + 1]],
                                &m->x[3 * (size_t)m->bface[3 * f + 2]], q);
-        best = fmin(best, sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
-                               (p[2] - q[2]) * (p[2] - q[2])));
+        best = fmin(best,
+                    sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                         (p[2] - q[2]) * (p[2] - q[2])));
     }
     return best;
 }
@@ -249,17 +253,22 @@ static void test_readers(void)
     same_mesh("cube22.msh", "cube.node");
     same_mesh("cube.ele", "cube.node");
     /* size limit and errors name the file and line */
-    CHECK(pk_mesh_read_msh(data("cube41.msh"), 1000, &m, err, sizeof err) != 0 && strstr(err, "limit"));
-    CHECK(pk_mesh_read_tetgen(data("cube.node"), 1000, &m, err, sizeof err) != 0 && strstr(err, "limit"));
-    CHECK(pk_mesh_read_msh(data("cube.node"), 0, &m, err, sizeof err) != 0 && strstr(err, "not a Gmsh"));
-    CHECK(pk_mesh_read_msh(data("missing.msh"), 0, &m, err, sizeof err) != 0 && strstr(err, "cannot open"));
+    CHECK(pk_mesh_read_msh(data("cube41.msh"), 1000, &m, err, sizeof err) != 0 &&
+          strstr(err, "limit"));
+    CHECK(pk_mesh_read_tetgen(data("cube.node"), 1000, &m, err, sizeof err) != 0 &&
+          strstr(err, "limit"));
+    CHECK(pk_mesh_read_msh(data("cube.node"), 0, &m, err, sizeof err) != 0 &&
+          strstr(err, "not a Gmsh"));
+    CHECK(pk_mesh_read_msh(data("missing.msh"), 0, &m, err, sizeof err) != 0 &&
+          strstr(err, "cannot open"));
 }
 
 static void test_inline_json(void)
 {
     json_error_t je;
     json_t *j = json_loads("{\"nodes\": [[0,0,0],[1,0,0],[0,1,0],[0,0,1],[1,1,1]],"
-                           " \"tets\": [[0,2,1,3],[1,2,3,4]], \"regions\": [4, 5]}", 0, &je);
+                           " \"tets\": [[0,2,1,3],[1,2,3,4]], \"regions\": [4, 5]}",
+                           0, &je);
     pk_mesh m;
     pk_mesh_report rep;
     char err[256];

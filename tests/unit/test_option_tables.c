@@ -30,7 +30,8 @@ static void nodes_at(json_t *doc, json_t *node, const char *ptr, json_t **out, s
     for (int c = 0; c < 3; c++) {
         json_t *arr = json_object_get(node, comb[c]), *item;
         size_t i;
-        json_array_foreach(arr, i, item) nodes_at(doc, item, ptr, out, n, depth + 1);
+        json_array_foreach (arr, i, item)
+            nodes_at(doc, item, ptr, out, n, depth + 1);
     }
     nodes_at(doc, json_object_get(node, "then"), ptr, out, n, depth + 1);
     nodes_at(doc, json_object_get(node, "else"), ptr, out, n, depth + 1);
@@ -74,14 +75,17 @@ static int check_row(json_t *doc, const pk_option_table *t, const pk_option *o, 
         if (d) {
             with_default = 1;
             if (!dflt || !same_value(d, dflt)) {
-                char *a = json_dumps(d, JSON_ENCODE_ANY), *b = dflt ? json_dumps(dflt, JSON_ENCODE_ANY) : NULL;
-                fprintf(stderr, "  %s: schema default %s, table %s\n", o->pointer, a, b ? b : "implicit");
+                char *a = json_dumps(d, JSON_ENCODE_ANY),
+                     *b = dflt ? json_dumps(dflt, JSON_ENCODE_ANY) : NULL;
+                fprintf(stderr, "  %s: schema default %s, table %s\n", o->pointer, a,
+                        b ? b : "implicit");
                 free(a);
                 free(b);
                 bad++;
             }
         }
-        json_t *mn = json_object_get(nodes[i], "minimum"), *mx = json_object_get(nodes[i], "maximum");
+        json_t *mn = json_object_get(nodes[i], "minimum"),
+               *mx = json_object_get(nodes[i], "maximum");
         if (mn)
             lo = fmin(lo, json_number_value(mn));
         if (mx)
@@ -91,13 +95,14 @@ static int check_row(json_t *doc, const pk_option_table *t, const pk_option *o, 
             if (json_object_get(nodes[i], "const"))
                 json_array_append(values, json_object_get(nodes[i], "const"));
             size_t k;
-            json_array_foreach(vals, k, v) json_array_append(values, v);
+            json_array_foreach (vals, k, v)
+                json_array_append(values, v);
         }
     }
     if (o->type == PK_OPT_ENUM) { /* the same names in the table and the schema */
         size_t k;
         json_t *v;
-        json_array_foreach(values, k, v) {
+        json_array_foreach (values, k, v) {
             int found = 0;
             for (size_t j = 0; o->names[j]; j++)
                 found |= json_is_string(v) && !strcmp(o->names[j], json_string_value(v));
@@ -109,8 +114,8 @@ static int check_row(json_t *doc, const pk_option_table *t, const pk_option *o, 
         }
         for (size_t j = 0; o->names[j]; j++) {
             int found = 0;
-            json_array_foreach(values, k, v) found |=
-                json_is_string(v) && !strcmp(o->names[j], json_string_value(v));
+            json_array_foreach (values, k, v)
+                found |= json_is_string(v) && !strcmp(o->names[j], json_string_value(v));
             if (!found) {
                 fprintf(stderr, "  %s: table name %s not in the schema\n", o->pointer, o->names[j]);
                 bad++;
@@ -122,8 +127,10 @@ static int check_row(json_t *doc, const pk_option_table *t, const pk_option *o, 
         fprintf(stderr, "  %s: the table has a default, the schema none\n", o->pointer);
         bad++;
     }
-    if (o->type == PK_OPT_INTEGER && ((isfinite(lo) && lo != o->lo) || (isfinite(hi) && hi != o->hi))) {
-        fprintf(stderr, "  %s: range [%g, %g], schema [%g, %g]\n", o->pointer, o->lo, o->hi, lo, hi);
+    if (o->type == PK_OPT_INTEGER &&
+        ((isfinite(lo) && lo != o->lo) || (isfinite(hi) && hi != o->hi))) {
+        fprintf(stderr, "  %s: range [%g, %g], schema [%g, %g]\n", o->pointer, o->lo, o->hi, lo,
+                hi);
         bad++;
     }
     json_decref(dflt);
@@ -152,7 +159,8 @@ static int table_has(const char *schema, const char *pointer)
 }
 
 /* Every "default" of the schema belongs to a row. */
-static int defaults_covered(const char *schema, json_t *doc, json_t *node, const char *path, int depth)
+static int defaults_covered(const char *schema, json_t *doc, json_t *node, const char *path,
+                            int depth)
 {
     if (!json_is_object(node) || depth > 32)
         return 0;
@@ -168,13 +176,14 @@ static int defaults_covered(const char *schema, json_t *doc, json_t *node, const
     for (int c = 0; c < 3; c++) {
         json_t *arr = json_object_get(node, comb[c]), *item;
         size_t i;
-        json_array_foreach(arr, i, item) bad += defaults_covered(schema, doc, item, path, depth + 1);
+        json_array_foreach (arr, i, item)
+            bad += defaults_covered(schema, doc, item, path, depth + 1);
     }
     bad += defaults_covered(schema, doc, json_object_get(node, "then"), path, depth + 1);
     bad += defaults_covered(schema, doc, json_object_get(node, "else"), path, depth + 1);
     const char *key;
     json_t *sub;
-    json_object_foreach(json_object_get(node, "properties"), key, sub) {
+    json_object_foreach (json_object_get(node, "properties"), key, sub) {
         char p[256];
         snprintf(p, sizeof p, "%s/%s", path, key);
         bad += defaults_covered(schema, doc, sub, p, depth + 1);
@@ -200,9 +209,11 @@ static void test_tables_match_schemas(void)
             bad += check_row(doc, t, &t->rows[j], filled);
         free(filled);
     }
-    static const char *const schemas[] = {"pack.inputs.schema.json", "homogenize.inputs.schema.json"};
+    static const char *const schemas[] = {"pack.inputs.schema.json",
+                                          "homogenize.inputs.schema.json"};
     for (int s = 0; s < 2; s++)
-        bad += defaults_covered(schemas[s], pk_schema_get(schemas[s]), pk_schema_get(schemas[s]), "", 0);
+        bad += defaults_covered(schemas[s], pk_schema_get(schemas[s]), pk_schema_get(schemas[s]),
+                                "", 0);
     CHECK_MSG(bad == 0, "%d mismatches between the option tables and the schemas", bad);
     json_decref(empty);
 }
@@ -236,9 +247,10 @@ static void test_bad_values_named(void)
 /* A sieve curve of no sizes (the schema's minItems bypassed). */
 static void test_empty_sieve_refused(void)
 {
-    json_t *in = json_loads("{\"dim\": 2, \"domain\": {\"box\": {\"size\": [10, 10]}}, \"count\": 5,"
-                            "\"grading\": {\"type\": \"sieve\", \"sizes\": [], \"passing\": []}}",
-                            0, NULL);
+    json_t *in =
+        json_loads("{\"dim\": 2, \"domain\": {\"box\": {\"size\": [10, 10]}}, \"count\": 5,"
+                   "\"grading\": {\"type\": \"sieve\", \"sizes\": [], \"passing\": []}}",
+                   0, NULL);
     pk_pack_job job;
     pk_schema_errors errs = {0};
     pk_pack_job_from_json(in, &job, &errs);

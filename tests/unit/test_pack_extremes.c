@@ -22,11 +22,13 @@ static const pk_check_ctx local = {0};
 static const char *const bases[] = {
     "{\"dim\":2,\"domain\":{\"box\":{\"size\":[20,20],\"periodic\":[true,false]}},"
     "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":60},"
-    "{\"d\":1,\"volume_percent\":40}]},\"d_min\":0.5,\"phi\":{\"value\":0.3,\"refers_to\":\"resolved\"},"
+    "{\"d\":1,\"volume_percent\":40}]},\"d_min\":0.5,\"phi\":{\"value\":0.3,\"refers_to\":"
+    "\"resolved\"},"
     "\"delta_d\":0.1,\"seed\":3,\"rsa\":{\"max_failed_draws\":100000},"
     "\"limits\":{\"max_particles\":100000,\"wall_time_s\":5}}",
 
-    "{\"dim\":2,\"domain\":{\"box\":{\"size\":[20,20]}},\"grading\":{\"type\":\"classes\",\"classes\":"
+    "{\"dim\":2,\"domain\":{\"box\":{\"size\":[20,20]}},\"grading\":{\"type\":\"classes\","
+    "\"classes\":"
     "[{\"d\":2,\"mass_percent\":50,\"density\":2.6},{\"d\":1,\"mass_percent\":50,\"density\":2}]},"
     "\"count\":30}",
 
@@ -39,9 +41,11 @@ static const char *const bases[] = {
     "\"phi\":{\"value\":0.3,\"refers_to\":\"mix\"}}",
 
     "{\"dim\":2,\"domain\":{\"box\":{\"size\":[20,20]}},"
-    "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]},\"count\":30,"
+    "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]},\"count\":"
+    "30,"
     "\"delta_d\":0.1,\"algorithm\":\"edmd\",\"limits\":{\"wall_time_s\":5},"
-    "\"edmd\":{\"delta\":0.5,\"growth_rate\":0.05,\"jamming\":{\"reduced_pressure\":1e6,\"rate_factor\":0.1,"
+    "\"edmd\":{\"delta\":0.5,\"growth_rate\":0.05,\"jamming\":{\"reduced_pressure\":1e6,\"rate_"
+    "factor\":0.1,"
     "\"delta_phi\":1e-9,\"events\":100},\"stall\":{\"events\":1000,\"growth\":1e-12},"
     "\"rescale_tolerance\":0.1,\"skin\":0.6,\"max_events\":1000000}}",
 
@@ -50,10 +54,12 @@ static const char *const bases[] = {
     "\"neighbours\":8,\"max_combos\":30,\"max_passes\":2,\"max_tets\":100000}}",
 
     "{\"dim\":3,\"domain\":{\"box\":{\"size\":[8,8,8]}},\"algorithm\":\"tetfill\","
-    "\"phi\":{\"value\":0.3,\"refers_to\":\"resolved\"},\"tetfill\":{\"r_min\":0.6,\"r_max\":1.2,\"max_passes\":2}}",
+    "\"phi\":{\"value\":0.3,\"refers_to\":\"resolved\"},\"tetfill\":{\"r_min\":0.6,\"r_max\":1.2,"
+    "\"max_passes\":2}}",
 
     "{\"dim\":3,\"algorithm\":\"tetfill\",\"count\":20,\"tetfill\":{\"ratio\":2,\"max_passes\":2},"
-    "\"domain\":{\"mesh\":{\"nodes\":[[0,0,0],[8,0,0],[0,8,0],[8,8,0],[0,0,8],[8,0,8],[0,8,8],[8,8,8]],"
+    "\"domain\":{\"mesh\":{\"nodes\":[[0,0,0],[8,0,0],[0,8,0],[8,8,0],[0,0,8],[8,0,8],[0,8,8],[8,8,"
+    "8]],"
     "\"tets\":[[0,1,3,7],[0,1,5,7],[0,2,3,7],[0,2,6,7],[0,4,5,7],[0,4,6,7]],"
     "\"regions\":[1,1,1,1,1,1]}}}",
 };
@@ -87,8 +93,7 @@ static void schema_leaves(json_t *root, json_t *s, const char *at, json_t *out, 
         json_array_append_new(out, json_string(at));
     const char *k;
     json_t *v;
-    json_object_foreach(json_object_get(s, "properties"), k, v)
-    {
+    json_object_foreach (json_object_get(s, "properties"), k, v) {
         char sub[256];
         snprintf(sub, sizeof sub, "%s/%s", at, k);
         schema_leaves(root, v, sub, out, depth + 1);
@@ -102,7 +107,8 @@ static void schema_leaves(json_t *root, json_t *s, const char *at, json_t *out, 
     const char *comb[] = {"oneOf", "anyOf", "allOf"};
     for (int c = 0; c < 3; c++) {
         size_t i;
-        json_array_foreach(json_object_get(s, comb[c]), i, v) schema_leaves(root, v, at, out, depth + 1);
+        json_array_foreach (json_object_get(s, comb[c]), i, v)
+            schema_leaves(root, v, at, out, depth + 1);
     }
 }
 
@@ -131,8 +137,7 @@ static void instance_leaves(json_t *v, const char *ptr, const char *tmpl, leaf *
     if (json_is_object(v)) {
         const char *k;
         json_t *c;
-        json_object_foreach(v, k, c)
-        {
+        json_object_foreach (v, k, c) {
             snprintf(p2, sizeof p2, "%s/%s", ptr, k);
             snprintf(t2, sizeof t2, "%s/%s", tmpl, k);
             instance_leaves(c, p2, t2, out, n, cap, v, k, 0);
@@ -140,8 +145,7 @@ static void instance_leaves(json_t *v, const char *ptr, const char *tmpl, leaf *
     } else if (json_is_array(v)) {
         size_t i;
         json_t *c;
-        json_array_foreach(v, i, c)
-        {
+        json_array_foreach (v, i, c) {
             snprintf(p2, sizeof p2, "%s/%zu", ptr, i);
             snprintf(t2, sizeof t2, "%s/*", tmpl);
             instance_leaves(c, p2, t2, out, n, cap, v, NULL, i);
@@ -232,22 +236,23 @@ static void test_numeric_fields_walk(void)
                     for (size_t k = 0; k < e.n; k++) {
                         const char *ep = e.items[k].pointer, *lp = leaves[i].ptr;
                         size_t el = strlen(ep), ll = strlen(lp);
-                        if (!strncmp(ep, lp, ll) || (el > 0 && el < ll && !strncmp(ep, lp, el) &&
-                                                     lp[el] == '/'))
+                        if (!strncmp(ep, lp, ll) ||
+                            (el > 0 && el < ll && !strncmp(ep, lp, el) && lp[el] == '/'))
                             named = 1;
                     }
                     /* rules between fields: their message gives both sides */
-                    const char *relational[] = {"wallSize", "periodicSize", "periodicJamming",
-                                                "ascending", "lessThanDmax", "sumTo100",
+                    const char *relational[] = {"wallSize",      "periodicSize", "periodicJamming",
+                                                "ascending",     "lessThanDmax", "sumTo100",
                                                 "positiveTotal", "maxParticles", "resolvedBelow1",
-                                                "radii", "mesh", "meshScale", "grading"};
+                                                "radii",         "mesh",         "meshScale",
+                                                "grading"};
                     for (size_t k = 0; k < e.n && !named; k++)
                         for (size_t r = 0; r < sizeof relational / sizeof *relational; r++)
                             if (!strcmp(e.items[k].rule, relational[r]))
                                 named = 2;
                     named_direct += named == 1;
-                    CHECK_MSG(named, "base %zu %s = %g: refused at %s (%s: %s), not at the field", b,
-                              leaves[i].ptr, values[v], e.items[0].pointer, e.items[0].rule,
+                    CHECK_MSG(named, "base %zu %s = %g: refused at %s (%s: %s), not at the field",
+                              b, leaves[i].ptr, values[v], e.items[0].pointer, e.items[0].rule,
                               e.items[0].message);
                 } else {
                     json_t *sum;
@@ -265,8 +270,7 @@ static void test_numeric_fields_walk(void)
     }
     size_t i;
     json_t *w;
-    json_array_foreach(want, i, w)
-    {
+    json_array_foreach (want, i, w) {
         const char *t = json_string_value(w);
         CHECK_MSG(json_object_get(covered, t), "numeric field %s is in no base job", t);
     }
@@ -327,7 +331,10 @@ static long long placed(const json_t *sum)
     return json_integer_value(json_object_get(sum, "count_placed"));
 }
 
-static double phi_of(const json_t *sum) { return json_real_value(json_object_get(sum, "phi_resolved")); }
+static double phi_of(const json_t *sum)
+{
+    return json_real_value(json_object_get(sum, "phi_resolved"));
+}
 
 /* N = 1, 2, 8 in walled and periodic boxes, 2D and 3D, RSA and EDMD: every
  * grain placed, complete, the audit clean. */
@@ -339,17 +346,19 @@ static void test_few_grains(void)
             for (int per = 0; per < 2; per++)
                 for (int a = 0; a < 2; a++) {
                     char buf[512];
-                    snprintf(buf, sizeof buf,
-                             "{\"dim\":%d,\"domain\":{\"box\":{\"size\":[10,10%s],\"periodic\":%s}},"
-                             "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]},"
-                             "\"count\":%d,\"delta_d\":0.1,\"algorithm\":\"%s\"}",
-                             dim, dim == 3 ? ",10" : "", per ? "true" : "false", n, algs[a]);
+                    snprintf(
+                        buf, sizeof buf,
+                        "{\"dim\":%d,\"domain\":{\"box\":{\"size\":[10,10%s],\"periodic\":%s}},"
+                        "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_"
+                        "percent\":100}]},"
+                        "\"count\":%d,\"delta_d\":0.1,\"algorithm\":\"%s\"}",
+                        dim, dim == 3 ? ",10" : "", per ? "true" : "false", n, algs[a]);
                     int rc;
                     json_t *sum = run_text(buf, &rc);
                     CHECK_MSG(rc == 0 && sane(sum, rc) && placed(sum) == n &&
                                   json_is_true(json_object_get(sum, "complete")),
-                              "dim %d N %d periodic %d %s: rc %d placed %lld", dim, n, per, algs[a], rc,
-                              placed(sum));
+                              "dim %d N %d periodic %d %s: rc %d placed %lld", dim, n, per, algs[a],
+                              rc, placed(sum));
                     json_decref(sum);
                 }
 }
@@ -362,8 +371,10 @@ static void test_size_ratio_1000(void)
     for (int a = 0; a < 2; a++) {
         char buf[512];
         snprintf(buf, sizeof buf,
-                 "{\"dim\":3,\"domain\":{\"box\":{\"size\":[2500,2500,2500],\"periodic\":[true,false,true]}},"
-                 "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":1000,\"volume_percent\":99.99998},"
+                 "{\"dim\":3,\"domain\":{\"box\":{\"size\":[2500,2500,2500],\"periodic\":[true,"
+                 "false,true]}},"
+                 "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":1000,\"volume_percent\":99."
+                 "99998},"
                  "{\"d\":1,\"volume_percent\":0.00002}]},\"count\":201,\"algorithm\":\"%s\","
                  "\"limits\":{\"wall_time_s\":20}}",
                  algs[a]);
@@ -387,7 +398,8 @@ static void test_gap_above_smallest_grain(void)
         snprintf(buf, sizeof buf,
                  "{\"dim\":3,\"domain\":{\"box\":{\"size\":[20,20,20]}},"
                  "\"grading\":{\"type\":\"sieve\",\"sizes\":[1,2],\"passing\":[0,100]},"
-                 "\"count\":50,\"delta_d\":3,\"algorithm\":%s}", algs[a]);
+                 "\"count\":50,\"delta_d\":3,\"algorithm\":%s}",
+                 algs[a]);
         int rc;
         json_t *sum = run_text(buf, &rc);
         CHECK_MSG(rc == 0 && sane(sum, rc) && placed(sum) == 50 &&
@@ -403,7 +415,8 @@ static void test_one_and_empty_classes(void)
 {
     const char *gradings[] = {
         "{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]}",
-        "{\"type\":\"classes\",\"classes\":[{\"d\":4,\"volume_percent\":0},{\"d\":2,\"volume_percent\":100},"
+        "{\"type\":\"classes\",\"classes\":[{\"d\":4,\"volume_percent\":0},{\"d\":2,\"volume_"
+        "percent\":100},"
         "{\"d\":1,\"volume_percent\":0}]}",
         "{\"type\":\"sieve\",\"sizes\":[1,2,3,4],\"passing\":[0,0,100,100]}",
     };
@@ -421,8 +434,7 @@ static void test_one_and_empty_classes(void)
                       "grading %zu %s: rc %d φ %g", g, a ? "edmd" : "rsa", rc, phi_of(sum));
             size_t i;
             json_t *c;
-            json_array_foreach(json_object_get(sum, "classes"), i, c)
-            {
+            json_array_foreach (json_object_get(sum, "classes"), i, c) {
                 if (json_real_value(json_object_get(c, "target_fraction")) == 0)
                     CHECK(json_integer_value(json_object_get(c, "placed")) == 0);
             }
@@ -441,12 +453,14 @@ static void test_scale_invariance(void)
         for (int k = 0; k < 3; k++) {
             double f = scales[k];
             char buf[640];
-            snprintf(buf, sizeof buf,
-                     "{\"dim\":3,\"domain\":{\"box\":{\"size\":[%.17g,%.17g,%.17g],\"periodic\":[true,false,true]}},"
-                     "\"grading\":{\"type\":\"sieve\",\"sizes\":[%.17g,%.17g],\"passing\":[0,100]},"
-                     "\"phi\":{\"value\":0.3,\"refers_to\":\"resolved\"},\"delta_d\":%.17g,\"seed\":3,"
-                     "\"algorithm\":\"%s\"}",
-                     12 * f, 12 * f, 12 * f, 1 * f, 2 * f, 0.1 * f, a ? "edmd" : "rsa");
+            snprintf(
+                buf, sizeof buf,
+                "{\"dim\":3,\"domain\":{\"box\":{\"size\":[%.17g,%.17g,%.17g],\"periodic\":[true,"
+                "false,true]}},"
+                "\"grading\":{\"type\":\"sieve\",\"sizes\":[%.17g,%.17g],\"passing\":[0,100]},"
+                "\"phi\":{\"value\":0.3,\"refers_to\":\"resolved\"},\"delta_d\":%.17g,\"seed\":3,"
+                "\"algorithm\":\"%s\"}",
+                12 * f, 12 * f, 12 * f, 1 * f, 2 * f, 0.1 * f, a ? "edmd" : "rsa");
             int rc;
             json_t *sum = run_text(buf, &rc);
             CHECK_MSG(rc == 0 && sane(sum, rc) && json_is_true(json_object_get(sum, "complete")),
@@ -473,18 +487,20 @@ static void test_target_above_reachable(void)
 {
     for (int a = 0; a < 2; a++) {
         char buf[512];
-        snprintf(buf, sizeof buf,
-                 "{\"dim\":2,\"domain\":{\"box\":{\"size\":[20,20]}},"
-                 "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]},"
-                 "\"phi\":{\"value\":0.95,\"refers_to\":\"resolved\"},\"algorithm\":\"%s\"%s,"
-                 "\"limits\":{\"wall_time_s\":20}}",
-                 a ? "edmd" : "rsa", a ? "" : ",\"rsa\":{\"max_failed_draws\":10000}");
+        snprintf(
+            buf, sizeof buf,
+            "{\"dim\":2,\"domain\":{\"box\":{\"size\":[20,20]}},"
+            "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]},"
+            "\"phi\":{\"value\":0.95,\"refers_to\":\"resolved\"},\"algorithm\":\"%s\"%s,"
+            "\"limits\":{\"wall_time_s\":20}}",
+            a ? "edmd" : "rsa", a ? "" : ",\"rsa\":{\"max_failed_draws\":10000}");
         int rc;
         json_t *sum = run_text(buf, &rc);
         const char *w = json_string_value(json_array_get(json_object_get(sum, "warnings"), 0));
         CHECK_MSG(rc == 0 && sane(sum, rc) && json_is_false(json_object_get(sum, "complete")) &&
                       w && strstr(w, "0.95") && phi_of(sum) < 0.92,
-                  "%s: rc %d φ %g warning %s", a ? "edmd" : "rsa", rc, phi_of(sum), w ? w : "(none)");
+                  "%s: rc %d φ %g warning %s", a ? "edmd" : "rsa", rc, phi_of(sum),
+                  w ? w : "(none)");
         json_decref(sum);
     }
 }

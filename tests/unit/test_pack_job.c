@@ -26,7 +26,8 @@ static int plan_from(const char *inputs_json, pk_pack_plan *plan)
     if (!n)
         n = pk_pack_job_from_json(in, &job, &errs) + pk_pack_plan_make(&job, plan, &errs);
     for (size_t i = 0; i < errs.n; i++)
-        fprintf(stderr, "  %s %s %s\n", errs.items[i].pointer, errs.items[i].rule, errs.items[i].message);
+        fprintf(stderr, "  %s %s %s\n", errs.items[i].pointer, errs.items[i].rule,
+                errs.items[i].message);
     pk_schema_errors_free(&errs);
     json_decref(in);
     return n ? -1 : 0;
@@ -62,7 +63,8 @@ static int run_inputs(const char *inputs_json, json_t **sum, int *file_written)
     int fd = mkstemp(out);
     close(fd);
     unlink(out);
-    json_t *job = json_pack("{s:s,s:o}", "process", "pack", "inputs", json_loads(inputs_json, 0, NULL));
+    json_t *job =
+        json_pack("{s:s,s:o}", "process", "pack", "inputs", json_loads(inputs_json, 0, NULL));
     pk_schema_errors errs = {0};
     char err[512] = "";
     *sum = NULL;
@@ -89,7 +91,10 @@ static void test_plan_reference_counts(void)
     const char *fmt = "{\"dim\":3,\"domain\":{\"box\":{\"size\":[150,150,150]}},\"grading\":%s,"
                       "\"d_min\":2,\"phi\":{\"value\":0.7,\"refers_to\":\"mix\"},"
                       "\"limits\":{\"max_particles\":100000000}}";
-    struct { const char *grading; double n, phi_eff; } cases[] = {
+    struct {
+        const char *grading;
+        double n, phi_eff;
+    } cases[] = {
         {"{\"type\":\"preset\",\"name\":\"A16\"}", 44202, 0.553},
         {"{\"type\":\"preset\",\"name\":\"B16\"}", 40049, 0.406},
         {"{\"type\":\"fuller\",\"q\":0.7,\"d_max\":16}", 39704, 0.537},
@@ -112,7 +117,8 @@ static void test_plan_resolved_target(void)
     pk_pack_plan plan;
     CHECK(plan_from("{\"dim\":3,\"domain\":{\"box\":{\"size\":[80,80,80]}},"
                     "\"grading\":{\"type\":\"preset\",\"name\":\"A16\"},\"d_min\":2,"
-                    "\"phi\":{\"value\":0.4227,\"refers_to\":\"resolved\"}}", &plan) == 0);
+                    "\"phi\":{\"value\":0.4227,\"refers_to\":\"resolved\"}}",
+                    &plan) == 0);
     CHECK_NEAR(plan.mass_cut, 0.21, 1e-12);
     CHECK_NEAR(plan.phi_mix, 0.4227 / 0.79, 1e-12);
     CHECK_NEAR(plan.expected_n, 5125, 1.5); /* Titscher §6.3: φ_M = 0.535 → 5 125 */
@@ -129,7 +135,8 @@ static void test_run_count_matches_plan(void)
     json_t *job = json_loads(
         "{\"process\":\"pack\",\"inputs\":{\"dim\":3,\"domain\":{\"box\":{\"size\":[80,80,80]}},"
         "\"grading\":{\"type\":\"preset\",\"name\":\"A16\"},\"d_min\":2,"
-        "\"phi\":{\"value\":0.3,\"refers_to\":\"mix\"},\"seed\":5}}", 0, NULL);
+        "\"phi\":{\"value\":0.3,\"refers_to\":\"mix\"},\"seed\":5}}",
+        0, NULL);
     pk_schema_errors errs = {0};
     json_t *sum = NULL;
     char err[256];
@@ -138,7 +145,8 @@ static void test_run_count_matches_plan(void)
         double expected = json_real_value(json_object_get(sum, "count_expected"));
         double placed = (double)json_integer_value(json_object_get(sum, "count_placed"));
         CHECK_NEAR(expected, 5125.0 * 0.3 / 0.535, 1.5);
-        CHECK_MSG(fabs(placed - expected) < 0.03 * expected, "placed %g expected %g", placed, expected);
+        CHECK_MSG(fabs(placed - expected) < 0.03 * expected, "placed %g expected %g", placed,
+                  expected);
         double phi = json_real_value(json_object_get(sum, "phi_mix"));
         /* one 16 mm grain is 0.4 % of the 80 mm cube: the overshoot bound */
         CHECK(phi >= 0.3 && phi < 0.3 + 0.005);
@@ -150,7 +158,8 @@ static void test_run_count_matches_plan(void)
     unlink(out);
 }
 
-#define MONO2D(L) "\"dim\":2,\"domain\":{\"box\":{\"size\":[" L "," L "]}}," \
+#define MONO2D(L)                                                                                  \
+    "\"dim\":2,\"domain\":{\"box\":{\"size\":[" L "," L "]}},"                                     \
     "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]}"
 
 /* Issue 21 item 4: an integer written as a decimal is that integer (jansson
@@ -162,12 +171,16 @@ static void test_integer_as_real(void)
     CHECK_NEAR(plan.expected_n, 50, 0);
     json_t *a, *b;
     int fa, fb;
-    CHECK(run_inputs("{" MONO2D("20") ",\"count\":50.0,\"seed\":5.0,\"rsa\":{\"max_failed_draws\":1000.0}}",
-                     &a, &fa) == 0);
-    CHECK(run_inputs("{" MONO2D("20") ",\"count\":50,\"seed\":5,\"rsa\":{\"max_failed_draws\":1000}}",
-                     &b, &fb) == 0);
+    CHECK(
+        run_inputs(
+            "{" MONO2D("20") ",\"count\":50.0,\"seed\":5.0,\"rsa\":{\"max_failed_draws\":1000.0}}",
+            &a, &fa) == 0);
+    CHECK(
+        run_inputs("{" MONO2D("20") ",\"count\":50,\"seed\":5,\"rsa\":{\"max_failed_draws\":1000}}",
+                   &b, &fb) == 0);
     CHECK(json_integer_value(json_object_get(a, "count_placed")) == 50);
-    CHECK(json_integer_value(json_object_get(json_object_get(a, "rsa"), "max_failed_draws")) == 1000);
+    CHECK(json_integer_value(json_object_get(json_object_get(a, "rsa"), "max_failed_draws")) ==
+          1000);
     /* same seed: the same packing */
     CHECK(json_real_value(json_object_get(a, "smallest_gap")) ==
           json_real_value(json_object_get(b, "smallest_gap")));
@@ -176,10 +189,13 @@ static void test_integer_as_real(void)
     CHECK(refused("{" MONO2D("20") ",\"count\":1e308}", "/count", "maximum"));
     CHECK(refused("{" MONO2D("20") ",\"count\":5,\"limits\":{\"max_particles\":1e308}}",
                   "/limits/max_particles", "maximum"));
-    CHECK(refused("{" MONO2D("20") ",\"count\":5,\"algorithm\":\"edmd\",\"edmd\":{\"max_events\":1e308}}",
-                  "/edmd/max_events", "maximum"));
-    CHECK(refused("{" MONO2D("20") ",\"count\":5,\"algorithm\":\"edmd\",\"edmd\":{\"stall\":{\"events\":1e308}}}",
-                  "/edmd/stall/events", "maximum"));
+    CHECK(refused(
+        "{" MONO2D("20") ",\"count\":5,\"algorithm\":\"edmd\",\"edmd\":{\"max_events\":1e308}}",
+        "/edmd/max_events", "maximum"));
+    CHECK(refused(
+        "{" MONO2D(
+            "20") ",\"count\":5,\"algorithm\":\"edmd\",\"edmd\":{\"stall\":{\"events\":1e308}}}",
+        "/edmd/stall/events", "maximum"));
     CHECK(refused("{" MONO2D("20") ",\"count\":2.5}", "/count", "type"));
 }
 
@@ -199,9 +215,10 @@ static void test_phi_implied_above_one(void)
  * same small counts run. */
 static void test_periodic_jamming_rule(void)
 {
-    const char *fmt = "{\"dim\":3,\"domain\":{\"box\":{\"size\":[10,10,10],\"periodic\":true}},"
-                      "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]},"
-                      "\"count\":%d,\"algorithm\":\"edmd\",\"edmd\":{\"until\":\"%s\"}}";
+    const char *fmt =
+        "{\"dim\":3,\"domain\":{\"box\":{\"size\":[10,10,10],\"periodic\":true}},"
+        "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]},"
+        "\"count\":%d,\"algorithm\":\"edmd\",\"edmd\":{\"until\":\"%s\"}}";
     char buf[512];
     snprintf(buf, sizeof buf, fmt, 8, "jammed");
     CHECK(refused(buf, "/domain/box/size/0", "periodicJamming"));
@@ -228,7 +245,9 @@ static void test_saturated_warns(void)
     json_t *sum;
     int f;
     CHECK(run_inputs("{" MONO2D("20") ",\"phi\":{\"value\":0.8,\"refers_to\":\"resolved\"},"
-                     "\"rsa\":{\"max_failed_draws\":1000}}", &sum, &f) == 0 && f);
+                                      "\"rsa\":{\"max_failed_draws\":1000}}",
+                     &sum, &f) == 0 &&
+          f);
     CHECK(json_is_false(json_object_get(sum, "complete")));
     CHECK(!json_object_get(sum, "failure"));
     const char *w = first_warning(sum);
@@ -242,11 +261,12 @@ static void test_wall_time_fails(void)
 {
     json_t *sum;
     int f;
-    int rc = run_inputs("{\"dim\":3,\"domain\":{\"box\":{\"size\":[30,30,30],\"periodic\":true}},"
-                        "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]},"
-                        "\"phi\":{\"value\":0.5,\"refers_to\":\"resolved\"},\"algorithm\":\"edmd\","
-                        "\"edmd\":{\"until\":\"jammed\"},\"limits\":{\"wall_time_s\":0.2}}",
-                        &sum, &f);
+    int rc = run_inputs(
+        "{\"dim\":3,\"domain\":{\"box\":{\"size\":[30,30,30],\"periodic\":true}},"
+        "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]},"
+        "\"phi\":{\"value\":0.5,\"refers_to\":\"resolved\"},\"algorithm\":\"edmd\","
+        "\"edmd\":{\"until\":\"jammed\"},\"limits\":{\"wall_time_s\":0.2}}",
+        &sum, &f);
     CHECK(rc == 2 && f);
     const char *why = json_string_value(json_object_get(sum, "failure"));
     CHECK_MSG(why && strstr(why, "wall time"), "failure: %s", why ? why : "(none)");
@@ -285,7 +305,8 @@ static void test_stop_in_rsa_start(void)
         char err[512];
         CHECK(pk_job_run(job, 1, out, &mon, &sum, &errs, err, sizeof err) == 2);
         const char *why = json_string_value(json_object_get(sum, "failure"));
-        CHECK_MSG(why && strstr(why, "cancelled"), "%s: failure %s", shapes[k], why ? why : "(none)");
+        CHECK_MSG(why && strstr(why, "cancelled"), "%s: failure %s", shapes[k],
+                  why ? why : "(none)");
         long long placed = json_integer_value(json_object_get(sum, "count_placed"));
         CHECK(placed > 0 && placed < 3223);
         CHECK(json_integer_value(json_object_get(sum, "pairs_below_delta_d")) == 0);
@@ -303,8 +324,10 @@ static void test_maximize_short_keeps_file(void)
 {
     json_t *sum;
     int f;
-    int rc = run_inputs("{" MONO2D("20") ",\"count\":50,\"delta_d\":1.4,\"algorithm\":\"edmd\","
-                        "\"edmd\":{\"maximize\":\"delta_d\",\"wall_gap\":\"half\"}}", &sum, &f);
+    int rc =
+        run_inputs("{" MONO2D("20") ",\"count\":50,\"delta_d\":1.4,\"algorithm\":\"edmd\","
+                                    "\"edmd\":{\"maximize\":\"delta_d\",\"wall_gap\":\"half\"}}",
+                   &sum, &f);
     CHECK(rc == 0 && f);
     double dd = json_real_value(json_object_get(json_object_get(sum, "edmd"), "delta_d_reached"));
     CHECK(dd > 0.5 && dd < 1.4);
@@ -320,9 +343,11 @@ static void test_until_jammed_complete(void)
 {
     json_t *sum;
     int f;
-    CHECK(run_inputs("{\"dim\":3,\"domain\":{\"box\":{\"size\":[10,10,10]}},"
-                     "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]},"
-                     "\"count\":8,\"algorithm\":\"edmd\",\"edmd\":{\"until\":\"jammed\"}}", &sum, &f) == 0);
+    CHECK(run_inputs(
+              "{\"dim\":3,\"domain\":{\"box\":{\"size\":[10,10,10]}},"
+              "\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":2,\"volume_percent\":100}]},"
+              "\"count\":8,\"algorithm\":\"edmd\",\"edmd\":{\"until\":\"jammed\"}}",
+              &sum, &f) == 0);
     CHECK(!strcmp(json_string_value(json_object_get(sum, "termination_reason")), "jammed"));
     CHECK(json_is_true(json_object_get(sum, "complete")));
     json_decref(sum);

@@ -24,8 +24,8 @@ typedef struct job {
     atomic_int on_workers; /* parts run by another thread than the caller */
     thrd_t caller;
     int nt;
-    uint64_t in;                  /* written by the caller before the run */
-    uint64_t out[MAXT][WORDS];    /* plain stores by the parts */
+    uint64_t in;               /* written by the caller before the run */
+    uint64_t out[MAXT][WORDS]; /* plain stores by the parts */
 } job;
 
 static void part(void *ctx, int t, int nt)

@@ -56,7 +56,8 @@ static void test_inverse_transform(void)
         double eq10 = a * b / cbrt(b * b * b * (1 - u) + a * a * a * u);
         CHECK_NEAR(pk_class_sample(&c, 3, u), eq10, 1e-12 * eq10);
         double d = a + (b - a) * k / 20.0;
-        double eq8 = b * b * b * a * a * a / (b * b * b - a * a * a) * (1 / (a * a * a) - 1 / (d * d * d));
+        double eq8 =
+            b * b * b * a * a * a / (b * b * b - a * a * a) * (1 / (a * a * a) - 1 / (d * d * d));
         CHECK_NEAR(pk_class_number_cdf(&c, 3, d), eq8, 1e-13);
     }
     /* General law, dims 2/3, β = 0 / 0.35 / 0.7, ratios 2 … 1000: the number
@@ -193,7 +194,10 @@ static void test_din(void)
     CHECK(pk_grading_preset(&g, "a16") == 0); /* case-insensitive */
 
     const double V150 = 150.0 * 150 * 150, V80 = 80.0 * 80 * 80;
-    const struct { const char *name; double dmin, phiM, V, N, phieff, phitol; } cases[] = {
+    const struct {
+        const char *name;
+        double dmin, phiM, V, N, phieff, phitol;
+    } cases[] = {
         {"A16", 2, 0.70, V150, 44202, 0.553, 5e-4},
         {"B16", 2, 0.70, V150, 40049, 0.406, 5e-4},
         {"A16", 0.5, 0.70, V150, 822630, 0.644, 5e-4},
@@ -270,8 +274,10 @@ static void test_fuller(void)
         CHECK_MSG(fabs(n - n80[k]) <= 1, "a=80 phi_eff %g: %.2f vs %.0f", phe[k], n, n80[k]);
     }
     /* a = 32: "468 … 596" for φ_eff 0.55 … 0.70. */
-    CHECK(fabs(pk_grading_expected_count(&g, 3, 0.55 * 32768.0 / (1 - g.mass_below), NULL) - 468) <= 1);
-    CHECK(fabs(pk_grading_expected_count(&g, 3, 0.70 * 32768.0 / (1 - g.mass_below), NULL) - 596) <= 1);
+    CHECK(fabs(pk_grading_expected_count(&g, 3, 0.55 * 32768.0 / (1 - g.mass_below), NULL) - 468) <=
+          1);
+    CHECK(fabs(pk_grading_expected_count(&g, 3, 0.70 * 32768.0 / (1 - g.mass_below), NULL) - 596) <=
+          1);
     /* passing = Fuller's P(d) exactly (relative round-off). */
     for (double d = 2; d <= 16; d *= 1.3)
         CHECK_NEAR(pk_grading_passing(&g, d), sqrt(d / 16), 1e-14);
@@ -481,7 +487,11 @@ static void test_ks(void)
 {
     const size_t n = 20000;
     const double crit = 1.63 / sqrt((double)n);
-    struct { const char *label; pk_size_class c; int dim; } cases[] = {
+    struct {
+        const char *label;
+        pk_size_class c;
+        int dim;
+    } cases[] = {
         {"3D beta=0 [2,4]", mkclass(2, 4, 0), 3},
         {"2D beta=0 [2,4]", mkclass(2, 4, 0), 2},
         {"3D Fuller q=0.7 [2,16]", mkclass(2, 16, 0.7), 3},
@@ -532,17 +542,22 @@ static void test_bad_inputs(void)
     CHECK(pk_grading_from_fuller(&g, 1.0, 16, 2) == -1 && contains(pk_psd_error(), "0 < q < 1"));
     CHECK(pk_grading_from_fuller(&g, 0.0, 16, 2) == -1);
     CHECK(pk_grading_from_fuller(&g, NAN, 16, 2) == -1);
-    CHECK(pk_grading_from_fuller(&g, 0.5, 16, 16) == -1 && contains(pk_psd_error(), "d_floor < d_max"));
+    CHECK(pk_grading_from_fuller(&g, 0.5, 16, 16) == -1 &&
+          contains(pk_psd_error(), "d_floor < d_max"));
     CHECK(pk_grading_from_fuller(&g, 0.5, 16, 0) == -1);
     CHECK(pk_grading_from_fuller(&g, 0.5, INFINITY, 2) == -1);
 
     const double d2[2] = {1, 2}, s_neg[2] = {1, -1}, s_zero[2] = {0, 0}, d_nan[2] = {NAN, 2};
     const double s_ok[2] = {1, 1}, rho0[2] = {1, 0};
     CHECK(pk_grading_from_classes(&g, d2, s_ok, NULL, 0) == -1);
-    CHECK(pk_grading_from_classes(&g, d2, s_neg, NULL, 2) == -1 && contains(pk_psd_error(), "index 1"));
-    CHECK(pk_grading_from_classes(&g, d2, s_zero, NULL, 2) == -1 && contains(pk_psd_error(), "sum"));
-    CHECK(pk_grading_from_classes(&g, d_nan, s_ok, NULL, 2) == -1 && contains(pk_psd_error(), "index 0"));
-    CHECK(pk_grading_from_classes(&g, d2, s_ok, rho0, 2) == -1 && contains(pk_psd_error(), "density"));
+    CHECK(pk_grading_from_classes(&g, d2, s_neg, NULL, 2) == -1 &&
+          contains(pk_psd_error(), "index 1"));
+    CHECK(pk_grading_from_classes(&g, d2, s_zero, NULL, 2) == -1 &&
+          contains(pk_psd_error(), "sum"));
+    CHECK(pk_grading_from_classes(&g, d_nan, s_ok, NULL, 2) == -1 &&
+          contains(pk_psd_error(), "index 0"));
+    CHECK(pk_grading_from_classes(&g, d2, s_ok, rho0, 2) == -1 &&
+          contains(pk_psd_error(), "density"));
 
     CHECK(pk_grading_preset(&g, "D16") == -1 && contains(pk_psd_error(), "unknown"));
     CHECK(pk_grading_preset(&g, NULL) == -1);

@@ -28,13 +28,20 @@ static pk_queue *fresh(void)
 
 static int submit(pk_queue *q, const char *owner, const char *key, const char *fp, char id[37])
 {
-    pk_submit s = {.process = "pack", .inputs_json = "{\"dim\":2}", .owner = owner,
-                   .idempotency_key = key, .request_sha256 = fp, .max_queued = 5,
+    pk_submit s = {.process = "pack",
+                   .inputs_json = "{\"dim\":2}",
+                   .owner = owner,
+                   .idempotency_key = key,
+                   .request_sha256 = fp,
+                   .max_queued = 5,
                    .max_queued_per_owner = 3};
     return pk_queue_submit(q, &s, id);
 }
 
-static const char *str(json_t *row, const char *k) { return json_string_value(json_object_get(row, k)); }
+static const char *str(json_t *row, const char *k)
+{
+    return json_string_value(json_object_get(row, k));
+}
 
 static void test_schema_version(void)
 {
@@ -47,7 +54,8 @@ static void test_schema_version(void)
     CHECK(sqlite3_step(st) == SQLITE_ROW && sqlite3_column_int(st, 0) == pk_schema_version());
     sqlite3_finalize(st);
     sqlite3_prepare_v2(h, "PRAGMA journal_mode", -1, &st, NULL);
-    CHECK(sqlite3_step(st) == SQLITE_ROW && !strcmp((const char *)sqlite3_column_text(st, 0), "wal"));
+    CHECK(sqlite3_step(st) == SQLITE_ROW &&
+          !strcmp((const char *)sqlite3_column_text(st, 0), "wal"));
     sqlite3_finalize(st);
     /* a database from a newer packd is refused, not silently used */
     sqlite3_exec(h, "PRAGMA user_version = 999", NULL, NULL, NULL);
@@ -68,10 +76,13 @@ static void test_submit_limits_and_keys(void)
     CHECK(submit(q, "ann", NULL, NULL, b) == PK_Q_OK);
     CHECK(submit(q, "ann", NULL, NULL, b) == PK_Q_OWNER_FULL); /* 3 of ann waiting */
     CHECK(submit(q, "cid", NULL, NULL, b) == PK_Q_OK);
-    CHECK(submit(q, "dan", NULL, NULL, b) == PK_Q_FULL);       /* 5 waiting in all */
+    CHECK(submit(q, "dan", NULL, NULL, b) == PK_Q_FULL); /* 5 waiting in all */
     int total = 0;
-    pk_job_filter acc = {.status_json = "[\"accepted\"]", .created_from = NAN, .created_before = NAN,
-                         .min_duration = NAN, .max_duration = NAN};
+    pk_job_filter acc = {.status_json = "[\"accepted\"]",
+                         .created_from = NAN,
+                         .created_before = NAN,
+                         .min_duration = NAN,
+                         .max_duration = NAN};
     json_t *l = pk_queue_list(q, &acc, 2, 0, &total);
     CHECK(total == 5 && json_array_size(l) == 2);
     json_decref(l);
@@ -94,9 +105,11 @@ static void test_claim_run_finish(void)
         pk_queue_progress(q, a, 25 * k, p);
         json_decref(p);
     }
-    CHECK(!strcmp(pk_queue_finish(q, a, "successful", "finished", "{\"n\":1}", "ab", 12), "successful"));
+    CHECK(!strcmp(pk_queue_finish(q, a, "successful", "finished", "{\"n\":1}", "ab", 12),
+                  "successful"));
     json_t *row = pk_queue_get(q, a);
-    CHECK(!strcmp(str(row, "status"), "successful") && json_integer_value(json_object_get(row, "progress")) == 100);
+    CHECK(!strcmp(str(row, "status"), "successful") &&
+          json_integer_value(json_object_get(row, "progress")) == 100);
     CHECK(json_integer_value(json_object_get(json_object_get(row, "summary"), "n")) == 1);
     json_decref(row);
     /* finishing twice does not resurrect or change a final job */
@@ -109,7 +122,8 @@ static void test_claim_run_finish(void)
     CHECK(json_array_size(ev) == 4);
     CHECK(!strcmp(str(json_array_get(ev, 0), "kind"), "status"));
     CHECK(!strcmp(str(json_array_get(ev, 2), "kind"), "progress"));
-    CHECK(json_number_value(json_object_get(json_object_get(json_array_get(ev, 2), "data"), "fraction")) == 0.75);
+    CHECK(json_number_value(
+              json_object_get(json_object_get(json_array_get(ev, 2), "data"), "fraction")) == 0.75);
     long long first = json_integer_value(json_object_get(json_array_get(ev, 0), "id"));
     json_t *later = pk_queue_events(q, a, first, 100); /* SSE resume */
     CHECK(json_array_size(later) == json_array_size(ev) - 1);
@@ -154,7 +168,8 @@ static void test_recover_bounded(void)
     json_decref(pk_queue_claim(q)); /* third start, third death */
     CHECK(pk_queue_recover(q, 3, &failed) == 0 && failed == 1);
     json_t *row = pk_queue_get(q, a);
-    CHECK(!strcmp(str(row, "status"), "failed") && json_integer_value(json_object_get(row, "attempts")) == 3);
+    CHECK(!strcmp(str(row, "status"), "failed") &&
+          json_integer_value(json_object_get(row, "attempts")) == 3);
     json_decref(row);
     /* a graceful re-queue gives the start back */
     char b[37];
@@ -162,7 +177,8 @@ static void test_recover_bounded(void)
     json_decref(pk_queue_claim(q));
     pk_queue_requeue(q, b, "shutdown");
     row = pk_queue_get(q, b);
-    CHECK(!strcmp(str(row, "status"), "accepted") && json_integer_value(json_object_get(row, "attempts")) == 0);
+    CHECK(!strcmp(str(row, "status"), "accepted") &&
+          json_integer_value(json_object_get(row, "attempts")) == 0);
     json_decref(row);
     pk_queue_close(q);
 }
@@ -181,8 +197,13 @@ static void *submit_and_claim(void *p)
     for (int i = 0; i < w->n; i++) {
         char id[37], key[32];
         snprintf(key, sizeof key, "key-%d", i % 10); /* 10 distinct keys per owner */
-        pk_submit s = {.process = "pack", .inputs_json = "{}", .owner = w->owner, .idempotency_key = key,
-                       .request_sha256 = "same", .max_queued = 1000, .max_queued_per_owner = 1000};
+        pk_submit s = {.process = "pack",
+                       .inputs_json = "{}",
+                       .owner = w->owner,
+                       .idempotency_key = key,
+                       .request_sha256 = "same",
+                       .max_queued = 1000,
+                       .max_queued_per_owner = 1000};
         int rc = pk_queue_submit(w->q, &s, id);
         if (rc != PK_Q_OK && rc != PK_Q_EXISTING)
             return (void *)1;
@@ -212,8 +233,8 @@ static void test_concurrent_connections(void)
     }
     CHECK(!bad);
     int total = 0;
-    pk_job_filter all = {.created_from = NAN, .created_before = NAN, .min_duration = NAN,
-                         .max_duration = NAN};
+    pk_job_filter all = {
+        .created_from = NAN, .created_before = NAN, .min_duration = NAN, .max_duration = NAN};
     json_decref(pk_queue_list(q1, &all, 1, 0, &total));
     CHECK_MSG(total == 20, "jobs = %d (2 owners x 10 keys)", total);
     CHECK(w[0].claimed + w[1].claimed + w[2].claimed + w[3].claimed == 20);

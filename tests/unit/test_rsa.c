@@ -18,7 +18,8 @@ static void brute_gaps(const pk_box *b, const pk_particles *p, double *min_gap, 
     for (size_t i = 0; i < p->n; i++) {
         for (int k = 0; k < b->dim; k++)
             if (!b->periodic[k])
-                *min_wall = fmin(*min_wall, fmin(p->x[3 * i + k], b->L[k] - p->x[3 * i + k]) - p->r[i]);
+                *min_wall =
+                    fmin(*min_wall, fmin(p->x[3 * i + k], b->L[k] - p->x[3 * i + k]) - p->r[i]);
         for (size_t j = i + 1; j < p->n; j++) {
             double g = sqrt(pk_box_dist2(b, &p->x[3 * i], &p->x[3 * j])) - p->r[i] - p->r[j];
             *min_gap = fmin(*min_gap, g);
@@ -155,13 +156,15 @@ static void test_rsa_ratio_1000(void)
     CHECK(st.placed == n);
     pk_gap_report rep;
     CHECK(pk_gap_audit(&b, &p, 0.001, 1e-10, 0.01, &rep) == 0);
-    CHECK_MSG(rep.pairs_below == 0, "%zu pairs below Δd (min gap %g)", rep.pairs_below, rep.min_gap);
+    CHECK_MSG(rep.pairs_below == 0, "%zu pairs below Δd (min gap %g)", rep.pairs_below,
+              rep.min_gap);
     /* cross-check the audit with brute force on the coarse–fine pairs */
     double gmin = INFINITY;
     for (size_t i = 0; i < n_big; i++)
         for (size_t j = 0; j < p.n; j++)
             if (j != i)
-                gmin = fmin(gmin, sqrt(pk_box_dist2(&b, &p.x[3 * i], &p.x[3 * j])) - p.r[i] - p.r[j]);
+                gmin =
+                    fmin(gmin, sqrt(pk_box_dist2(&b, &p.x[3 * i], &p.x[3 * j])) - p.r[i] - p.r[j]);
     CHECK(gmin >= 0.001 - 1e-10);
     free(d);
     free(sp);

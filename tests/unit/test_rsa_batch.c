@@ -24,19 +24,20 @@ typedef struct setup {
     size_t n;
     double *d;
     int32_t *sp;
-    size_t nfixed;              /* grains present before the run */
-    double fixed[4][4];         /* x, y, z, r */
+    size_t nfixed;      /* grains present before the run */
+    double fixed[4][4]; /* x, y, z, r */
 } setup;
 
 /* Runs RSA; batch = 0: plain reference; else batched with that many attempts
  * per batch (SIZE_MAX: adaptive). */
-static void place(const setup *u, size_t batch, uint32_t min_run, pk_particles *p,
-                  pk_rsa_stats *st)
+static void place(const setup *u, size_t batch, uint32_t min_run, pk_particles *p, pk_rsa_stats *st)
 {
     pk_particles_init(p, u->box.dim, u->n + u->nfixed);
     for (size_t k = 0; k < u->nfixed; k++)
         pk_particles_push(p, u->fixed[k], u->fixed[k][3], 9);
-    pk_rsa_params prm = {.delta_d = u->delta_d, .max_failed_draws = u->max_failed, .seed = 21,
+    pk_rsa_params prm = {.delta_d = u->delta_d,
+                         .max_failed_draws = u->max_failed,
+                         .seed = 21,
                          .draws = PK_RSA_DRAWS_PLAIN,
                          .test = {.one_at_a_time = batch == 0,
                                   .batch_attempts = batch == SIZE_MAX ? 0 : (uint32_t)batch,
@@ -47,8 +48,8 @@ static void place(const setup *u, size_t batch, uint32_t min_run, pk_particles *
 static int same(const pk_particles *a, const pk_particles *b)
 {
     return a->n == b->n && memcmp(a->x, b->x, 3 * a->n * sizeof(double)) == 0 &&
-           memcmp(a->r, b->r, a->n * sizeof(double)) == 0 &&
-           memcmp(a->species, b->species, a->n * sizeof(int32_t)) == 0;
+        memcmp(a->r, b->r, a->n * sizeof(double)) == 0 &&
+        memcmp(a->species, b->species, a->n * sizeof(int32_t)) == 0;
 }
 
 /* The reference once, then the batched path at each batch size. */
@@ -73,8 +74,7 @@ static void compare(const char *name, const setup *u, uint32_t min_run, size_t e
                   sizes[q], p.n, ref.n);
         CHECK_MSG(sb.draws == sr.draws && sb.reason == sr.reason && sb.placed == sr.placed,
                   "%s, B = %zu: draws %llu/%llu reason %d/%d", name, sizes[q],
-                  (unsigned long long)sb.draws, (unsigned long long)sr.draws, sb.reason,
-                  sr.reason);
+                  (unsigned long long)sb.draws, (unsigned long long)sr.draws, sb.reason, sr.reason);
         pk_particles_free(&p);
     }
     pk_particles_free(&ref);
@@ -214,8 +214,7 @@ static void test_cells_predicate_and_neighbours(void)
         }
     }
     CHECK(seam > 20); /* points next to seams and walls are among them */
-    size_t nkept =
-        pk_rsa_cells_filter(&C, &pts[0][0], &off[0][0], pts[200], NULL, key, 200, kept);
+    size_t nkept = pk_rsa_cells_filter(&C, &pts[0][0], &off[0][0], pts[200], NULL, key, 200, kept);
     int ascending = 1;
     for (size_t j = 0; j < nkept; j++) {
         ascending &= j == 0 || kept[j] > kept[j - 1];
@@ -253,9 +252,9 @@ static void test_cells_band_matches_exact_predicate(void)
          * the store makes (the 16-bit band's error bound assumes h < 2c) */
         {.dim = 3, .L = {7.9, 3.6, 5.2}, .periodic = {true, false, true}},
     };
-    const double delta[] = {-1e-3, -2e-4, -1.3e-4, -1.1e-4, -1e-4, -3e-5, -1e-6, -1e-9,
-                            -1e-13, -2e-16, 0, 2e-16, 1e-13, 1e-9, 1e-6, 3e-5, 1e-4,
-                            1.1e-4, 1.3e-4, 2e-4, 1e-3};
+    const double delta[] = {-1e-3, -2e-4,  -1.3e-4, -1.1e-4, -1e-4,  -3e-5, -1e-6,
+                            -1e-9, -1e-13, -2e-16,  0,       2e-16,  1e-13, 1e-9,
+                            1e-6,  3e-5,   1e-4,    1.1e-4,  1.3e-4, 2e-4,  1e-3};
     const int nd = (int)(sizeof delta / sizeof *delta);
     pk_rng g;
     pk_rng_seed(&g, 11, 2);
@@ -281,8 +280,10 @@ static void test_cells_band_matches_exact_predicate(void)
             if (i >= 4 && i < 12)
                 pts[i][i % b->dim] = i % 4 < 2 ? lo[i % b->dim] : lo[i % b->dim] + span[i % b->dim];
             for (int k = 0; i >= 12 && k < b->dim; k++) /* two cells of two: (2,1,1), (4,2,2) */
-                pts[i][k] = lo[k] + C.h[k] * ((i < 14 ? 1 + (k == 0) : 2 + 2 * (k == 0)) % C.n[k] +
-                                              (i % 2 ? 0.8 : 0.15) + 0.05 * pk_rng_uniform(&g));
+                pts[i][k] = lo[k] +
+                    C.h[k] *
+                        ((i < 14 ? 1 + (k == 0) : 2 + 2 * (k == 0)) % C.n[k] +
+                         (i % 2 ? 0.8 : 0.15) + 0.05 * pk_rng_uniform(&g));
             CHECK(pk_rsa_cells_insert(&C, pts[i], (uint32_t)i) == 0);
         }
         int nq = 0;
@@ -308,8 +309,7 @@ static void test_cells_band_matches_exact_predicate(void)
         static double off[NQ][3];
         for (int i = 0; i < NQ; i++)
             key[i] = pk_rsa_cells_key_q(&C, q[i], off[i]);
-        size_t nk =
-            pk_rsa_cells_filter(&C, &pts[0][0], &off[0][0], &q[0][0], NULL, key, NQ, kept);
+        size_t nk = pk_rsa_cells_filter(&C, &pts[0][0], &off[0][0], &q[0][0], NULL, key, NQ, kept);
         memset(keep, 0, sizeof keep);
         for (size_t j = 0; j < nk; j++)
             keep[kept[j]] = 1;
@@ -325,11 +325,11 @@ static void test_cells_band_matches_exact_predicate(void)
             band += fabs(m2 / (s * s) - 1) < 1e-6;
             open += !hit;
         }
-        printf("  dim %d: %d queries, %d within 1e-6 of contact, %d kept, %d wrong\n", b->dim,
-               NQ, band, open, wrong);
+        printf("  dim %d: %d queries, %d within 1e-6 of contact, %d kept, %d wrong\n", b->dim, NQ,
+               band, open, wrong);
         CHECK_MSG(wrong == 0, "dim %d: %d answers differ from the exact predicate", b->dim, wrong);
         CHECK(band > NQ / 12 && open > NQ / 20); /* the band and both answers are exercised */
-        CHECK(C.nextra > 0);                    /* and the overflow pool */
+        CHECK(C.nextra > 0);                     /* and the overflow pool */
         int two = 0, three = 0; /* cells of two (the 16-bit test) and of three or more */
         for (int i = 0; i < NS; i++) {
             double o[3];

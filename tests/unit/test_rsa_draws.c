@@ -20,7 +20,8 @@ static const char *job_fmt =
     "{\"process\": \"pack\", \"inputs\": {\"dim\": 3, \"unit\": \"mm\","
     " \"domain\": {\"box\": {\"size\": [10, 10, 10], \"periodic\": true}},"
     " \"grading\": {\"type\": \"classes\", \"classes\": [{\"d\": 1.0, \"volume_percent\": 100}]},"
-    " \"sampling\": \"discrete\", \"count\": 2000, \"phi\": {\"value\": 0.33, \"refers_to\": \"resolved\"},"
+    " \"sampling\": \"discrete\", \"count\": 2000, \"phi\": {\"value\": 0.33, \"refers_to\": "
+    "\"resolved\"},"
     " \"algorithm\": \"rsa\", \"seed\": 3%s}}";
 
 /* Runs the job with `extra` appended to its inputs; the summary (new ref) or NULL. */
@@ -54,7 +55,9 @@ static uint64_t core_draws(double d, pk_rsa_draws draws, int one_at_a_time)
         dd[i] = d;
     pk_particles p;
     pk_particles_init(&p, 3, NGRAIN);
-    pk_rsa_params prm = {.max_failed_draws = 1000000, .seed = SEED, .draws = draws,
+    pk_rsa_params prm = {.max_failed_draws = 1000000,
+                         .seed = SEED,
+                         .draws = draws,
                          .test.one_at_a_time = one_at_a_time};
     pk_rsa_stats st;
     CHECK(pk_rsa_place(&b, dd, sp, NGRAIN, &prm, NULL, &p, &st) == 0 && st.placed == NGRAIN);
@@ -99,7 +102,7 @@ static void test_unknown_draws_refused(void)
     int hit = 0;
     for (size_t i = 0; i < errs.n; i++)
         hit |= strcmp(errs.items[i].pointer, "/inputs/rsa/draws") == 0 &&
-               strcmp(errs.items[i].rule, "enum") == 0;
+            strcmp(errs.items[i].rule, "enum") == 0;
     CHECK(hit);
     json_decref(sum);
     pk_schema_errors_free(&errs);

@@ -44,8 +44,8 @@ static void draw_range(const pk_box *b, double r, double gap, double *lo, double
 
 /* Is fine voxel j (per axis) inside the ball (x, rad), the voxel taken at
  * the image of x nearest to its centre?  All 2^dim corners within rad. */
-static int voxel_in_ball(const pk_box *b, const pk_rsa_region *R, const int64_t *j,
-                         const double *x, double rad)
+static int voxel_in_ball(const pk_box *b, const pk_rsa_region *R, const int64_t *j, const double *x,
+                         double rad)
 {
     double a[3] = {0, 0, 0}, mid[3] = {0, 0, 0}, s[3] = {0, 0, 0};
     for (int k = 0; k < b->dim; k++) {
@@ -145,10 +145,10 @@ static void test_marks_are_exact(void)
             fine *= table.hf[k];
         for (int i = 0; i < NB; i++)
             balls += pk_ball_measure(b->dim, rad[i]);
-        printf("  box %d: %ld marked (table), %ld (direct), %.2f of the balls' volume\n", t,
-               marked, dmarked, (double)marked * fine / balls);
-        CHECK_MSG(wrong == 0 && dwrong == 0, "box %d: %ld / %ld marks outside every ball", t,
-                  wrong, dwrong);
+        printf("  box %d: %ld marked (table), %ld (direct), %.2f of the balls' volume\n", t, marked,
+               dmarked, (double)marked * fine / balls);
+        CHECK_MSG(wrong == 0 && dwrong == 0, "box %d: %ld / %ld marks outside every ball", t, wrong,
+                  dwrong);
         CHECK_MSG(extra == 0, "box %d: %ld table marks the direct cover lacks", t, extra);
         /* measured 0.48 (3D) .. 0.7 (2D): fine voxels c/8 (c/16 in 2D) leave a skin */
         CHECK((double)marked * fine > 0.3 * balls);
@@ -235,7 +235,8 @@ static void freeze(frozen *F, int dim, size_t n, double phi, double gap)
     F->c = 1 + gap;
     double L = dim == 3 ? cbrt((double)n * pk_ball_measure(3, 0.5) / phi)
                         : sqrt((double)n * pk_ball_measure(2, 0.5) / phi);
-    F->box = (pk_box){.dim = dim, .L = {L, L, dim == 3 ? L : 0}, .periodic = {true, dim == 3, true}};
+    F->box =
+        (pk_box){.dim = dim, .L = {L, L, dim == 3 ? L : 0}, .periodic = {true, dim == 3, true}};
     for (int k = 0; k < dim; k++) {
         F->lo[k] = F->box.periodic[k] ? 0 : F->r + 0.5 * gap;
         F->span[k] = F->box.periodic[k] ? L : L - 2 * F->lo[k];
@@ -245,8 +246,8 @@ static void freeze(frozen *F, int dim, size_t n, double phi, double gap)
     for (size_t i = 0; i < n; i++)
         d[i] = 1.0;
     pk_particles_init(&F->p, dim, n);
-    pk_rsa_params prm = {.delta_d = gap, .max_failed_draws = 1000000, .seed = 77,
-                         .draws = PK_RSA_DRAWS_PLAIN};
+    pk_rsa_params prm = {
+        .delta_d = gap, .max_failed_draws = 1000000, .seed = 77, .draws = PK_RSA_DRAWS_PLAIN};
     pk_rsa_stats st;
     CHECK(pk_rsa_place(&F->box, d, sp, n, &prm, NULL, &F->p, &st) == 0 && st.placed == n);
     free(d);
@@ -365,7 +366,8 @@ static void test_draws_uniform_over_open_space(void)
         double xs = chi2_two(sp, sr, NSPACE, &ds), xn = chi2_two(np, nr, NNEAR, &dn);
         double bs = chi2_two(sp, sb, NSPACE, &dbs), bn = chi2_two(np, nb, NNEAR, &dbn);
         printf("  dim %d: region vs plain chi2 space %.1f (dof %d), nearest %.1f (dof %d); "
-               "biased sampler: %.1f, %.1f\n", dim, xs, ds, xn, dn, bs, bn);
+               "biased sampler: %.1f, %.1f\n",
+               dim, xs, ds, xn, dn, bs, bn);
         CHECK_MSG(chi2_ok(xs, ds) && chi2_ok(xn, dn), "dim %d: region draws not uniform", dim);
         /* the control: the same test rejects a sampler that is slightly wrong */
         CHECK_MSG(!chi2_ok(bs, dbs) || !chi2_ok(bn, dbn), "dim %d: the test has no power", dim);
@@ -385,7 +387,9 @@ static void mono_run(int dim, size_t n, double phi, uint64_t seed, int plain, pk
     for (size_t i = 0; i < n; i++)
         d[i] = 1.0;
     pk_particles_init(p, dim, n);
-    pk_rsa_params prm = {.delta_d = 0, .max_failed_draws = 1000000, .seed = seed,
+    pk_rsa_params prm = {.delta_d = 0,
+                         .max_failed_draws = 1000000,
+                         .seed = seed,
                          .draws = plain ? PK_RSA_DRAWS_PLAIN : PK_RSA_DRAWS_OPEN};
     CHECK(pk_rsa_place(b, d, sp, n, &prm, NULL, p, st) == 0);
     free(d);
@@ -482,8 +486,8 @@ static void test_runs_match_plain(void)
     double pr = mean_of(fr, NSEED), pp = mean_of(fp, NSEED);
     double t = (pr - pp) / sqrt(var_of(fr, NSEED) / NSEED + var_of(fp, NSEED) / NSEED);
     printf("  contact bin %.0f / %.0f pairs, chi2 = %.2f; open fraction %.5f / %.5f, t = %.2f; "
-           "draws per grain %.1f / %.1f\n", hr[0], hp[0], chi2, pr, pp, t, dr / 12000.0,
-           dp / 12000.0);
+           "draws per grain %.1f / %.1f\n",
+           hr[0], hp[0], chi2, pr, pp, t, dr / 12000.0, dp / 12000.0);
     CHECK_MSG(chi2 < 30, "pair distributions differ, chi2 = %.1f", chi2);
     CHECK_MSG(fabs(t) < 5, "insertion probability differs, t = %.2f", t);
     /* the point of it: measured ≈ 22 vs 35 draws per grain */
@@ -497,16 +501,16 @@ static void audit(const pk_box *b, const pk_particles *p, double gap, const char
     double worst = INFINITY, wall = INFINITY;
     for (size_t i = 0; i < p->n; i++) {
         for (size_t j = i + 1; j < p->n; j++)
-            worst = fmin(worst, sqrt(pk_box_dist2(b, &p->x[3 * i], &p->x[3 * j])) - p->r[i] -
-                                    p->r[j]);
+            worst =
+                fmin(worst, sqrt(pk_box_dist2(b, &p->x[3 * i], &p->x[3 * j])) - p->r[i] - p->r[j]);
         for (int k = 0; k < b->dim; k++)
             if (!b->periodic[k])
                 wall = fmin(wall, fmin(p->x[3 * i + k], b->L[k] - p->x[3 * i + k]) - p->r[i]);
     }
-    printf("  %s: %zu grains, smallest gap %.6g (dd %.3g), to walls %.6g\n", name, p->n, worst,
-           gap, wall);
-    CHECK_MSG(worst >= gap && wall >= 0.5 * gap, "%s: gap %.17g / wall %.17g below dd", name,
-              worst, wall);
+    printf("  %s: %zu grains, smallest gap %.6g (dd %.3g), to walls %.6g\n", name, p->n, worst, gap,
+           wall);
+    CHECK_MSG(worst >= gap && wall >= 0.5 * gap, "%s: gap %.17g / wall %.17g below dd", name, worst,
+              wall);
 }
 
 /* Region runs in walled, mixed and 2D boxes with Δd, after grains of another
@@ -537,7 +541,8 @@ static void test_region_runs_exact_and_reproducible(void)
         pk_rsa_stats st[2];
         for (int rep = 0; rep < 2; rep++) {
             pk_particles_init(&p[rep], b->dim, big + n);
-            pk_rsa_params prm = {.delta_d = cs[t].gap, .max_failed_draws = cs[t].max_failed,
+            pk_rsa_params prm = {.delta_d = cs[t].gap,
+                                 .max_failed_draws = cs[t].max_failed,
                                  .seed = 40 + (uint64_t)t};
             CHECK(pk_rsa_place(b, d, sp, big + n, &prm, NULL, &p[rep], &st[rep]) == 0);
         }
@@ -547,9 +552,8 @@ static void test_region_runs_exact_and_reproducible(void)
         if (t < 2)
             CHECK(st[0].reason == PK_STOP_COMPLETE && st[0].placed == big + n);
         else
-            CHECK((st[0].reason == PK_STOP_MAX_FAILED_DRAWS ||
-                   st[0].reason == PK_STOP_SATURATED) && st[0].placed < big + n &&
-                  (double)st[0].placed > 0.5 * (double)(big + n));
+            CHECK((st[0].reason == PK_STOP_MAX_FAILED_DRAWS || st[0].reason == PK_STOP_SATURATED) &&
+                  st[0].placed < big + n && (double)st[0].placed > 0.5 * (double)(big + n));
         CHECK(st[0].draws == st[1].draws && st[0].reason == st[1].reason && p[0].n == p[1].n &&
               memcmp(p[0].x, p[1].x, 3 * p[0].n * sizeof(double)) == 0);
         for (int rep = 0; rep < 2; rep++)

@@ -38,7 +38,9 @@ static void mono_run(int dim, size_t n, double phi, uint64_t seed, int plain, pk
     pk_particles_init(p, dim, n);
     /* one at a time: equal grains would otherwise take the batched path (which
      * equals the plain one bit for bit, test_rsa_batch.c) and skip the voxels */
-    pk_rsa_params prm = {.delta_d = 0, .max_failed_draws = 1000000, .seed = seed,
+    pk_rsa_params prm = {.delta_d = 0,
+                         .max_failed_draws = 1000000,
+                         .seed = seed,
                          .draws = plain ? PK_RSA_DRAWS_PLAIN : PK_RSA_DRAWS_OPEN,
                          .test.one_at_a_time = 1};
     CHECK(pk_rsa_place(b, d, sp, n, &prm, NULL, p, st) == 0);
@@ -79,9 +81,10 @@ static void test_fast_matches_plain_pair_distribution(void)
         for (int k = 0; k < NBIN; k++)
             if (hf[k] + hp[k] > 0)
                 chi2 += (hf[k] - hp[k]) * (hf[k] - hp[k]) / (hf[k] + hp[k]);
-        printf("  dim %d: pairs in [d,2d) fast %.0f plain %.0f, first bin %.0f / %.0f, chi2 = %.2f\n",
-               dim, hf[0] + hf[1] + hf[2] + hf[3] + hf[4] + hf[5] + hf[6],
-               hp[0] + hp[1] + hp[2] + hp[3] + hp[4] + hp[5] + hp[6], hf[0], hp[0], chi2);
+        printf(
+            "  dim %d: pairs in [d,2d) fast %.0f plain %.0f, first bin %.0f / %.0f, chi2 = %.2f\n",
+            dim, hf[0] + hf[1] + hf[2] + hf[3] + hf[4] + hf[5] + hf[6],
+            hp[0] + hp[1] + hp[2] + hp[3] + hp[4] + hp[5] + hp[6], hf[0], hp[0], chi2);
         CHECK_MSG(chi2 < 30, "dim %d: fast and plain pair distributions differ, chi2 = %.1f", dim,
                   chi2);
     }
@@ -181,8 +184,8 @@ static void test_fast_respects_present_grains(void)
     int32_t *sp = calloc(n, sizeof *sp);
     for (size_t i = 0; i < n; i++)
         d[i] = 0.5;
-    pk_rsa_params prm = {.delta_d = 0.02, .max_failed_draws = 100000, .seed = 8,
-                         .test.one_at_a_time = 1};
+    pk_rsa_params prm = {
+        .delta_d = 0.02, .max_failed_draws = 100000, .seed = 8, .test.one_at_a_time = 1};
     pk_rsa_stats st;
     CHECK(pk_rsa_place(&b, d, sp, n, &prm, NULL, &p, &st) == 0);
     CHECK(p.n == 4 + st.placed && st.placed > 1000);

@@ -45,7 +45,8 @@ static void test_nist_million_a_in_odd_chunks(void)
         left -= n;
     }
     CHECK(pk_sha256_final(s, d) == 0);
-    CHECK(pk_sha256_from_hex("cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0", want) == 0);
+    CHECK(pk_sha256_from_hex("cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0",
+                             want) == 0);
     CHECK(!memcmp(d, want, 32));
 }
 

@@ -52,7 +52,7 @@ static int same_solution(pk_sparse_factor *f, pk_sparse_factor *g, size_t n)
     for (size_t k = 0; same && k < n; k++)
         b[k] = cos(0.37 * (double)k) + 0.1;
     same = same && pk_sparse_cholmod.solve(f, 1, b, x) == 0 &&
-           pk_sparse_cholmod.solve(g, 1, b, y) == 0 && memcmp(x, y, n * sizeof *x) == 0;
+        pk_sparse_cholmod.solve(g, 1, b, y) == 0 && memcmp(x, y, n * sizeof *x) == 0;
     free(b), free(x), free(y);
     return same;
 }

@@ -61,7 +61,8 @@ static int in_tet(const pk_mesh *m, size_t e, const double *p)
             w[j] = d[3][j] - d[0][j];
         }
         s += fabs(u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-                  u[2] * (v[0] * w[1] - v[1] * w[0])) / 6;
+                  u[2] * (v[0] * w[1] - v[1] * w[0])) /
+            6;
     }
     return s <= pk_mesh_tet_volume(m, e) * (1 + 1e-9);
 }
@@ -70,7 +71,8 @@ static int in_tet(const pk_mesh *m, size_t e, const double *p)
 static double face_distance(const pk_mesh *m, size_t f, const double x[3])
 {
     double q[3];
-    pk_closest_on_triangle(x, &m->x[3 * (size_t)m->bface[3 * f]], &m->x[3 * (size_t)m->bface[3 * f + 1]],
+    pk_closest_on_triangle(x, &m->x[3 * (size_t)m->bface[3 * f]],
+                           &m->x[3 * (size_t)m->bface[3 * f + 1]],
                            &m->x[3 * (size_t)m->bface[3 * f + 2]], q);
     return sqrt((x[0] - q[0]) * (x[0] - q[0]) + (x[1] - q[1]) * (x[1] - q[1]) +
                 (x[2] - q[2]) * (x[2] - q[2]));
@@ -257,8 +259,8 @@ static void test_densify_saturates(void)
     pk_mesh_free(&m);
 }
 
-static void run_box(uint64_t seed, int passes, double phi_target, size_t n_target,
-                    pk_particles *p, pk_tetfill_stats *st, pk_monitor *mon)
+static void run_box(uint64_t seed, int passes, double phi_target, size_t n_target, pk_particles *p,
+                    pk_tetfill_stats *st, pk_monitor *mon)
 {
     pk_mesh m;
     char err[256];
@@ -338,7 +340,8 @@ static void test_cancel(void)
     pk_tetfill_stats st;
     volatile sig_atomic_t flag = 1;
     cancel_probe by_flag = {0};
-    pk_monitor mon = {.fn = cancel_when_placed, .ctx = &by_flag, .cancel = &flag, .interval_s = 1e-9};
+    pk_monitor mon = {
+        .fn = cancel_when_placed, .ctx = &by_flag, .cancel = &flag, .interval_s = 1e-9};
     run_box(1, 10, 0, 0, &p, &st, &mon);
     CHECK_MSG(st.reason == PK_STOP_CANCELLED, "stop reason %d", (int)st.reason);
     CHECK(by_flag.calls == 0); /* the flag wins before any report */

@@ -29,7 +29,8 @@ static void test_generate(void)
     char a[PK_TOKEN_LEN + 1], b[PK_TOKEN_LEN + 1];
     CHECK(pk_token_generate(a) == 0 && pk_token_generate(b) == 0);
     CHECK(strlen(a) == PK_TOKEN_LEN && !strncmp(a, PK_TOKEN_PREFIX, strlen(PK_TOKEN_PREFIX)));
-    CHECK(strspn(a + strlen(PK_TOKEN_PREFIX), "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-_") ==
+    CHECK(strspn(a + strlen(PK_TOKEN_PREFIX),
+                 "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-_") ==
           PK_TOKEN_LEN - strlen(PK_TOKEN_PREFIX));
     CHECK(strcmp(a, b) != 0);
 }

@@ -60,34 +60,34 @@ static int usable(const pk_box *b, double r, double gap, const double *span, siz
 }
 
 typedef struct scratch {
-    size_t cap;         /* attempts */
-    size_t capd;        /* region draws (rpos, rbit) */
-    double *pos;        /* [cap][3] attempts in attempt order */
-    uint32_t *rpos;     /* region draws: list position of each draw, then the cell of
+    size_t cap;      /* attempts */
+    size_t capd;     /* region draws (rpos, rbit) */
+    double *pos;     /* [cap][3] attempts in attempt order */
+    uint32_t *rpos;  /* region draws: list position of each draw, then the cell of
                            each draw not rejected at once (in draw order) */
-    uint8_t *rbit;      /* its fine voxel (same order as rpos) */
-    uint32_t *rdraw;    /* draw number of each draw not rejected at once */
-    uint32_t *ord;      /* [cap + 1] draw number of each attempt in its batch
+    uint8_t *rbit;   /* its fine voxel (same order as rpos) */
+    uint32_t *rdraw; /* draw number of each draw not rejected at once */
+    uint32_t *ord;   /* [cap + 1] draw number of each attempt in its batch
                            (region draws: certain rejections make no attempt) */
-    uint32_t *key;      /* bucket of each attempt */
-    double *spos;       /* [cap][3] attempts' offsets from their cells' corners
+    uint32_t *key;   /* bucket of each attempt */
+    double *spos;    /* [cap][3] attempts' offsets from their cells' corners
                            (pk_rsa_cells_key_q) in bucket order */
-    uint32_t *sidx;     /* attempt index of each sorted entry */
-    uint32_t *skey;     /* its cell key */
-    uint32_t *kept;     /* sorted positions of the survivors of step 2 */
-    uint64_t *sbit;     /* bit a: attempt a survived step 2 */
-    int32_t *slot;      /* survivor number of attempt a (set where sbit is) */
-    double *surv;       /* [cap][3] survivors in sorted order (before step 2: the
+    uint32_t *sidx;  /* attempt index of each sorted entry */
+    uint32_t *skey;  /* its cell key */
+    uint32_t *kept;  /* sorted positions of the survivors of step 2 */
+    uint64_t *sbit;  /* bit a: attempt a survived step 2 */
+    int32_t *slot;   /* survivor number of attempt a (set where sbit is) */
+    double *surv;    /* [cap][3] survivors in sorted order (before step 2: the
                            attempts' offsets in attempt order) */
-    uint32_t *vkey;     /* survivors' keys */
-    uint8_t *taken;     /* survivor accepted in step 3 */
-    uint32_t *pid;      /* its index in the particle array (set where taken is) */
-    uint32_t *count;    /* [MAX_BUCKETS + 1] */
-    size_t stale;       /* region draws of the last batch that fell in a fully covered cell */
+    uint32_t *vkey;  /* survivors' keys */
+    uint8_t *taken;  /* survivor accepted in step 3 */
+    uint32_t *pid;   /* its index in the particle array (set where taken is) */
+    uint32_t *count; /* [MAX_BUCKETS + 1] */
+    size_t stale;    /* region draws of the last batch that fell in a fully covered cell */
     /* step 3: hash of the batch's accepted survivors by cell */
-    int32_t *head;      /* [power of two >= 2 cap] */
-    int32_t *hnext;     /* per survivor */
-    uint64_t *hcell;    /* per survivor: its cell */
+    int32_t *head;   /* [power of two >= 2 cap] */
+    int32_t *hnext;  /* per survivor */
+    uint64_t *hcell; /* per survivor: its cell */
 } scratch;
 
 static void scratch_free(scratch *w)
@@ -129,10 +129,7 @@ static void *renew(void *p, size_t bytes, int *fail)
 }
 
 /* Capacity for a request of n: at least twice the last, so few renewals. */
-static size_t grown(size_t cap, size_t n)
-{
-    return n > 2 * cap ? n : 2 * cap;
-}
+static size_t grown(size_t cap, size_t n) { return n > 2 * cap ? n : 2 * cap; }
 
 /* Room for region batches of B draws (grows only, contents not kept; -1 when
  * out of memory). */
@@ -293,8 +290,8 @@ static size_t region_pick(const pk_rsa_region *reg, scratch *w, size_t B, pk_rng
  * w->ord[*A] = B.  Returns the number of survivors, SIZE_MAX when out of
  * memory. */
 static size_t draw_and_filter(const pk_rsa_cells *C, const double *px, scratch *w, size_t B,
-                              int dim, const double *lo, const double *span, pk_rng *rng,
-                              int shift, uint32_t nbucket, const pk_rsa_region *reg, size_t *A)
+                              int dim, const double *lo, const double *span, pk_rng *rng, int shift,
+                              uint32_t nbucket, const pk_rsa_region *reg, size_t *A)
 {
     size_t open = 0;
     if (reg) { /* the certain rejections need no room beyond the draw arrays */
@@ -368,9 +365,8 @@ static size_t draw_and_filter(const pk_rsa_cells *C, const double *px, scratch *
  * left open.  -1 when out of memory (the run then keeps plain draws).  Marks
  * are optional for correctness: a cancel request cuts the marking short. */
 static int region_start(pk_rsa_region *reg, const pk_rsa_cells *C, const pk_box *b, double r,
-                        double gap, const double *lo, const double *span,
-                        const pk_particles *out, size_t first, size_t m, pk_monitor *mon,
-                        pk_progress *pg)
+                        double gap, const double *lo, const double *span, const pk_particles *out,
+                        size_t first, size_t m, pk_monitor *mon, pk_progress *pg)
 {
     const double c = 2 * r + gap;
     uint64_t cells = 1;
@@ -416,8 +412,7 @@ static int region_start(pk_rsa_region *reg, const pk_rsa_cells *C, const pk_box 
                 if (!(a & PK_RSA_CELLS_MORE))
                     ids[k++] = a;
                 else
-                    for (int32_t e = (int32_t)(a & PK_RSA_CELLS_POOL); e >= 0;
-                         e = C->extra[e].next)
+                    for (int32_t e = (int32_t)(a & PK_RSA_CELLS_POOL); e >= 0; e = C->extra[e].next)
                         ids[k++] = C->extra[e].id;
             }
         }
@@ -490,8 +485,8 @@ static pk_stop_reason run_batches(const pk_rsa_batch_env *e, double r, const int
         if (!region && region_allowed && p_acc < REGION_SWITCH_ACC &&
             m - placed >= REGION_MIN_LEFT) {
             region_allowed = 0;
-            region = region_start(&reg, &C, b, r, prm->delta_d, lo, span, out, first, m, mon,
-                                  pg) == 0;
+            region =
+                region_start(&reg, &C, b, r, prm->delta_d, lo, span, out, first, m, mon, pg) == 0;
         }
         if (region && reg.nlist == 0) {
             reason = PK_STOP_SATURATED; /* every fine voxel lies in an exclusion ball */
@@ -554,7 +549,7 @@ static pk_stop_reason run_batches(const pk_rsa_batch_env *e, double r, const int
             const double *x = &w.surv[3 * (size_t)j];
             const uint32_t key = w.vkey[j];
             int ok = !batch_hits(&C, &w, map, hmask, x, key) &&
-                     (grid_empty || !pk_grid_overlaps(grid, out, x, r));
+                (grid_empty || !pk_grid_overlaps(grid, out, x, r));
             if (!ok) {
                 if (++failed >= max_failed) {
                     used = next_d;
@@ -647,7 +642,7 @@ int pk_rsa_batch_place(const pk_rsa_batch_env *e, double r, const int32_t *speci
     if (m < (min_run ? min_run : PK_RSA_BATCH_MIN_RUN) ||
         !usable(e->b, r, e->prm->delta_d, span, m))
         return 0;
-    *why = e->enter && e->enter(e->ctx) != 0 ? PK_STOP_ERROR
-                                              : run_batches(e, r, species, m, lo, span);
+    *why =
+        e->enter && e->enter(e->ctx) != 0 ? PK_STOP_ERROR : run_batches(e, r, species, m, lo, span);
     return 1;
 }

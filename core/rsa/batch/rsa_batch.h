@@ -15,15 +15,15 @@
 /* The state of rsa.c's placement loop that a batched run works on. */
 typedef struct pk_rsa_batch_env {
     const pk_box *b;
-    const pk_rsa_params *prm;     /* Δd, N^F, draws, test overrides */
-    const pk_grid *grid;          /* the grains placed before the run */
-    pk_rng *rng;                  /* the position stream, left just after the run's last draw */
+    const pk_rsa_params *prm; /* Δd, N^F, draws, test overrides */
+    const pk_grid *grid;      /* the grains placed before the run */
+    pk_rng *rng;              /* the position stream, left just after the run's last draw */
     pk_monitor *mon;
     pk_progress *pg;
     double box_measure;
-    double *solid;                /* grows by the run's grains' measure */
-    pk_particles *out;            /* the run's grains are appended (not added to grid) */
-    pk_rsa_stats *st;             /* adds to placed and draws */
+    double *solid;     /* grows by the run's grains' measure */
+    pk_particles *out; /* the run's grains are appended (not added to grid) */
+    pk_rsa_stats *st;  /* adds to placed and draws */
     /* Called once the run is known to take the batched path, before its first
      * draw: the caller makes grid hold every grain placed so far.  0 or -1. */
     int (*enter)(void *ctx);

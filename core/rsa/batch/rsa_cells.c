@@ -126,7 +126,7 @@ static void set_offsets(pk_rsa_cells *C)
     C->nrow = zr ? 9 : 3;
     for (int r = 0; r < C->nrow; r++)
         C->row[r] = (int64_t)(r / 3 - zr) * (int64_t)C->stride[2] +
-                    (int64_t)(r % 3 - 1) * (int64_t)C->stride[1] - 1;
+            (int64_t)(r % 3 - 1) * (int64_t)C->stride[1] - 1;
     for (unsigned oct = 0; oct < 8; oct++) {
         int cnt = 0;
         for (int rank = 0; rank < 16; rank++) /* rank 0: the cell itself */
@@ -179,7 +179,8 @@ int pk_rsa_cells_around(const pk_rsa_cells *C, const double *x, uint64_t out[27]
         for (int y = 0; y < m[1]; y++)
             for (int xx = 0; xx < m[0]; xx++)
                 out[cnt++] = ((uint64_t)a[2][z] * (uint64_t)C->np[1] + (uint64_t)a[1][y]) *
-                                 (uint64_t)C->np[0] + (uint64_t)a[0][xx];
+                        (uint64_t)C->np[0] +
+                    (uint64_t)a[0][xx];
     return cnt;
 }
 
@@ -265,14 +266,17 @@ int pk_rsa_cells_insert(pk_rsa_cells *C, const double *x, uint32_t id)
             a[k][m[k]++] = 0;
     }
     if (m[0] * m[1] * m[2] == 1) /* off the seams: no ghost */
-        return store(C, ((uint64_t)a[2][0] * (uint64_t)C->np[1] + (uint64_t)a[1][0]) *
-                                (uint64_t)C->np[0] + (uint64_t)a[0][0],
+        return store(C,
+                     ((uint64_t)a[2][0] * (uint64_t)C->np[1] + (uint64_t)a[1][0]) *
+                             (uint64_t)C->np[0] +
+                         (uint64_t)a[0][0],
                      f, id);
     for (int z = 0; z < m[2]; z++)
         for (int y = 0; y < m[1]; y++)
             for (int xx = 0; xx < m[0]; xx++) {
                 uint64_t lin = ((uint64_t)a[2][z] * (uint64_t)C->np[1] + (uint64_t)a[1][y]) *
-                                   (uint64_t)C->np[0] + (uint64_t)a[0][xx];
+                        (uint64_t)C->np[0] +
+                    (uint64_t)a[0][xx];
                 if (store(C, lin, f, id) != 0)
                     return -1;
             }
@@ -315,8 +319,7 @@ static inline int cell_hits(const pk_rsa_cells *C, const pk_rsa_cell1 *c, const 
         return near_one(C, c->x, b, q, px, x);
     if (!(b & PK_RSA_CELLS_THREE)) {
         /* a step's centre is u + 1/2: compare with q - hq/2 */
-        const double qh[3] = {q[0] - 0.5 * C->hq[0], q[1] - 0.5 * C->hq[1],
-                              q[2] - 0.5 * C->hq[2]};
+        const double qh[3] = {q[0] - 0.5 * C->hq[0], q[1] - 0.5 * C->hq[1], q[2] - 0.5 * C->hq[2]};
         const double a = qdist2(C, qh, c->q[0]), d = qdist2(C, qh, c->q[1]);
         if (a < C->q2_lo || d < C->q2_lo)
             return 1;
@@ -336,8 +339,8 @@ static inline int cell_hits(const pk_rsa_cells *C, const pk_rsa_cell1 *c, const 
 #define PREFETCH_AHEAD 8
 
 size_t pk_rsa_cells_filter(const pk_rsa_cells *C, const double *px, const double *qs,
-                           const double *pos, const uint32_t *idx, const uint32_t *key,
-                           size_t n, uint32_t *kept)
+                           const double *pos, const uint32_t *idx, const uint32_t *key, size_t n,
+                           uint32_t *kept)
 {
     size_t cnt = 0;
     const int nrow = C->nrow;

@@ -27,10 +27,10 @@
 #include "core/space/box.h"
 
 #define PK_RSA_CELLS_BAND 0x1p-14
-#define PK_RSA_CELLS_NONE 0xffffffffu /* empty slot */
-#define PK_RSA_CELLS_MORE 0x80000000u /* id: the cell's grains are in the pool */
+#define PK_RSA_CELLS_NONE 0xffffffffu  /* empty slot */
+#define PK_RSA_CELLS_MORE 0x80000000u  /* id: the cell's grains are in the pool */
 #define PK_RSA_CELLS_THREE 0x40000000u /* id, with MORE: three or more grains */
-#define PK_RSA_CELLS_POOL 0x3fffffffu /* id, with MORE: the chain's first pool entry */
+#define PK_RSA_CELLS_POOL 0x3fffffffu  /* id, with MORE: the chain's first pool entry */
 /* Offsets of a cell's first two grains in 16-bit steps of h/65536 and the band
  * of their quick test: a step's error moves a squared distance near contact by
  * < 1.1e-4·c², inside ±2^-12·c² (README.md, "Why it is exact"). */
@@ -39,12 +39,12 @@
 
 typedef struct pk_rsa_cell1 {
     union {
-        float x[3];             /* one grain: its offsets from the cell's lower corner
+        float x[3];       /* one grain: its offsets from the cell's lower corner
                                    (z = 0 in 2D) */
-        uint16_t q[2][3];       /* two or more (MORE): the first two grains' offsets in
+        uint16_t q[2][3]; /* two or more (MORE): the first two grains' offsets in
                                    steps of h/65536, rounded down */
     };
-    uint32_t id;                /* particle index, PK_RSA_CELLS_NONE = empty; with
+    uint32_t id; /* particle index, PK_RSA_CELLS_NONE = empty; with
                                    PK_RSA_CELLS_MORE: the cell holds two or more grains, all
                                    in the pool (exact offsets and indices), the chain
                                    starting at entry id & PK_RSA_CELLS_POOL; THREE set when
@@ -54,19 +54,19 @@ typedef struct pk_rsa_cell1 {
 typedef struct pk_rsa_extra {
     float x[3];
     uint32_t id;
-    int32_t next;               /* next pool entry of the cell, -1 = last */
+    int32_t next; /* next pool entry of the cell, -1 = last */
 } pk_rsa_extra;
 
 typedef struct pk_rsa_cells {
     int dim;
     double L[PK_MAXDIM];
-    double quarter[PK_MAXDIM];  /* L/4 on periodic axes (beyond it the image may
+    double quarter[PK_MAXDIM]; /* L/4 on periodic axes (beyond it the image may
                                    shift), +inf on walled and unused axes */
-    double lo[PK_MAXDIM];       /* lower end of the draw range per axis */
-    double h[PK_MAXDIM];        /* cell edge (0 on unused axes) */
+    double lo[PK_MAXDIM];      /* lower end of the draw range per axis */
+    double h[PK_MAXDIM];       /* cell edge (0 on unused axes) */
     double inv_h[PK_MAXDIM];
-    double inv_h2[PK_MAXDIM];   /* 2·inv_h: half cells (the key's octant) */
-    uint64_t jmax[PK_MAXDIM];   /* 2n - 1: last half cell */
+    double inv_h2[PK_MAXDIM]; /* 2·inv_h: half cells (the key's octant) */
+    uint64_t jmax[PK_MAXDIM]; /* 2n - 1: last half cell */
     int periodic[PK_MAXDIM];
     double seam_lo[PK_MAXDIM];  /* x < seam_lo or x >= seam_hi: maybe in a seam cell */
     double seam_hi[PK_MAXDIM];  /* (pk_rsa_cells_seam; -inf / +inf where never,
@@ -80,12 +80,12 @@ typedef struct pk_rsa_cells {
     double hq[PK_MAXDIM];       /* h/65536: a 16-bit step (0 on unused axes) */
     uint64_t stride[PK_MAXDIM]; /* padded index = base + sum_k i_k·stride[k] */
     uint64_t base;
-    int noff;                   /* 3^dim */
-    int64_t off[8][27];         /* offsets in the padded array of the cell itself (first)
+    int noff;               /* 3^dim */
+    int64_t off[8][27];     /* offsets in the padded array of the cell itself (first)
                                    and its neighbours per octant of the cell (bit k: upper
                                    half along axis k), the near sides first: a rejected
                                    attempt usually meets its overlap in the first few */
-    double shift[8][27][3];     /* the neighbour's corner minus the cell's */
+    double shift[8][27][3]; /* the neighbour's corner minus the cell's */
     /* Occupancy: bit i of occ is set once padded cell i holds a grain (ghost
      * copies included), so a test reads 9 (3D) or 3 (2D) runs of 3 bits from
      * an array 256 times smaller than the cells and touches nonempty cells
@@ -220,7 +220,7 @@ static inline unsigned pk_rsa_cells_octant(uint32_t key)
     return key >> PK_RSA_CELLS_OCT_SHIFT & 7u;
 }
 size_t pk_rsa_cells_filter(const pk_rsa_cells *C, const double *px, const double *q,
-                           const double *pos, const uint32_t *idx, const uint32_t *key,
-                           size_t n, uint32_t *kept);
+                           const double *pos, const uint32_t *idx, const uint32_t *key, size_t n,
+                           uint32_t *kept);
 
 #endif

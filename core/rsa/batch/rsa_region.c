@@ -13,8 +13,7 @@ int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, cons
                        const double *span, double c, int steps)
 {
     memset(R, 0, sizeof *R);
-    if (!b || b->dim < 2 || b->dim > 3 || !(c > 0) || steps < 1 ||
-        steps > PK_RSA_REGION_MAX_STEPS)
+    if (!b || b->dim < 2 || b->dim > 3 || !(c > 0) || steps < 1 || steps > PK_RSA_REGION_MAX_STEPS)
         return -1;
     R->dim = b->dim;
     R->S = b->dim == 3 ? 4 : 8; /* S^dim = 64: one word per cell */
@@ -59,7 +58,8 @@ int pk_rsa_region_init(pk_rsa_region *R, const pk_box *b, const int64_t *n, cons
         if (b->periodic[k] && n[k] < 2 * R->D + 1)
             return -1; /* the cells around a grain must be distinct */
     size_t ne = b->dim == 3 ? (size_t)R->Q * R->Q * R->Q : (size_t)R->Q * R->Q;
-    R->entry = (size_t)(2 * R->D + 1) * (size_t)(2 * R->D + 1) * (b->dim == 3 ? (size_t)(2 * R->D + 1) : 1);
+    R->entry = (size_t)(2 * R->D + 1) * (size_t)(2 * R->D + 1) *
+        (b->dim == 3 ? (size_t)(2 * R->D + 1) : 1);
     R->tab = malloc(ne * R->entry * sizeof *R->tab);
     R->trows = malloc(ne * sizeof *R->trows);
     R->tcnt = malloc(ne);
@@ -117,8 +117,7 @@ void pk_rsa_region_compact(pk_rsa_region *R)
 /* Fine voxels j along axis k whose interval [a, a + hf] lies within
  * [x - w, x + w]: j from ceil((x - w - lo)/hf) to floor((x + w - lo)/hf) - 1,
  * unwrapped on periodic axes, clipped on walled ones.  Returns 0 if none. */
-static int inside_range(const pk_rsa_region *R, int k, double x, double w, int64_t *j0,
-                        int64_t *j1)
+static int inside_range(const pk_rsa_region *R, int k, double x, double w, int64_t *j0, int64_t *j1)
 {
     *j0 = (int64_t)ceil((x - w - R->lo[k]) * R->inv_hf[k]);
     *j1 = (int64_t)floor((x + w - R->lo[k]) * R->inv_hf[k]) - 1;
@@ -218,7 +217,7 @@ static void make_entry(pk_rsa_region *R, size_t e, const double *p)
     const double rad = R->c - R->margin - R->delta;
     if (!(rad > 0))
         return;
-    const int nj = W * S;       /* fine voxels j = -D·S .. (D+1)·S - 1 per axis */
+    const int nj = W * S;                 /* fine voxels j = -D·S .. (D+1)·S - 1 per axis */
     double f[3][(2 * MAX_REACH + 1) * 8]; /* squared distance to the far face of fine voxel j */
     for (int k = 0; k < dim; k++)
         for (int j = 0; j < nj; j++) {
@@ -310,12 +309,12 @@ static void finish_entry(pk_rsa_region *R, size_t e)
 static inline uint64_t flip_x(uint64_t v)
 {
     return (v & 0x1111111111111111ull) << 3 | (v & 0x2222222222222222ull) << 1 |
-           (v >> 1 & 0x2222222222222222ull) | (v >> 3 & 0x1111111111111111ull);
+        (v >> 1 & 0x2222222222222222ull) | (v >> 3 & 0x1111111111111111ull);
 }
 static inline uint64_t flip_y(uint64_t v)
 {
     return (v & 0x000f000f000f000full) << 12 | (v & 0x00f000f000f000f0ull) << 4 |
-           (v >> 4 & 0x00f000f000f000f0ull) | (v >> 12 & 0x000f000f000f000full);
+        (v >> 4 & 0x00f000f000f000f0ull) | (v >> 12 & 0x000f000f000f000full);
 }
 static inline uint64_t flip_z(uint64_t v)
 {

@@ -29,13 +29,13 @@
 typedef struct pk_rsa_region {
     int dim, S;
     int periodic[PK_MAXDIM];
-    int64_t n[PK_MAXDIM];       /* cells per axis (1 on unused axes) */
-    int sbits;                  /* log2 S */
-    int64_t nf[PK_MAXDIM];      /* fine voxels per axis: S·n */
-    double lo[PK_MAXDIM];       /* lower end of the draw range */
-    double hf[PK_MAXDIM];       /* fine voxel edge span/(S·n) */
+    int64_t n[PK_MAXDIM];  /* cells per axis (1 on unused axes) */
+    int sbits;             /* log2 S */
+    int64_t nf[PK_MAXDIM]; /* fine voxels per axis: S·n */
+    double lo[PK_MAXDIM];  /* lower end of the draw range */
+    double hf[PK_MAXDIM];  /* fine voxel edge span/(S·n) */
     double inv_hf[PK_MAXDIM];
-    double margin;              /* cover radius shrink: round-off never marks an open point */
+    double margin; /* cover radius shrink: round-off never marks an open point */
     double h[PK_MAXDIM], inv_h[PK_MAXDIM]; /* cell edge */
     /* Marks of a run grain (ball radius c) come from a table: the centre's
      * offset in its cell, quantised to Q steps per axis, selects the marks of
@@ -43,22 +43,22 @@ typedef struct pk_rsa_region {
      * about the step's centre (delta: half the step's diagonal), so they hold
      * for every centre in the step.  Entries are made when first needed (in
      * 3D those of one octant; the others are their mirror images). */
-    int Q, D;                   /* steps per axis; cells reached on each side */
-    size_t entry;               /* words per entry: (2D + 1)^dim */
+    int Q, D;     /* steps per axis; cells reached on each side */
+    size_t entry; /* words per entry: (2D + 1)^dim */
     double c, delta;
-    uint64_t *tab;              /* [Q^dim][entry]: word ((dz+D)·W + dy+D)·W + dx+D, W = 2D + 1 */
-    uint32_t *trows;            /* [Q^dim]: bit r set when row r (W words along x) marks */
-    uint8_t *tcnt;              /* [Q^dim]: 1 made, 0xff = not made yet */
-    int tab_far;                /* the table outgrows a core's cache (1 MB): entries are
+    uint64_t *tab;   /* [Q^dim][entry]: word ((dz+D)·W + dy+D)·W + dx+D, W = 2D + 1 */
+    uint32_t *trows; /* [Q^dim]: bit r set when row r (W words along x) marks */
+    uint8_t *tcnt;   /* [Q^dim]: 1 made, 0xff = not made yet */
+    int tab_far;     /* the table outgrows a core's cache (1 MB): entries are
                                    fetched ahead with the marks' rows */
-    int nrow;                   /* rows of 2D + 1 cells around a cell: (2D + 1)^(dim - 1) */
+    int nrow;        /* rows of 2D + 1 cells around a cell: (2D + 1)^(dim - 1) */
     int64_t roff[(2 * PK_RSA_REGION_MAX_REACH + 1) * (2 * PK_RSA_REGION_MAX_REACH + 1)];
-                                /* index offset of each row's middle cell (off the seams) */
+    /* index offset of each row's middle cell (off the seams) */
     uint64_t ncell;
-    uint64_t *covered;          /* [ncell] bit set: fine voxel inside an exclusion ball */
-    uint32_t *list;             /* cells that had an open fine voxel at the last compaction */
+    uint64_t *covered; /* [ncell] bit set: fine voxel inside an exclusion ball */
+    uint32_t *list;    /* cells that had an open fine voxel at the last compaction */
     uint64_t nlist;
-    int listed;                 /* 0 until the first compaction: then every cell counts as
+    int listed; /* 0 until the first compaction: then every cell counts as
                                    listed (nlist = ncell) and list[] is not yet written */
 } pk_rsa_region;
 
@@ -90,10 +90,10 @@ void pk_rsa_region_mark(pk_rsa_region *R, const double *x);
 /* Where the mark of a grain at x goes: its cell and its table entry.
  * Located once, a mark can be fetched ahead and made later. */
 typedef struct pk_rsa_region_spot {
-    int64_t i[3];               /* the cell's coordinates */
-    uint64_t word;              /* its word in covered[] */
-    uint32_t e;                 /* the table entry */
-    int inner;                  /* the 2D + 1 cells around lie in the range on every axis */
+    int64_t i[3];  /* the cell's coordinates */
+    uint64_t word; /* its word in covered[] */
+    uint32_t e;    /* the table entry */
+    int inner;     /* the 2D + 1 cells around lie in the range on every axis */
 } pk_rsa_region_spot;
 
 pk_rsa_region_spot pk_rsa_region_locate(const pk_rsa_region *R, const double *x);
