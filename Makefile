@@ -153,7 +153,7 @@ FUZZ_CC      ?= clang
 FUZZ_SECONDS ?= 60
 FUZZ_TARGETS := request gmsh tetgen h5_rve
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
-FUZZ_CFLAGS   = $(CSTD) -O1 -g $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -DPACKD_VERSION='"$(VERSION)"' \
+FUZZ_CFLAGS   = $(CSTD) -O1 -g -MMD -MP $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -DPACKD_VERSION='"$(VERSION)"' \
                $(shell pkg-config --cflags $(PKGS) 2>/dev/null) -I/usr/include/suitesparse -I. -I$(FUZZ_BUILD)/gen
 FUZZ_OBJ     := $(CORE_SRC:%.c=$(FUZZ_BUILD)/obj/%.o) $(API_SRC:%.c=$(FUZZ_BUILD)/obj/%.o) \
                $(FUZZ_BUILD)/obj/gen/schemas_embedded.o
