@@ -20,9 +20,9 @@ static const struct {
     void (*help)(const char *name, FILE *f); /* --help; NULL: the usage line */
 } commands[] = {
     {"run", cmd_run,
-     "run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--progress] [--progress-fd N]\n"
+     "run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--json] [--progress] [--progress-fd N]\n"
      "                                                    run a job, write its result",
-     NULL},
+     own_help},
     {"validate", cmd_validate,
      "validate JOB.json                                 check a job, print its plan or errors",
      NULL},

@@ -1,0 +1,91 @@
+/* run_summary.c — the end of `packd run` (run_summary.h). */
+#include <string.h>
+
+#include "run_line.h"
+#include "run_summary.h"
+
+void pk_run_summary_drop_series(json_t *summary)
+{
+    const char *key;
+    json_t *v;
+    void *tmp;
+    json_object_foreach_safe (summary, tmp, key, v) {
+        if (!strcmp(key, "history"))
+            json_object_del(summary, key);
+        else if (json_is_object(v))
+            pk_run_summary_drop_series(v);
+    }
+}
+
+static const char *str(const json_t *o, const char *key)
+{
+    const char *s = json_string_value(json_object_get(o, key));
+    return s ? s : "";
+}
+
+static double num(const json_t *o, const char *key)
+{
+    return json_number_value(json_object_get(o, key));
+}
+
+static void pack_lines(FILE *f, const json_t *s, const char *phi)
+{
+    fprintf(f, "  grains    %lld placed of %lld requested\n",
+            (long long)json_integer_value(json_object_get(s, "count_placed")),
+            (long long)json_integer_value(json_object_get(s, "count_requested")));
+    if (json_is_number(json_object_get(s, "phi_resolved")))
+        fprintf(f, "  %s %.4f resolved (target %.4f), %.4f of the mix (target %.4f)\n", phi,
+                num(s, "phi_resolved"), num(s, "phi_target_resolved"), num(s, "phi_mix"),
+                num(s, "phi_target_mix"));
+    if (json_is_number(json_object_get(s, "smallest_gap")))
+        fprintf(f, "  gap       smallest %.4g, %lld pairs below the minimum\n",
+                num(s, "smallest_gap"),
+                (long long)json_integer_value(json_object_get(s, "pairs_below_delta_d")));
+}
+
+static void homogenize_lines(FILE *f, const json_t *s)
+{
+    fprintf(f, "  RVE       %lld grains, %lld contacts, %lld rattlers\n",
+            (long long)json_integer_value(json_object_get(s, "rve_particles")),
+            (long long)json_integer_value(json_object_get(s, "contacts")),
+            (long long)json_integer_value(json_object_get(s, "rattlers")));
+    json_t *audit = json_object_get(s, "audit");
+    fprintf(f, "  steps     %lld (%lld not converged)%s\n",
+            (long long)json_integer_value(json_object_get(s, "steps")),
+            (long long)json_integer_value(json_object_get(s, "steps_not_converged")),
+            !audit                                               ? ""
+                : json_is_true(json_object_get(audit, "passed")) ? ", audit passed"
+                                                                 : ", audit FAILED");
+}
+
+void pk_run_summary_print(FILE *f, const json_t *s, double seconds, int utf8)
+{
+    const char *process = str(s, "process"), *algo = str(s, "algorithm");
+    const char *reason = str(s, "termination_reason");
+    int failed = json_is_string(json_object_get(s, "failure"));
+    int complete = json_is_true(json_object_get(s, "complete"));
+    fprintf(f, "%s", process);
+    if (*algo || json_is_string(json_object_get(s, "boundary_condition")))
+        fprintf(f, " (%s)", *algo ? algo : str(s, "boundary_condition"));
+    fprintf(f, ": %s, %s", failed ? "FAILED" : "successful", complete ? "complete" : "incomplete");
+    if (*reason && strcmp(reason, "complete") != 0)
+        fprintf(f, " (%s)", reason);
+    fputc('\n', f);
+    if (!strcmp(process, "homogenize"))
+        homogenize_lines(f, s);
+    else
+        pack_lines(f, s, utf8 ? "φ        " : "phi      "); /* 9 columns */
+    char t[32];
+    pk_run_line_duration(seconds, t, sizeof t);
+    fprintf(f, "  time      %s\n", t);
+    json_t *w = json_object_get(s, "warnings");
+    size_t i;
+    json_t *v;
+    json_array_foreach (w, i, v)
+        fprintf(f, "  %-9s %s\n", i ? "" : "warnings", json_string_value(v));
+    if (failed)
+        fprintf(f, "  failure   %s\n", str(s, "failure"));
+    fprintf(f, "  output    %s%s\n", str(s, "output"), failed ? " (partial)" : "");
+    if (json_is_string(json_object_get(s, "xdmf")))
+        fprintf(f, "  xdmf      %s\n", str(s, "xdmf"));
+}
