@@ -38,7 +38,7 @@ static void pack_lines(FILE *f, const json_t *s, const char *phi)
                 num(s, "phi_resolved"), num(s, "phi_target_resolved"), num(s, "phi_mix"),
                 num(s, "phi_target_mix"));
     if (json_is_number(json_object_get(s, "smallest_gap")))
-        fprintf(f, "  gap       smallest %.4g, %lld pairs below the minimum\n",
+        fprintf(f, "  gap       smallest %.6g, %lld pairs below the minimum\n",
                 num(s, "smallest_gap"),
                 (long long)json_integer_value(json_object_get(s, "pairs_below_delta_d")));
 }
