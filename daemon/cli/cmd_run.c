@@ -127,10 +127,7 @@ int cmd_run(int argc, char **argv)
         }
     }
     if (!job_path || !out_path) {
-        fprintf(stderr,
-                "usage: packd run JOB.json -o OUT.h5 [--xdmf OUT.xdmf] [--pictures DIR] [--json] "
-                "[--progress] [--progress-fd N] [--threads N] [--checkpoint FILE "
-                "[--checkpoint-interval S]]\n");
+        run_help(stderr);
         return 64;
     }
     json_t *job = cli_load_json(job_path);

@@ -22,11 +22,11 @@ void pk_run_line_init(pk_run_line *l, FILE *tty)
 {
     memset(l, 0, sizeof *l);
     l->t0 = pk_wall_seconds();
+    l->utf8 = locale_is_utf8();
     const char *term = getenv("TERM");
     if (!tty || !isatty(fileno(tty)) || (term && !strcmp(term, "dumb")))
         return;
     l->tty = tty;
-    l->utf8 = locale_is_utf8();
     struct winsize ws;
     l->cols = ioctl(fileno(tty), TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0 ? ws.ws_col : 80;
     l->fraction = l->phi = l->eta_s = -1;

@@ -10,7 +10,7 @@
 
 typedef struct pk_run_line {
     FILE *tty; /* NULL: no line (not a terminal) */
-    int utf8;  /* the terminal takes "φ" and "…" */
+    int utf8;  /* the locale takes "φ" */
     int cols;  /* the terminal's width */
     int drawn; /* a line is on the screen */
     double t0; /* the run's start (wall seconds) */
