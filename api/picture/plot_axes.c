@@ -63,12 +63,16 @@ void pk_plot_axis_fit(pk_plot_axis *a, double lo, double hi, int log)
         a->exp10 = 3 * (int)floor(log10(big) / 3);
 }
 
+/* A value a plot can show: finite, and not the ±1.8e308 result files write
+ * for a non-finite figure. */
+static int plottable(double v) { return isfinite(v) && fabs(v) < 1e300; }
+
 int pk_plot_range(const double *v, size_t n, int log, double *lo, double *hi)
 {
     *lo = INFINITY;
     *hi = -INFINITY;
     for (size_t i = 0; i < n; i++)
-        if (isfinite(v[i]) && (!log || v[i] > 0)) {
+        if (plottable(v[i]) && (!log || v[i] > 0)) {
             *lo = fmin(*lo, v[i]);
             *hi = fmax(*hi, v[i]);
         }
@@ -241,7 +245,7 @@ void pk_plot_title_y(cairo_t *cr, const pk_plot *p, int right, const char *name,
 
 static int shown(const pk_plot *p, double x, double y)
 {
-    return isfinite(x) && isfinite(y) && (!p->x.log || x > 0) && (!p->y.log || y > 0);
+    return plottable(x) && plottable(y) && (!p->x.log || x > 0) && (!p->y.log || y > 0);
 }
 
 static void set_style(cairo_t *cr, const pk_plot_style *s)

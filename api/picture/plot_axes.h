@@ -26,12 +26,13 @@ typedef struct pk_plot_style {
     int markers; /* 1: a dot on every point; 2: dots without the line */
 } pk_plot_style;
 
-/* An axis over the data range [lo, hi] (non-finite values, and on a log
- * axis values ≤ 0, ignored before the call): linear axes widen to whole
- * tick steps, log axes to the 1-2-5 values around the range. */
+/* An axis over the data range [lo, hi] (as pk_plot_range finds it):
+ * linear axes widen to whole tick steps, log axes to the 1-2-5 values
+ * around the range. */
 void pk_plot_axis_fit(pk_plot_axis *a, double lo, double hi, int log);
-/* The range of the n values of v an axis can show (log: > 0 only);
- * 0 when there is none. */
+/* The range of the n values of v a plot can show (finite and below 1e300
+ * in magnitude: result files write ±1.8e308 for a non-finite figure; log:
+ * > 0 only); 0 when there is none. */
 int pk_plot_range(const double *v, size_t n, int log, double *lo, double *hi);
 
 /* Canvas coordinates of data values (x on p->x, y on p->y). */
@@ -52,7 +53,7 @@ void pk_plot_title_y(cairo_t *cr, const pk_plot *p, int right, const char *name,
                      const pk_plot_style *colour);
 
 /* The polyline through (x[i], y[i]), broken where a point cannot be shown
- * (not finite; ≤ 0 on a log axis), clipped to the area. */
+ * (see pk_plot_range), clipped to the area. */
 void pk_plot_line(cairo_t *cr, const pk_plot *p, const double *x, const double *y, size_t n,
                   const pk_plot_style *s);
 
