@@ -23,6 +23,18 @@ const pk_output pk_outputs[] = {
      "target and achieved grading curves (pack jobs)", 1},
     {"grading.svg", "image/svg+xml", "the grading curve",
      "target and achieved grading curves (pack jobs)", 1},
+    {"history.png", "image/png", "the EDMD history",
+     "phi and reduced pressure over the events (EDMD)", 1},
+    {"history.svg", "image/svg+xml", "the EDMD history",
+     "phi and reduced pressure over the events (EDMD)", 1},
+    {"stress.png", "image/png", "the stress-strain curve", "P components over F (homogenize jobs)",
+     1},
+    {"stress.svg", "image/svg+xml", "the stress-strain curve",
+     "P components over F (homogenize jobs)", 1},
+    {"residual.png", "image/png", "the residual history",
+     "relaxation residual of every load step (homogenize jobs)", 1},
+    {"residual.svg", "image/svg+xml", "the residual history",
+     "relaxation residual of every load step (homogenize jobs)", 1},
     {NULL, NULL, NULL, NULL, 0},
 };
 
@@ -55,7 +67,7 @@ int pk_exec_opts_parse(json_t *body, pk_exec_opts *o, char *detail, size_t n)
         if (!pk_output_find(key)) {
             snprintf(detail, n,
                      "/outputs/%.60s: no such output (summary, result, xdmf, "
-                     "picture.png, picture.svg, grading.png, grading.svg)",
+                     "picture, grading, history, stress, residual .png/.svg)",
                      key);
             return -1;
         }

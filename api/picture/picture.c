@@ -10,17 +10,27 @@
 #include "picture_internal.h"
 
 static const struct {
-    const char *name;
+    const char *name, *file, *help;
     pk_picture_kind kind;
     int (*draw)(const char *h5_path, const char *out_path, char *err, size_t errlen);
 } kinds[] = {
-    {"packing", PK_PICTURE_PACKING, pk_picture_packing},
-    {"grading", PK_PICTURE_GRADING, pk_picture_grading},
+    {"packing", "picture",
+     "the grains by size class (3D: mid-plane section and depth-shaded view along -z)",
+     PK_PICTURE_PACKING, pk_picture_packing},
+    {"grading", "grading", "the grading curve, target against achieved (pack results)",
+     PK_PICTURE_GRADING, pk_picture_grading},
+    {"history", "history", "phi and reduced pressure over the events (pack results made by EDMD)",
+     PK_PICTURE_HISTORY, pk_picture_history},
+    {"stress", "stress", "stress-strain curve, P components over F (homogenize results)",
+     PK_PICTURE_STRESS, pk_picture_stress},
+    {"residual", "residual", "relaxation residual of every load step (homogenize results)",
+     PK_PICTURE_RESIDUAL, pk_picture_residual},
 };
+#define KINDS (sizeof kinds / sizeof *kinds)
 
 int pk_picture_kind_parse(const char *name, pk_picture_kind *kind)
 {
-    for (size_t i = 0; i < sizeof kinds / sizeof *kinds; i++)
+    for (size_t i = 0; i < KINDS; i++)
         if (name && !strcmp(name, kinds[i].name)) {
             *kind = kinds[i].kind;
             return 0;
@@ -28,10 +38,21 @@ int pk_picture_kind_parse(const char *name, pk_picture_kind *kind)
     return -1;
 }
 
+const char *pk_picture_kind_name(int i, const char **file, const char **help)
+{
+    if (i < 0 || (size_t)i >= KINDS)
+        return NULL;
+    if (file)
+        *file = kinds[i].file;
+    if (help)
+        *help = kinds[i].help;
+    return kinds[i].name;
+}
+
 int pk_picture_write(const char *h5_path, pk_picture_kind kind, const char *out_path, char *err,
                      size_t errlen)
 {
-    for (size_t i = 0; i < sizeof kinds / sizeof *kinds; i++)
+    for (size_t i = 0; i < KINDS; i++)
         if (kinds[i].kind == kind)
             return kinds[i].draw(h5_path, out_path, err, errlen);
     snprintf(err, errlen, "no such picture kind");
@@ -46,25 +67,20 @@ int pk_picture_write_set(const char *h5_path, const char *dir, char *err, size_t
         return 0;
     size_t n = p.n;
     pk_particles_free(&p);
-    static const struct {
-        const char *file;
-        pk_picture_kind kind;
-        int svg;
-    } set[] = {{"picture.png", PK_PICTURE_PACKING, 0},
-               {"picture.svg", PK_PICTURE_PACKING, 1},
-               {"grading.png", PK_PICTURE_GRADING, 0},
-               {"grading.svg", PK_PICTURE_GRADING, 1}};
+    static const char *const ext[] = {"png", "svg"};
     int drawn = 0, failed = 0;
     char path[4096], e[512];
-    for (size_t i = 0; i < sizeof set / sizeof *set; i++) {
-        if (set[i].kind == PK_PICTURE_PACKING && set[i].svg && n > PK_PICTURE_SVG_MAX_GRAINS)
-            continue;
-        snprintf(path, sizeof path, "%s/%s", dir, set[i].file);
-        if (pk_picture_write(h5_path, set[i].kind, path, e, sizeof e) == 0)
-            drawn++;
-        else if (set[i].kind == PK_PICTURE_PACKING && !failed++)
-            snprintf(err, errlen, "%s", e);
-    }
+    for (size_t i = 0; i < KINDS; i++)
+        for (int svg = 0; svg < 2; svg++) {
+            int packing = kinds[i].kind == PK_PICTURE_PACKING;
+            if (packing && svg && n > PK_PICTURE_SVG_MAX_GRAINS)
+                continue;
+            snprintf(path, sizeof path, "%s/%s.%s", dir, kinds[i].file, ext[svg]);
+            if (kinds[i].draw(h5_path, path, e, sizeof e) == 0)
+                drawn++;
+            else if (packing && !failed++)
+                snprintf(err, errlen, "%s", e);
+        }
     return drawn;
 }
 

@@ -9,10 +9,11 @@
 static int usage(FILE *f)
 {
     fprintf(f,
-            "usage: packd picture RESULT.h5 -o FILE.svg|FILE.png [--kind packing|grading]\n"
-            "  packing  the grains (2D: as the papers draw them; 3D: mid-plane section and a\n"
-            "           depth-shaded view along -z), coloured by size class (default)\n"
-            "  grading  the grading curve, target against achieved (pack results)\n");
+            "usage: packd picture RESULT.h5 -o FILE.svg|FILE.png [--kind KIND]\n"
+            "kinds (default packing; a kind needs its data in the file):\n");
+    const char *name, *help;
+    for (int i = 0; (name = pk_picture_kind_name(i, NULL, &help)); i++)
+        fprintf(f, "  %-9s %s\n", name, help);
     return f == stderr ? 64 : 0;
 }
 

@@ -126,7 +126,7 @@ static enum MHD_Result send_output(pk_req *r, json_t *row, const pk_output *out)
             char d[200];
             snprintf(d, sizeof d,
                      "this job has no such picture (SVG packings are drawn up to %d "
-                     "grains, grading curves for pack results)",
+                     "grains, each plot when the result has its data)",
                      PK_PICTURE_SVG_MAX_GRAINS);
             rc = pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output", d,
                                  NULL, 0);
@@ -190,8 +190,8 @@ enum MHD_Result route_result_file(pk_req *r)
     const pk_output *out = pk_output_find(r->seg[3]);
     if (!out)
         return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output",
-                               "outputs: summary, result, xdmf, picture.png, picture.svg, "
-                               "grading.png, grading.svg",
+                               "outputs: summary, result, xdmf, picture, grading, history, "
+                               "stress, residual .png/.svg",
                                NULL, 0);
     json_t *row = pk_job_visible(r, r->seg[1]);
     if (!row)

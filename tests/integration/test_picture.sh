@@ -1,8 +1,10 @@
 #!/bin/sh
 # test_picture.sh — `packd picture`: real PNG files decoded back (zlib only)
 # whose inked share of the box is the packing's φ (plus the outlines), SVG
-# files that parse as XML, the 3D two-panel layout, the grading curve, and
-# the errors a user meets.  The service's pictures are tested in test_serve.sh.
+# files that parse as XML, the 3D two-panel layout, the grading curve, the
+# plots (EDMD history, homogenization stress and residual: coloured curves
+# across the plot area), the worker's picture set, and the errors a user
+# meets.  The service's pictures are tested in test_serve.sh.
 set -u
 PACKD=${PACKD:-build/packd}
 SRC=${PACKD_SRC:-.}
@@ -33,7 +35,41 @@ check picture_3d_two_panels test "$(echo "$fill3" | cut -d' ' -f1)" = 1548
 # a section through grains at φ_eff = 0.316 inks about φ of the plane (area fraction = volume fraction)
 check picture_3d_section_ink python3 -c "f = float('$fill3'.split()[2]); assert 0.25 <= f <= 0.42, f"
 
+# plots: PNG curves reach across the plot area (coloured pixels in >= 80 % of
+# its columns; a legend alone spans < 40 %), SVG parses.  Plot areas (api/picture/
+# picture_history.c, picture_homog.c): x 80..670 (history) or 80..730, y 50..420.
+svg_parses() { python3 -c "import xml.etree.ElementTree as E, sys; E.parse(sys.argv[1])" "$1"; }
+plot_ok() { # NAME FILE.h5 KIND RIGHT
+    "$PACKD" picture "$2" --kind "$3" -o "$T/$3.png" 2>"$T/$3.err" &&
+        "$PACKD" picture "$2" --kind "$3" -o "$T/$3.svg" 2>>"$T/$3.err"
+    check "$1_drawn" test $? -eq 0
+    cols=$(python3 "$SRC/tests/tools/png_fill.py" "$T/$3.png" 82 48 "$4" 424 colour)
+    check "$1_png_curves" python3 -c "w, h, f, c = '$cols'.split(); assert float(c) >= 0.8 and float(f) > 0.003, '$cols'"
+    check "$1_svg" svg_parses "$T/$3.svg"
+}
+# EDMD (its worker picture set too: the plots whose data the result holds)
+mkdir "$T/pics"
+(cd "$SRC" && "$PACKD" run examples/edmd-quartz-2d.json -o "$T/e.h5" --pictures "$T/pics" >/dev/null 2>&1)
+plot_ok picture_history "$T/e.h5" history 668
+check picture_set_has_history test -s "$T/pics/history.png" -a -s "$T/pics/history.svg" -a -s "$T/pics/grading.png"
+check picture_set_skips_homogenize_plots test ! -e "$T/pics/stress.png" -a ! -e "$T/pics/residual.svg"
+# homogenization (the RVE made first, in $T where the example reads it)
+(cd "$T" && "$PACKD" run "$SRC/examples/homogenize/rve-rsa-2d.json" -o rve-2d.h5 >/dev/null 2>&1 &&
+    "$PACKD" run "$SRC/examples/homogenize/homogenize-periodic-2d.json" -o h.h5 >/dev/null 2>&1)
+plot_ok picture_stress "$T/h.h5" stress 728
+plot_ok picture_residual "$T/h.h5" residual 728
+
 # errors
+# a plot asked of a result without its data names what is missing
+"$PACKD" picture "$T/q.h5" --kind history -o "$T/x.png" 2>"$T/e2"
+check picture_history_needs_edmd test $? -eq 2 -a -n "$(grep 'has no EDMD history' "$T/e2")"
+"$PACKD" picture "$T/e.h5" --kind stress -o "$T/x.svg" 2>"$T/e3"
+check picture_stress_needs_homogenize test $? -eq 2 -a -n "$(grep 'has no stress-strain data' "$T/e3")"
+"$PACKD" picture "$T/q.h5" --kind residual -o "$T/x.png" 2>"$T/e4"
+check picture_residual_needs_homogenize test $? -eq 2 -a -n "$(grep 'has no residual history' "$T/e4")"
+check picture_no_file_left_by_a_refusal test ! -e "$T/x.png" -a ! -e "$T/x.svg"
+"$PACKD" picture "$T/q.h5" --kind nosuch -o "$T/x.png" 2>"$T/e5"
+check picture_unknown_kind_lists_kinds test $? -eq 64 -a -n "$(grep 'residual' "$T/e5")"
 "$PACKD" picture "$T/q.h5" -o "$T/q.jpg" 2>"$T/e1"
 check picture_refuses_unknown_format grep -q '.svg or .png' "$T/e1"
 "$PACKD" picture "$T/missing.h5" -o "$T/m.png" 2>/dev/null

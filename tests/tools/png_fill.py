@@ -1,7 +1,11 @@
 #!/usr/bin/env python3
-"""png_fill.py FILE.png X0 Y0 X1 Y1 — print the width, height and the share
-of non-white pixels in the rectangle [X0,X1) × [Y0,Y1) of an 8-bit RGB/RGBA
-PNG, decoded here with zlib alone (no imaging library needed)."""
+"""png_fill.py FILE.png X0 Y0 X1 Y1 [colour] — print the width, height and the
+share of non-white pixels in the rectangle [X0,X1) × [Y0,Y1) of an 8-bit
+RGB/RGBA PNG, decoded here with zlib alone (no imaging library needed).
+With "colour", only coloured pixels count (channels differing by more than
+60: a plot's curves, not its grey grid or black text), and a fourth figure
+is the share of the rectangle's columns that hold any (how far the curves
+reach across a plot, which a legend alone does not)."""
 import struct, sys, zlib
 
 
@@ -40,10 +44,16 @@ def decode(path):
 
 w, h, bpp, rows = decode(sys.argv[1])
 x0, y0, x1, y1 = (int(v) for v in sys.argv[2:6])
+colour = sys.argv[6:7] == ["colour"]
 filled = total = 0
+columns = set()
 for y in range(y0, y1):
     r = rows[y]
     for x in range(x0, x1):
         total += 1
-        filled += r[x * bpp] + r[x * bpp + 1] + r[x * bpp + 2] < 3 * 245
-print(w, h, f"{filled / total:.4f}")
+        px = r[x * bpp:x * bpp + 3]
+        ink = max(px) - min(px) > 60 if colour else sum(px) < 3 * 245
+        filled += ink
+        if ink:
+            columns.add(x)
+print(w, h, f"{filled / total:.4f}" + (f" {len(columns) / (x1 - x0):.4f}" if colour else ""))
