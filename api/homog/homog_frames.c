@@ -13,7 +13,8 @@ void pk_homog_frames_init(pk_homog_frames *fr, const pk_homog_rve *rve, size_t n
     memset(fr, 0, sizeof *fr);
     fr->dim = rve->dim;
     fr->n = rve->n;
-    fr->keep = rve->n > 0 && nstep <= PK_HOMOG_FRAMES_MAX / rve->n;
+    fr->keep =
+        rve->n > 0 && nstep <= PK_HOMOG_FRAMES_MAX_STEPS && nstep <= PK_HOMOG_FRAMES_MAX / rve->n;
 }
 
 /* Σ_j |f_n,ij| per grain at s (the normal law of (4.3), E_n,ij per pair). */

@@ -2,11 +2,13 @@
  * for the result file as H5MD time-dependent elements under /particles/rve
  * (docs/result-format.md) so a viewer (the XDMF sidecar's temporal
  * collection) can play the load path: positions [steps][n][dim] and the
- * contact force carried by each grain [steps][n].
+ * contact force carried by each grain [steps][n], with a per-step view of
+ * each (an HDF5 virtual dataset) that the sidecar reads.
  *
- * Rule: the frames are kept when steps·n <= PK_HOMOG_FRAMES_MAX grain-steps
- * (at most 24 MiB of positions in 3D); a larger run keeps none and its
- * sidecar shows the reference packing only. */
+ * Rule: the frames are kept when the load path has at most
+ * PK_HOMOG_FRAMES_MAX_STEPS steps and steps·n <= PK_HOMOG_FRAMES_MAX
+ * grain-steps (at most 24 MiB of positions in 3D); a larger run keeps none
+ * and its sidecar shows the reference packing only. */
 #ifndef PK_HOMOG_FRAMES_H
 #define PK_HOMOG_FRAMES_H
 
@@ -18,6 +20,7 @@
 #include "core/homog/homog_rve.h"
 
 #define PK_HOMOG_FRAMES_MAX ((size_t)1000000)
+#define PK_HOMOG_FRAMES_MAX_STEPS ((size_t)1000) /* two views per step in the file */
 
 typedef struct pk_homog_frames {
     int dim, keep;
