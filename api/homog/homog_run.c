@@ -10,6 +10,7 @@
 #include "api/results/h5_result.h"
 #include "core/homog/homog_audit.h"
 #include "homog_checkpoint.h"
+#include "homog_frames.h"
 #include "homog_job.h"
 #include "homog_record.h"
 #include "core/homog/homog_tangent.h"
@@ -144,6 +145,7 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
     int rc = -1;
     pk_homog_rve rve = {0};
     pk_homog_state com = {0}, tr = {0};
+    pk_homog_frames fr = {0};   /* the deformed grains per step (homog_frames.h) */
     pk_sparse_ctx *nctx = NULL; /* Newton's solver context over the whole load path */
     pk_par *pool = NULL;        /* the job's threads (NULL: serial; the same results) */
     json_t *rec = NULL, *aud = NULL, *sum = NULL;
@@ -163,6 +165,7 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
         }
     pk_homog_opts o;
     opts_of(&job, &rve, &o);
+    pk_homog_frames_init(&fr, &rve, job.nstep);
     /* a contact pattern seen in an earlier factorisation of this job (elastic
      * load steps) reuses its analysis; without a context (NULL on failure)
      * every factorisation is analysed afresh — the same numbers either way */
@@ -258,7 +261,8 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
             break;
         }
         unjammed += st.contacts == 0 || (nfree && st.rattlers >= nfree);
-        if (pk_homog_commit(&com, &tr) != 0) {
+        if (pk_homog_commit(&com, &tr) != 0 ||
+            pk_homog_frames_add(&fr, &rve, &o, &com, k, job.nstep) != 0) {
             snprintf(err, errlen, "out of memory");
             goto out;
         }
@@ -397,6 +401,7 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
     if (!h)
         goto out;
     int w = pk_h5_write_particles(h, &box, &p, "1");
+    w |= pk_homog_frames_write(h, &fr, &rve, "1");
     w |= pk_h5_write_parameters(h, "homogenize", job_json, 0);
     w |= pk_h5_obs_json(h, "homogenize", rec);
     w |= pk_h5_obs_json(h, "audit", aud);
@@ -419,6 +424,7 @@ out:
     json_decref(aud);
     json_decref(sum);
     pk_homog_state_free(&com);
+    pk_homog_frames_free(&fr);
     pk_homog_state_free(&tr);
     pk_homog_rve_free(&rve);
     pk_particles_free(&p);

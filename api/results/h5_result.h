@@ -47,6 +47,18 @@ int pk_h5_obs_ints(pk_h5 *h, const char *name, const int64_t *v, size_t n);
 #include <jansson.h>
 int pk_h5_obs_json(pk_h5 *h, const char *prefix, json_t *obj);
 
+/* An n-d array (rank <= 3) at an absolute path ("/particles/rve/position/value"),
+ * intermediate groups made; unit may be NULL.  0 on success. */
+typedef enum { PK_H5_F64, PK_H5_I64, PK_H5_I32 } pk_h5_type;
+int pk_h5_write_array(pk_h5 *h, const char *path, pk_h5_type type, int rank, const size_t *dims,
+                      const void *data, const char *unit);
+/* A second name (hard link) for an existing object, e.g. a shared box group. */
+int pk_h5_link(pk_h5 *h, const char *existing, const char *path);
+
+/* A view of src[k] (an HDF5 virtual dataset in this file, no copy of the
+ * data) at path: src has rank 2 or 3, the view its last dimensions. */
+int pk_h5_slice_view(pk_h5 *h, const char *src, size_t k, const char *path);
+
 /* Close, fsync and rename into place.  Frees h.  0 on success. */
 int pk_h5_commit(pk_h5 *h, char *err, size_t errlen);
 /* Close and remove the temporary file.  Frees h. */

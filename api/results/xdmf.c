@@ -70,17 +70,182 @@ int pk_xdmf_relative_ref(const char *h5_path, const char *xdmf_path, char *out, 
     return w < 0 || (size_t)w >= n - o ? -1 : 0;
 }
 
-/* 1 when the file has /particles/grains/id (older files do not). */
-static int has_ids(const char *h5_path)
+/* The dimensions of the dataset at path (rank, or -1 when absent). */
+static int dims_of(hid_t f, const char *path, hsize_t d[3])
 {
-    hid_t f = H5Fopen(h5_path, H5F_ACC_RDONLY, H5P_DEFAULT);
-    if (f < 0)
+    char part[256];
+    /* every link on the way must exist before H5Dopen may look */
+    for (const char *p = strchr(path + 1, '/');; p = strchr(p + 1, '/')) {
+        snprintf(part, sizeof part, "%.*s", p ? (int)(p - path) : (int)strlen(path), path);
+        if (H5Lexists(f, part, H5P_DEFAULT) <= 0)
+            return -1;
+        if (!p)
+            break;
+    }
+    hid_t ds = H5Dopen2(f, path, H5P_DEFAULT);
+    if (ds < 0)
+        return -1;
+    hid_t sp = H5Dget_space(ds);
+    int rank = H5Sget_simple_extent_ndims(sp);
+    if (rank > 3 || H5Sget_simple_extent_dims(sp, d, NULL) < 0)
+        rank = -1;
+    H5Sclose(sp);
+    H5Dclose(ds);
+    return rank;
+}
+
+/* A DataItem of an HDF dataset: dims as written, number type and size. */
+static void item(FILE *f, const char *ind, const char *dims, const char *type, int prec,
+                 const char *ref, const char *path)
+{
+    fprintf(f,
+            "%s<DataItem Dimensions=\"%s\" NumberType=\"%s\" Precision=\"%d\" "
+            "Format=\"HDF\">%s:%s</DataItem>\n",
+            ind, dims, type, prec, ref, path);
+}
+
+/* The grains: one vertex cell per grain (the Xdmf3 reader makes no cells
+ * without the connectivity 0..N-1: /particles/grains/id, inline for files
+ * without it). */
+static void grains_grid(FILE *f, hid_t h, const char *ref, size_t n, int dim)
+{
+    hsize_t d[3];
+    char s[64];
+    fprintf(f,
+            "    <Grid Name=\"grains\" GridType=\"Uniform\">\n"
+            "      <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
+            "NodesPerElement=\"1\">\n",
+            n);
+    snprintf(s, sizeof s, "%zu 1", n);
+    if (dims_of(h, "/particles/grains/id", d) == 1) {
+        item(f, "        ", s, "Int", 8, ref, "/particles/grains/id");
+    } else {
+        fprintf(f,
+                "        <DataItem Dimensions=\"%s\" NumberType=\"Int\" Precision=\"8\" "
+                "Format=\"XML\">",
+                s);
+        for (size_t i = 0; i < n; i++)
+            fprintf(f, i % 16 == 15 ? "%zu\n" : "%zu ", i);
+        fprintf(f, "</DataItem>\n");
+    }
+    fprintf(f, "      </Topology>\n      <Geometry GeometryType=\"%s\">\n",
+            dim == 3 ? "XYZ" : "XY");
+    snprintf(s, sizeof s, "%zu %d", n, dim);
+    item(f, "        ", s, "Float", 8, ref, "/particles/grains/position");
+    snprintf(s, sizeof s, "%zu", n);
+    fprintf(f,
+            "      </Geometry>\n"
+            "      <Attribute Name=\"radius\" AttributeType=\"Scalar\" Center=\"Node\">\n");
+    item(f, "        ", s, "Float", 8, ref, "/particles/grains/radius");
+    fprintf(f,
+            "      </Attribute>\n"
+            "      <Attribute Name=\"species\" AttributeType=\"Scalar\" Center=\"Node\">\n");
+    item(f, "        ", s, "Int", 4, ref, "/particles/grains/species");
+    fprintf(f, "      </Attribute>\n");
+    if (dims_of(h, "/particles/grains/id", d) == 1) {
+        fprintf(f, "      <Attribute Name=\"id\" AttributeType=\"Scalar\" Center=\"Node\">\n");
+        item(f, "        ", s, "Int", 8, ref, "/particles/grains/id");
+        fprintf(f, "      </Attribute>\n");
+    }
+    fprintf(f, "    </Grid>\n");
+}
+
+/* A tetfill result's mesh: its flat node (x, y, z per node) and tet (4
+ * node indices per tet) arrays are read as XYZ and Tetrahedron data as
+ * they are, with the region of each tet as a cell attribute. */
+static void mesh_grid(FILE *f, hid_t h, const char *ref)
+{
+    const char *nodes = "/observables/tetfill/mesh_nodes", *tets = "/observables/tetfill/mesh_tets",
+               *regions = "/observables/tetfill/mesh_regions";
+    hsize_t dn[3], dt[3], dr[3];
+    if (dims_of(h, nodes, dn) != 1 || dims_of(h, tets, dt) != 1 || dn[0] % 3 || dt[0] % 4 || !dt[0])
+        return;
+    char s[64];
+    fprintf(f,
+            "    <Grid Name=\"mesh\" GridType=\"Uniform\">\n"
+            "      <Topology TopologyType=\"Tetrahedron\" NumberOfElements=\"%llu\" "
+            "NodesPerElement=\"4\">\n",
+            (unsigned long long)(dt[0] / 4));
+    snprintf(s, sizeof s, "%llu", (unsigned long long)dt[0]);
+    item(f, "        ", s, "Int", 8, ref, tets);
+    fprintf(f, "      </Topology>\n      <Geometry GeometryType=\"XYZ\">\n");
+    snprintf(s, sizeof s, "%llu", (unsigned long long)dn[0]);
+    item(f, "        ", s, "Float", 8, ref, nodes);
+    fprintf(f, "      </Geometry>\n");
+    if (dims_of(h, regions, dr) == 1 && dr[0] == dt[0] / 4) {
+        fprintf(f, "      <Attribute Name=\"region\" AttributeType=\"Scalar\" Center=\"Cell\">\n");
+        snprintf(s, sizeof s, "%llu", (unsigned long long)dr[0]);
+        item(f, "        ", s, "Int", 8, ref, regions);
+        fprintf(f, "      </Attribute>\n");
+    }
+    fprintf(f, "    </Grid>\n");
+}
+
+/* A homogenize result's load path: a temporal collection with one grid per
+ * recorded step (deformed centres, radius, contact force per grain) from
+ * /particles/rve, read through the per-step views views/<element>/<k>
+ * (ParaView's Xdmf3 reader crashes on a HyperSlab geometry and drops a
+ * HyperSlab attribute). */
+static int steps_grid(FILE *f, hid_t h, const char *ref)
+{
+    const char *pos = "/particles/rve/position/value", *frc = "/particles/rve/contact_force/value",
+               *tim = "/particles/rve/position/time";
+    hsize_t dx[3], df[3], dt[3], dd[3];
+    if (dims_of(h, pos, dx) != 3 || dims_of(h, tim, dt) != 1 || dt[0] != dx[0] || !dx[0] ||
+        (dx[2] != 2 && dx[2] != 3) || dims_of(h, "/particles/rve/id", dd) != 1 || dd[0] != dx[1] ||
+        dims_of(h, "/particles/rve/views/position/0", dd) != 2)
         return 0;
-    int yes = H5Lexists(f, "/particles", H5P_DEFAULT) > 0 &&
-        H5Lexists(f, "/particles/grains", H5P_DEFAULT) > 0 &&
-        H5Lexists(f, "/particles/grains/id", H5P_DEFAULT) > 0;
-    H5Fclose(f);
-    return yes;
+    int with_force = dims_of(h, frc, df) == 2 && df[0] == dx[0] && df[1] == dx[1] &&
+        dims_of(h, "/particles/rve/views/contact_force/0", dd) == 1;
+    double *t = malloc(dt[0] * sizeof *t);
+    hid_t ds = H5Dopen2(h, tim, H5P_DEFAULT);
+    int ok = t && ds >= 0 && H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, t) >= 0;
+    if (ds >= 0)
+        H5Dclose(ds);
+    if (!ok) {
+        free(t);
+        return 0;
+    }
+    const unsigned long long n = dx[1];
+    char s[64];
+    fprintf(f,
+            "    <Grid Name=\"load steps\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
+    for (hsize_t k = 0; k < dx[0]; k++) {
+        fprintf(f,
+                "      <Grid Name=\"step %llu\" GridType=\"Uniform\">\n"
+                "        <Time Value=\"%.17g\"/>\n"
+                "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%llu\" "
+                "NodesPerElement=\"1\">\n",
+                (unsigned long long)k, t[k], n);
+        snprintf(s, sizeof s, "%llu 1", n);
+        item(f, "          ", s, "Int", 8, ref, "/particles/rve/id");
+        fprintf(f, "        </Topology>\n        <Geometry GeometryType=\"%s\">\n",
+                dx[2] == 3 ? "XYZ" : "XY");
+        char view[64];
+        snprintf(view, sizeof view, "/particles/rve/views/position/%llu", (unsigned long long)k);
+        snprintf(s, sizeof s, "%llu %llu", n, (unsigned long long)dx[2]);
+        item(f, "          ", s, "Float", 8, ref, view);
+        fprintf(f,
+                "        </Geometry>\n"
+                "        <Attribute Name=\"radius\" AttributeType=\"Scalar\" Center=\"Node\">\n");
+        snprintf(s, sizeof s, "%llu", n);
+        item(f, "          ", s, "Float", 8, ref, "/particles/rve/radius");
+        fprintf(f, "        </Attribute>\n");
+        if (with_force) {
+            fprintf(f,
+                    "        <Attribute Name=\"contact_force\" AttributeType=\"Scalar\" "
+                    "Center=\"Node\">\n");
+            snprintf(view, sizeof view, "/particles/rve/views/contact_force/%llu",
+                     (unsigned long long)k);
+            snprintf(s, sizeof s, "%llu", n);
+            item(f, "          ", s, "Float", 8, ref, view);
+            fprintf(f, "        </Attribute>\n");
+        }
+        fprintf(f, "      </Grid>\n");
+    }
+    fprintf(f, "    </Grid>\n");
+    free(t);
+    return 1;
 }
 
 int pk_xdmf_write(const char *h5_path, const char *h5_ref, const char *xdmf_path, char *err,
@@ -100,56 +265,33 @@ int pk_xdmf_write(const char *h5_path, const char *h5_ref, const char *xdmf_path
         }
         h5_ref = rel;
     }
+    hid_t h = H5Fopen(h5_path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (h < 0) {
+        snprintf(err, errlen, "cannot open %s", h5_path);
+        return -1;
+    }
     char ref[1024], tmp[1100];
     xml_escape(h5_ref, ref, sizeof ref);
     snprintf(tmp, sizeof tmp, "%s.tmp.%ld", xdmf_path, (long)getpid());
     FILE *f = fopen(tmp, "w");
     if (!f) {
+        H5Fclose(h);
         snprintf(err, errlen, "cannot write %s", tmp);
         return -1;
     }
     fprintf(f,
             "<?xml version=\"1.0\" ?>\n"
-            "<!-- packd grains: open with ParaView's Xdmf3 reader; the data is in %s -->\n"
+            "<!-- packd result: open with ParaView's Xdmf3 reader; the data is in %s -->\n"
             "<Xdmf Version=\"3.0\">\n"
-            "  <Domain>\n"
-            "    <Grid Name=\"grains\" GridType=\"Uniform\">\n"
-            "      <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
-            "NodesPerElement=\"1\">\n",
-            ref, n);
-    /* the Xdmf3 reader makes no cells without the connectivity (0..N-1) */
-    if (has_ids(h5_path)) {
-        fprintf(f,
-                "        <DataItem Dimensions=\"%zu 1\" NumberType=\"Int\" Precision=\"8\" "
-                "Format=\"HDF\">%s:/particles/grains/id</DataItem>\n",
-                n, ref);
-    } else {
-        fprintf(f,
-                "        <DataItem Dimensions=\"%zu 1\" NumberType=\"Int\" Precision=\"8\" "
-                "Format=\"XML\">",
-                n);
-        for (size_t i = 0; i < n; i++)
-            fprintf(f, i % 16 == 15 ? "%zu\n" : "%zu ", i);
-        fprintf(f, "</DataItem>\n");
-    }
-    fprintf(f,
-            "      </Topology>\n"
-            "      <Geometry GeometryType=\"%s\">\n"
-            "        <DataItem Dimensions=\"%zu %d\" NumberType=\"Float\" Precision=\"8\" "
-            "Format=\"HDF\">%s:/particles/grains/position</DataItem>\n"
-            "      </Geometry>\n"
-            "      <Attribute Name=\"radius\" AttributeType=\"Scalar\" Center=\"Node\">\n"
-            "        <DataItem Dimensions=\"%zu\" NumberType=\"Float\" Precision=\"8\" "
-            "Format=\"HDF\">%s:/particles/grains/radius</DataItem>\n"
-            "      </Attribute>\n"
-            "      <Attribute Name=\"species\" AttributeType=\"Scalar\" Center=\"Node\">\n"
-            "        <DataItem Dimensions=\"%zu\" NumberType=\"Int\" Precision=\"4\" "
-            "Format=\"HDF\">%s:/particles/grains/species</DataItem>\n"
-            "      </Attribute>\n"
-            "    </Grid>\n"
-            "  </Domain>\n"
-            "</Xdmf>\n",
-            b.dim == 3 ? "XYZ" : "XY", n, b.dim, ref, n, ref, n, ref);
+            "  <Domain>\n",
+            ref);
+    /* a load path replaces the reference grains: the Xdmf3 reader shows only
+     * the temporal collection of a domain that has one */
+    if (!steps_grid(f, h, ref))
+        grains_grid(f, h, ref, n, b.dim);
+    mesh_grid(f, h, ref);
+    fprintf(f, "  </Domain>\n</Xdmf>\n");
+    H5Fclose(h);
     if (fclose(f) != 0 || rename(tmp, xdmf_path) != 0) {
         unlink(tmp);
         snprintf(err, errlen, "cannot write %s", xdmf_path);

@@ -1,0 +1,129 @@
+/* homog_frames.c — the deformed grains per load step (contract in
+ * homog_frames.h). */
+#include "homog_frames.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/dem/dem_contact.h"
+
+void pk_homog_frames_init(pk_homog_frames *fr, const pk_homog_rve *rve, size_t nstep)
+{
+    memset(fr, 0, sizeof *fr);
+    fr->dim = rve->dim;
+    fr->n = rve->n;
+    fr->keep =
+        rve->n > 0 && nstep <= PK_HOMOG_FRAMES_MAX_STEPS && nstep <= PK_HOMOG_FRAMES_MAX / rve->n;
+}
+
+/* Σ_j |f_n,ij| per grain at s (the normal law of (4.3), E_n,ij per pair). */
+static int grain_forces(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homog_state *s,
+                        double *out)
+{
+    pk_dem_geom g = {.dim = rve->dim, .periodic = rve->periodic};
+    memcpy(g.L, rve->L, sizeof g.L);
+    pk_dem_geom_set_F(&g, s->F);
+    pk_dem_pairs c = {0};
+    pk_homog_pairs_setup(&c, rve, o);
+    int rc = pk_dem_pairs_build(&c, &g, s->x, rve->r, rve->n, o->dr.skin);
+    memset(out, 0, rve->n * sizeof *out);
+    if (rc == 0) {
+        pk_dem_eval(&c, &g, s->x, rve->r, rve->n, o->E_n, NULL, NULL, NULL);
+        for (size_t p = 0; p < c.n; p++) {
+            if (!(c.eps[p] >= 0) || !(c.len[p] > 0))
+                continue;
+            double f = o->E_n * (c.kf ? c.kf[p] : 1) * c.eps[p];
+            out[c.i[p]] += f;
+            out[c.j[p]] += f;
+        }
+    }
+    pk_dem_pairs_free(&c);
+    return rc;
+}
+
+int pk_homog_frames_add(pk_homog_frames *fr, const pk_homog_rve *rve, const pk_homog_opts *o,
+                        const pk_homog_state *s, size_t k, size_t nstep)
+{
+    if (!fr->keep)
+        return 0;
+    const size_t n = fr->n, dim = (size_t)fr->dim;
+    if (fr->count == fr->cap) {
+        size_t cap = fr->cap ? 2 * fr->cap : 8;
+        int64_t *st = realloc(fr->step, cap * sizeof *st);
+        if (st)
+            fr->step = st;
+        double *t = realloc(fr->time, cap * sizeof *t);
+        if (t)
+            fr->time = t;
+        double *x = realloc(fr->x, cap * n * dim * sizeof *x);
+        if (x)
+            fr->x = x;
+        double *f = realloc(fr->force, cap * n * sizeof *f);
+        if (f)
+            fr->force = f;
+        if (!st || !t || !x || !f)
+            return -1;
+        fr->cap = cap;
+    }
+    const size_t c = fr->count;
+    fr->step[c] = (int64_t)k;
+    fr->time[c] = (double)(k + 1) / (double)nstep;
+    for (size_t i = 0; i < n; i++)
+        for (size_t a = 0; a < dim; a++)
+            fr->x[(c * n + i) * dim + a] = s->x[3 * i + a];
+    if (grain_forces(rve, o, s, &fr->force[c * n]) != 0)
+        return -1;
+    fr->count++;
+    return 0;
+}
+
+int pk_homog_frames_write(pk_h5 *h, const pk_homog_frames *fr, const pk_homog_rve *rve,
+                          const char *unit)
+{
+    if (!fr->count)
+        return 0;
+    const size_t n = fr->n, c = fr->count;
+    int rc = pk_h5_link(h, "/particles/grains/box", "/particles/rve/box");
+    rc |= pk_h5_write_array(h, "/particles/rve/radius", PK_H5_F64, 1, &n, rve->r, unit);
+    rc |= pk_h5_write_array(h, "/particles/rve/grain", PK_H5_I32, 1, &n, rve->grain, NULL);
+    int64_t *id = malloc(n * sizeof *id);
+    if (!id)
+        return -1;
+    for (size_t i = 0; i < n; i++)
+        id[i] = (int64_t)i;
+    rc |= pk_h5_write_array(h, "/particles/rve/id", PK_H5_I64, 1, &n, id, NULL);
+    free(id);
+    /* H5MD time-dependent elements: step, time, value */
+    const char *el[2] = {"position", "contact_force"};
+    for (int e = 0; e < 2; e++) {
+        char p[64];
+        snprintf(p, sizeof p, "/particles/rve/%s/step", el[e]);
+        rc |= pk_h5_write_array(h, p, PK_H5_I64, 1, &c, fr->step, NULL);
+        snprintf(p, sizeof p, "/particles/rve/%s/time", el[e]);
+        rc |= pk_h5_write_array(h, p, PK_H5_F64, 1, &c, fr->time, NULL);
+    }
+    size_t dx[3] = {c, n, (size_t)fr->dim}, df[2] = {c, n};
+    rc |= pk_h5_write_array(h, "/particles/rve/position/value", PK_H5_F64, 3, dx, fr->x, unit);
+    rc |= pk_h5_write_array(h, "/particles/rve/contact_force/value", PK_H5_F64, 2, df, fr->force,
+                            NULL);
+    /* per step views position/<k> [n][dim] and contact_force/<k> [n] for the
+     * XDMF sidecar: ParaView's Xdmf3 reader reads no HyperSlab */
+    for (size_t k = 0; k < c; k++)
+        for (int e = 0; e < 2; e++) {
+            char src[64], p[64];
+            snprintf(src, sizeof src, "/particles/rve/%s/value", el[e]);
+            snprintf(p, sizeof p, "/particles/rve/views/%s/%zu", el[e], k);
+            rc |= pk_h5_slice_view(h, src, k, p);
+        }
+    return rc ? -1 : 0;
+}
+
+void pk_homog_frames_free(pk_homog_frames *fr)
+{
+    free(fr->step);
+    free(fr->time);
+    free(fr->x);
+    free(fr->force);
+    memset(fr, 0, sizeof *fr);
+}
