@@ -88,8 +88,7 @@ const rows = new Map(); // jobID -> {tr, status, bar, msg}
 function setProgress(row, p) {
   if (typeof p === 'number') {
     row.bar.value = p;
-    row.bar.textContent = p + ' %';
-    row.bar.title = p + ' %';
+    row.pct.textContent = ' ' + p + ' %';
   }
 }
 
@@ -125,8 +124,9 @@ function jobRow(j) {
     bar.value = 0;
     bar.className = 'job-progress';
     const barc = el('td');
-    barc.appendChild(bar);
-    row = { tr, status: el('td'), bar, msg: el('td') };
+    const pct = el('span', '', 'pct');
+    barc.append(bar, pct);
+    row = { tr, status: el('td'), bar, pct, msg: el('td') };
     tr.append(idc, el('td', j.processID), row.status, barc, row.msg, el('td', (j.created || '').replace('T', ' ').replace('Z', '')));
     rows.set(j.jobID, row);
   }
@@ -137,9 +137,13 @@ function jobRow(j) {
   return row;
 }
 
+let packResults = []; // successful pack jobs: the RVEs a homogenize example can take
+
 async function refreshList() {
   try {
     const doc = await api('jobs?limit=50');
+    packResults = (doc.jobs || []).filter((j) => j.processID === 'pack' && j.status === 'successful');
+    fillRVE();
     const tbody = $('jobs').tBodies[0];
     const seen = new Set();
     for (const j of doc.jobs || []) {
@@ -177,6 +181,26 @@ function pickExample() {
   if (!ex) return;
   $('example-comment').textContent = ex.comment || '';
   $('inputs').value = JSON.stringify(ex.inputs, null, 2);
+  fillRVE();
+}
+
+// A homogenize example names an RVE file of its own folder; here it takes
+// the result of one of the user's finished pack jobs instead.
+function fillRVE() {
+  const ex = examples[Number($('example').value)];
+  const wants = !!(ex && ex.inputs.rve);
+  $('rve-pick').hidden = !wants;
+  const sel = $('rve');
+  const keep = sel.value;
+  sel.replaceChildren(el('option', wants && !packResults.length ? '(first run a pack example)' : '(as in the example)'));
+  sel.options[0].value = '';
+  for (const j of packResults) {
+    const o = el('option', j.jobID.slice(0, 8) + ' ' + (j.created || ''));
+    o.value = '/jobs/' + j.jobID + '/results/result';
+    sel.appendChild(o);
+  }
+  sel.value = keep;
+  if (sel.value !== keep || !keep) sel.selectedIndex = packResults.length ? 1 : 0;
 }
 
 async function submitExample(ev) {
@@ -185,6 +209,7 @@ async function submitExample(ev) {
   if (!ex) return;
   let inputs;
   try { inputs = JSON.parse($('inputs').value); } catch (e) { showError('Inputs: ' + e.message); return; }
+  if (inputs.rve && $('rve').value) inputs.rve = { href: $('rve').value };
   try {
     const doc = await api('processes/' + encodeURIComponent(ex.process) + '/execution', {
       method: 'POST', headers: { 'Content-Type': 'application/json' },
@@ -248,7 +273,7 @@ function summaryRows(obj, prefix, tbody, depth) {
     const key = prefix ? prefix + '.' + k : k;
     if (v !== null && typeof v === 'object' && !Array.isArray(v)) {
       if (depth < 2) summaryRows(v, key, tbody, depth + 1);
-    } else if (!Array.isArray(v) || v.length <= 8) {
+    } else if (!Array.isArray(v) || (v.length <= 8 && v.every((x) => typeof x !== 'object'))) {
       const tr = el('tr');
       const shown = typeof v === 'number' && !Number.isInteger(v) ? Number(v.toPrecision(6)) : v;
       tr.append(el('th', key), el('td', Array.isArray(v) ? JSON.stringify(v) : shown));

@@ -52,12 +52,21 @@ if [ ! -f "$PW/package.json" ]; then # once per build folder
 fi
 SHOTS="$BUILD/screenshots"
 mkdir -p "$SHOTS"
-rm -f "$SHOTS"/dashboard-*.png "$SHOTS/result.h5"
-PLAYWRIGHT_CORE="$PW" CHROMIUM="$CHROMIUM" SLOW=$SLOW HOME="$T" timeout $((180 * SLOW)) \
-    node "$SRC/tests/integration/dashboard_driver.js" "$B" "$SHOTS" meier-quartz-2d.json >"$T/drv.txt" 2>&1
-grep -E '^(PASS|FAIL|SKIP) ' "$T/drv.txt"
-grep -qE '^(PASS|FAIL) ' "$T/drv.txt" || fail dashboard_driver "$(tail -3 "$T/drv.txt")"
-check dashboard_download_is_hdf5 sh -c "h5ls '$SHOTS/result.h5' | grep -q '^particles'"
-id=$(sed -n 's/^JOB //p' "$T/drv.txt")
-c -o "$T/api.h5" "$B/jobs/$id/results/result"
-check dashboard_download_is_the_result cmp -s "$SHOTS/result.h5" "$T/api.h5"
+rm -f "$SHOTS"/dashboard-*.png "$SHOTS"/result*.h5
+browse() { # TAG [TOKEN]: the driver's PASS/FAIL lines, then the download checked
+    PLAYWRIGHT_CORE="$PW" CHROMIUM="$CHROMIUM" SLOW=$SLOW HOME="$T" TOKEN="${2:-}" timeout $((180 * SLOW)) \
+        node "$SRC/tests/integration/dashboard_driver.js" "$B" "$SHOTS" meier-quartz-2d.json >"$T/drv.txt" 2>&1
+    grep -E '^(PASS|FAIL|SKIP) ' "$T/drv.txt"
+    grep -qE '^(PASS|FAIL) ' "$T/drv.txt" || fail "dashboard_driver$1" "$(tail -3 "$T/drv.txt")"
+    check "dashboard_download_is_hdf5$1" sh -c "h5ls '$SHOTS/result$1.h5' | grep -q '^particles'"
+    id=$(sed -n 's/^JOB //p' "$T/drv.txt")
+    c ${2:+-H "Authorization: Bearer $2"} -o "$T/api.h5" "$B/jobs/$id/results/result"
+    check "dashboard_download_is_the_result$1" cmp -s "$SHOTS/result$1.h5" "$T/api.h5"
+}
+browse ""
+
+# auth on: the token typed into the page; pictures and files come as blobs
+tok=$("$PACKD" token add alice --data "$T/auth" 2>/dev/null)
+printf 'auth = on\n' >"$T/auth.conf"
+start_daemon auth --config "$T/auth.conf" || exit 1
+browse _auth "$tok"
