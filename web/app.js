@@ -312,12 +312,17 @@ async function showJob(id) {
   if (s.status !== 'successful') return;
   let res;
   try { res = await api('jobs/' + encodeURIComponent(id) + '/results'); } catch (e) { showError('Results: ' + e.message); return; }
-  if (res['picture.png']) picture(id, 'picture.png', 'the packing');
-  if (res['grading.png']) picture(id, 'grading.png', 'the grading curve');
-  download(id, 'result', id + '.h5', 'HDF5 result (H5MD)');
-  download(id, 'xdmf', id + '.xdmf', 'XDMF for ParaView (save next to the .h5 file)');
-  for (const o of ['picture.png', 'picture.svg', 'grading.png', 'grading.svg'])
-    if (res[o]) download(id, o, id + '-' + o, res[o].title + ' (' + o.split('.')[1].toUpperCase() + ')');
+  // every output the results document lists: PNG pictures and plots shown,
+  // every file offered for download (the HDF5 result and its XDMF first)
+  const outs = Object.keys(res).filter((k) => res[k] && res[k].href);
+  for (const k of outs)
+    if (res[k].type === 'image/png') picture(id, k, res[k].title || k);
+  const order = (k) => (k === 'result' ? 0 : k === 'xdmf' ? 1 : 2);
+  for (const k of outs.sort((a, b) => order(a) - order(b))) {
+    if (k === 'result') download(id, k, id + '.h5', 'HDF5 result (H5MD)');
+    else if (k === 'xdmf') download(id, k, id + '.xdmf', 'XDMF for ParaView (save it next to the .h5 file)');
+    else download(id, k, id + '-' + k, (res[k].title || k) + ' (' + k.split('.').pop().toUpperCase() + ')');
+  }
   try {
     summaryRows(await api(fileURL(id, 'summary')), '', $('summary').tBodies[0], 0);
   } catch (e) { showError('Summary: ' + e.message); }

@@ -108,7 +108,8 @@ enum MHD_Result pk_send_dashboard_page(pk_req *r)
 
 enum MHD_Result route_dashboard_asset(pk_req *r)
 {
-    const pk_web_asset *a = strncmp(r->seg[1], "examples", 8) ? asset(r->seg[1]) : NULL;
+    /* the page itself is served at / only: its links are relative to it */
+    const pk_web_asset *a = strcmp(r->seg[1], "index.html") ? asset(r->seg[1]) : NULL;
     if (!a)
         return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such dashboard file",
                                NULL, 0);
