@@ -41,12 +41,13 @@ CORE_SRC   := $(call tree,core)
 API_SRC    := $(call tree,api)
 DAEMON_SRC := $(filter-out daemon/cli/main.c,$(call tree,daemon))
 SCHEMAS    := $(sort $(wildcard schemas/*.json))
+WEB        := $(sort $(wildcard web/*)) $(sort $(wildcard examples/*.json examples/*/*.json))
 UNIT_SRC   := $(wildcard tests/unit/test_*.c)
 BENCH_SRC  := $(wildcard bench/*.c)
 
 CORE_OBJ   := $(CORE_SRC:%.c=$(BUILD)/obj/%.o)
 API_OBJ    := $(API_SRC:%.c=$(BUILD)/obj/%.o) $(BUILD)/obj/gen/schemas_embedded.o
-DAEMON_OBJ := $(DAEMON_SRC:%.c=$(BUILD)/obj/%.o)
+DAEMON_OBJ := $(DAEMON_SRC:%.c=$(BUILD)/obj/%.o) $(BUILD)/obj/gen/web_embedded.o
 LIB_OBJ    := $(DAEMON_OBJ) $(API_OBJ) $(CORE_OBJ)
 UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 BENCH_BIN  := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
@@ -84,6 +85,15 @@ $(BUILD)/gen/schemas_embedded.c: $(SCHEMAS) tools/embed-schemas.sh
 	sh tools/embed-schemas.sh $(SCHEMAS) > $@
 
 $(BUILD)/obj/gen/schemas_embedded.o: $(BUILD)/gen/schemas_embedded.c
+	@mkdir -p $(@D)
+	$(CC) $(BASE_CFLAGS) -I. -c $< -o $@
+
+# The dashboard (web/) and the examples it offers are compiled in the same way.
+$(BUILD)/gen/web_embedded.c: $(WEB) tools/embed-web.sh
+	@mkdir -p $(@D)
+	sh tools/embed-web.sh $(WEB) > $@
+
+$(BUILD)/obj/gen/web_embedded.o: $(BUILD)/gen/web_embedded.c
 	@mkdir -p $(@D)
 	$(CC) $(BASE_CFLAGS) -I. -c $< -o $@
 

@@ -4,12 +4,16 @@
 # build directory.  As root it runs apt-get itself, as another user through sudo when
 # sudo is installed; otherwise it prints the one command to run as root and fails.
 set -eu
-PKGS="build-essential pkg-config libmicrohttpd-dev libcurl4-openssl-dev libssl-dev libjansson-dev libsqlite3-dev libhdf5-dev hdf5-tools curl python3 python3-jsonschema python3-owslib libsuitesparse-dev libopenblas0-serial procps libcairo2-dev fonts-dejavu-core clang libclang-rt-14-dev"
+PKGS="build-essential pkg-config libmicrohttpd-dev libcurl4-openssl-dev libssl-dev libjansson-dev libsqlite3-dev libhdf5-dev hdf5-tools curl python3 python3-jsonschema python3-owslib libsuitesparse-dev libopenblas0-serial procps libcairo2-dev fonts-dejavu-core clang libclang-rt-14-dev chromium nodejs"
 if ! command -v dpkg-query >/dev/null 2>&1 || ! command -v apt-get >/dev/null 2>&1; then
     echo "install-deps: not a Debian system; install the equivalents of these by hand:" >&2
     echo "  $PKGS" >&2
     exit 0
 fi
+# The dashboard's browser test (tests/integration/test_dashboard.sh) drives
+# chromium with playwright-core from npm; a node from elsewhere (NodeSource)
+# brings its own npm, which Debian's npm package would conflict with.
+command -v npm >/dev/null 2>&1 || PKGS="$PKGS npm"
 # Optional: what bench/service.sh drives the daemon with (PACKD_BENCH_DEPS=1).
 [ "${PACKD_BENCH_DEPS:-0}" = 1 ] && PKGS="$PKGS wrk sqlite3"
 missing=""

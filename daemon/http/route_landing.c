@@ -1,7 +1,9 @@
-/* GET /, /conformance, /api — what the service is and which standards it follows. */
+/* GET /, /conformance, /api — what the service is and which standards it follows.
+ * A browser asking for / gets the dashboard instead (route_dashboard.c). */
 #include <string.h>
 
 #include "http.h"
+#include "route_dashboard.h"
 #include "api/schemas/schemas_embedded.h"
 
 static json_t *mklink(const char *href, const char *rel, const char *type, const char *title)
@@ -11,6 +13,8 @@ static json_t *mklink(const char *href, const char *rel, const char *type, const
 
 enum MHD_Result route_landing(pk_req *r)
 {
+    if (pk_prefers_html(r)) /* a browser: the dashboard */
+        return pk_send_dashboard_page(r);
     json_t *links = json_array();
     json_array_append_new(links, mklink("/", "self", "application/json", "this document"));
     json_array_append_new(links,

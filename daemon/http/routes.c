@@ -4,6 +4,7 @@
  * an admin token, everything else a token; owners are checked in the
  * handlers' lookups (auth.c). */
 #include "http.h"
+#include "route_dashboard.h"
 
 const pk_route pk_routes[] = {
     {"GET", "/", route_landing, PK_PUBLIC},
@@ -22,5 +23,9 @@ const pk_route pk_routes[] = {
     {"GET", "/files/*", route_file_get, PK_USER},
     {"GET", "/metrics", route_metrics, PK_ADMIN},
     {"GET", "/healthz", route_healthz, PK_PUBLIC},
+    /* the browser dashboard: its page is / for a browser (route_landing) */
+    {"GET", "/dashboard/examples", route_dashboard_examples, PK_PUBLIC},
+    {"GET", "/dashboard/*", route_dashboard_asset, PK_PUBLIC},
+    {"GET", "/dashboard/jobs/*/inputs", route_dashboard_inputs, PK_USER},
     {NULL, NULL, NULL, PK_PUBLIC},
 };

@@ -1,0 +1,154 @@
+/* route_dashboard.c — the browser dashboard: the files of web/ and the examples compiled
+ * in (web_assets.h), the page at / for a browser, and the job's inputs the
+ * job page shows.  The page runs only its own script (Content-Security-Policy);
+ * it reads the API as any client does, with the user's bearer token. */
+#include "route_dashboard.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <unistd.h>
+
+#include "auth.h"
+#include "web_assets.h"
+#include "daemon/store/job_files.h"
+
+/* Pictures and downloads of an auth'd page are fetched with the token and
+ * shown from blob: URLs. */
+#define CSP "default-src 'self'; img-src 'self' blob:; object-src 'none'; frame-ancestors 'none'"
+
+/* q of the most specific range of accept matching type ("text/html"):
+ * an exact type, then its major type with a wildcard subtype, then any
+ * type; 0 when none matches. */
+static double accept_q(const char *accept, const char *type)
+{
+    size_t major = strcspn(type, "/");
+    double best = 0;
+    int best_rank = -1;
+    for (const char *p = accept; *p;) {
+        size_t n = strcspn(p, ",");
+        char range[128];
+        snprintf(range, sizeof range, "%.*s", (int)(n < sizeof range ? n : sizeof range - 1), p);
+        p += n + (p[n] == ',');
+        char *params = strchr(range, ';');
+        double q = 1;
+        if (params) {
+            *params++ = 0;
+            char *qs = strstr(params, "q=");
+            if (qs)
+                q = strtod(qs + 2, NULL);
+        }
+        char *t = range + strspn(range, " \t");
+        t[strcspn(t, " \t")] = 0;
+        int rank = -1;
+        if (!strcasecmp(t, type))
+            rank = 2;
+        else if (!strncasecmp(t, type, major + 1) && !strcmp(t + major + 1, "*"))
+            rank = 1;
+        else if (!strcmp(t, "*/*"))
+            rank = 0;
+        if (rank > best_rank) {
+            best_rank = rank;
+            best = q;
+        }
+    }
+    return best;
+}
+
+int pk_prefers_html(pk_req *r)
+{
+    const char *accept = pk_header(r, "Accept");
+    return accept && accept_q(accept, "text/html") > accept_q(accept, "application/json");
+}
+
+static const pk_web_asset *asset(const char *name)
+{
+    for (const pk_web_asset *a = pk_web_assets; a->name; a++)
+        if (!strcmp(a->name, name))
+            return a;
+    return NULL;
+}
+
+static const char *media_type(const char *name)
+{
+    static const char *const types[][2] = {
+        {".html", "text/html; charset=utf-8"}, {".js", "text/javascript; charset=utf-8"},
+        {".css", "text/css; charset=utf-8"},   {".svg", "image/svg+xml"},
+        {".json", "application/json"},
+    };
+    const char *dot = strrchr(name, '.');
+    for (size_t i = 0; dot && i < sizeof types / sizeof *types; i++)
+        if (!strcmp(dot, types[i][0]))
+            return types[i][1];
+    return "application/octet-stream";
+}
+
+static enum MHD_Result send_asset(pk_req *r, const pk_web_asset *a)
+{
+    struct MHD_Response *resp =
+        MHD_create_response_from_buffer(a->len, (void *)a->data, MHD_RESPMEM_PERSISTENT);
+    if (resp) {
+        MHD_add_response_header(resp, "Content-Type", media_type(a->name));
+        MHD_add_response_header(resp, "Content-Security-Policy", CSP);
+        MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
+        MHD_add_response_header(resp, "Cache-Control", "no-cache");
+        MHD_add_response_header(resp, "Vary", "Accept");
+    }
+    return pk_send(r, 200, resp);
+}
+
+enum MHD_Result pk_send_dashboard_page(pk_req *r)
+{
+    const pk_web_asset *a = asset("index.html");
+    if (!a)
+        return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error",
+                               "the dashboard is not compiled in", NULL, 0);
+    return send_asset(r, a);
+}
+
+enum MHD_Result route_dashboard_asset(pk_req *r)
+{
+    /* the page itself is served at / only: its links are relative to it */
+    const pk_web_asset *a = strcmp(r->seg[1], "index.html") ? asset(r->seg[1]) : NULL;
+    if (!a)
+        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such dashboard file",
+                               NULL, 0);
+    return send_asset(r, a);
+}
+
+/* [{name, process, comment, inputs}] of every example compiled in. */
+enum MHD_Result route_dashboard_examples(pk_req *r)
+{
+    json_t *list = json_array();
+    for (const pk_web_asset *a = pk_web_assets; a->name; a++) {
+        if (strncmp(a->name, "examples/", 9) != 0)
+            continue;
+        json_t *ex = json_loadb((const char *)a->data, a->len, 0, NULL);
+        if (json_is_object(ex) && json_is_object(json_object_get(ex, "inputs"))) {
+            json_object_set_new(ex, "name", json_string(a->name + 9));
+            json_array_append(list, ex);
+        }
+        json_decref(ex);
+    }
+    return pk_send_json(r, 200, json_pack("{s:o}", "examples", list), NULL);
+}
+
+/* {process, inputs} as the job was submitted (job.json). */
+enum MHD_Result route_dashboard_inputs(pk_req *r)
+{
+    json_t *row = pk_job_visible(r, r->seg[2]);
+    if (!row)
+        return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[2], NULL, 0);
+    json_decref(row);
+    pk_config cfg = pk_service_config(r->svc);
+    char dir[1200], path[1300];
+    pk_job_dir(cfg.data, r->seg[2], dir, sizeof dir);
+    pk_job_file_path(dir, PK_JOB_INPUT, path, sizeof path);
+    json_t *job = access(path, R_OK) == 0 ? json_load_file(path, 0, NULL) : NULL;
+    if (!json_is_object(job)) {
+        json_decref(job);
+        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found",
+                               "the job's inputs are not kept", NULL, 0);
+    }
+    return pk_send_json(r, 200, job, NULL);
+}

@@ -1,0 +1,72 @@
+#!/bin/sh
+# test_dashboard.sh — the browser dashboard: GET / negotiates (a browser gets
+# the page, a JSON client the landing document as before), its assets carry
+# the Content-Security-Policy, and headless Chromium (Debian's chromium,
+# driven by playwright-core from npm, cached in the build folder) submits an
+# example, watches its bar reach 100 %, sees the picture and downloads the
+# result, which h5ls reads.  Screenshots: $PACKD_BUILD/screenshots/.
+. "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
+BUILD=${PACKD_BUILD:-$(dirname "$PACKD")}
+
+start_daemon dash || exit 1
+BROWSER_ACCEPT='text/html,application/xhtml+xml,application/xml;q=0.9,image/avif,image/webp,*/*;q=0.8'
+c -D "$T/h.txt" -o "$T/page.html" -H "Accept: $BROWSER_ACCEPT" "$B/"
+check dashboard_page_for_browser grep -qi '^content-type: text/html' "$T/h.txt"
+check dashboard_page_csp grep -qi "^content-security-policy: default-src 'self'" "$T/h.txt"
+check dashboard_page_no_inline_script sh -c "! grep -qiE '<script>|<script [^>]*>[^<]| on[a-z]+=' '$T/page.html'"
+n=0
+for accept in '' 'application/json' '*/*' 'application/json, text/html;q=0.5'; do
+    n=$((n + 1)) # no Accept, JSON, anything, JSON preferred
+    c -D "$T/j.txt" -o "$T/landing.json" ${accept:+-H "Accept: $accept"} "$B/"
+    check "dashboard_json_landing_$n" sh -c \
+        "grep -qi '^content-type: application/json' '$T/j.txt' &&
+         python3 -c \"import json; assert json.load(open('$T/landing.json'))['title'] == 'packd job service'\""
+done
+c -D "$T/a.txt" -o "$T/app.js" "$B/dashboard/app.js"
+check dashboard_script_served grep -qi '^content-type: text/javascript' "$T/a.txt"
+c -o "$T/ex.json" "$B/dashboard/examples"
+check dashboard_examples_listed python3 -c "
+import json; d = json.load(open('$T/ex.json'))['examples']
+assert any(e['name'] == 'meier-quartz-2d.json' and e['inputs']['dim'] == 2 for e in d), d"
+check dashboard_asset_404 test "$(c -o /dev/null -w '%{http_code}' "$B/dashboard/nope.js")" = 404
+
+# --- the browser
+CHROMIUM=$(command -v chromium || true)
+if [ -z "$CHROMIUM" ]; then
+    skip dashboard_browser "Debian's chromium is not installed (apt-get install chromium)"
+    exit 0
+fi
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+    skip dashboard_browser "node/npm are not installed (apt-get install nodejs npm)"
+    exit 0
+fi
+NODE_DIR="$BUILD/node"
+PW="$NODE_DIR/node_modules/playwright-core"
+if [ ! -f "$PW/package.json" ]; then # once per build folder
+    mkdir -p "$NODE_DIR"
+    if ! PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm install --prefix "$NODE_DIR" --no-audit --no-fund \
+        --silent playwright-core@1 >"$T/npm.log" 2>&1; then
+        skip dashboard_browser "npm install playwright-core failed (offline?): $(tail -1 "$T/npm.log")"
+        exit 0
+    fi
+fi
+SHOTS="$BUILD/screenshots"
+mkdir -p "$SHOTS"
+rm -f "$SHOTS"/dashboard-*.png "$SHOTS"/result*.h5
+browse() { # TAG [TOKEN]: the driver's PASS/FAIL lines, then the download checked
+    PLAYWRIGHT_CORE="$PW" CHROMIUM="$CHROMIUM" SLOW=$SLOW HOME="$T" TOKEN="${2:-}" timeout $((180 * SLOW)) \
+        node "$SRC/tests/integration/dashboard_driver.js" "$B" "$SHOTS" meier-quartz-2d.json >"$T/drv.txt" 2>&1
+    grep -E '^(PASS|FAIL|SKIP) ' "$T/drv.txt"
+    grep -qE '^(PASS|FAIL) ' "$T/drv.txt" || fail "dashboard_driver$1" "$(tail -3 "$T/drv.txt")"
+    check "dashboard_download_is_hdf5$1" sh -c "h5ls '$SHOTS/result$1.h5' | grep -q '^particles'"
+    id=$(sed -n 's/^JOB //p' "$T/drv.txt")
+    c ${2:+-H "Authorization: Bearer $2"} -o "$T/api.h5" "$B/jobs/$id/results/result"
+    check "dashboard_download_is_the_result$1" cmp -s "$SHOTS/result$1.h5" "$T/api.h5"
+}
+browse ""
+
+# auth on: the token typed into the page; pictures and files come as blobs
+tok=$("$PACKD" token add alice --data "$T/auth" 2>/dev/null)
+printf 'auth = on\n' >"$T/auth.conf"
+start_daemon auth --config "$T/auth.conf" || exit 1
+browse _auth "$tok"

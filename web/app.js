@@ -1,0 +1,362 @@
+// packd dashboard: the job list with live progress, a job page, and a form
+// that submits the examples.  It reads the API as any client does; job data
+// enters the page only as text (textContent), never as markup.
+'use strict';
+
+const $ = (id) => document.getElementById(id);
+const token = () => localStorage.getItem('packd.token') || '';
+const FINAL = ['successful', 'failed', 'dismissed'];
+const MAX_STREAMS = 4; // a browser keeps ~6 connections per host
+
+function headers(extra) {
+  const h = Object.assign({}, extra || {});
+  if (token()) h.Authorization = 'Bearer ' + token();
+  return h;
+}
+
+function showError(text) {
+  const e = $('error');
+  e.textContent = text || '';
+  e.hidden = !text;
+}
+
+async function api(path, opts) {
+  const o = Object.assign({}, opts || {});
+  o.headers = headers(Object.assign({ Accept: 'application/json' }, o.headers || {}));
+  const r = await fetch(path, o);
+  const body = await r.json().catch(() => ({}));
+  if (!r.ok) {
+    const msg = (body.title || r.statusText) + (body.detail ? ': ' + body.detail : '');
+    throw new Error(r.status + ' ' + msg);
+  }
+  return body;
+}
+
+function el(tag, text, cls) {
+  const e = document.createElement(tag);
+  if (text !== undefined && text !== null) e.textContent = String(text);
+  if (cls) e.className = cls;
+  return e;
+}
+
+// --- live progress: the job's event stream (text/event-stream over fetch, so
+// the token goes in a header; EventSource cannot send one)
+const streams = new Map(); // jobID -> AbortController
+
+function stream(id, onEvent) {
+  if (streams.has(id) || streams.size >= MAX_STREAMS) return;
+  const ctl = new AbortController();
+  streams.set(id, ctl);
+  (async () => {
+    try {
+      const r = await fetch('jobs/' + encodeURIComponent(id) + '/events',
+        { headers: headers({ Accept: 'text/event-stream' }), signal: ctl.signal });
+      if (!r.ok || !r.body) return;
+      const reader = r.body.pipeThrough(new TextDecoderStream()).getReader();
+      let buf = '';
+      for (;;) {
+        const { value, done } = await reader.read();
+        if (done) break;
+        buf += value;
+        let cut;
+        while ((cut = buf.indexOf('\n\n')) >= 0) {
+          const block = buf.slice(0, cut);
+          buf = buf.slice(cut + 2);
+          let kind = 'message', data = '';
+          for (const line of block.split('\n')) {
+            if (line.startsWith('event:')) kind = line.slice(6).trim();
+            else if (line.startsWith('data:')) data += line.slice(5).trim();
+          }
+          if (data) {
+            try { onEvent(kind, JSON.parse(data)); } catch (e) { /* not JSON: ignore */ }
+          }
+        }
+      }
+    } catch (e) { /* aborted or the connection dropped: the list poll goes on */ }
+    finally { streams.delete(id); }
+  })();
+}
+
+function stopStreams() {
+  for (const ctl of streams.values()) ctl.abort();
+  streams.clear();
+}
+
+// --- the job list
+const rows = new Map(); // jobID -> {tr, status, bar, msg}
+
+function setProgress(row, p) {
+  if (typeof p === 'number') {
+    row.bar.value = p;
+    row.pct.textContent = ' ' + p + ' %';
+  }
+}
+
+function setStatus(row, st) {
+  row.status.textContent = st;
+  row.status.className = 'status st-' + st;
+  row.tr.dataset.status = st;
+}
+
+function onListEvent(id) {
+  return (kind, d) => {
+    const row = rows.get(id);
+    if (!row) return;
+    if (d.status) setStatus(row, d.status);
+    if (typeof d.message === 'string') row.msg.textContent = d.message;
+    if (kind === 'progress' && d.stage) row.msg.textContent = d.stage + (d.phi ? ', φ = ' + Number(d.phi).toFixed(4) : '');
+    setProgress(row, d.progress);
+  };
+}
+
+function jobRow(j) {
+  let row = rows.get(j.jobID);
+  if (!row) {
+    const tr = el('tr');
+    tr.dataset.job = j.jobID;
+    const link = el('a', j.jobID.slice(0, 8));
+    link.href = '#/jobs/' + encodeURIComponent(j.jobID);
+    link.title = j.jobID;
+    const idc = el('td');
+    idc.appendChild(el('code')).appendChild(link);
+    const bar = el('progress');
+    bar.max = 100;
+    bar.value = 0;
+    bar.className = 'job-progress';
+    const barc = el('td');
+    const pct = el('span', '', 'pct');
+    barc.append(bar, pct);
+    row = { tr, status: el('td'), bar, pct, msg: el('td') };
+    tr.append(idc, el('td', j.processID), row.status, barc, row.msg, el('td', (j.created || '').replace('T', ' ').replace('Z', '')));
+    rows.set(j.jobID, row);
+  }
+  setStatus(row, j.status);
+  row.msg.textContent = j.message || '';
+  setProgress(row, j.status === 'successful' ? 100 : j.progress);
+  if (!FINAL.includes(j.status)) stream(j.jobID, onListEvent(j.jobID));
+  return row;
+}
+
+let packResults = []; // successful pack jobs: the RVEs a homogenize example can take
+
+async function refreshList() {
+  try {
+    const doc = await api('jobs?limit=50');
+    packResults = (doc.jobs || []).filter((j) => j.processID === 'pack' && j.status === 'successful');
+    fillRVE();
+    const tbody = $('jobs').tBodies[0];
+    const seen = new Set();
+    for (const j of doc.jobs || []) {
+      seen.add(j.jobID);
+      tbody.appendChild(jobRow(j).tr); // in the list's order (newest first)
+    }
+    for (const [id, row] of rows)
+      if (!seen.has(id)) { row.tr.remove(); rows.delete(id); }
+    showError('');
+  } catch (e) {
+    showError('Job list: ' + e.message + (token() ? '' : ' (auth on? enter a token above)'));
+  }
+}
+
+// --- the examples form
+let examples = [];
+
+async function loadExamples() {
+  try {
+    examples = (await api('dashboard/examples')).examples || [];
+  } catch (e) { showError('Examples: ' + e.message); return; }
+  const sel = $('example');
+  sel.replaceChildren();
+  examples.forEach((ex, i) => {
+    const o = el('option', ex.name.replace(/\.json$/, '') + ' (' + ex.process + ')');
+    o.value = String(i);
+    sel.appendChild(o);
+  });
+  sel.addEventListener('change', pickExample);
+  pickExample();
+}
+
+function pickExample() {
+  const ex = examples[Number($('example').value)];
+  if (!ex) return;
+  $('example-comment').textContent = ex.comment || '';
+  $('inputs').value = JSON.stringify(ex.inputs, null, 2);
+  fillRVE();
+}
+
+// A homogenize example names an RVE file of its own folder; here it takes
+// the result of one of the user's finished pack jobs instead.
+function fillRVE() {
+  const ex = examples[Number($('example').value)];
+  const wants = !!(ex && ex.inputs.rve);
+  $('rve-pick').hidden = !wants;
+  const sel = $('rve');
+  const keep = sel.value;
+  sel.replaceChildren(el('option', wants && !packResults.length ? '(first run a pack example)' : '(as in the example)'));
+  sel.options[0].value = '';
+  for (const j of packResults) {
+    const o = el('option', j.jobID.slice(0, 8) + ' ' + (j.created || ''));
+    o.value = '/jobs/' + j.jobID + '/results/result';
+    sel.appendChild(o);
+  }
+  sel.value = keep;
+  if (sel.value !== keep || !keep) sel.selectedIndex = packResults.length ? 1 : 0;
+}
+
+async function submitExample(ev) {
+  ev.preventDefault();
+  const ex = examples[Number($('example').value)];
+  if (!ex) return;
+  let inputs;
+  try { inputs = JSON.parse($('inputs').value); } catch (e) { showError('Inputs: ' + e.message); return; }
+  if (inputs.rve && $('rve').value) inputs.rve = { href: $('rve').value };
+  try {
+    const doc = await api('processes/' + encodeURIComponent(ex.process) + '/execution', {
+      method: 'POST', headers: { 'Content-Type': 'application/json' },
+      body: JSON.stringify({ inputs }),
+    });
+    const out = $('submitted');
+    out.replaceChildren('submitted ');
+    const a = el('a', doc.jobID);
+    a.href = '#/jobs/' + encodeURIComponent(doc.jobID);
+    out.appendChild(a);
+    showError('');
+    await refreshList();
+  } catch (e) { showError('Submit: ' + e.message); }
+}
+
+// --- the job page
+let pageJob = null;
+
+function fileURL(id, output) {
+  return 'jobs/' + encodeURIComponent(id) + '/results/' + output;
+}
+
+// With a token, pictures and files come through fetch (an <img> or a link
+// cannot send the header) and are shown from blob: URLs.
+async function blobURL(url) {
+  const r = await fetch(url, { headers: headers() });
+  if (!r.ok) throw new Error(r.status + ' ' + r.statusText);
+  return URL.createObjectURL(await r.blob());
+}
+
+function picture(id, output, title) {
+  const fig = el('figure');
+  const img = el('img');
+  img.alt = title;
+  img.dataset.output = output;
+  fig.append(img, el('figcaption', title));
+  $('pictures').appendChild(fig);
+  if (token()) blobURL(fileURL(id, output)).then((u) => { img.src = u; }, (e) => showError(output + ': ' + e.message));
+  else img.src = fileURL(id, output);
+}
+
+function download(id, output, name, title) {
+  const li = el('li');
+  const a = el('a', title);
+  a.href = fileURL(id, output);
+  a.download = name;
+  a.dataset.output = output;
+  if (token()) {
+    a.addEventListener('click', async (ev) => {
+      if (a.href.startsWith('blob:')) return;
+      ev.preventDefault();
+      try { a.href = await blobURL(fileURL(id, output)); a.click(); } catch (e) { showError(title + ': ' + e.message); }
+    });
+  }
+  li.append(a, el('span', ' (' + name + ')'));
+  $('downloads').appendChild(li);
+}
+
+function summaryRows(obj, prefix, tbody, depth) {
+  for (const [k, v] of Object.entries(obj || {})) {
+    const key = prefix ? prefix + '.' + k : k;
+    if (v !== null && typeof v === 'object' && !Array.isArray(v)) {
+      if (depth < 2) summaryRows(v, key, tbody, depth + 1);
+    } else if (!Array.isArray(v) || (v.length <= 8 && v.every((x) => typeof x !== 'object'))) {
+      const tr = el('tr');
+      const shown = typeof v === 'number' && !Number.isInteger(v) ? Number(v.toPrecision(6)) : v;
+      tr.append(el('th', key), el('td', Array.isArray(v) ? JSON.stringify(v) : shown));
+      tbody.appendChild(tr);
+    }
+  }
+}
+
+function showJobStatus(s) {
+  $('job-status').textContent = s.status;
+  $('job-status').className = 'status st-' + s.status;
+  const p = s.status === 'successful' ? 100 : s.progress;
+  if (typeof p === 'number') { $('job-progress').value = p; $('job-percent').textContent = p + ' %'; }
+  if (typeof s.message === 'string') $('job-message').textContent = s.message;
+}
+
+async function showJob(id) {
+  pageJob = id;
+  $('job-id').textContent = id;
+  for (const k of ['pictures', 'downloads', 'job-message', 'job-percent', 'job-inputs']) $(k).replaceChildren();
+  $('summary').tBodies[0].replaceChildren();
+  let s;
+  try { s = await api('jobs/' + encodeURIComponent(id)); } catch (e) { showError('Job: ' + e.message); return; }
+  showJobStatus(s);
+  api('dashboard/jobs/' + encodeURIComponent(id) + '/inputs').then(
+    (j) => { $('job-inputs').textContent = JSON.stringify(j.inputs, null, 2); },
+    () => { $('job-inputs').textContent = '(not available)'; });
+  if (!FINAL.includes(s.status)) {
+    stream(id, (kind, d) => {
+      if (pageJob !== id) return;
+      showJobStatus(d);
+      if (d.status && FINAL.includes(d.status)) showJob(id);
+    });
+    return;
+  }
+  if (s.status !== 'successful') return;
+  let res;
+  try { res = await api('jobs/' + encodeURIComponent(id) + '/results'); } catch (e) { showError('Results: ' + e.message); return; }
+  // every output the results document lists: PNG pictures and plots shown,
+  // every file offered for download (the HDF5 result and its XDMF first)
+  const outs = Object.keys(res).filter((k) => res[k] && res[k].href);
+  for (const k of outs)
+    if (res[k].type === 'image/png') picture(id, k, res[k].title || k);
+  const order = (k) => (k === 'result' ? 0 : k === 'xdmf' ? 1 : 2);
+  for (const k of outs.sort((a, b) => order(a) - order(b))) {
+    if (k === 'result') download(id, k, id + '.h5', 'HDF5 result (H5MD)');
+    else if (k === 'xdmf') download(id, k, id + '.xdmf', 'XDMF for ParaView (save it next to the .h5 file)');
+    else download(id, k, id + '-' + k, (res[k].title || k) + ' (' + k.split('.').pop().toUpperCase() + ')');
+  }
+  try {
+    summaryRows(await api(fileURL(id, 'summary')), '', $('summary').tBodies[0], 0);
+  } catch (e) { showError('Summary: ' + e.message); }
+}
+
+// --- routing: #/ the list, #/jobs/ID a job
+let listTimer = null;
+
+function route() {
+  stopStreams();
+  rows.clear();
+  $('jobs').tBodies[0].replaceChildren();
+  clearInterval(listTimer);
+  const m = location.hash.match(/^#\/jobs\/([^/]+)$/);
+  $('list-view').hidden = !!m;
+  $('job-view').hidden = !m;
+  if (m) {
+    showJob(decodeURIComponent(m[1]));
+  } else {
+    pageJob = null;
+    refreshList();
+    listTimer = setInterval(refreshList, 5000);
+  }
+}
+
+document.addEventListener('DOMContentLoaded', () => {
+  $('token').value = token();
+  $('token-form').addEventListener('submit', (ev) => {
+    ev.preventDefault();
+    localStorage.setItem('packd.token', $('token').value.trim());
+    route();
+  });
+  $('submit-form').addEventListener('submit', submitExample);
+  window.addEventListener('hashchange', route);
+  loadExamples();
+  route();
+});
