@@ -80,18 +80,18 @@ $(BUILD)/obj/daemon/%.o: daemon/%.c | $(DEPS_OK)
 
 # The schemas are compiled into the binary so `packd validate` and the daemon
 # serve exactly the files in schemas/, wherever packd is installed.
-$(BUILD)/gen/schemas_embedded.c: $(SCHEMAS) tools/embed-schemas.sh
+$(BUILD)/gen/schemas_embedded.c: $(SCHEMAS) tools/embed.sh
 	@mkdir -p $(@D)
-	sh tools/embed-schemas.sh $(SCHEMAS) > $@
+	sh tools/embed.sh api/schemas/schemas_embedded.h pk_embedded_schema pk_embedded_schemas char / $(SCHEMAS) > $@
 
 $(BUILD)/obj/gen/schemas_embedded.o: $(BUILD)/gen/schemas_embedded.c
 	@mkdir -p $(@D)
 	$(CC) $(BASE_CFLAGS) -I. -c $< -o $@
 
 # The dashboard (web/) and the examples it offers are compiled in the same way.
-$(BUILD)/gen/web_embedded.c: $(WEB) tools/embed-web.sh
+$(BUILD)/gen/web_embedded.c: $(WEB) tools/embed.sh
 	@mkdir -p $(@D)
-	sh tools/embed-web.sh $(WEB) > $@
+	sh tools/embed.sh daemon/http/web_assets.h pk_web_asset pk_web_assets 'unsigned char' web/ $(WEB) > $@
 
 $(BUILD)/obj/gen/web_embedded.o: $(BUILD)/gen/web_embedded.c
 	@mkdir -p $(@D)
@@ -183,9 +183,9 @@ $(FUZZ_BUILD)/obj/%.o: %.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -c $< -o $@
 
-$(FUZZ_BUILD)/gen/schemas_embedded.c: $(SCHEMAS) tools/embed-schemas.sh
+$(FUZZ_BUILD)/gen/schemas_embedded.c: $(SCHEMAS) tools/embed.sh
 	@mkdir -p $(@D)
-	sh tools/embed-schemas.sh $(SCHEMAS) > $@
+	sh tools/embed.sh api/schemas/schemas_embedded.h pk_embedded_schema pk_embedded_schemas char / $(SCHEMAS) > $@
 
 $(FUZZ_BUILD)/obj/gen/schemas_embedded.o: $(FUZZ_BUILD)/gen/schemas_embedded.c
 	@mkdir -p $(@D)

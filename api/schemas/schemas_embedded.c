@@ -1,5 +1,5 @@
 /* schemas_embedded.c — lookup over the generated table of schemas/ files
- * (build/gen/schemas_embedded.c, written by tools/embed-schemas.sh). */
+ * (build/gen/schemas_embedded.c, written by tools/embed.sh). */
 #include "schemas_embedded.h"
 
 #include <string.h>

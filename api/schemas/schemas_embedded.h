@@ -1,5 +1,5 @@
 /* schemas_embedded.h — the files of schemas/, compiled into packd.
- * Generated table (build/gen/schemas_embedded.c); see tools/embed-schemas.sh. */
+ * Generated table (build/gen/schemas_embedded.c); see tools/embed.sh. */
 #ifndef PK_SCHEMAS_EMBEDDED_H
 #define PK_SCHEMAS_EMBEDDED_H
 

@@ -1,5 +1,5 @@
 /* web_assets.h — files compiled into the binary for the dashboard
- * (tools/embed-web.sh): the files of web/ by base name ("app.js") and the example jobs
+ * (tools/embed.sh): the files of web/ by base name ("app.js") and the example jobs
  * by their path under examples/ ("examples/meier-quartz-2d.json"). */
 #ifndef PK_WEB_ASSETS_H
 #define PK_WEB_ASSETS_H
