@@ -180,10 +180,14 @@ static int line_search(step_ws *w, double *eta)
 
 /* The tangent predictor of the part (fe2_solver.h): from the converged
  * state s (its A and fint), the prescribed increments delta [ndof] (0 on the
- * free dofs) and w->fext, set w->u and the reference norm of the part. */
-static int predictor(step_ws *w, const pk_fe2_state *s, const double *delta, double *r_ref)
+ * free dofs) and w->fext: w->u = s->u + Δu_D, the linearised −R in rhs, its
+ * norm in *r_ref, and with *have_du the correction Δu_f in du (none when
+ * the start has no usable tangent, e.g. a loose packing). */
+static int predictor(step_ws *w, const pk_fe2_state *s, const double *delta, double *r_ref,
+                     int *have_du)
 {
     const pk_fe2_problem *pb = w->pb;
+    *have_du = 0;
     memcpy(w->b.A, s->A, 16 * w->b.ngp * sizeof *s->A);
     double *Kd = w->utry; /* scratch: K·Δu_D over all dofs */
     if (fe2_stiffness(pb, &w->b, NULL, w->ndof, &w->K) != 0)
@@ -205,16 +209,22 @@ static int predictor(step_ws *w, const pk_fe2_state *s, const double *delta, dou
         return PART_FATAL;
     pk_sparse_info info;
     pk_sparse_factor *f = pb->solver->factor(&w->K, &info);
-    if (!f) /* no usable tangent (e.g. a loose start): Newton from u + Δu_D */
+    if (!f)
         return info.status == PK_SPARSE_FAILED ? PART_FATAL : PART_CONVERGED;
     int src = pb->solver->solve(f, 1, w->rhs, w->du);
     pb->solver->release(f);
     if (src != 0)
         return PART_FATAL;
-    for (size_t d = 0; d < w->ndof; d++)
-        if (w->map[d] >= 0)
-            w->u[d] += w->du[w->map[d]];
+    *have_du = 1;
     return PART_CONVERGED;
+}
+
+static double norm_free(const step_ws *w)
+{
+    double r = 0;
+    for (size_t q = 0; q < w->nfree; q++)
+        r += w->rhs[q] * w->rhs[q];
+    return sqrt(r);
 }
 
 /* One part: the predictor from s, then Newton to equilibrium under w->fext. */
@@ -222,18 +232,24 @@ static int newton(step_ws *w, const pk_fe2_state *s, const double *delta, pk_fe2
 {
     const pk_fe2_problem *pb = w->pb;
     const pk_fe2_newton_opts *o = w->o;
-    double r0;
-    int rc = predictor(w, s, delta, &r0);
+    double r0, r, eta = 1;
+    int have_du, rc = predictor(w, s, delta, &r0, &have_du);
     if (rc != PART_CONVERGED) {
         snprintf(w->why, sizeof w->why, "out of memory or solver failure (predictor)");
         return rc;
     }
     it->abs_res0 = r0;
     it->res[it->n++] = 1;
-    it->ls_eta[0] = 1;
-    if ((rc = round_at(w, w->u)) != PART_CONVERGED)
+    /* the predictor's correction takes the line search too: g(0) is the
+     * linearised residual's R·Δu */
+    if (have_du)
+        rc = line_search(w, &eta);
+    else if ((rc = round_at(w, w->u)) == PART_CONVERGED)
+        free_residual(w);
+    if (rc != PART_CONVERGED)
         return rc;
-    double r = free_residual(w);
+    it->ls_eta[0] = eta;
+    r = norm_free(w);
     if (!(r0 > 0))
         r0 = r;
     for (int k = 1;; k++) {
@@ -269,15 +285,12 @@ static int newton(step_ws *w, const pk_fe2_state *s, const double *delta, pk_fe2
             snprintf(w->why, sizeof w->why, "macro solve failed");
             return PART_FATAL;
         }
-        double eta = 1;
+        eta = 1;
         if ((rc = line_search(w, &eta)) != PART_CONVERGED)
             return rc;
         if (k < 64)
             it->ls_eta[k] = eta;
-        r = 0;
-        for (size_t q = 0; q < w->nfree; q++)
-            r += w->rhs[q] * w->rhs[q];
-        r = sqrt(r);
+        r = norm_free(w);
     }
 }
 

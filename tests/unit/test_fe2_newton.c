@@ -260,6 +260,67 @@ static void test_step_cutting(void)
     pk_fe2_mesh_free(&b.m);
 }
 
+/* A hyperelastic surrogate hardening in volume: Φ = λ/2 t² + μ ε:ε + β/4 t⁴
+ * (t = tr ε), P̄ = λ t 1 + 2μ ε + β t³ 1, Ā = its exact derivative. */
+static int hard_eval(void *ctx, size_t g, const double F[4], double P[4], double A[16],
+                     pk_fe2_gp_info *info, char *why, size_t whylen)
+{
+    const double beta = *(const double *)ctx;
+    pk_fe2_linear_elastic le = {.lambda = 1, .mu = 1};
+    pk_fe2_material lin = pk_fe2_linear_elastic_material(&le);
+    lin.eval(lin.ctx, g, F, P, A, info, why, whylen);
+    const double t = F[0] + F[3] - 2;
+    P[0] += beta * t * t * t, P[3] += beta * t * t * t;
+    for (int I = 0; I < 4; I += 3)
+        for (int J = 0; J < 4; J += 3)
+            A[4 * I + J] += 3 * beta * t * t;
+    return 0;
+}
+
+static int hard_commit(void *ctx, size_t g)
+{
+    (void)ctx, (void)g;
+    return 0;
+}
+
+/* Newton from the soft start tangent overshoots a hardening material: the
+ * line search (g(1) changes sign and grows) takes s < 1 and the step
+ * converges to the same equilibrium as without it, in fewer iterations. */
+static void test_line_search(void)
+{
+    block b;
+    block_make(&b, 0.05);
+    double beta = 1e6;
+    pk_fe2_material mat = {"hardening", &beta, hard_eval, hard_commit};
+    pk_fe2_problem pb = {&b.m, &mat, b.nfix, b.fix, &pk_sparse_cholmod, NULL};
+    pk_fe2_state s[2];
+    pk_fe2_step_report rep[2];
+    double uD[32] = {0};
+    for (int ls = 0; ls < 2; ls++) {
+        CHECK(pk_fe2_state_init(&s[ls], &b.m) == 0);
+        pk_fe2_newton_opts o = newton_opts();
+        o.line_search = ls;
+        o.max_iter = 60;
+        int rc = pk_fe2_step(&pb, &o, &s[ls], uD, b.fp, &rep[ls], NULL);
+        CHECK_MSG(rc == 0, "line search %d: %s", ls, rep[ls].why);
+        const pk_fe2_iterations *it = &rep[ls].parts[0];
+        double emin = 1;
+        for (int k = 0; k + 1 < it->n; k++)
+            emin = fmin(emin, it->ls_eta[k]);
+        printf("  line search %d: %d residuals, smallest eta %.3g, last %.2e\n", ls, it->n, emin,
+               it->res[it->n - 1]);
+        CHECK(ls ? emin < 1 : emin == 1);
+    }
+    CHECK(rep[1].parts[0].n < rep[0].parts[0].n);
+    double du = 0, un = 0;
+    for (size_t d = 0; d < s[0].ndof; d++)
+        du = fmax(du, fabs(s[0].u[d] - s[1].u[d])), un = fmax(un, fabs(s[0].u[d]));
+    CHECK_MSG(du < 1e-9 * un, "solutions differ by %g of %g", du, un);
+    for (int ls = 0; ls < 2; ls++)
+        pk_fe2_state_free(&s[ls]);
+    pk_fe2_mesh_free(&b.m);
+}
+
 static void test_cancel(void)
 {
     block b;
@@ -285,6 +346,7 @@ int main(void)
     RUN(test_quadratic_taylor);
     RUN(test_pool_bits);
     RUN(test_step_cutting);
+    RUN(test_line_search);
     RUN(test_cancel);
     return check_summary();
 }
