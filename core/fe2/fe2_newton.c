@@ -434,7 +434,7 @@ int pk_fe2_step(const pk_fe2_problem *pb, const pk_fe2_newton_opts *o, pk_fe2_st
         }
         if (rep->cuts >= o->max_cuts) {
             snprintf(rep->why, sizeof rep->why,
-                     "step not converged at %.4g of its load after %d cuts: %s", t0, rep->cuts,
+                     "step not converged at %.4g of its load after %d cuts: %.180s", t0, rep->cuts,
                      w.why);
             ret = 1;
             goto out;
