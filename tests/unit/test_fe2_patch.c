@@ -10,6 +10,7 @@
 #include "check.h"
 #include "homog_fixture.h"
 #include "fe2_fixture.h"
+#include "core/fe2/fe2_fields.h"
 
 static const double H[4] = {0.01, 0.003, -0.002, -0.005}; /* ∇u: 11, 12, 21, 22 */
 
@@ -183,11 +184,79 @@ static void test_patch_traction(void)
     pk_fe2_mesh_free(&m);
 }
 
+/* Shoelace area of the deformed element e. */
+static double deformed_area(const pk_fe2_mesh *m, size_t e, const double *u)
+{
+    const int nen = pk_fe2_elem_nodes(m, e);
+    double a = 0;
+    for (int k = 0; k < nen; k++) {
+        const size_t p = (size_t)m->conn[4 * e + k], q = (size_t)m->conn[4 * e + (k + 1) % nen];
+        const double xp = m->xy[2 * p] + u[2 * p], yp = m->xy[2 * p + 1] + u[2 * p + 1];
+        const double xq = m->xy[2 * q] + u[2 * q], yq = m->xy[2 * q + 1] + u[2 * q + 1];
+        a += 0.5 * (xp * yq - xq * yp);
+    }
+    return a;
+}
+
+/* σ̄ = J⁻¹P̄F̄ᵀ inverts P̄ = Jσ̄F̄⁻ᵀ; von Mises of uniaxial and shear stress;
+ * the deformed volume equals the shoelace areas of the deformed elements
+ * under random nodal displacements (Q1 and triangles). */
+static void test_fields(void)
+{
+    const double F[4] = {1.02, 0.03, -0.01, 0.97}, sig[4] = {-0.3, 0.05, 0.05, -0.1};
+    const double J = F[0] * F[3] - F[1] * F[2];
+    const double Fit[4] = {F[3] / J, -F[2] / J, -F[1] / J, F[0] / J}; /* F⁻ᵀ */
+    double P[4], s[4];
+    for (int i = 0; i < 2; i++)
+        for (int k = 0; k < 2; k++)
+            P[2 * i + k] = J * (sig[2 * i] * Fit[k] + sig[2 * i + 1] * Fit[2 + k]);
+    pk_fe2_cauchy(F, P, s);
+    for (int I = 0; I < 4; I++)
+        CHECK_NEAR(s[I], sig[I], 1e-15);
+    const double uni[4] = {2, 0, 0, 0}, shear[4] = {0, 1, 1, 0};
+    CHECK_NEAR(pk_fe2_von_mises(uni), 2 * sqrt(0.75), 1e-15);
+    CHECK_NEAR(pk_fe2_von_mises(shear), sqrt(3.0), 1e-15);
+    for (int which = 0; which < 2; which++) {
+        pk_fe2_mesh m;
+        if (which)
+            mesh_triangles(&m, 1);
+        else
+            mesh_q1_distorted(&m);
+        double *u = malloc(2 * m.nnode * sizeof *u), *R = malloc(2 * m.nnode * sizeof *R);
+        pk_rng rng;
+        pk_rng_seed(&rng, 9, 0);
+        for (size_t d = 0; d < 2 * m.nnode; d++)
+            u[d] = pk_rng_range(&rng, -0.1, 0.1);
+        /* the Gauss points' F̄ through the residual's evaluation round */
+        pk_fe2_state st;
+        CHECK(pk_fe2_state_init(&st, &m) == 0);
+        pk_fe2_linear_elastic le = {1, 1};
+        pk_fe2_material mat = pk_fe2_linear_elastic_material(&le);
+        int32_t fix[32];
+        size_t nfix = 0;
+        for (size_t d = 0; d < 2 * m.nnode; d++)
+            fix[nfix++] = (int32_t)d;
+        pk_fe2_problem pb = {&m, &mat, nfix, fix, &pk_sparse_cholmod, NULL};
+        pk_fe2_newton_opts o = newton_opts();
+        pk_fe2_step_report rep;
+        double fz[32] = {0};
+        CHECK(pk_fe2_step(&pb, &o, &st, u, fz, &rep, NULL) == 0);
+        double want = 0;
+        for (size_t e = 0; e < m.nelem; e++)
+            want += deformed_area(&m, e, u);
+        CHECK_NEAR(pk_fe2_deformed_volume(&m, st.F), want, 1e-14);
+        pk_fe2_state_free(&st);
+        free(u), free(R);
+        pk_fe2_mesh_free(&m);
+    }
+}
+
 int main(void)
 {
     RUN(test_mesh);
     RUN(test_patch_q1);
     RUN(test_patch_triangles);
     RUN(test_patch_traction);
+    RUN(test_fields);
     return check_summary();
 }
