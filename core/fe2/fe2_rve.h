@@ -18,7 +18,10 @@
  *
  * The RVEs are shared read-only; each Gauss point's own relaxation runs
  * serially (opts.par and opts.newton_ctx are cleared), so distinct Gauss
- * points may be evaluated on different threads with the same bits. */
+ * points may be evaluated on different threads with the same bits.  Their
+ * calls into the sparse solvers (the tangent's, and opts.newton's if set)
+ * are serialised by the adapter's lock: CHOLMOD with Debian's serial
+ * OpenBLAS is not reentrant. */
 #ifndef PK_FE2_RVE_H
 #define PK_FE2_RVE_H
 
@@ -34,6 +37,7 @@ typedef struct pk_fe2_rve {
     pk_homog_state *committed, *trial; /* [ngp] */
     pk_homog_step *start;              /* [nrve] the relaxation at F̄ = 1 */
     double *P0;                        /* [nrve][4] P̄ of the start state (prestress) */
+    void *lock; /* serialises the evaluations' calls into the sparse solvers (fe2_rve.c) */
 } pk_fe2_rve;
 
 /* Set up ngp Gauss points over the nrve RVEs rve[] with the options o (its
