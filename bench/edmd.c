@@ -21,7 +21,11 @@
  * PACKD_BENCH_CASE=TEXT runs only the cases whose name contains TEXT (one
  * case under valgrind --tool=callgrind: instructions per collision).
  * Titscher's walled A16 (Δd = 1 mm at φ_M = 53.5 %, both wall rules, through
- * packd's job path) is bench/edmd_titscher. */
+ * packd's job path) is bench/edmd_titscher.
+ * The run leads with the real workloads, job files of bench/jobs/ run
+ * through pk_job_run in a child process each (case=job_…: collisions per CPU
+ * second of the whole job, the job's own maxrss_kb) and their ratio to the
+ * monodisperse job in the same box. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -31,6 +35,7 @@
 #include "core/edmd/edmd.h"
 #include "api/process.h"
 #include "core/rsa/rsa.h"
+#include "bench/jobs/bench_job.h"
 
 /* Case filter: PACKD_BENCH_CASE=TEXT keeps the cases whose name contains it. */
 static int wanted(const char *name)
@@ -223,8 +228,56 @@ static void meier(const char *name, const char *grading, double L, int seed)
         job_case(nm, job);
 }
 
+/* A job file of bench/jobs/ with `patch` merged into its inputs, run
+ * through pk_job_run in a child process (bench/jobs/bench_job.h): its
+ * collisions per CPU second of the whole job (RSA start, EDMD, audit, file)
+ * and the job's own peak memory.  NAN on failure. */
+static double file_case(const char *name, const char *job, const char *patch)
+{
+    if (!wanted(name))
+        return NAN;
+    bench_job r;
+    if (bench_job_run(job, patch, &r) != 0) {
+        printf("bench=edmd case=%s job=%s error=\"%s\"\n", name, job, r.err);
+        fflush(stdout);
+        return NAN;
+    }
+    json_t *o = json_object_get(r.sum, "edmd");
+    double coll = bench_num(o, "events_pair"), ev = bench_num(o, "events");
+    printf("bench=edmd case=%s job=%s n=%.0f phi=%.5f phi_mix=%.5f reason=%s events=%.0f "
+           "collisions=%.0f seconds=%.3f cpu_s=%.3f collisions_per_cpu_s=%.3g "
+           "events_per_cpu_s=%.3g maxrss_kb=%ld\n",
+           name, job, bench_num(r.sum, "count_placed"), bench_num(r.sum, "phi_resolved"),
+           bench_num(r.sum, "phi_mix"),
+           json_string_value(json_object_get(r.sum, "termination_reason")), ev, coll,
+           bench_num(r.sum, "seconds_place"), r.cpu_s, coll / r.cpu_s, ev / r.cpu_s, r.maxrss_kb);
+    fflush(stdout);
+    json_decref(r.sum);
+    return coll / r.cpu_s;
+}
+
+/* The real workloads first: Titscher's walled A16 (Δd = 1 mm) grown past
+ * RSA's reach (φ_M 0.40 → 0.50, default RSA start), B16 likewise, the
+ * Fuller curve 0.5–16 (Δd 0.25) and Meier's sand at 10⁵ grains, beside the
+ * monodisperse job in the same box for the ratio. */
+static void jobs(void)
+{
+    const char *to50 = "{\"algorithm\":\"edmd\",\"phi\":{\"value\":0.50}}";
+    double a = file_case("job_a16_dd1_4e3_phiM050", "a16-dd1-4e3", to50);
+    file_case("job_b16_dd1_4e3_phiM050", "b16-dd1-4e3", to50);
+    file_case("job_fuller_q05_d05to16_dd025_phiM050", "fuller-q05-d05-16", to50);
+    file_case("job_meier_quartz_2d_1e5_phi060", "meier-quartz-2d-1e5",
+              "{\"algorithm\":\"edmd\",\"phi\":{\"value\":0.60}}");
+    double m = file_case("job_mono_d5_4e3_phi055", "mono-d5-4e3", NULL);
+    if (!isnan(a) && !isnan(m))
+        printf("bench=edmd case=job_a16_over_mono collision_rate_ratio=%.3f\n", a / m);
+    fflush(stdout);
+}
+
 int main(void)
 {
+    jobs();
+    mono("mono3d_1e3_to_phi060", 1000, 0.1, 0, 0.60);
     mono("mono3d_1e4_to_phi060", 10000, 0.1, 0, 0.60);
     mono_from("mono3d_1e4_to_phi060_rsa030", 10000, 0.1, 0, 0.60, 0.30);
     mono("mono3d_1e4_jam_rate0.02", 10000, 0.02, 1, 0);

@@ -1,4 +1,13 @@
-/* bench/rsa — RSA placement rate.  Prints one machine-readable line per case:
+/* bench/rsa — RSA placement rate.  It leads with the real workloads, job
+ * files of bench/jobs/ run through `packd run`'s code path (pk_job_run), each
+ * run in a child process (`rsa jobs`: only these):
+ *   bench=rsa case=NAME job=FILE n=N placed=N reason=R phi_mix=F seconds=S
+ *             cpu_s=S rate=GRAINS_PER_CPU_S rate_wall=GRAINS_PER_S
+ *             draws_per_grain=X maxrss_kb=N ... reps=K rate_min rate_max
+ * (rate: grains placed per CPU second of the whole job; seconds: the
+ * placement's wall time; maxrss_kb: the job's peak resident memory; the line
+ * is the median run's) and a scaling line for A16.  Then the monodisperse
+ * references, one line per case:
  *   bench=rsa case=NAME n=N placed=N seconds=S cpu_s=S sys_s=S minflt=N
  *             rate=PLACEMENTS_PER_S draws_per_grain=X maxrss_kb=N
  * and a final line with the rate ratio 1e6/1e4 (flat = the placer scales).
@@ -39,6 +48,7 @@
 #include "api/pack/pack_job.h"
 #include "api/process.h"
 #include "core/rsa/rsa.h"
+#include "bench/jobs/bench_job.h"
 
 enum path { PLAIN, VOXELS, BATCH_PLAIN, BATCHED };
 /* Runs of the default path's cases (medians; ~0.1, 0.4 and 2.5 s in all). */
@@ -216,34 +226,75 @@ static double mono(const char *name, int dim, size_t n, double phi, enum path pa
     return rate[med];
 }
 
-static void job_case(const char *name, const char *path)
+/* A job file of bench/jobs/ (`patch` merged into its inputs) run reps times
+ * through pk_job_run, each in a child process: the line of the run with the
+ * median rate (grains placed per CPU second of the whole job: sizes,
+ * placement, audit, file), with the slowest and fastest rates beside it. */
+static double job_case(const char *name, const char *job, const char *patch, int reps)
 {
-    json_error_t e;
-    json_t *job = json_load_file(path, 0, &e);
-    if (!job) {
-        printf("bench=rsa case=%s error=\"%s\"\n", name, e.text);
-        return;
+    double rate[MAX_REPS];
+    bench_job run[MAX_REPS];
+    int order[MAX_REPS];
+    reps = reps < 1 ? 1 : (reps > MAX_REPS ? MAX_REPS : reps);
+    for (int k = 0; k < reps; k++) {
+        if (bench_job_run(job, patch, &run[k]) != 0) {
+            printf("bench=rsa case=%s job=%s error=\"%s\"\n", name, job, run[k].err);
+            for (int i = 0; i < k; i++)
+                json_decref(run[i].sum);
+            return NAN;
+        }
+        rate[k] = bench_num(run[k].sum, "count_placed") / run[k].cpu_s;
+        order[k] = k;
     }
-    pk_schema_errors errs = {0};
-    json_t *sum = NULL;
-    char err[512];
-    const char *out = "/tmp/packd-bench-rsa.h5";
-    int rc = pk_job_run(job, 1, out, NULL, &sum, &errs, err, sizeof err);
-    if (rc == 0) {
-        double s = json_real_value(json_object_get(sum, "seconds_place"));
-        json_int_t placed = json_integer_value(json_object_get(sum, "count_placed"));
-        printf("bench=rsa case=%s n=%lld placed=%lld seconds=%.3f rate=%.0f phi=%.4f reason=%s\n",
-               name, (long long)json_integer_value(json_object_get(sum, "count_requested")),
-               (long long)placed, s, (double)placed / s,
-               json_real_value(json_object_get(sum, "phi_resolved")),
-               json_string_value(json_object_get(sum, "termination_reason")));
-    } else {
-        printf("bench=rsa case=%s error=\"%s\"\n", name, err);
-    }
-    remove(out);
-    json_decref(sum);
-    json_decref(job);
-    pk_schema_errors_free(&errs);
+    for (int i = 1; i < reps; i++) /* insertion sort by rate */
+        for (int j = i; j > 0 && rate[order[j]] < rate[order[j - 1]]; j--) {
+            int t = order[j];
+            order[j] = order[j - 1];
+            order[j - 1] = t;
+        }
+    const bench_job *m = &run[order[reps / 2]];
+    json_t *sum = m->sum, *rsa = json_object_get(sum, "rsa");
+    double placed = bench_num(sum, "count_placed"), wall = bench_num(sum, "seconds_place");
+    printf("bench=rsa case=%s job=%s n=%.0f placed=%.0f reason=%s phi_mix=%.4f seconds=%.3f "
+           "cpu_s=%.3f rate=%.0f rate_wall=%.0f draws_per_grain=%.2f maxrss_kb=%ld "
+           "smallest_gap=%.6g smallest_wall_gap=%.6g reps=%d rate_min=%.0f rate_max=%.0f\n",
+           name, job, bench_num(sum, "count_requested"), placed,
+           json_string_value(json_object_get(sum, "termination_reason")), bench_num(sum, "phi_mix"),
+           wall, m->cpu_s, rate[order[reps / 2]], placed / wall, bench_num(rsa, "draws_per_grain"),
+           m->maxrss_kb, bench_num(sum, "smallest_gap"),
+           json_object_get(sum, "smallest_wall_gap") ? bench_num(sum, "smallest_wall_gap") : NAN,
+           reps, rate[order[0]], rate[order[reps - 1]]);
+    fflush(stdout);
+    double r = rate[order[reps / 2]];
+    for (int k = 0; k < reps; k++)
+        json_decref(run[k].sum);
+    return r;
+}
+
+/* The real workloads (bench/jobs/): DIN A16 and B16 with Δd = 1 mm, a Fuller
+ * curve q = 0.5 from 0.5 to 16 mm, Meier's quartz sand; the 4·10⁵-grain A16
+ * and Titscher's 150 mm specimen with PACKD_BENCH_LARGE=1. */
+static void jobs(void)
+{
+    int large = getenv("PACKD_BENCH_LARGE") && atoi(getenv("PACKD_BENCH_LARGE"));
+    double a3 = job_case("a16_dd1_4e3", "a16-dd1-4e3", NULL, 5);
+    double a4 = job_case("a16_dd1_4e4", "a16-dd1-4e4", NULL, 3);
+    double a5 = large ? job_case("a16_dd1_4e5", "a16-dd1-4e5", NULL, 1) : NAN;
+    job_case("a16_dd1_4e3_wall_gap_none", "a16-dd1-4e3", "{\"rsa\":{\"wall_gap\":\"none\"}}", 5);
+    double z4 = job_case("a16_dd0_4e4", "a16-dd0-4e4", NULL, 3);
+    job_case("b16_dd1_4e3", "b16-dd1-4e3", NULL, 5);
+    job_case("b16_dd1_4e4", "b16-dd1-4e4", NULL, 3);
+    job_case("fuller_q05_d05to16_dd025", "fuller-q05-d05-16", NULL, 3);
+    job_case("meier_quartz_2d_1e5", "meier-quartz-2d-1e5", NULL, 3);
+    if (large)
+        job_case("titscher150_a16_dmin05_dd05", "titscher150-a16-dmin05", NULL, 1);
+    else
+        printf("bench=rsa case=a16_dd1_4e5 skipped=set_PACKD_BENCH_LARGE=1\n"
+               "bench=rsa case=titscher150_a16_dmin05_dd05 skipped=set_PACKD_BENCH_LARGE=1\n");
+    printf("bench=rsa case=a16_scaling rate_ratio_4e4_over_4e3=%.3f rate_ratio_4e5_over_4e3=%.3f "
+           "rate_ratio_dd1_over_dd0_4e4=%.3f\n",
+           a4 / a3, a5 / a3, a4 / z4);
+    fflush(stdout);
 }
 
 int main(int argc, char **argv)
@@ -258,10 +309,9 @@ int main(int argc, char **argv)
                r6 / r4, r5 / r4);
         return 0;
     }
-    const char *src = getenv("PACKD_SRC");
-    char path[1024];
-    snprintf(path, sizeof path, "%s/examples/din-a16-3d-walled.json", src ? src : ".");
-    job_case("din_a16_phiM40_walled_dd1", path);
+    jobs();
+    if (argc > 1 && strcmp(argv[1], "jobs") == 0)
+        return 0;
     double p4 = mono("mono3d_phi030_1e4_plain", 3, 10000, 0.30, PLAIN, 3);
     double p5 = mono("mono3d_phi030_1e5_plain", 3, 100000, 0.30, PLAIN, 1);
     double v4 = mono("mono3d_phi030_1e4_voxels", 3, 10000, 0.30, VOXELS, 3);

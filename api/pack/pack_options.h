@@ -12,6 +12,7 @@
 typedef struct pk_rsa_options {
     uint64_t max_failed_draws; /* "rsa": {"max_failed_draws"} */
     int draws;                 /* "rsa": {"draws"}: pk_rsa_draws */
+    int wall_gap;              /* "rsa": {"wall_gap"}: pk_rsa_wall_gap */
 } pk_rsa_options;
 
 typedef struct pk_edmd_options {

@@ -61,7 +61,7 @@ static void start_covering(segment *sg, const pk_particles *out, pk_monitor *mon
 /* Build the voxel set for grain i onwards (all bits set; the placed grains
  * mark their zones once start_covering runs). */
 static void begin_segment(segment *sg, const pk_box *b, const double *diameters, size_t i, size_t n,
-                          double gap, const pk_particles *out)
+                          double gap, double wall, const pk_particles *out)
 {
     double r = 0.5 * diameters[i];
     double r_valid = fmax(0.5 * diameters[n - 1], r / SEGMENT_RATIO);
@@ -69,10 +69,10 @@ static void begin_segment(segment *sg, const pk_box *b, const double *diameters,
     while (i + count < n && 0.5 * diameters[i + count] >= r_valid)
         count++;
     sg->retry_below = r_valid;
-    uint64_t nv = pk_rsa_vox_count(b, r_valid, r, gap);
+    uint64_t nv = pk_rsa_vox_count(b, r_valid, r, gap, wall);
     if (nv == 0 || nv > (uint64_t)VOXELS_PER_GRAIN * count + VOXELS_FREE)
         return;
-    if (pk_rsa_vox_init(&sg->vox, b, r_valid, r, gap) != 0)
+    if (pk_rsa_vox_init(&sg->vox, b, r_valid, r, gap, wall) != 0)
         return; /* out of memory for the set: plain draws still work */
     sg->first = out->n;
     sg->on = 1;
@@ -114,7 +114,8 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
     *st = (pk_rsa_stats){.reason = PK_STOP_ERROR, .requested = n};
     if (!b || !prm || !out || out->dim != b->dim || (n && (!diameters || !species)))
         return -1;
-    if (!(prm->delta_d >= 0) || prm->max_failed_draws == 0)
+    if (!(prm->delta_d >= 0) || prm->max_failed_draws == 0 ||
+        (prm->wall_gap != PK_RSA_WALL_GAP_HALF && prm->wall_gap != PK_RSA_WALL_GAP_NONE))
         return -1;
     for (size_t i = 0; i < n; i++)
         if (!(diameters[i] > 0) || (i && diameters[i] > diameters[i - 1]))
@@ -128,6 +129,8 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
         return -1;
 
     const double gap = prm->delta_d;
+    /* the clearance kept at walls: Δd/2 (spec §2.1 step 2), or none */
+    const double wall = prm->wall_gap == PK_RSA_WALL_GAP_NONE ? 0 : 0.5 * gap;
     pk_grid grid;
     if (pk_grid_init(&grid, b, 0.5 * diameters[n - 1], 0.5 * diameters[0], gap, out->n + n) != 0)
         return -1;
@@ -158,7 +161,7 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
                                   .ctx = &flush};
     for (size_t i = 0; i < n; i++) {
         double r = 0.5 * diameters[i];
-        /* Draw range per axis: walls keep the grain Δd/2 away (spec §2.1). */
+        /* Draw range per axis: walls keep the grain `wall` away (spec §2.1). */
         double lo[PK_MAXDIM] = {0, 0, 0}, span[PK_MAXDIM] = {0, 0, 0};
         int fits = 1;
         for (int k = 0; k < b->dim; k++) {
@@ -166,7 +169,7 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
                 lo[k] = 0;
                 span[k] = b->L[k];
             } else {
-                lo[k] = r + 0.5 * gap;
+                lo[k] = r + wall;
                 span[k] = b->L[k] - 2 * lo[k];
                 if (span[k] < 0)
                     fits = 0;
@@ -199,7 +202,7 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
             break;
         }
         if (!sg.on && r < sg.retry_below)
-            begin_segment(&sg, b, diameters, i, n, gap, out);
+            begin_segment(&sg, b, diameters, i, n, gap, wall, out);
         uint64_t failed = 0, vid = 0;
         double x[PK_MAXDIM] = {0, 0, 0};
         int saturated = 0;

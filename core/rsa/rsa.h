@@ -3,7 +3,8 @@
  * Grains are placed largest first at uniformly drawn positions; a draw is
  * rejected if the grain comes closer than Δd to a placed grain (surface to
  * surface) or, on a walled axis, closer than Δd/2 to a wall (the draw range
- * is shrunk so this never needs a test: spec §2.1 step 2).  After
+ * is shrunk so this never needs a test: spec §2.1 step 2; `wall_gap` NONE
+ * keeps Δd between grains only and lets grains touch the walls).  After
  * `max_failed_draws` consecutive rejections of one grain the run stops with
  * what it has placed (Titscher's N^F failure criterion).  When the draws come
  * from the voxels not yet covered (rsa_voxels.h) and none is left, the box is
@@ -35,11 +36,19 @@ typedef enum pk_rsa_draws {
                                     are batched with the same outcome bit for bit) */
 } pk_rsa_draws;
 
+/* The clearance kept at walls. */
+typedef enum pk_rsa_wall_gap {
+    PK_RSA_WALL_GAP_HALF = 0, /* "half" (default): every wall clearance >= Δd/2 (spec §2.1) */
+    PK_RSA_WALL_GAP_NONE      /* "none": Δd between grains only, grains may touch the walls
+                                 (Titscher §3/§6.3; EDMD's wall_gap none) */
+} pk_rsa_wall_gap;
+
 typedef struct pk_rsa_params {
     double delta_d;            /* minimum surface gap Δd (>= 0) */
     uint64_t max_failed_draws; /* N^F (e.g. 1e6) */
     uint64_t seed;             /* positions use stream 1 of this seed */
     pk_rsa_draws draws;
+    pk_rsa_wall_gap wall_gap;
     struct {                     /* test and bench overrides; all 0 in jobs */
         int one_at_a_time;       /* 1: runs of equal grains are not batched either */
         uint32_t batch_attempts; /* attempts per batch; 0 = adaptive */

@@ -18,7 +18,7 @@ static double edge_bound(int dim, double r_valid, double gap)
 
 /* Per-axis lattice: origin, span and voxel count; 0 if the axis cannot be tiled. */
 static int axis_lattice(const pk_box *b, int k, double r_valid, double r_top, double gap,
-                        double *org, double *span, int64_t *n)
+                        double wall, double *org, double *span, int64_t *n)
 {
     double e = edge_bound(b->dim, r_valid, gap);
     if (b->periodic[k]) {
@@ -27,7 +27,7 @@ static int axis_lattice(const pk_box *b, int k, double r_valid, double r_top, do
         *org = 0;
         *span = b->L[k];
     } else {
-        *org = r_valid + 0.5 * gap;
+        *org = r_valid + wall;
         *span = b->L[k] - 2 * *org;
         if (!(*span > 0))
             return 0;
@@ -39,15 +39,16 @@ static int axis_lattice(const pk_box *b, int k, double r_valid, double r_top, do
     return 1;
 }
 
-uint64_t pk_rsa_vox_count(const pk_box *b, double r_valid, double r_top, double gap)
+uint64_t pk_rsa_vox_count(const pk_box *b, double r_valid, double r_top, double gap, double wall)
 {
-    if (!b || b->dim < 2 || b->dim > 3 || !(r_valid > 0) || !(r_top >= r_valid) || !(gap >= 0))
+    if (!b || b->dim < 2 || b->dim > 3 || !(r_valid > 0) || !(r_top >= r_valid) || !(gap >= 0) ||
+        !(wall >= 0))
         return 0;
     uint64_t total = 1;
     for (int k = 0; k < b->dim; k++) {
         double org, span;
         int64_t n;
-        if (!axis_lattice(b, k, r_valid, r_top, gap, &org, &span, &n))
+        if (!axis_lattice(b, k, r_valid, r_top, gap, wall, &org, &span, &n))
             return 0;
         if (total > MAX_VOXELS / (uint64_t)n)
             return UINT64_MAX;
@@ -56,10 +57,11 @@ uint64_t pk_rsa_vox_count(const pk_box *b, double r_valid, double r_top, double 
     return total;
 }
 
-int pk_rsa_vox_init(pk_rsa_vox *v, const pk_box *b, double r_valid, double r_top, double gap)
+int pk_rsa_vox_init(pk_rsa_vox *v, const pk_box *b, double r_valid, double r_top, double gap,
+                    double wall)
 {
     memset(v, 0, sizeof *v);
-    uint64_t nv = pk_rsa_vox_count(b, r_valid, r_top, gap);
+    uint64_t nv = pk_rsa_vox_count(b, r_valid, r_top, gap, wall);
     if (nv == 0 || nv >= MAX_VOXELS)
         return -1;
     v->box = *b;
@@ -73,7 +75,7 @@ int pk_rsa_vox_init(pk_rsa_vox *v, const pk_box *b, double r_valid, double r_top
         if (k >= b->dim)
             continue;
         double span;
-        axis_lattice(b, k, r_valid, r_top, gap, &v->org[k], &span, &v->n[k]);
+        axis_lattice(b, k, r_valid, r_top, gap, wall, &v->org[k], &span, &v->n[k]);
         v->e[k] = span / (double)v->n[k];
         v->inv_e[k] = 1 / v->e[k];
         lmax = fmax(lmax, b->L[k]);

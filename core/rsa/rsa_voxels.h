@@ -62,11 +62,13 @@ typedef struct pk_rsa_vox {
 
 /* Number of voxels a set for (b, r_valid, gap) would hold, or 0 when the
  * structure cannot serve this box (a walled axis with no draw range, or a
- * periodic edge not larger than twice the contact distance 2 r_top + Δd). */
-uint64_t pk_rsa_vox_count(const pk_box *b, double r_valid, double r_top, double gap);
+ * periodic edge not larger than twice the contact distance 2 r_top + Δd).
+ * wall: the clearance kept at walls (Δd/2, or 0 with wall_gap none). */
+uint64_t pk_rsa_vox_count(const pk_box *b, double r_valid, double r_top, double gap, double wall);
 
 /* All voxels active, no grain stored.  0, or -1 (bad input / out of memory). */
-int pk_rsa_vox_init(pk_rsa_vox *v, const pk_box *b, double r_valid, double r_top, double gap);
+int pk_rsa_vox_init(pk_rsa_vox *v, const pk_box *b, double r_valid, double r_top, double gap,
+                    double wall);
 void pk_rsa_vox_free(pk_rsa_vox *v);
 
 /* Mark the sub-voxels certainly inside the exclusion ball B(x, r + r_valid + Δd)

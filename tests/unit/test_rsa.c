@@ -307,6 +307,58 @@ static int cmp_size(const void *a, const void *b)
 
 /* The grid reports exactly the brute-force neighbour set, every grain once,
  * across levels, periodic seams and after moves/removals. */
+/* wall_gap: "half" keeps every wall clearance >= Δd/2, "none" only keeps the
+ * grains inside the walls (the gaps between grains stay >= Δd) — and then some
+ * grains come closer to a wall than Δd/2.  Both the one-grain-at-a-time path
+ * (polydisperse, plain and open draws) and the batched path (equal grains). */
+static void test_rsa_wall_gap(void)
+{
+    const double dd = 0.5, L = 12;
+    pk_box b = {.dim = 3, .L = {L, L, L}};
+    for (int mono = 0; mono < 2; mono++)
+        for (int draws = 0; draws < 2; draws++)
+            for (int wg = 0; wg < 2; wg++) {
+                size_t n = 1200;
+                double *d = mono ? malloc(n * sizeof *d) : poly_sizes(n, 0.6, 1.5, 3);
+                for (size_t i = 0; mono && i < n; i++)
+                    d[i] = 1.0;
+                int32_t *sp = calloc(n, sizeof *sp);
+                pk_particles p;
+                pk_particles_init(&p, 3, n);
+                pk_rsa_params prm = {.delta_d = dd,
+                                     .max_failed_draws = 20000,
+                                     .seed = 4,
+                                     .draws = draws ? PK_RSA_DRAWS_PLAIN : PK_RSA_DRAWS_OPEN,
+                                     .wall_gap = wg ? PK_RSA_WALL_GAP_NONE : PK_RSA_WALL_GAP_HALF};
+                pk_rsa_stats st;
+                CHECK(pk_rsa_place(&b, d, sp, n, &prm, NULL, &p, &st) == 0);
+                CHECK_MSG(st.placed > 100, "mono %d draws %d wg %d placed %zu", mono, draws, wg,
+                          st.placed);
+                double gmin, wmin;
+                brute_gaps(&b, &p, &gmin, &wmin);
+                CHECK_MSG(gmin >= dd - 1e-12 * L, "mono %d wall_gap %d: min gap %.17g", mono, wg,
+                          gmin);
+                if (wg)
+                    CHECK_MSG(wmin >= -1e-12 * L && wmin < 0.1 * dd,
+                              "mono %d draws %d wall_gap none: min wall clearance %.17g", mono,
+                              draws, wmin);
+                else
+                    CHECK_MSG(wmin >= 0.5 * dd - 1e-12 * L,
+                              "mono %d draws %d wall_gap half: min wall clearance %.17g", mono,
+                              draws, wmin);
+                free(d);
+                free(sp);
+                pk_particles_free(&p);
+            }
+    pk_rsa_params bad = {.delta_d = dd, .max_failed_draws = 10, .wall_gap = 2};
+    pk_particles p;
+    pk_particles_init(&p, 3, 1);
+    double d1 = 1;
+    int32_t s1 = 0;
+    CHECK(pk_rsa_place(&b, &d1, &s1, 1, &bad, NULL, &p, NULL) == -1);
+    pk_particles_free(&p);
+}
+
 static void test_grid_query_matches_brute_force(void)
 {
     for (int dim = 2; dim <= 3; dim++)
@@ -386,5 +438,6 @@ int main(void)
     RUN(test_rsa_no_room);
     RUN(test_rsa_cancel);
     RUN(test_rsa_saturation);
+    RUN(test_rsa_wall_gap);
     return check_summary();
 }

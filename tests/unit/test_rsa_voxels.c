@@ -227,7 +227,7 @@ static void test_cover_is_exact(void)
             b.periodic[k] = dim == 3;
         pk_rsa_vox v;
         double r_valid = 0.4, gap = 0.05;
-        CHECK(pk_rsa_vox_init(&v, &b, r_valid, 0.5, gap) == 0);
+        CHECK(pk_rsa_vox_init(&v, &b, r_valid, 0.5, gap, 0.5 * gap) == 0);
         pk_rng g;
         pk_rng_seed(&g, 77, (uint64_t)dim);
         double c[12][3] = {{0}}, R[12];
