@@ -76,6 +76,11 @@ static void inline_mesh(json_t *j, pk_mesh2d *m, pk_schema_errors *errs)
     const char *name;
     json_t *set;
     json_object_foreach (json_object_get(j, "sets"), name, set) {
+        if (strlen(name) > 63) {
+            pk_schema_errors_add(errs, "/mesh/sets", "semantic",
+                                 "set name \"%.40s...\" is longer than 63 characters", name);
+            return;
+        }
         pk_mesh2d_set *s = pk_mesh2d_add_set(m, name);
         json_t *sn = json_object_get(set, "nodes"), *se = json_object_get(set, "edges");
         size_t nn = json_array_size(sn), ne = json_array_size(se);
