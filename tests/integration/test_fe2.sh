@@ -69,6 +69,7 @@ h5dump -d /observables/fe2/newton/iterations/relative_residual r.h5 >res.dump 2>
 check newton_history_starts_at_1 grep -q '(0): 1,' res.dump
 check xdmf_sidecar sh -c "grep -q 'TopologyType=\"Quadrilateral\"' r.xdmf &&
     test \$(grep -c '<Time ' r.xdmf) -eq 3"
+check xdmf_items_match python3 "$SRC/tests/tools/xdmf_check.py" r.xdmf
 
 # 2. a step that cannot converge: failed (exit 3), the step and reason named, the partial file kept
 "$PACKD" run fail.json -o f.h5 --json >f.json 2>f.err
