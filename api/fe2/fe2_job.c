@@ -10,6 +10,7 @@
 
 #include "api/process.h"
 
+static const char *const initial_stress_names[] = {"free", "balanced", NULL};
 #define F(m) PK_OPT_FIELD(pk_fe2_job, m)
 static const pk_option fe2_rows[] = {
     {"/newton/rtol", PK_OPT_NUMBER, F(newton.rtol), .dflt = 1e-8},
@@ -17,6 +18,7 @@ static const pk_option fe2_rows[] = {
     {"/newton/max_iter", PK_OPT_INTEGER, F(newton.max_iter), .dflt = 20, .lo = 1, .hi = 64},
     {"/newton/line_search", PK_OPT_BOOL, F(newton.line_search), .dflt = 1},
     {"/newton/max_cuts", PK_OPT_INTEGER, F(newton.max_cuts), .dflt = 6, .lo = 0, .hi = 30},
+    {"/initial_stress", PK_OPT_ENUM, F(balanced), .names = initial_stress_names},
     {"/limits/wall_time_s", PK_OPT_NUMBER, F(wall_time_s), PK_OPT_IMPLICIT},
     {"/limits/max_gauss_points", PK_OPT_INTEGER, F(max_gauss_points), .dflt = 20000, .lo = 1,
      .hi = 1000000},

@@ -32,6 +32,7 @@ typedef struct pk_fe2_job {
     /* the option table's fields */
     pk_fe2_newton_opts newton;
     double wall_time_s;
+    int balanced; /* initial_stress: 0 free, 1 balanced */
     size_t max_gauss_points, max_grains_total;
     /* borrowed from the inputs (they outlive the job: process.h) */
     json_t *mesh, *bcs, *stages;

@@ -100,7 +100,7 @@ int pk_fe2_run(const void *parsed, int threads, const char *job_json, const char
     pk_fe2_record rec = {0};
     pk_par *pool = NULL;
     json_t *sum = NULL;
-    double *uD = NULL, *fext = NULL;
+    double *uD = NULL, *fext = NULL, *f0 = NULL;
     const double **micro = NULL;
     int rc = -1, have_rve = 0, have_mr = 0;
     if (pk_fe2_setup_build(job, &s, &errs) != 0) { /* a mesh file read only now (service) */
@@ -153,6 +153,18 @@ int pk_fe2_run(const void *parsed, int threads, const char *job_json, const char
     }
     for (size_t i = 0; i < job->n_micro_gp; i++)
         micro[i] = mr.committed[job->micro_gp[i]].x;
+    /* initial_stress balanced: f_int of the start state at u = 0 joins every
+     * load (a trial evaluation, nothing committed) */
+    if (job->balanced) {
+        char why[256] = "";
+        f0 = calloc(s.ndof + 1, sizeof *f0);
+        int r0 = f0 ? pk_fe2_residual(&pb, st.u, NULL, f0, NULL, why, sizeof why) : -1;
+        if (r0 != 0) {
+            snprintf(err, errlen, "initial_stress balanced: the start state: %s",
+                     r0 > 0 ? why : "out of memory");
+            goto out;
+        }
+    }
 
     size_t nstep = 0, done = 0, cuts_total = 0, iters_total = 0;
     for (size_t k = 0; k < s.nstage; k++)
@@ -172,6 +184,8 @@ int pk_fe2_run(const void *parsed, int threads, const char *job_json, const char
             pc.step = done + 1;
             double t = (double)i / (double)s.increments[k];
             pk_fe2_setup_targets(&s, k, t, uD, fext);
+            for (size_t d = 0; f0 && d < s.ndof; d++)
+                fext[d] += f0[d];
             pk_fe2_step_report rep;
             memset(&rep, 0, sizeof rep);
             int r = pk_fe2_step(&pb, &job->newton, &st, uD, fext, &rep, &wm);
@@ -266,6 +280,7 @@ out:
     json_decref(sum);
     free(uD);
     free(fext);
+    free(f0);
     free(micro);
     pk_fe2_record_free(&rec);
     pk_fe2_state_free(&st);

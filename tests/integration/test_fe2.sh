@@ -49,6 +49,10 @@ bad("inverted", lambda i: i.update(mesh={"nodes": [[0, 0], [1, 0], [1, 1], [0, 1
 f = copy.deepcopy(job); f["inputs"]["stages"][1] = {"increments": 1, "targets": {"top_y": -9.5}}
 f["inputs"]["newton"] = {"max_cuts": 0}
 json.dump(f, open(t + "/fail.json", "w"))
+# the prestressed start balanced and no load: u = 0 is the equilibrium
+z = copy.deepcopy(job); z["inputs"]["initial_stress"] = "balanced"
+z["inputs"]["stages"] = [{"increments": 1, "targets": {"p": 0}}]
+json.dump(z, open(t + "/balanced.json", "w"))
 EOF
 
 # 1. packd run: complete, 3 load steps, the pressure's resultant p·ly = 0.5 held by the left support
@@ -70,6 +74,14 @@ check newton_history_starts_at_1 grep -q '(0): 1,' res.dump
 check xdmf_sidecar sh -c "grep -q 'TopologyType=\"Quadrilateral\"' r.xdmf &&
     test \$(grep -c '<Time ' r.xdmf) -eq 3"
 check xdmf_items_match python3 "$SRC/tests/tools/xdmf_check.py" r.xdmf
+
+# 1b. initial_stress balanced: the radius-inflated RVE's prestress does not move an unloaded block
+#     (free, the same block expands: the dilatancy of the run above is large)
+"$PACKD" run balanced.json -o z.h5 --json >z.json 2>z.err
+check initial_stress_balanced python3 -c "
+import json; z = json.load(open('z.json')); r = json.load(open('r.json'))
+assert z['complete'] and z['dilatancy_percent_per_step'] == [0.0], z
+assert r['dilatancy_percent_per_step'][0] > 10, r['dilatancy_percent_per_step']"
 
 # 2. a step that cannot converge: failed (exit 3), the step and reason named, the partial file kept
 "$PACKD" run fail.json -o f.h5 --json >f.json 2>f.err
