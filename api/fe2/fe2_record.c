@@ -278,6 +278,11 @@ int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r)
         snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", k ? "\n" : "",
                  s->bc[k].name);
     rc |= pk_h5_obs_string(h, "fe2/reaction/names", names);
+    double comp[256];
+    size_t nb = s->nbc < 256 ? s->nbc : 256;
+    for (size_t k = 0; k < nb; k++)
+        comp[k] = s->bc[k].type == PK_FE2_DISPLACEMENT ? s->bc[k].comp : -1;
+    rc |= iarr(h, "/observables/fe2/reaction/component", comp, nb);
     for (size_t i = 0; i < r->nmicro && r->nstep; i++) {
         char name[64];
         snprintf(name, sizeof name, "micro/gauss_point_%zu", r->micro_gp[i]);

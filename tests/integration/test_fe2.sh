@@ -73,6 +73,8 @@ h5dump -d /observables/fe2/newton/iterations/relative_residual r.h5 >res.dump 2>
 check newton_history_starts_at_1 grep -q '(0): 1,' res.dump
 check xdmf_sidecar sh -c "grep -q 'TopologyType=\"Quadrilateral\"' r.xdmf &&
     test \$(grep -c '<Time ' r.xdmf) -eq 3"
+"$PACKD" picture r.h5 -o resp.svg --kind response >/dev/null 2>&1
+check picture_response test -s resp.svg
 check xdmf_items_match python3 "$SRC/tests/tools/xdmf_check.py" r.xdmf
 
 # 1b. initial_stress balanced: the radius-inflated RVE's prestress does not move an unloaded block
@@ -101,6 +103,8 @@ ID=$(member sub.json jobID)
 check daemon_accepts test "$code" = 201 -a -n "$ID"
 check daemon_successful wait_status "$ID" successful 60
 c -o d.h5 "$B/jobs/$ID/results/result"
+c -o res.json "$B/jobs/$ID/results"
+check daemon_lists_response_picture grep -q 'response.png' res.json
 check daemon_result_read_back sh -c "h5dump -d /observables/fe2/displacement/value d.h5 | grep -q '( 3, 9, 2 )'"
 
 # 4. invalid inputs: 422 naming the field and the rule
