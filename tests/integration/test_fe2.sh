@@ -43,6 +43,9 @@ bad("friction", lambda i: i["micro"].update(friction={"rho_deg": 20}))
 bad("conflict", lambda i: i["boundary_conditions"].append(
     {"name": "corner", "type": "displacement", "on": "lower_left", "component": "x"}) or
     i["stages"][0]["targets"].update(corner=0.5))
+bad("loaded", lambda i: i["boundary_conditions"].append({"name": "q", "type": "pressure", "on": "top"})
+    or i["stages"][0]["targets"].update(q=0.1))
+bad("edges", lambda i: i["boundary_conditions"][3].update(on="upper_right"))
 bad("inverted", lambda i: i.update(mesh={"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]],
     "elements": [[0, 3, 2, 1]], "sets": {"left": {"nodes": [0, 3], "edges": [[0, 3]]}}}))
 # the push in one increment to 95 % compression, no cuts allowed: the RVE cannot follow
@@ -76,6 +79,12 @@ check xdmf_sidecar sh -c "grep -q 'TopologyType=\"Quadrilateral\"' r.xdmf &&
 "$PACKD" picture r.h5 -o resp.svg --kind response >/dev/null 2>&1
 check picture_response test -s resp.svg
 check xdmf_items_match python3 "$SRC/tests/tools/xdmf_check.py" r.xdmf
+
+# 1a. the Gauss points on 2 threads: the same result, bit for bit (the result digest)
+"$PACKD" run job.json -o r2.h5 --threads 2 --json >r2.json 2>r2.err
+check threads_same_bits python3 -c "
+import json; a = json.load(open('r.json')); b = json.load(open('r2.json'))
+assert a['result_digest'] == b['result_digest'] and b['threads'] == 2, (a['result_digest'], b)"
 
 # 1b. initial_stress balanced: the radius-inflated RVE's prestress does not move an unloaded block
 #     (free, the same block expands: the dilatancy of the run above is large)
@@ -111,6 +120,7 @@ check daemon_result_read_back sh -c "h5dump -d /observables/fe2/displacement/val
 has_error() { grep -A1 "\"pointer\": \"$2\"" "$1" | grep -q "\"rule\": \"$3\""; }
 for case in set:/inputs/boundary_conditions/3/on:set target:/inputs/stages/1/targets/top:target \
     friction:/inputs/micro/friction:friction conflict:/inputs/boundary_conditions/4:conflict \
+    loaded:/inputs/boundary_conditions/4:loadOnPrescribed edges:/inputs/boundary_conditions/3:edges \
     inverted:/inputs/mesh:mesh; do
     name=${case%%:*}
     rest=${case#*:}
