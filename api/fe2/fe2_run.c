@@ -61,7 +61,12 @@ static int load_rve(const pk_fe2_job *job, int threads, const char *out_path, pk
     char *text = json_dumps(job->pack_inputs, JSON_SORT_KEYS | JSON_COMPACT);
     json_t *sum = NULL;
     char e2[400] = "";
-    int rc = text ? pack->run(job->pack_job, threads, text, tmp, mon, &sum, e2, sizeof e2) : -1;
+    /* its own copy of the monitor: the pack run restarts the clock with its
+     * own wall limit, the job's limit keeps counting from the job's start */
+    pk_monitor pm = mon ? *mon : (pk_monitor){0};
+    int rc = text
+        ? pack->run(job->pack_job, threads, text, tmp, mon ? &pm : NULL, &sum, e2, sizeof e2)
+        : -1;
     free(text);
     if (rc == 0 && pk_verdict_failed(sum)) {
         snprintf(err, errlen, "the nested pack job (micro.rve.pack) failed: %s",
