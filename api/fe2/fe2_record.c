@@ -3,6 +3,7 @@
 #include "fe2_record.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -54,18 +55,40 @@ int pk_fe2_record_init(pk_fe2_record *r, const pk_fe2_setup *s, const size_t *mi
     return 0;
 }
 
-static pk_fe2_dbuf *bufs(pk_fe2_record *r, size_t *n)
-{
-    *n = (size_t)(&r->it_eta - &r->step) + 1;
-    return &r->step;
-}
-
 void pk_fe2_record_free(pk_fe2_record *r)
 {
-    size_t n;
-    pk_fe2_dbuf *b = bufs(r, &n);
-    for (size_t i = 0; i < n; i++)
-        free(b[i].v);
+#define B(m) offsetof(pk_fe2_record, m)
+    static const size_t bufs[] = {B(step),
+                                  B(time),
+                                  B(stage),
+                                  B(cuts),
+                                  B(u),
+                                  B(x),
+                                  B(F),
+                                  B(P),
+                                  B(sigma),
+                                  B(mises),
+                                  B(mises_elem),
+                                  B(energy),
+                                  B(coordination),
+                                  B(rattlers),
+                                  B(relax_iter),
+                                  B(reaction),
+                                  B(area),
+                                  B(dilatancy),
+                                  B(micro_x),
+                                  B(part_step),
+                                  B(part_t0),
+                                  B(part_t1),
+                                  B(part_n),
+                                  B(part_abs0),
+                                  B(part_conv),
+                                  B(it_part),
+                                  B(it_res),
+                                  B(it_eta)};
+#undef B
+    for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
+        free(((pk_fe2_dbuf *)((char *)r + bufs[i]))->v);
     memset(r, 0, sizeof *r);
 }
 

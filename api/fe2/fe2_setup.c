@@ -460,6 +460,19 @@ size_t pk_fe2_setup_build(const pk_fe2_job *job, pk_fe2_setup *s, pk_schema_erro
     }
     if (errs->n != before || stage_values(job, s, errs) != 0 || fixed_dofs(s, errs) != 0)
         return errs->n - before;
+    /* at least one x and one y and a third prescribed dof: else K is
+     * singular under a rigid translation or rotation */
+    int comp[2] = {0, 0};
+    for (size_t i = 0; i < s->nfix; i++)
+        comp[s->fix_dof[i] % 2] = 1;
+    if (!comp[0] || !comp[1] || s->nfix < 3)
+        pk_schema_errors_add(errs, "/boundary_conditions", "rigidMotion",
+                             "%zu prescribed degrees of freedom (%s): the mesh needs at least "
+                             "three, in x and in y, against rigid translations and rotation",
+                             s->nfix,
+                             !comp[0]       ? "none in x"
+                                 : !comp[1] ? "none in y"
+                                            : "too few");
     load_on_prescribed(s, errs);
     return errs->n - before;
 }

@@ -46,6 +46,8 @@ bad("conflict", lambda i: i["boundary_conditions"].append(
 bad("loaded", lambda i: i["boundary_conditions"].append({"name": "q", "type": "pressure", "on": "top"})
     or i["stages"][0]["targets"].update(q=0.1))
 bad("edges", lambda i: i["boundary_conditions"][3].update(on="upper_right"))
+bad("rigid", lambda i: i.update(boundary_conditions=i["boundary_conditions"][3:]) or
+    i["stages"][1]["targets"].clear())
 bad("inverted", lambda i: i.update(mesh={"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]],
     "elements": [[0, 3, 2, 1]], "sets": {"left": {"nodes": [0, 3], "edges": [[0, 3]]}}}))
 # the push in one increment to 95 % compression, no cuts allowed: the RVE cannot follow
@@ -121,7 +123,7 @@ has_error() { grep -A1 "\"pointer\": \"$2\"" "$1" | grep -q "\"rule\": \"$3\""; 
 for case in set:/inputs/boundary_conditions/3/on:set target:/inputs/stages/1/targets/top:target \
     friction:/inputs/micro/friction:friction conflict:/inputs/boundary_conditions/4:conflict \
     loaded:/inputs/boundary_conditions/4:loadOnPrescribed edges:/inputs/boundary_conditions/3:edges \
-    inverted:/inputs/mesh:mesh; do
+    rigid:/inputs/boundary_conditions:rigidMotion inverted:/inputs/mesh:mesh; do
     name=${case%%:*}
     rest=${case#*:}
     code=$(post "bad_$name.json" "bad_$name.out")
