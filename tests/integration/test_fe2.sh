@@ -10,7 +10,7 @@
 . "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
 cd "$T" || exit 1
 
-python3 - "$T" <<'EOF'
+python3 - "$T" "$SRC" <<'EOF'
 import json, sys, copy
 t = sys.argv[1]
 job = {"process": "fe2", "inputs": {
@@ -54,6 +54,15 @@ bad("inverted", lambda i: i.update(mesh={"nodes": [[0, 0], [1, 0], [1, 1], [0, 1
 f = copy.deepcopy(job); f["inputs"]["stages"][1] = {"increments": 1, "targets": {"top_y": -9.5}}
 f["inputs"]["newton"] = {"max_cuts": 0}
 json.dump(f, open(t + "/fail.json", "w"))
+# a Gmsh mesh (a Q1 and a triangle, physical groups as sets): a point load at the tip
+g = copy.deepcopy(job); g["inputs"]["mesh"] = {"file": sys.argv[2] + "/tests/data/meshes/plate22.msh"}
+g["inputs"]["boundary_conditions"] = [
+    {"name": "left_x", "type": "displacement", "on": "left", "component": "x"},
+    {"name": "bottom_y", "type": "displacement", "on": "bottom side", "component": "y"},
+    {"name": "tip", "type": "force", "on": "tip"}]
+g["inputs"]["stages"] = [{"increments": 2, "targets": {"tip": [-0.002, 0]}}]
+g["inputs"]["initial_stress"] = "balanced"; g["inputs"]["output"] = {}
+json.dump(g, open(t + "/gmsh.json", "w"))
 # the prestressed start balanced and no load: u = 0 is the equilibrium
 z = copy.deepcopy(job); z["inputs"]["initial_stress"] = "balanced"
 z["inputs"]["stages"] = [{"increments": 1, "targets": {"p": 0}}]
@@ -87,6 +96,14 @@ check xdmf_items_match python3 "$SRC/tests/tools/xdmf_check.py" r.xdmf
 check threads_same_bits python3 -c "
 import json; a = json.load(open('r.json')); b = json.load(open('r2.json'))
 assert a['result_digest'] == b['result_digest'] and b['threads'] == 2, (a['result_digest'], b)"
+
+# 1c. a Gmsh mesh of a quadrilateral and a triangle: runs, the sidecar's topology is Mixed
+"$PACKD" run gmsh.json -o g.h5 --xdmf g.xdmf --json >g.json 2>g.err
+check gmsh_mesh_runs python3 -c "
+import json; s = json.load(open('g.json'))
+assert s['complete'] and s['gauss_points'] == 5 and s['elements'] == 2, s
+assert abs(s['reaction_per_step']['left_x'][-1] - 0.002) < 1e-9, s['reaction_per_step']"
+check gmsh_xdmf_mixed grep -q 'TopologyType="Mixed"' g.xdmf
 
 # 1b. initial_stress balanced: the radius-inflated RVE's prestress does not move an unloaded block
 #     (free, the same block expands: the dilatancy of the run above is large)
