@@ -135,6 +135,24 @@ c -o res.json "$B/jobs/$ID/results"
 check daemon_lists_response_picture grep -q 'response.png' res.json
 check daemon_result_read_back sh -c "h5dump -d /observables/fe2/displacement/value d.h5 | grep -q '( 3, 9, 2 )'"
 
+# 3b. the served process description: each input's schema usable alone by a third-party
+#     validator (python3-jsonschema), the micro options bundled from homogenize's and pack's schemas
+check description_schemas_standalone python3 - "$B" job.json <<'PYEOF'
+import json, sys, urllib.request
+from jsonschema import validators
+B, job = sys.argv[1], json.load(open(sys.argv[2]))
+d = json.load(urllib.request.urlopen(B + "/processes/fe2", timeout=20))
+for name, value in job["inputs"].items():
+    schema = d["inputs"][name]["schema"]
+    cls = validators.validator_for(schema)
+    cls.check_schema(schema)
+    cls(schema).validate(value)
+schema = d["inputs"]["micro"]["schema"]
+cls = validators.validator_for(schema)
+assert list(cls(schema).iter_errors({"rve": {"file": "x"}, "boundary_condition": "voigt"}))
+assert list(cls(schema).iter_errors({"rve": {"pack": {"dim": 7}}, "boundary_condition": "taylor"}))
+PYEOF
+
 # 4. invalid inputs: 422 naming the field and the rule
 has_error() { grep -A1 "\"pointer\": \"$2\"" "$1" | grep -q "\"rule\": \"$3\""; }
 for case in set:/inputs/boundary_conditions/3/on:set target:/inputs/stages/1/targets/top:target \
