@@ -26,6 +26,10 @@
 #define FE2_LS_TOL 0.8
 #define FE2_LS_MAX 6
 #define FE2_LS_MIN 0.05
+/* A residual below FE2_ROUNDOFF × max(|f_int| of the part's start, |f_ext|)
+ * (all dofs) is round-off: converged whatever rtol says (a part that moves
+ * nothing has a reference residual at round-off itself). */
+#define FE2_ROUNDOFF 1e-13
 
 int pk_fe2_state_init(pk_fe2_state *s, const pk_fe2_mesh *m)
 {
@@ -240,6 +244,10 @@ static int newton(step_ws *w, const pk_fe2_state *s, const double *delta, pk_fe2
     }
     it->abs_res0 = r0;
     it->res[it->n++] = 1;
+    double fi = 0, fe = 0;
+    for (size_t d = 0; d < w->ndof; d++)
+        fi += s->fint[d] * s->fint[d], fe += w->fext[d] * w->fext[d];
+    const double rfloor = FE2_ROUNDOFF * sqrt(fmax(fi, fe));
     /* the predictor's correction takes the line search too: g(0) is the
      * linearised residual's R·Δu */
     if (have_du)
@@ -260,7 +268,7 @@ static int newton(step_ws *w, const pk_fe2_state *s, const double *delta, pk_fe2
             snprintf(w->why, sizeof w->why, "residual not finite");
             return PART_FAILED;
         }
-        if (r <= o->atol || rel <= o->rtol) {
+        if (r <= o->atol || rel <= o->rtol || r <= rfloor) {
             it->converged = 1;
             return PART_CONVERGED;
         }
@@ -426,7 +434,7 @@ int pk_fe2_step(const pk_fe2_problem *pb, const pk_fe2_newton_opts *o, pk_fe2_st
         }
         if (rep->cuts >= o->max_cuts) {
             snprintf(rep->why, sizeof rep->why,
-                     "step not converged at %.4g of its load after %d cuts: %s", t0, rep->cuts,
+                     "step not converged at %.4g of its load after %d cuts: %.180s", t0, rep->cuts,
                      w.why);
             ret = 1;
             goto out;

@@ -65,7 +65,7 @@ static int rve_eval(void *ctx, size_t g, const double F[4], double P[4], double 
         info->energy = st.energy_density;
         info->coordination = st.coordination;
         info->rattlers = st.rattlers;
-        info->relax_iter = st.dr.iterations;
+        info->relax_iter = st.dr.iterations + (st.used_newton ? st.newton.iterations : 0);
     }
     return 0;
 }
@@ -111,6 +111,10 @@ int pk_fe2_rve_init(pk_fe2_rve *m, const pk_homog_rve *rve, size_t nrve, const p
         pk_homog_state_free(&s0);
         if (rc != 0) {
             snprintf(err, errlen, "RVE %zu at F = 1: %s", k, eval_error(rc));
+            goto fail;
+        }
+        if (m->start[k].dr.stop == PK_DR_CANCELLED || m->start[k].dr.stop == PK_DR_WALL_TIME) {
+            snprintf(err, errlen, "RVE %zu at F = 1: %s", k, pk_dr_stop_name(m->start[k].dr.stop));
             goto fail;
         }
         pk_homog_audit au;

@@ -110,6 +110,20 @@ static void test_quadratic_taylor(void)
     CHECK_MSG(quadratic(&r1.parts[0], &worst) && quadratic(&r2.parts[0], &worst),
               "not quadratic: res[k+1]/res[k]^2 up to %g", worst);
     CHECK(r1.parts[0].n <= 7 && r2.parts[0].n <= 7);
+    /* a step that moves nothing converges at once (its reference residual
+     * is round-off itself) and changes nothing */
+    double *u1 = malloc(s.ndof * sizeof *u1), uD[32] = {0};
+    memcpy(u1, s.u, s.ndof * sizeof *u1);
+    for (size_t k = 0; k < b.nfix; k++)
+        uD[k] = s.u[b.fix[k]];
+    pk_fe2_newton_opts o2 = newton_opts();
+    o2.atol = 0;
+    pk_fe2_step_report r3;
+    CHECK_MSG(pk_fe2_step(&pb, &o2, &s, uD, b.fp, &r3, NULL) == 0, "hold: %s", r3.why);
+    CHECK(r3.cuts == 0 && r3.nparts == 1 && r3.parts[0].n == 2);
+    for (size_t d = 0; d < s.ndof; d++)
+        CHECK(fabs(s.u[d] - u1[d]) <= 1e-15);
+    free(u1);
     double fv = 0; /* the resultant on the bottom (nodes 0, 1, 2) */
     for (int a = 0; a < 3; a++)
         fv += s.fint[2 * a + 1] - s.fext[2 * a + 1];
