@@ -156,8 +156,6 @@ int pk_fe2_run(const void *parsed, int threads, const char *job_json, const char
         snprintf(err, errlen, "out of memory");
         goto out;
     }
-    for (size_t i = 0; i < job->n_micro_gp; i++)
-        micro[i] = mr.committed[job->micro_gp[i]].x;
     /* initial_stress balanced: f_int of the start state at u = 0 joins every
      * load (a trial evaluation, nothing committed) */
     if (job->balanced) {
@@ -202,6 +200,10 @@ int pk_fe2_run(const void *parsed, int threads, const char *job_json, const char
                 iters_total += (size_t)(rep.parts[q].n > 0 ? rep.parts[q].n - 1 : 0);
             cuts_total += (size_t)rep.cuts;
             if (r == 0) {
+                /* the committed centres of the output Gauss points (a commit
+                 * may have moved their storage) */
+                for (size_t g = 0; g < job->n_micro_gp; g++)
+                    micro[g] = mr.committed[job->micro_gp[g]].x;
                 if (pk_fe2_record_step(&rec, done + 1, (double)k + t, k, rep.cuts, &st, micro) !=
                     0) {
                     snprintf(err, errlen, "out of memory");
