@@ -32,10 +32,12 @@ const pk_option_table pk_fe2_options =
 /* Append the errors of tmp to errs with prefix before their pointers. */
 static void copy_prefixed(pk_schema_errors *errs, const pk_schema_errors *tmp, const char *prefix)
 {
-    for (size_t i = 0; i < tmp->n; i++)
-        pk_schema_errors_add(errs, "", tmp->items[i].rule, "%s", tmp->items[i].message),
-            snprintf(errs->items[errs->n - 1].pointer, sizeof errs->items[0].pointer, "%s%s",
-                     prefix, tmp->items[i].pointer);
+    for (size_t i = 0; i < tmp->n; i++) {
+        char ptr[sizeof tmp->items[0].pointer];
+        snprintf(ptr, sizeof ptr, "%s%.*s", prefix, (int)(sizeof ptr - strlen(prefix) - 1),
+                 tmp->items[i].pointer);
+        pk_schema_errors_add(errs, ptr, tmp->items[i].rule, "%s", tmp->items[i].message);
+    }
 }
 
 /* The micro options as 'homogenize' inputs: the same keys, one F̄ = 1 as
