@@ -35,6 +35,10 @@ const pk_output pk_outputs[] = {
      "relaxation residual of every load step (homogenize jobs)", 1},
     {"residual.svg", "image/svg+xml", "the residual history",
      "relaxation residual of every load step (homogenize jobs)", 1},
+    {"response.png", "image/png", "the fe2 response",
+     "reactions of the supports and dilatancy per load step (fe2 jobs)", 1},
+    {"response.svg", "image/svg+xml", "the fe2 response",
+     "reactions of the supports and dilatancy per load step (fe2 jobs)", 1},
     {NULL, NULL, NULL, NULL, 0},
 };
 
@@ -67,7 +71,7 @@ int pk_exec_opts_parse(json_t *body, pk_exec_opts *o, char *detail, size_t n)
         if (!pk_output_find(key)) {
             snprintf(detail, n,
                      "/outputs/%.60s: no such output (summary, result, xdmf, "
-                     "picture, grading, history, stress, residual .png/.svg)",
+                     "picture, grading, history, stress, residual, response .png/.svg)",
                      key);
             return -1;
         }

@@ -29,7 +29,8 @@ json_t *pk_process_summary(const pk_process *p)
 }
 
 /* Add to `into` every definition of `defs` that node refers to as
- * "#/$defs/<name>", and theirs in turn. */
+ * "#/$defs/<name>", and theirs in turn; and every other embedded schema
+ * it refers to by file name, whole. */
 static void collect_defs(json_t *node, json_t *defs, json_t *into)
 {
     if (json_is_array(node)) {
@@ -43,11 +44,22 @@ static void collect_defs(json_t *node, json_t *defs, json_t *into)
     json_t *v;
     json_object_foreach (node, key, v) {
         const char *ref = json_string_value(v);
+        char file[128];
+        size_t flen = ref ? strcspn(ref, "#") : 0;
         if (!strcmp(key, "$ref") && ref && !strncmp(ref, "#/$defs/", 8)) {
             json_t *def = json_object_get(defs, ref + 8);
             if (def && !json_object_get(into, ref + 8)) {
                 json_object_set(into, ref + 8, def);
                 collect_defs(def, defs, into);
+            }
+        } else if (!strcmp(key, "$ref") && ref && flen && flen < sizeof file) {
+            /* another embedded schema ("homogenize.inputs.schema.json#/…"):
+             * bundled whole under its own "$id", where the reference finds it */
+            snprintf(file, sizeof file, "%.*s", (int)flen, ref);
+            json_t *doc = pk_schema_get(file);
+            if (doc && !json_object_get(into, file)) {
+                json_object_set(into, file, doc);
+                collect_defs(doc, NULL, into); /* its own #/$defs stay inside it */
             }
         } else if (json_is_object(v) || json_is_array(v)) {
             collect_defs(v, defs, into);

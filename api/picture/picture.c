@@ -25,6 +25,8 @@ static const struct {
      PK_PICTURE_STRESS, pk_picture_stress},
     {"residual", "residual", "relaxation residual of every load step (homogenize results)",
      PK_PICTURE_RESIDUAL, pk_picture_residual},
+    {"response", "response", "reactions of the supports and dilatancy per load step (fe2 results)",
+     PK_PICTURE_RESPONSE, pk_picture_response},
 };
 #define KINDS (sizeof kinds / sizeof *kinds)
 

@@ -12,7 +12,9 @@
  *   stress    the stress–strain curve of a homogenization: the components of
  *             P̄ over the F̄ component the load varies most;
  *   residual  the relaxation residual ‖f‖ of every homogenization step
- *             (logarithmic), at its start, relaxed, and the target.
+ *             (logarithmic), at its start, relaxed, and the target;
+ *   response  an fe2 run over its load steps: the reactions of the supports
+ *             and the dilatancy of the specimen.
  * A kind is drawn only from a file that holds its data; asked of another
  * file it fails with an error naming what is missing.  The format follows
  * the output file's extension (.svg or .png). */
@@ -26,7 +28,8 @@ typedef enum {
     PK_PICTURE_GRADING,
     PK_PICTURE_HISTORY,
     PK_PICTURE_STRESS,
-    PK_PICTURE_RESIDUAL
+    PK_PICTURE_RESIDUAL,
+    PK_PICTURE_RESPONSE
 } pk_picture_kind;
 
 /* A kind's name ("packing", "grading", ...) → kind; -1 for any other name. */

@@ -191,7 +191,7 @@ enum MHD_Result route_result_file(pk_req *r)
     if (!out)
         return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output",
                                "outputs: summary, result, xdmf, picture, grading, history, "
-                               "stress, residual .png/.svg",
+                               "stress, residual, response .png/.svg",
                                NULL, 0);
     json_t *row = pk_job_visible(r, r->seg[1]);
     if (!row)

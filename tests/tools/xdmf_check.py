@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
-"""xdmf_check.py XDMF [--points N] [--tets] [--steps S] [--paraview] — check an
+"""xdmf_check.py XDMF [--points N] [--tets] [--steps S] [--mesh2d E] [--paraview] — check an
 XDMF sidecar the way a reader does: every HDF DataItem (also inside a
 HyperSlab) names, relative to the XDMF's folder, a dataset of that shape and
 number type (read back with h5dump -H); a HyperSlab's count is its stated
 shape and lies inside the dataset; every Uniform grid's Topology carries its
 connectivity.  --points N: the grains grid has N vertex cells.  --tets: a
 Tetrahedron grid is there.  --steps S: a temporal collection of S grids,
-each with its Time.  With --paraview and Debian's pvpython present,
+each with its Time.  --mesh2d E: an fe2 macro mesh of E cells (ParaView
+must see E cells and the point data "displacement").  With --paraview and Debian's pvpython present,
 ParaView's Xdmf3 reader opens the file headless and must make points > 0
 and cells > 0 (with --points: the grains' N points and N cells; --tets: tet
 cells; --steps: S time steps); prints "SKIP paraview: pvpython not installed"
@@ -67,6 +68,7 @@ def main():
     want_points = int(arg("--points")) if arg("--points") else None
     want_steps = int(arg("--steps")) if arg("--steps") else None
     want_tets = "--tets" in sys.argv
+    want_mesh2d = int(arg("--mesh2d")) if arg("--mesh2d") else None
     base = os.path.dirname(os.path.abspath(path))
     tree = E.parse(path)
     inner = set()
@@ -96,7 +98,7 @@ def main():
         assert all(s.find("Time") is not None for s in steps), "a step grid without Time"
     print(f"xdmf: {len(grids)} grids, every DataItem matches its dataset")
     if "--paraview" in sys.argv:
-        paraview(path, want_points, want_tets, want_steps)
+        paraview(path, want_points, want_tets, want_steps, want_mesh2d)
 
 
 # Run inside pvpython: counts per block of the reader's output (the last time step).
@@ -127,7 +129,7 @@ print('points', i.GetNumberOfPoints(), 'cells', i.GetNumberOfCells(), 'tets', te
 """
 
 
-def paraview(path, want_points, want_tets, want_steps):
+def paraview(path, want_points, want_tets, want_steps, want_mesh2d=None):
     pv = shutil.which("pvpython") or shutil.which("pvbatch")
     if not pv:
         print("SKIP paraview: pvpython not installed (Debian's paraview)")
@@ -140,6 +142,10 @@ def paraview(path, want_points, want_tets, want_steps):
     pts, cells, tets, steps = (int(m.group(k)) for k in range(1, 5))
     arrays = re.search(r"arrays (\S*)", res.stdout).group(1).split(",")
     print(f"paraview: {pts} points, {cells} cells, {tets} tets, {steps} time steps, point data {arrays}")
+    if want_mesh2d is not None:  # an fe2 macro mesh, no grains
+        assert cells == want_mesh2d and "displacement" in arrays, (cells, arrays)
+        assert want_steps is None or steps == want_steps, f"ParaView sees {steps} time steps"
+        return
     assert "radius" in arrays, "ParaView sees no radius"
     assert pts > 0 and cells > 0, "ParaView's Xdmf3 reader made no cells"
     if want_points is not None and not want_tets and want_steps is None:
