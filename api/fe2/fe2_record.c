@@ -108,21 +108,6 @@ int pk_fe2_record_newton(pk_fe2_record *r, size_t step, const pk_fe2_step_report
     return rc ? -1 : 0;
 }
 
-void pk_fe2_cauchy(const double F[4], const double P[4], double sigma[4])
-{
-    const double J = F[0] * F[3] - F[1] * F[2];
-    for (int i = 0; i < 2; i++)
-        for (int j = 0; j < 2; j++)
-            sigma[2 * i + j] = (P[2 * i] * F[2 * j] + P[2 * i + 1] * F[2 * j + 1]) / J;
-}
-
-double pk_fe2_mises(const double s[4])
-{
-    const double h = 0.5 * (s[0] + s[3]);
-    const double d0 = s[0] - h, d3 = s[3] - h;
-    return sqrt(1.5 * (d0 * d0 + d3 * d3 + s[1] * s[1] + s[2] * s[2]));
-}
-
 int pk_fe2_record_step(pk_fe2_record *r, size_t step, double time, size_t stage, int cuts,
                        const pk_fe2_state *st, const double *const *micro_pos)
 {
@@ -145,7 +130,7 @@ int pk_fe2_record_step(pk_fe2_record *r, size_t step, double time, size_t stage,
         double sig[4], w;
         size_t e;
         pk_fe2_cauchy(&st->F[4 * g], &st->P[4 * g], sig);
-        double vm = pk_fe2_mises(sig);
+        double vm = pk_fe2_von_mises(sig);
         rc |= push(&r->sigma, sig, 4) | push1(&r->mises, vm);
         pk_fe2_gauss_point(m, g, NULL, &e, &w);
         el[e] += w * vm;

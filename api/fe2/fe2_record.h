@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include "api/results/h5_result.h"
+#include "core/fe2/fe2_fields.h"
 #include "core/fe2/fe2_solver.h"
 #include "fe2_job.h"
 
@@ -44,11 +45,6 @@ int pk_fe2_record_newton(pk_fe2_record *r, size_t step, const pk_fe2_step_report
  * (micro_pos[i] → [ngrain][3] or NULL).  0 / −1. */
 int pk_fe2_record_step(pk_fe2_record *r, size_t step, double time, size_t stage, int cuts,
                        const pk_fe2_state *st, const double *const *micro_pos);
-
-/* Cauchy stress σ = P̄F̄ᵀ/det F̄ and von Mises √(3/2 s:s) with the deviator
- * of the 2×2 in-plane stress, s = σ − ½ tr σ 1 (the 2D RVE has no σ₃₃). */
-void pk_fe2_cauchy(const double F[4], const double P[4], double sigma[4]);
-double pk_fe2_mises(const double sigma[4]);
 
 /* Everything under /observables/fe2 (and the per-step views of the XDMF
  * sidecar).  0 / −1. */

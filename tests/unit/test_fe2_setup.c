@@ -91,9 +91,9 @@ static void test_stress_measures(void)
     CHECK_NEAR(sig[0], 4, 1e-15);
     CHECK(sig[1] == 0 && sig[2] == 0 && sig[3] == 0);
     const double uni[4] = {2, 0, 0, 0}, shear[4] = {0, 1, 1, 0}, hydro[4] = {-3, 0, 0, -3};
-    CHECK_NEAR(pk_fe2_mises(uni), sqrt(3.0), 1e-15); /* s = diag(1, −1): √(3/2 · 2) */
-    CHECK_NEAR(pk_fe2_mises(shear), sqrt(3.0), 1e-15);
-    CHECK(pk_fe2_mises(hydro) == 0);
+    CHECK_NEAR(pk_fe2_von_mises(uni), sqrt(3.0), 1e-15); /* s = diag(1, −1): √(3/2 · 2) */
+    CHECK_NEAR(pk_fe2_von_mises(shear), sqrt(3.0), 1e-15);
+    CHECK(pk_fe2_von_mises(hydro) == 0);
 }
 
 int main(void)
