@@ -392,7 +392,7 @@ def make_rve(r, n, seed):
     return rve if s is not None else None
 
 
-RELAX_N = 500
+RELAX_N = 1500
 
 
 def study_relax(r, out, seeds):
@@ -491,7 +491,7 @@ STUDIES = {
     "grains": study_grains, "stress": study_stress, "dmin": study_dmin, "relax": study_relax,
     "tangent": study_tangent, "tetfill": study_tetfill,
 }
-SEEDS = {"algo": 2, "maxphi": 2, "growth": 2, "stops": 2, "grains": 5, "stress": 5, "dmin": 2, "relax": 3,
+SEEDS = {"algo": 2, "maxphi": 2, "growth": 2, "stops": 2, "grains": 5, "stress": 5, "dmin": 2, "relax": 2,
          "tangent": 2, "tetfill": 3}
 
 
