@@ -353,8 +353,8 @@ def study_dmin(r, out, seeds):
                 out.line("dmin", grading="a16", d_min=dmin, alg=alg, seed=seed, **pack_fields(s),
                          cut=s.get("mass_cut_fraction", 0.0), cpu_s=cpu)
         # Fig. 10/11: the largest Δd the shell reaches at this d_min (EDMD, maximize delta_d,
-        # stopped at reduced pressure 10^6; at d_min 0.5 one run costs minutes: left out)
-        if dmin < 1.0:
+        # stopped at reduced pressure 10^6; below d_min 2 one run costs minutes: left out)
+        if dmin < 2.0:
             continue
         for seed in range(1, seeds + 1):
             job = json.loads(json.dumps(base))
