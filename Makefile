@@ -119,7 +119,7 @@ bench: $(DEPS_OK) $(BUILD)/packd $(BENCH_BIN)
 	@echo "== bench/service.sh"; PACKD=$(BUILD)/packd sh bench/service.sh
 
 # The trade study (docs/tradeoffs.md): `make tradeoffs` measures every trade
-# (bench/tradeoff/run.py, ~15 CPU min on one core; the lines go to
+# (bench/tradeoff/run.py, ~7 CPU min on one core; the lines go to
 # docs/tradeoffs/data/) and redraws; `make tradeoff-plots` only redraws the
 # plots and tables from the kept lines.  TRADEOFF_STUDIES=... runs a subset.
 # Debian's python3, which has python3-matplotlib (not a pyenv or venv one).

@@ -136,11 +136,11 @@ def algo(data, out, tables):
         brows.append([grading, be, len(by[("rsa", targets[0])])])
         for t in targets:
             ra, ed = by.get(("rsa", t), []), by.get(("edmd", t), [])
-            trows.append([grading, "%.3f" % t, pm([r["cpu_s"] for r in ra], "%.2f") if ra else "– (minutes)",
+            trows.append([grading, "%.3f" % t, pm([r["cpu_s"] for r in ra], "%.2f") if ra else "– (past its reach)",
                           "%d/%d" % (sum(r["complete"] for r in ra), len(ra)) if ra else "–",
                           pm([r["cpu_s"] for r in ed], "%.2f") if ed else "–",
                           "%d/%d" % (sum(r["complete"] for r in ed), len(ed)) if ed else "–",
-                          "%.0f" % ms([r["n"] for r in (ra or ed)])[0]])
+                          "%.0f" % ms([r["n"] for r in (ed or ra)])[0]])
     fig.tight_layout()
     fig.savefig(os.path.join(out, "algo.png"))
     plt.close(fig)
