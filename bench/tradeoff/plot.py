@@ -84,7 +84,7 @@ def errbar(ax, xs, groups, key, label, **kw):
 
 # ---------------------------------------------------------------------------------------------
 GRADING_NAME = {"mono": "equal spheres d = 4, 64 mm walled cube",
-                "a16_gap": "A16, d_min 2, Δd 1 mm, 48 mm walled cube (φ_M)",
+                "a16_gap": "A16, d_min 2, Δd 1 mm, 48 mm walled cube (φ_M; EDMD wall_gap none)",
                 "fuller": "Fuller q 0.5, d 2–16, 80 mm walled cube (φ_eff)"}
 
 
@@ -323,6 +323,9 @@ def dmin(data, out, tables):
     a2.set_ylabel("CPU s")
     for ax in (a1, a2):
         ax.set_xscale("log")
+        ax.set_xticks(ds)
+        ax.set_xticklabels(["%g" % d for d in ds])
+        ax.minorticks_off()
         ax.set_xlabel("d_min (mm)")
     a2.legend()
     fig.tight_layout()
