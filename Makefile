@@ -52,7 +52,7 @@ LIB_OBJ    := $(DAEMON_OBJ) $(API_OBJ) $(CORE_OBJ)
 UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 BENCH_BIN  := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
-.PHONY: all deps test sanitize bench run clean check-schemas install format
+.PHONY: all deps test sanitize bench run clean check-schemas install format tradeoffs tradeoff-plots
 .SECONDARY:
 
 all: $(DEPS_OK) $(BUILD)/packd $(BENCH_BIN)
@@ -117,6 +117,20 @@ sanitize:
 bench: $(DEPS_OK) $(BUILD)/packd $(BENCH_BIN)
 	@for b in $(BENCH_BIN); do echo "== $$b"; $$b || exit 1; done
 	@echo "== bench/service.sh"; PACKD=$(BUILD)/packd sh bench/service.sh
+
+# The trade study (docs/tradeoffs.md): `make tradeoffs` measures every trade
+# (bench/tradeoff/run.py, ~7 CPU min on one core; the lines go to
+# docs/tradeoffs/data/) and redraws; `make tradeoff-plots` only redraws the
+# plots and tables from the kept lines.  TRADEOFF_STUDIES=... runs a subset.
+# Debian's python3, which has python3-matplotlib (not a pyenv or venv one).
+TRADEOFF_STUDIES ?=
+PYTHON3 ?= /usr/bin/python3
+tradeoffs: $(DEPS_OK) $(BUILD)/packd
+	$(PYTHON3) bench/tradeoff/run.py --packd $(BUILD)/packd --data docs/tradeoffs/data $(TRADEOFF_STUDIES)
+	$(MAKE) --no-print-directory tradeoff-plots
+
+tradeoff-plots: $(DEPS_OK)
+	$(PYTHON3) bench/tradeoff/plot.py --data docs/tradeoffs/data --out docs/tradeoffs --doc docs/tradeoffs.md >/dev/null
 
 run: $(DEPS_OK) $(BUILD)/packd
 	$(BUILD)/packd serve
