@@ -165,7 +165,10 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
     int wrote = write_job_file(job_path, file);
     int wrote_errno = errno;
     json_decref(file);
-    char threads[16], interval[32];
+    char threads[16], interval[32], owner[128];
+    /* the job's owner is its result's /h5md/author */
+    const char *own = json_string_value(json_object_get(job, "owner"));
+    snprintf(owner, sizeof owner, "%s", own ? own : "packd");
     pthread_mutex_lock(&s->mu);
     snprintf(threads, sizeof threads, "%d", s->job_threads);
     snprintf(interval, sizeof interval, "%g",
@@ -204,7 +207,7 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
             _exit(125);
         execl(s->exe, "packd", "run", job_path, "-o", out_path, "--progress-fd", "3", "--threads",
               threads, "--pictures", dir, "--checkpoint", ckpt_path, "--checkpoint-interval",
-              interval, (char *)NULL);
+              interval, "--author", owner, (char *)NULL);
         _exit(127);
     }
     close(p[1]);

@@ -79,34 +79,29 @@ int pk_homog_frames_add(pk_homog_frames *fr, const pk_homog_rve *rve, const pk_h
 }
 
 int pk_homog_frames_write(pk_h5 *h, const pk_homog_frames *fr, const pk_homog_rve *rve,
-                          const char *unit)
+                          const pk_units *u)
 {
-    if (!fr->count)
-        return 0;
-    const size_t n = fr->n, c = fr->count;
+    const char *unit = u->length[0] ? u->length : NULL;
+    const size_t n = rve->n, c = fr->count;
     int rc = pk_h5_link(h, "/particles/grains/box", "/particles/rve/box");
     rc |= pk_h5_write_array(h, "/particles/rve/radius", PK_H5_F64, 1, &n, rve->r, unit);
     rc |= pk_h5_write_array(h, "/particles/rve/grain", PK_H5_I32, 1, &n, rve->grain, NULL);
-    int64_t *id = malloc(n * sizeof *id);
+    int64_t *id = malloc((n ? n : 1) * sizeof *id);
     if (!id)
         return -1;
     for (size_t i = 0; i < n; i++)
         id[i] = (int64_t)i;
     rc |= pk_h5_write_array(h, "/particles/rve/id", PK_H5_I64, 1, &n, id, NULL);
     free(id);
-    /* H5MD time-dependent elements: step, time, value */
+    if (!c)
+        return rc ? -1 : 0;
+    /* H5MD time-dependent elements: step, time (shared), value */
     const char *el[2] = {"position", "contact_force"};
-    for (int e = 0; e < 2; e++) {
-        char p[64];
-        snprintf(p, sizeof p, "/particles/rve/%s/step", el[e]);
-        rc |= pk_h5_write_array(h, p, PK_H5_I64, 1, &c, fr->step, NULL);
-        snprintf(p, sizeof p, "/particles/rve/%s/time", el[e]);
-        rc |= pk_h5_write_array(h, p, PK_H5_F64, 1, &c, fr->time, NULL);
-    }
     size_t dx[3] = {c, n, (size_t)fr->dim}, df[2] = {c, n};
-    rc |= pk_h5_write_array(h, "/particles/rve/position/value", PK_H5_F64, 3, dx, fr->x, unit);
-    rc |= pk_h5_write_array(h, "/particles/rve/contact_force/value", PK_H5_F64, 2, df, fr->force,
-                            NULL);
+    rc |= pk_h5_time_element(h, "/particles/rve/position", NULL, fr->step, fr->time, NULL,
+                             PK_H5_F64, 3, dx, fr->x, unit);
+    rc |= pk_h5_time_element(h, "/particles/rve/contact_force", "/particles/rve/position", NULL,
+                             NULL, NULL, PK_H5_F64, 2, df, fr->force, "N");
     /* per step views position/<k> [n][dim] and contact_force/<k> [n] for the
      * XDMF sidecar: ParaView's Xdmf3 reader reads no HyperSlab */
     for (size_t k = 0; k < c; k++)

@@ -16,6 +16,7 @@
 #include <stdint.h>
 
 #include "api/results/h5_result.h"
+#include "api/results/h5_units.h"
 #include "core/homog/homog_bc.h"
 #include "core/homog/homog_rve.h"
 
@@ -37,9 +38,11 @@ void pk_homog_frames_init(pk_homog_frames *fr, const pk_homog_rve *rve, size_t n
 /* Record the committed state s of load step k of nstep.  0 / -1 (memory). */
 int pk_homog_frames_add(pk_homog_frames *fr, const pk_homog_rve *rve, const pk_homog_opts *o,
                         const pk_homog_state *s, size_t k, size_t nstep);
-/* Write /particles/rve (nothing when no frame was kept); unit: lengths. */
+/* Write /particles/rve: box, radius, grain and id always (the particles
+ * group of /connectivity/contacts), position and contact_force when frames
+ * were kept; units of u. */
 int pk_homog_frames_write(pk_h5 *h, const pk_homog_frames *fr, const pk_homog_rve *rve,
-                          const char *unit);
+                          const pk_units *u);
 void pk_homog_frames_free(pk_homog_frames *fr);
 
 #endif

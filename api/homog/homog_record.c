@@ -5,6 +5,8 @@
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 /* "ab" (1-based digits) for indices a, b < 3 */
 static void comp_name(char *buf, size_t len, int a, int b)
@@ -236,5 +238,277 @@ int pk_homog_record_audit(json_t *aud, const pk_homog_audit *a)
     rc |= put(aud, "grains_outside", json_integer((json_int_t)a->outside));
     rc |= put(aud, "escape_radii", real_fin(a->escape));
     rc |= put(aud, "overlap_ratio", real_fin(a->overlap_ratio));
+    return rc ? -1 : 0;
+}
+
+/* ---- the record in the result file (H5MD time-dependent elements) ---- */
+
+#define OBS "/observables/"
+
+typedef struct {
+    pk_h5 *h;
+    const pk_units *u;
+    size_t nstep; /* steps requested: time = load fraction (k + 1)/nstep */
+} writer;
+
+/* step k and time (k+1)/nstep for k = first..first+S-1 */
+static int clock_of(size_t first, size_t S, size_t nstep, int64_t **step, double **time)
+{
+    *step = malloc((S ? S : 1) * sizeof **step);
+    *time = malloc((S ? S : 1) * sizeof **time);
+    if (!*step || !*time)
+        return -1;
+    for (size_t i = 0; i < S; i++) {
+        (*step)[i] = (int64_t)(first + i);
+        (*time)[i] = (double)(first + i + 1) / (double)(nstep ? nstep : 1);
+    }
+    return 0;
+}
+
+/* A JSON array of numbers as an element at path (clock: NULL to write
+ * step/time, else the element to share them with). */
+static int series(const writer *w, const char *path, const char *clock, json_t *arr,
+                  const int64_t *step, const double *time)
+{
+    size_t S = json_array_size(arr), i;
+    json_t *e;
+    int all_int = 1;
+    json_array_foreach (arr, i, e)
+        all_int &= json_is_integer(e);
+    const char *unit = pk_units_of(path + strlen(OBS), w->u);
+    void *v = malloc((S ? S : 1) * 8);
+    if (!v)
+        return -1;
+    json_array_foreach (arr, i, e) {
+        if (all_int && !unit)
+            ((int64_t *)v)[i] = (int64_t)json_integer_value(e);
+        else
+            ((double *)v)[i] = json_number_value(e);
+    }
+    int rc = pk_h5_time_element(w->h, path, clock, step, time, NULL,
+                                all_int && !unit ? PK_H5_I64 : PK_H5_F64, 1, &S, v, unit);
+    free(v);
+    return rc;
+}
+
+/* A tensor recorded by components {"11": [...], ...} as value [S][d][d]
+ * (the skew part: a < b recorded, the rest by antisymmetry). */
+static int tensor(const writer *w, const char *path, const char *clock, json_t *t, int dim,
+                  int skew, const int64_t *step, const double *time)
+{
+    size_t S = json_array_size(json_object_get(t, skew ? "12" : "11"));
+    double *v = calloc((S ? S : 1) * 9, sizeof *v);
+    if (!v)
+        return -1;
+    for (int a = 0; a < dim; a++)
+        for (int b = 0; b < dim; b++) {
+            char nm[3];
+            comp_name(nm, 3, skew && b < a ? b : a, skew && b < a ? a : b);
+            json_t *arr = json_object_get(t, nm);
+            double sign = skew && b < a ? -1 : 1;
+            for (size_t k = 0; arr && k < S; k++)
+                v[(k * (size_t)dim + (size_t)a) * (size_t)dim + (size_t)b] =
+                    sign * json_number_value(json_array_get(arr, k));
+        }
+    size_t dims[3] = {S, (size_t)dim, (size_t)dim};
+    int rc = pk_h5_time_element(w->h, path, clock, step, time, NULL, PK_H5_F64, 3, dims, v,
+                                pk_units_of(path + strlen(OBS), w->u));
+    free(v);
+    return rc;
+}
+
+/* Ā per tangent step: value [S][d][d][d][d], step = the listed steps. */
+static int tangent_A(const writer *w, json_t *t, int dim)
+{
+    json_t *steps = json_object_get(t, "step"), *A = json_object_get(t, "A");
+    size_t S = json_array_size(steps), d = (size_t)dim, n = d * d * d * d;
+    double *v = calloc((S ? S : 1) * n, sizeof *v), *time = malloc((S ? S : 1) * sizeof *time);
+    int64_t *step = malloc((S ? S : 1) * sizeof *step);
+    int rc = -1;
+    if (v && time && step) {
+        for (size_t k = 0; k < S; k++) {
+            step[k] = (int64_t)json_integer_value(json_array_get(steps, k));
+            time[k] = (double)(step[k] + 1) / (double)(w->nstep ? w->nstep : 1);
+        }
+        size_t q = 0;
+        for (int a = 0; a < dim; a++)
+            for (int b = 0; b < dim; b++)
+                for (int c = 0; c < dim; c++)
+                    for (int e = 0; e < dim; e++, q++) {
+                        char nm[8];
+                        comp4_name(nm, a, b, c, e);
+                        json_t *arr = json_object_get(A, nm);
+                        for (size_t k = 0; k < S; k++)
+                            v[k * n + q] = json_number_value(json_array_get(arr, k));
+                    }
+        size_t dims[5] = {S, d, d, d, d};
+        rc = pk_h5_time_element(w->h, OBS "homogenize/tangent/A", NULL, step, time, NULL, PK_H5_F64,
+                                5, dims, v, w->u->stress[0] ? w->u->stress : NULL);
+    }
+    free(v);
+    free(time);
+    free(step);
+    return rc;
+}
+
+/* Every per-step array of obj (and of its objects but tensors) as an element
+ * under prefix, sharing the clock of the first; the rest left in obj. */
+static int series_of(const writer *w, const char *prefix, json_t *obj, const char **clock,
+                     char *clock_buf, const int64_t *step, const double *time)
+{
+    const char *key;
+    json_t *v;
+    void *tmp;
+    int rc = 0;
+    json_object_foreach_safe (obj, tmp, key, v) {
+        char path[256];
+        snprintf(path, sizeof path, "%s/%s", prefix, key);
+        if (!json_is_array(v))
+            continue;
+        rc |= series(w, path, *clock, v, step, time);
+        if (!*clock) {
+            snprintf(clock_buf, 256, "%s", path);
+            *clock = clock_buf;
+        }
+        json_object_del(obj, key);
+    }
+    return rc;
+}
+
+/* final_state: [n][dim] positions and fluctuations, flags [n]. */
+static int final_state(const writer *w, json_t *fs, int dim)
+{
+    const char *key;
+    json_t *v;
+    int rc = 0;
+    json_object_foreach (fs, key, v) {
+        int vec = !strcmp(key, "position") || !strcmp(key, "fluctuation");
+        size_t n = json_array_size(v), i;
+        char path[128];
+        snprintf(path, sizeof path, OBS "homogenize/final_state/%s", key);
+        void *a = malloc((n ? n : 1) * 8);
+        if (!a)
+            return -1;
+        json_t *e;
+        json_array_foreach (v, i, e) {
+            if (vec)
+                ((double *)a)[i] = json_number_value(e);
+            else
+                ((int64_t *)a)[i] = (int64_t)json_integer_value(e);
+        }
+        size_t dims[2] = {vec ? n / (size_t)dim : n, (size_t)dim};
+        rc |= pk_h5_write_array(w->h, path, vec ? PK_H5_F64 : PK_H5_I64, vec ? 2 : 1, dims, a,
+                                pk_units_of(path + strlen(OBS), w->u));
+        free(a);
+    }
+    return rc;
+}
+
+/* The final contact network: /connectivity/contacts [n_c][2] (indices into
+ * /particles/rve) with the per-contact figures beside it. */
+static int final_contacts(const writer *w, json_t *fc, int dim)
+{
+    json_t *ci = json_object_get(fc, "i"), *cj = json_object_get(fc, "j");
+    size_t n = json_array_size(ci);
+    int64_t *pairs = malloc((n ? n : 1) * 2 * sizeof *pairs);
+    double *br = malloc((n ? n : 1) * (size_t)dim * sizeof *br);
+    double *ov = malloc((n ? n : 1) * sizeof *ov), *fn = malloc((n ? n : 1) * sizeof *fn);
+    int rc = -1;
+    if (pairs && br && ov && fn) {
+        json_t *b = json_object_get(fc, "branch");
+        for (size_t k = 0; k < n; k++) {
+            pairs[2 * k] = (int64_t)json_integer_value(json_array_get(ci, k));
+            pairs[2 * k + 1] = (int64_t)json_integer_value(json_array_get(cj, k));
+            ov[k] = json_number_value(json_array_get(json_object_get(fc, "overlap"), k));
+            fn[k] = json_number_value(json_array_get(json_object_get(fc, "normal_force"), k));
+            for (int a = 0; a < dim; a++)
+                br[k * (size_t)dim + (size_t)a] =
+                    json_number_value(json_array_get(b, k * (size_t)dim + (size_t)a));
+        }
+        size_t d2[2] = {n, (size_t)dim};
+        rc = pk_h5_connectivity(w->h, "/connectivity/contacts", pairs, n, "/particles/rve");
+        rc |= pk_h5_write_array(w->h, "/connectivity/contact_overlap", PK_H5_F64, 1, d2, ov,
+                                w->u->length[0] ? w->u->length : NULL);
+        rc |= pk_h5_write_array(w->h, "/connectivity/contact_normal_force", PK_H5_F64, 1, d2, fn,
+                                "N");
+        rc |= pk_h5_write_array(w->h, "/connectivity/contact_branch", PK_H5_F64, 2, d2, br,
+                                w->u->length[0] ? w->u->length : NULL);
+    }
+    free(pairs);
+    free(br);
+    free(ov);
+    free(fn);
+    return rc;
+}
+
+int pk_homog_record_write(pk_h5 *h, json_t *rec, json_t *aud, int dim, size_t audit_first,
+                          size_t nstep, const pk_units *u)
+{
+    writer w = {h, u, nstep};
+    json_t *r = json_deep_copy(rec), *a = json_deep_copy(aud);
+    int64_t *step = NULL, *astep = NULL;
+    double *time = NULL, *atime = NULL;
+    int rc = -1;
+    size_t S = json_array_size(json_object_get(rec, "J"));
+    size_t SA = json_array_size(json_object_get(aud, "passed"));
+    if (!r || !a || clock_of(0, S, nstep, &step, &time) != 0 ||
+        clock_of(audit_first, SA, nstep, &astep, &atime) != 0)
+        goto out;
+    /* the per-step series share one clock: the load steps 0..S-1 */
+    rc = 0;
+    const char *clock = NULL;
+    char clock_buf[256];
+    static const char *const tensors[] = {"F", "P", "sigma", "sigma_skew"};
+    for (int k = 0; k < 4; k++) {
+        char path[128];
+        snprintf(path, sizeof path, OBS "homogenize/%s", tensors[k]);
+        rc |= tensor(&w, path, clock, json_object_get(r, tensors[k]), dim, k == 3, step, time);
+        if (!clock) {
+            snprintf(clock_buf, sizeof clock_buf, "%s", path);
+            clock = clock_buf;
+        }
+        json_object_del(r, tensors[k]);
+    }
+    rc |= series_of(&w, OBS "homogenize", r, &clock, clock_buf, step, time);
+    rc |=
+        series_of(&w, OBS "homogenize/dr", json_object_get(r, "dr"), &clock, clock_buf, step, time);
+    json_t *t = json_object_get(r, "tangent");
+    if (t) {
+        rc |= tangent_A(&w, t, dim);
+        json_object_del(t, "A");
+        json_object_del(t, "step");
+        /* status, time and size of every committed step's tangent */
+        size_t ST = json_array_size(json_object_get(t, "status_code"));
+        int64_t *ts = NULL;
+        double *tt = NULL;
+        if (clock_of(0, ST, nstep, &ts, &tt) == 0) {
+            const char *tclock = NULL;
+            char tbuf[256];
+            rc |= series_of(&w, OBS "homogenize/tangent", t, &tclock, tbuf, ts, tt);
+        } else
+            rc = -1;
+        free(ts);
+        free(tt);
+    }
+    json_t *fs = json_object_get(r, "final_state"), *fc = json_object_get(r, "final_contacts");
+    if (fs)
+        rc |= final_state(&w, fs, dim);
+    if (fc)
+        rc |= final_contacts(&w, fc, dim);
+    json_object_del(r, "final_state");
+    json_object_del(r, "final_contacts");
+    rc |= pk_h5_obs_json_units(h, "homogenize", r, pk_units_of, u);
+    /* the audit: one entry per audited step (from audit_first on) */
+    const char *aclock = NULL;
+    char abuf[256];
+    rc |= series_of(&w, OBS "audit", a, &aclock, abuf, astep, atime);
+    rc |= pk_h5_obs_json(h, "audit", a);
+out:
+    json_decref(r);
+    json_decref(a);
+    free(step);
+    free(time);
+    free(astep);
+    free(atime);
     return rc ? -1 : 0;
 }

@@ -400,11 +400,16 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
     pk_h5 *h = pk_h5_create(out_path, err, errlen);
     if (!h)
         goto out;
-    int w = pk_h5_write_particles(h, &box, &p, "1");
-    w |= pk_homog_frames_write(h, &fr, &rve, "1");
+    /* lengths in the RVE file's unit, forces in N (E_n per length unit) */
+    char lunit[32];
+    pk_h5_read_unit(job.rve_file, lunit, sizeof lunit);
+    pk_units units;
+    pk_units_init(&units, lunit, dim);
+    const char *L = units.length[0] ? units.length : NULL;
+    int w = pk_h5_write_particles(h, &box, &p, L);
+    w |= pk_homog_frames_write(h, &fr, &rve, &units);
     w |= pk_h5_write_parameters(h, "homogenize", job_json, 0);
-    w |= pk_h5_obs_json(h, "homogenize", rec);
-    w |= pk_h5_obs_json(h, "audit", aud);
+    w |= pk_homog_record_write(h, rec, aud, dim, first, job.nstep, &units);
     w |= pk_verdict_write_h5(h, sum);
     if (w != 0) {
         pk_h5_abort(h);

@@ -21,6 +21,7 @@ typedef struct tetfill_setup {
     pk_mesh_report rep;
     double origin[3]; /* mesh frame = particle frame + origin */
     pk_tetfill_params prm;
+    char unit[32]; /* the job's length unit */
 } tetfill_setup;
 
 static void preset(void *dst) { pk_tetfill_defaults(&((pk_tetfill_options *)dst)->prm); }
@@ -77,6 +78,7 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
                  char *err, size_t errlen)
 {
     memset(S, 0, sizeof *S);
+    snprintf(S->unit, sizeof S->unit, "%s", job->unit);
     const pk_tetfill_options *o = &job->opt.tetfill;
     json_t *mesh = job->mesh;
     size_t max_tets = o->max_tets;
@@ -228,8 +230,8 @@ static json_t *observables(const tetfill_setup *S, const pk_tetfill_stats *ts,
     return o;
 }
 
-/* The mesh itself, in the particles' frame: mesh_nodes [3·nnode],
- * mesh_tets [4·ntet] (0-based), mesh_regions [ntet]. */
+/* The mesh itself, in the particles' frame: mesh_nodes [nnode][3] (the
+ * job's length unit), mesh_tets [ntet][4] (0-based), mesh_regions [ntet]. */
 static int write_mesh(pk_h5 *h, const char *prefix, void *extra)
 {
     const pk_mesh *m = &((tetfill_setup *)extra)->mesh;
@@ -238,12 +240,13 @@ static int write_mesh(pk_h5 *h, const char *prefix, void *extra)
     if (!t)
         return -1;
     int rc = 0;
-    snprintf(name, sizeof name, "%s/mesh_nodes", prefix);
-    rc |= pk_h5_obs_doubles(h, name, m->x, 3 * m->nnode, NULL);
+    size_t dn[2] = {m->nnode, 3}, dt[2] = {m->ntet, 4};
+    snprintf(name, sizeof name, "/observables/%s/mesh_nodes", prefix);
+    rc |= pk_h5_write_array(h, name, PK_H5_F64, 2, dn, m->x, ((tetfill_setup *)extra)->unit);
     for (size_t i = 0; i < 4 * m->ntet; i++)
         t[i] = m->t[i];
-    snprintf(name, sizeof name, "%s/mesh_tets", prefix);
-    rc |= pk_h5_obs_ints(h, name, t, 4 * m->ntet);
+    snprintf(name, sizeof name, "/observables/%s/mesh_tets", prefix);
+    rc |= pk_h5_write_array(h, name, PK_H5_I64, 2, dt, t, NULL);
     for (size_t i = 0; i < m->ntet; i++)
         t[i] = m->region[i];
     snprintf(name, sizeof name, "%s/mesh_regions", prefix);

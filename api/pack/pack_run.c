@@ -7,6 +7,7 @@
 
 #include "core/space/gap_audit.h"
 #include "api/results/h5_result.h"
+#include "api/results/h5_units.h"
 #include "api/job_verdict.h"
 #include "pack_job.h"
 #include "pack_placer.h"
@@ -96,8 +97,18 @@ static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const 
     rc |= pk_h5_obs_double(h, "count_expected", plan->expected_n, NULL);
     rc |= pk_h5_obs_string(h, "termination_reason", pk_stop_reason_name(st->reason));
     rc |= pk_h5_obs_string(h, "algorithm", job->algorithm);
-    if (st->obs)
-        rc |= pk_h5_obs_json(h, job->algorithm, st->obs);
+    if (st->obs) {
+        /* a history {events, time, ...} as H5MD time-dependent elements */
+        pk_units units;
+        pk_units_init(&units, u, dim);
+        json_t *obs = json_copy(st->obs), *hist = json_object_get(st->obs, "history");
+        char hp[64];
+        snprintf(hp, sizeof hp, "%s/history", job->algorithm);
+        if (hist && json_object_del(obs, "history") == 0)
+            rc |= pk_h5_obs_history(h, hp, hist, "events", "time");
+        rc |= obs ? pk_h5_obs_json_units(h, job->algorithm, obs, pk_units_of, &units) : -1;
+        json_decref(obs);
+    }
     if (st->write_extra)
         rc |= st->write_extra(h, job->algorithm, st->extra);
     rc |= pk_h5_obs_double(h, "smallest_gap", gap->min_gap, u);

@@ -4,7 +4,8 @@
  *             grains cut by a periodic side drawn on both sides with a dashed
  *             outline, walls solid and periodic sides dashed;
  *             3D: the mid-plane section (z = L_z/2) beside an orthographic
- *             view along −z, depth-shaded (nearer grains brighter);
+ *             view along −z, depth-shaded (nearer grains brighter); a tetfill
+ *             result's tet mesh outlined where the section cuts it;
  *   grading   the resolved grading curve, target against achieved, % passing
  *             over a logarithmic sieve axis, with φ_M and φ_eff;
  *   history   an EDMD run over its events: φ and the reduced pressure

@@ -21,7 +21,11 @@ int pk_picture_history(const char *h5_path, const char *out_path, char *err, siz
         return -1;
     }
     size_t n, np, nz;
-    double *ev = pk_plot_series(f, HISTORY "events", &n);
+    /* the events: the H5MD step of the history (a flat `events` series in
+     * files before the H5MD 1.1 layout) */
+    double *ev = pk_plot_series(f, HISTORY "phi/step", &n);
+    if (!ev)
+        ev = pk_plot_series(f, HISTORY "events", &n);
     double *phi = pk_plot_series(f, HISTORY "phi", &np);
     double *z = pk_plot_series(f, HISTORY "reduced_pressure", &nz);
     double phi_final = pk_plot_scalar(f, "/observables/edmd/phi_final");

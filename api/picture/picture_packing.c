@@ -7,6 +7,7 @@
 #include "api/results/h5_result.h"
 #include "picture_canvas.h"
 #include "picture_internal.h"
+#include "picture_mesh.h"
 
 #define PANEL 720.0 /* the longer box side, in pt/px */
 #define MARGIN 36.0
@@ -81,6 +82,27 @@ static void draw_section(cairo_t *cr, const frame *f, const pk_box *b, const pk_
                 draw_disk(cr, f, b, p->x[3 * i], p->x[3 * i + 1], sqrt(r * r - dz * dz),
                           p->species[i], classes, 1.0);
         }
+    cairo_restore(cr);
+}
+
+/* A tetfill result's mesh where the section plane z = z0 cuts it: each
+ * tet's cut polygon outlined in dark red over the grains. */
+static void draw_mesh_section(cairo_t *cr, const frame *f, const pk_picture_mesh *m, double z0)
+{
+    cairo_save(cr);
+    clip_to(cr, f);
+    cairo_set_source_rgb(cr, 0.7, 0.1, 0.1);
+    cairo_set_line_width(cr, 0.6);
+    cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+    for (size_t k = 0; k < m->nt; k++) {
+        double xy[4][2];
+        int n = pk_picture_mesh_cut(m, k, z0, xy);
+        for (int i = 0; i < n; i++)
+            (i ? cairo_line_to : cairo_move_to)(cr, fx(f, xy[i][0]), fy(f, xy[i][1]));
+        if (n)
+            cairo_close_path(cr);
+    }
+    cairo_stroke(cr);
     cairo_restore(cr);
 }
 
@@ -159,10 +181,16 @@ int pk_picture_packing(const char *h5_path, const char *out_path, char *err, siz
         draw_frame(c.cr, &f, &b);
     } else {
         draw_section(c.cr, &f, &b, &p, classes, 0.5 * b.L[2]);
+        pk_picture_mesh mesh;
+        int with_mesh = pk_picture_mesh_read(h5_path, &mesh) == 0;
+        if (with_mesh) {
+            draw_mesh_section(c.cr, &f, &mesh, 0.5 * b.L[2]);
+            pk_picture_mesh_free(&mesh);
+        }
         draw_frame(c.cr, &f, &b);
         cairo_set_source_rgb(c.cr, 0, 0, 0);
         pk_canvas_text(c.cr, f.x0 + pw / 2, f.y0 + ph + 0.5 * MARGIN, 0.5, 0.5, 12,
-                       "section z = Lz/2");
+                       with_mesh ? "section z = Lz/2 with the tet mesh" : "section z = Lz/2");
         f.x0 += pw + MARGIN;
         rc = draw_projection(c.cr, &f, &b, &p, classes);
         draw_frame(c.cr, &f, &b);

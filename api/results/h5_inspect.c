@@ -35,7 +35,7 @@ static json_t *read_dataset(hid_t d, size_t max_array)
             out = json_string(buf);
         H5Tclose(mt);
         free(buf);
-    } else if ((cls == H5T_FLOAT || cls == H5T_INTEGER) && rank <= 1 && total <= max_array) {
+    } else if ((cls == H5T_FLOAT || cls == H5T_INTEGER) && rank <= 5 && total <= max_array) {
         int is_int = cls == H5T_INTEGER;
         void *buf = malloc((size_t)(total ? total : 1) * 8);
         if (buf &&
@@ -45,11 +45,24 @@ static json_t *read_dataset(hid_t d, size_t max_array)
                 out = is_int ? json_integer((json_int_t)((long long *)buf)[0])
                              : json_real(((double *)buf)[0]);
             } else {
-                out = json_array();
+                /* nested arrays, row-major: [S][d][d] as S lists of d lists */
+                json_t *flat = json_array();
                 for (hsize_t i = 0; i < total; i++)
-                    json_array_append_new(out,
+                    json_array_append_new(flat,
                                           is_int ? json_integer((json_int_t)((long long *)buf)[i])
                                                  : json_real(((double *)buf)[i]));
+                for (int k = rank - 1; k > 0; k--) {
+                    json_t *up = json_array();
+                    for (size_t i = 0; i < json_array_size(flat); i += dims[k]) {
+                        json_t *row = json_array();
+                        for (hsize_t j = 0; j < dims[k]; j++)
+                            json_array_append(row, json_array_get(flat, i + j));
+                        json_array_append_new(up, row);
+                    }
+                    json_decref(flat);
+                    flat = up;
+                }
+                out = flat;
             }
         }
         free(buf);
@@ -82,7 +95,15 @@ static herr_t visit(hid_t obj, const char *name, const obj_info *info, void *vct
     hid_t d = H5Dopen2(obj, name, H5P_DEFAULT);
     if (d < 0)
         return 0;
-    json_object_set_new(c->obj, name, read_dataset(d, c->max_array));
+    /* an H5MD time-dependent element X is listed as X (its value); its step
+     * and time appear once, under the element that holds them (a visit sees
+     * each object once, the shared ones at their first name) */
+    char key[512];
+    size_t len = strlen(name);
+    snprintf(key, sizeof key, "%s", name);
+    if (len > 6 && !strcmp(name + len - 6, "/value"))
+        key[len - 6] = 0;
+    json_object_set_new(c->obj, key, read_dataset(d, c->max_array));
     H5Dclose(d);
     return 0;
 }

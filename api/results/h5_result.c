@@ -53,6 +53,20 @@ static int attr_string(hid_t obj, const char *name, const char *v)
     return rc < 0 ? -1 : 0;
 }
 
+/* An H5MD unit attribute (units module 1.0: scalar, fixed-length, ASCII). */
+static int attr_unit(hid_t obj, const char *v)
+{
+    hid_t t = string_type(strlen(v) + 1), s = H5Screate(H5S_SCALAR);
+    H5Tset_cset(t, H5T_CSET_ASCII);
+    hid_t a = H5Acreate2(obj, "unit", t, s, H5P_DEFAULT, H5P_DEFAULT);
+    herr_t rc = a < 0 ? -1 : H5Awrite(a, t, v);
+    if (a >= 0)
+        H5Aclose(a);
+    H5Sclose(s);
+    H5Tclose(t);
+    return rc < 0 ? -1 : 0;
+}
+
 static int attr_ints(hid_t obj, const char *name, const int *v, hsize_t n, int scalar)
 {
     hid_t s = scalar ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &n, NULL);
@@ -112,12 +126,19 @@ static int write_dataset(hid_t parent, hid_t lcpl, const char *name, hid_t type,
             total *= dims[k];
         rc = total ? H5Dwrite(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) : 0;
         if (rc >= 0 && unit)
-            rc = attr_string(d, "unit", unit);
+            rc = attr_unit(d, unit);
         H5Dclose(d);
     }
     H5Pclose(p);
     H5Sclose(s);
     return rc < 0 ? -1 : 0;
+}
+
+static char author_name[128] = "packd";
+
+void pk_h5_set_author(const char *name)
+{
+    snprintf(author_name, sizeof author_name, "%s", name && *name ? name : "packd");
 }
 
 pk_h5 *pk_h5_create(const char *path, char *err, size_t errlen)
@@ -176,8 +197,25 @@ pk_h5 *pk_h5_create(const char *path, char *err, size_t errlen)
     int ver[2] = {1, 1};
     attr_ints(md, "version", ver, 2, 0);
     hid_t au = make_group(md, "author", H5P_DEFAULT);
-    attr_string(au, "name", "packd user");
+    attr_string(au, "name", author_name);
     H5Gclose(au);
+    /* the units module: every dimensional dataset carries a `unit` string of
+     * SI symbols ("mm", "N mm-2"); H5MD units module 1.0 */
+    hid_t un = make_group(md, "modules/units", h->lcpl);
+    int uver[2] = {1, 0};
+    attr_ints(un, "version", uver, 2, 0);
+    {
+        hid_t t = string_type(3), s = H5Screate(H5S_SCALAR);
+        H5Tset_cset(t, H5T_CSET_ASCII);
+        hid_t a = H5Acreate2(un, "system", t, s, H5P_DEFAULT, H5P_DEFAULT);
+        if (a >= 0) {
+            H5Awrite(a, t, "SI");
+            H5Aclose(a);
+        }
+        H5Sclose(s);
+        H5Tclose(t);
+    }
+    H5Gclose(un);
     hid_t cr = make_group(md, "creator", H5P_DEFAULT);
     attr_string(cr, "name", "packd");
     attr_string(cr, "version", PACKD_VERSION);
@@ -299,8 +337,8 @@ int pk_h5_obs_ints(pk_h5 *h, const char *name, const int64_t *v, size_t n)
 int pk_h5_write_array(pk_h5 *h, const char *path, pk_h5_type type, int rank, const size_t *dims,
                       const void *data, const char *unit)
 {
-    hsize_t d[3];
-    if (rank < 0 || rank > 3)
+    hsize_t d[5];
+    if (rank < 0 || rank > 5)
         return -1;
     for (int k = 0; k < rank; k++)
         d[k] = (hsize_t)dims[k];
@@ -347,7 +385,8 @@ int pk_h5_slice_view(pk_h5 *h, const char *src, size_t k, const char *path)
     return rc;
 }
 
-int pk_h5_obs_json(pk_h5 *h, const char *prefix, json_t *obj)
+int pk_h5_obs_json_units(pk_h5 *h, const char *prefix, json_t *obj, pk_h5_unit_fn unit_of,
+                         const void *ctx)
 {
     const char *key;
     json_t *v;
@@ -355,16 +394,18 @@ int pk_h5_obs_json(pk_h5 *h, const char *prefix, json_t *obj)
     json_object_foreach (obj, key, v) {
         char name[256];
         snprintf(name, sizeof name, "%s/%s", prefix, key);
+        const char *unit = unit_of ? unit_of(name, ctx) : NULL;
         if (json_is_integer(v))
-            rc |= pk_h5_obs_int(h, name, (int64_t)json_integer_value(v));
+            rc |= unit ? pk_h5_obs_double(h, name, (double)json_integer_value(v), unit)
+                       : pk_h5_obs_int(h, name, (int64_t)json_integer_value(v));
         else if (json_is_real(v))
-            rc |= pk_h5_obs_double(h, name, json_real_value(v), NULL);
+            rc |= pk_h5_obs_double(h, name, json_real_value(v), unit);
         else if (json_is_boolean(v))
             rc |= pk_h5_obs_int(h, name, json_is_true(v));
         else if (json_is_string(v))
             rc |= pk_h5_obs_string(h, name, json_string_value(v));
         else if (json_is_object(v))
-            rc |= pk_h5_obs_json(h, name, v);
+            rc |= pk_h5_obs_json_units(h, name, v, unit_of, ctx);
         else if (json_is_array(v)) {
             size_t n = json_array_size(v), i;
             int all_int = 1, all_num = 1;
@@ -389,12 +430,99 @@ int pk_h5_obs_json(pk_h5 *h, const char *prefix, json_t *obj)
                     return -1;
                 json_array_foreach (v, i, e)
                     a[i] = json_number_value(e);
-                rc |= pk_h5_obs_doubles(h, name, a, n, NULL);
+                rc |= pk_h5_obs_doubles(h, name, a, n, unit);
                 free(a);
             }
         }
     }
     return rc ? -1 : 0;
+}
+
+int pk_h5_obs_json(pk_h5 *h, const char *prefix, json_t *obj)
+{
+    return pk_h5_obs_json_units(h, prefix, obj, NULL, NULL);
+}
+
+int pk_h5_time_element(pk_h5 *h, const char *path, const char *clock, const int64_t *step,
+                       const double *time, const char *time_unit, pk_h5_type type, int rank,
+                       const size_t *dims, const void *value, const char *unit)
+{
+    char p[512], c[512];
+    int rc = 0;
+    snprintf(p, sizeof p, "%s/step", path);
+    if (clock) {
+        snprintf(c, sizeof c, "%s/step", clock);
+        rc |= pk_h5_link(h, c, p);
+        snprintf(c, sizeof c, "%s/time", clock);
+        snprintf(p, sizeof p, "%s/time", path);
+        rc |= pk_h5_link(h, c, p);
+    } else {
+        rc |= pk_h5_write_array(h, p, PK_H5_I64, 1, dims, step, NULL);
+        snprintf(p, sizeof p, "%s/time", path);
+        rc |= pk_h5_write_array(h, p, PK_H5_F64, 1, dims, time, time_unit);
+    }
+    snprintf(p, sizeof p, "%s/value", path);
+    rc |= pk_h5_write_array(h, p, type, rank, dims, value, unit);
+    return rc ? -1 : 0;
+}
+
+int pk_h5_obs_history(pk_h5 *h, const char *prefix, json_t *hist, const char *step_key,
+                      const char *time_key)
+{
+    json_t *st = json_object_get(hist, step_key), *tm = json_object_get(hist, time_key);
+    size_t S = json_array_size(st);
+    if (json_array_size(tm) != S)
+        return -1;
+    int64_t *step = malloc((S ? S : 1) * sizeof *step);
+    double *time = malloc((S ? S : 1) * sizeof *time), *v = malloc((S ? S : 1) * sizeof *v);
+    int rc = step && time && v ? 0 : -1;
+    for (size_t k = 0; rc == 0 && k < S; k++) {
+        step[k] = (int64_t)json_number_value(json_array_get(st, k));
+        time[k] = json_number_value(json_array_get(tm, k));
+    }
+    char clock[256] = "";
+    const char *key;
+    json_t *arr;
+    json_object_foreach (hist, key, arr) {
+        if (rc || !strcmp(key, step_key) || !strcmp(key, time_key) || !json_is_array(arr) ||
+            json_array_size(arr) != S)
+            continue;
+        char path[256];
+        snprintf(path, sizeof path, "/observables/%s/%s", prefix, key);
+        for (size_t k = 0; k < S; k++)
+            v[k] = json_number_value(json_array_get(arr, k));
+        rc |= pk_h5_time_element(h, path, *clock ? clock : NULL, step, time, NULL, PK_H5_F64, 1, &S,
+                                 v, NULL);
+        if (!*clock)
+            snprintf(clock, sizeof clock, "%s", path);
+    }
+    free(step);
+    free(time);
+    free(v);
+    return rc;
+}
+
+int pk_h5_connectivity(pk_h5 *h, const char *path, const int64_t *pairs, size_t n,
+                       const char *particles_group)
+{
+    size_t d[2] = {n, 2};
+    if (pk_h5_write_array(h, path, PK_H5_I64, 2, d, pairs, NULL) != 0)
+        return -1;
+    /* H5MD 1.1 connectivity: the particles group the indices refer to */
+    hobj_ref_t ref;
+    hid_t ds = H5Dopen2(h->file, path, H5P_DEFAULT), s = H5Screate(H5S_SCALAR);
+    int rc = -1;
+    if (ds >= 0 && H5Rcreate(&ref, h->file, particles_group, H5R_OBJECT, -1) >= 0) {
+        hid_t a = H5Acreate2(ds, "particles_group", H5T_STD_REF_OBJ, s, H5P_DEFAULT, H5P_DEFAULT);
+        if (a >= 0) {
+            rc = H5Awrite(a, H5T_STD_REF_OBJ, &ref) < 0 ? -1 : 0;
+            H5Aclose(a);
+        }
+    }
+    H5Sclose(s);
+    if (ds >= 0)
+        H5Dclose(ds);
+    return rc;
 }
 
 static void h5_free(pk_h5 *h)
@@ -660,6 +788,49 @@ int pk_h5_read_particles(const char *path, pk_box *b, pk_particles *p, char *err
     }
     free(pos);
 out:
+    H5Fclose(f);
+    return rc;
+}
+
+int pk_h5_read_unit(const char *path, char *unit, size_t n)
+{
+    quiet_hdf5();
+    unit[0] = 0;
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0)
+        return -1;
+    hid_t d = H5Dopen2(f, "particles/grains/position", H5P_DEFAULT);
+    hid_t a = d >= 0 && H5Aexists(d, "unit") > 0 ? H5Aopen(d, "unit", H5P_DEFAULT) : -1;
+    hid_t t = a >= 0 ? H5Aget_type(a) : -1;
+    int rc = -1;
+    if (t >= 0 && H5Tget_class(t) == H5T_STRING) {
+        hid_t mt = H5Tcopy(H5T_C_S1);
+        if (H5Tis_variable_str(t) > 0) {
+            char *v = NULL;
+            H5Tset_size(mt, H5T_VARIABLE);
+            if (H5Aread(a, mt, &v) >= 0 && v) {
+                snprintf(unit, n, "%s", v);
+                H5free_memory(v);
+                rc = 0;
+            }
+        } else {
+            size_t len = H5Tget_size(t);
+            char *v = calloc(len + 1, 1);
+            H5Tset_size(mt, len + 1);
+            if (v && H5Aread(a, mt, v) >= 0) {
+                snprintf(unit, n, "%s", v);
+                rc = 0;
+            }
+            free(v);
+        }
+        H5Tclose(mt);
+    }
+    if (t >= 0)
+        H5Tclose(t);
+    if (a >= 0)
+        H5Aclose(a);
+    if (d >= 0)
+        H5Dclose(d);
     H5Fclose(f);
     return rc;
 }

@@ -1,6 +1,7 @@
 /* h5_result.h — packd result files, layout after H5MD 1.1 (docs/result-format.md).
  *
- *   /h5md                       version = [1,1]; /h5md/author, /h5md/creator (name, version)
+ *   /h5md                       version = [1,1]; /h5md/author (name: pk_h5_set_author),
+ *                               /h5md/creator (name, version), /h5md/modules/units (system SI)
  *   /particles/grains/box       attrs dimension, boundary[dim] ("periodic"|"none"); dataset edges[dim]
  *   /particles/grains/position  [N][dim] float64, attr unit
  *   /particles/grains/radius    [N] float64, attr unit      (packd element; H5MD has none)
@@ -26,6 +27,10 @@
 
 typedef struct pk_h5 pk_h5;
 
+/* The /h5md/author name of the files this process writes (the job's owner
+ * for a service job, the user for `packd run`); "packd" until set. */
+void pk_h5_set_author(const char *name);
+
 /* Creates "<path>.tmp.<pid>".  NULL on failure with a message in err. */
 pk_h5 *pk_h5_create(const char *path, char *err, size_t errlen);
 
@@ -46,12 +51,36 @@ int pk_h5_obs_ints(pk_h5 *h, const char *name, const int64_t *v, size_t n);
  * Other values are skipped.  0 on success. */
 #include <jansson.h>
 int pk_h5_obs_json(pk_h5 *h, const char *prefix, json_t *obj);
+/* The same with a unit attribute on the numbers unit_of names: it gets the
+ * observable's name ("edmd/delta_d_reached") and returns a unit string of
+ * the H5MD units module ("mm", "N mm-2") or NULL (dimensionless). */
+typedef const char *(*pk_h5_unit_fn)(const char *name, const void *ctx);
+int pk_h5_obs_json_units(pk_h5 *h, const char *prefix, json_t *obj, pk_h5_unit_fn unit_of,
+                         const void *ctx);
 
-/* An n-d array (rank <= 3) at an absolute path ("/particles/rve/position/value"),
+/* An n-d array (rank <= 5) at an absolute path ("/particles/rve/position/value"),
  * intermediate groups made; unit may be NULL.  0 on success. */
 typedef enum { PK_H5_F64, PK_H5_I64, PK_H5_I32 } pk_h5_type;
 int pk_h5_write_array(pk_h5 *h, const char *path, pk_h5_type type, int rank, const size_t *dims,
                       const void *data, const char *unit);
+/* An H5MD time-dependent element at path: path/step int64[S], path/time
+ * float64[S] (time_unit may be NULL), path/value of rank dims (dims[0] = S).
+ * With clock (the path of an element already written), step and time are
+ * hard links to clock's (H5MD shares them so).  0 on success. */
+int pk_h5_time_element(pk_h5 *h, const char *path, const char *clock, const int64_t *step,
+                       const double *time, const char *time_unit, pk_h5_type type, int rank,
+                       const size_t *dims, const void *value, const char *unit);
+/* A JSON history {step_key: [...], time_key: [...], name: [...], ...} as
+ * time-dependent elements /observables/<prefix>/<name> (step: step_key's
+ * values as integers, time: time_key's; the first element holds them, the
+ * others link to it).  0 on success. */
+int pk_h5_obs_history(pk_h5 *h, const char *prefix, json_t *hist, const char *step_key,
+                      const char *time_key);
+/* An H5MD connectivity dataset int64[n][2] at path with the attribute
+ * particles_group, an object reference to the particles group the indices
+ * number (e.g. "/particles/rve"). */
+int pk_h5_connectivity(pk_h5 *h, const char *path, const int64_t *pairs, size_t n,
+                       const char *particles_group);
 /* A second name (hard link) for an existing object, e.g. a shared box group. */
 int pk_h5_link(pk_h5 *h, const char *existing, const char *path);
 
@@ -67,5 +96,8 @@ void pk_h5_abort(pk_h5 *h);
 /* Read the grains back (tests, `packd inspect`, homogenization input).
  * `p` is initialised here.  0 on success. */
 int pk_h5_read_particles(const char *path, pk_box *b, pk_particles *p, char *err, size_t errlen);
+/* The length unit of a result's grains (the unit attribute of
+ * /particles/grains/position), "" and -1 when it has none. */
+int pk_h5_read_unit(const char *path, char *unit, size_t n);
 
 #endif

@@ -150,29 +150,43 @@ static void grains_grid(FILE *f, hid_t h, const char *ref, size_t n, int dim)
     fprintf(f, "    </Grid>\n");
 }
 
-/* A tetfill result's mesh: its flat node (x, y, z per node) and tet (4
- * node indices per tet) arrays are read as XYZ and Tetrahedron data as
- * they are, with the region of each tet as a cell attribute. */
+/* A tetfill result's mesh: nodes [n][3] as XYZ geometry, tets [m][4] (node
+ * indices) as Tetrahedron topology (files before H5MD 1.1 layout hold them
+ * flat, [3n] and [4m]: read alike), the region of each tet as a cell
+ * attribute. */
 static void mesh_grid(FILE *f, hid_t h, const char *ref)
 {
     const char *nodes = "/observables/tetfill/mesh_nodes", *tets = "/observables/tetfill/mesh_tets",
                *regions = "/observables/tetfill/mesh_regions";
     hsize_t dn[3], dt[3], dr[3];
-    if (dims_of(h, nodes, dn) != 1 || dims_of(h, tets, dt) != 1 || dn[0] % 3 || dt[0] % 4 || !dt[0])
+    int rn = dims_of(h, nodes, dn), rt = dims_of(h, tets, dt);
+    unsigned long long nn = rn == 2 && dn[1] == 3 ? dn[0]
+        : rn == 1 && dn[0] % 3 == 0               ? dn[0] / 3
+                                                  : 0,
+                       nt = rt == 2 && dt[1] == 4 ? dt[0]
+        : rt == 1 && dt[0] % 4 == 0               ? dt[0] / 4
+                                                  : 0;
+    if (!nn || !nt)
         return;
     char s[64];
     fprintf(f,
             "    <Grid Name=\"mesh\" GridType=\"Uniform\">\n"
             "      <Topology TopologyType=\"Tetrahedron\" NumberOfElements=\"%llu\" "
             "NodesPerElement=\"4\">\n",
-            (unsigned long long)(dt[0] / 4));
-    snprintf(s, sizeof s, "%llu", (unsigned long long)dt[0]);
+            nt);
+    if (rt == 2)
+        snprintf(s, sizeof s, "%llu 4", nt);
+    else
+        snprintf(s, sizeof s, "%llu", 4 * nt);
     item(f, "        ", s, "Int", 8, ref, tets);
     fprintf(f, "      </Topology>\n      <Geometry GeometryType=\"XYZ\">\n");
-    snprintf(s, sizeof s, "%llu", (unsigned long long)dn[0]);
+    if (rn == 2)
+        snprintf(s, sizeof s, "%llu 3", nn);
+    else
+        snprintf(s, sizeof s, "%llu", 3 * nn);
     item(f, "        ", s, "Float", 8, ref, nodes);
     fprintf(f, "      </Geometry>\n");
-    if (dims_of(h, regions, dr) == 1 && dr[0] == dt[0] / 4) {
+    if (dims_of(h, regions, dr) == 1 && dr[0] == nt) {
         fprintf(f, "      <Attribute Name=\"region\" AttributeType=\"Scalar\" Center=\"Cell\">\n");
         snprintf(s, sizeof s, "%llu", (unsigned long long)dr[0]);
         item(f, "        ", s, "Int", 8, ref, regions);

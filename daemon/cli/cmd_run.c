@@ -13,6 +13,7 @@
 #include "api/picture/picture.h"
 #include "api/process.h"
 #include "api/digest.h"
+#include "api/results/h5_result.h"
 #include "api/results/result_digest.h"
 #include "api/results/xdmf.h"
 
@@ -63,7 +64,8 @@ static void run_help(FILE *f)
           "  --progress-fd N            progress as JSON lines on file descriptor N\n"
           "  --threads N                threads of the parallel sections (1..64, default 1)\n"
           "  --checkpoint FILE          save/resume the run's state in FILE\n"
-          "  --checkpoint-interval S    seconds between checkpoints (default 30)\n\n"
+          "  --checkpoint-interval S    seconds between checkpoints (default 30)\n"
+          "  --author NAME              the result's /h5md/author (default $USER)\n\n"
           "On a terminal, a live progress line on stderr and a short summary on stdout;\n"
           "otherwise (or with --json) the summary as JSON on stdout, without the time\n"
           "series (they are in the result file).  Exit 0 done, 1 invalid job, 2 error,\n"
@@ -74,7 +76,7 @@ static void run_help(FILE *f)
 int cmd_run(int argc, char **argv)
 {
     const char *job_path = NULL, *out_path = NULL, *xdmf_path = NULL, *pictures_dir = NULL;
-    const char *ckpt_path = NULL;
+    const char *ckpt_path = NULL, *author = getenv("USER");
     double ckpt_interval = 30;
     int progress_fd = -1, json_summary = 0;
     /* the parallel sections' threads (the daemon passes its job_threads):
@@ -100,6 +102,8 @@ int cmd_run(int argc, char **argv)
             progress_fd = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--checkpoint") && i + 1 < argc)
             ckpt_path = argv[++i];
+        else if (!strcmp(argv[i], "--author") && i + 1 < argc)
+            author = argv[++i];
         else if (!strcmp(argv[i], "--checkpoint-interval") && i + 1 < argc) {
             char *end;
             ckpt_interval = strtod(argv[++i], &end);
@@ -176,6 +180,8 @@ int cmd_run(int argc, char **argv)
         free(text);
         pk_job_set_checkpoint(ckpt_path, digest, ckpt_interval);
     }
+    /* the file's author: the service's job owner, else who runs packd */
+    pk_h5_set_author(author && *author ? author : "packd run");
     int rc = pk_job_run(job, threads, out_path, &mon, &summary, &errs, err, sizeof err);
     pk_run_line_clear(&sink.line);
     int status;

@@ -1,7 +1,9 @@
 // dashboard_driver.js BASE_URL OUT_DIR EXAMPLE — drives the dashboard in
 // headless Chromium as a person would: open it, submit EXAMPLE, watch the
 // job's bar reach 100 %, open the job page, see the picture load, download
-// the HDF5 file.  Prints PASS/FAIL lines (tests/integration/check.inc) and
+// the HDF5 file; then submit the EDMD example with its inputs edited to grow
+// slower (about 5 s) and see its bar stand strictly between 0 and 100 %
+// while it runs (the live progress), then at 100 %.  Prints PASS/FAIL lines (tests/integration/check.inc) and
 // saves screenshots and the download in OUT_DIR.
 // Env: PLAYWRIGHT_CORE (the installed module), CHROMIUM, SLOW (wait factor),
 // TOKEN (auth on: typed into the token field first; the names of the PASS
@@ -79,6 +81,38 @@ async function step(name, fn) {
       ]);
       await dl.saveAs(path.join(out, 'result' + tag + '.h5'));
       if (dl.suggestedFilename() !== id + '.h5') throw new Error('named ' + dl.suggestedFilename());
+    });
+    await step('dashboard_bar_moves', async () => {
+      await page.goto(base + '/#/');
+      await page.selectOption('#example', { label: 'edmd-quartz-2d (pack)' });
+      await page.click('#submit-form details summary'); // "Inputs (editable JSON)"
+      const inputs = JSON.parse(await page.inputValue('#inputs'));
+      inputs.edmd.growth_rate = 0.004; // ~11 progress events 0.5 s apart
+      await page.fill('#inputs', JSON.stringify(inputs));
+      await page.click('#submit');
+      const a = await page.waitForSelector(`#submitted a:not(:has-text("${id}"))`);
+      const slowId = (await a.textContent()).trim();
+      const sel = `tr[data-job="${slowId}"]`;
+      await page.waitForSelector(sel);
+      // every value the bar shows, sampled every 20 ms in the page
+      await page.evaluate((s) => {
+        window.seenValues = [];
+        const t = setInterval(() => {
+          const tr = document.querySelector(s);
+          if (!tr) return;
+          window.seenValues.push(tr.querySelector('progress').value);
+          if (tr.dataset.status === 'successful' || tr.dataset.status === 'failed') clearInterval(t);
+        }, 20);
+      }, sel);
+      await page.waitForFunction(() => window.seenValues.some((v) => v > 0 && v < 100),
+        null, { timeout: 60000 * slow });
+      await page.screenshot({ path: shot('running'), fullPage: true });
+      await page.waitForFunction((s) => {
+        const tr = document.querySelector(s);
+        return tr && tr.dataset.status === 'successful' && tr.querySelector('progress').value === 100;
+      }, sel, { timeout: 60000 * slow });
+      const seen = await page.evaluate(() => [...new Set(window.seenValues)]);
+      console.log('BAR ' + seen.join(' '));
     });
     if (problems.length) fail('dashboard_no_script_errors', problems.join(' | '));
     else pass('dashboard_no_script_errors');

@@ -1,7 +1,8 @@
 #!/bin/sh
 # test_picture.sh — `packd picture`: real PNG files decoded back (zlib only)
 # whose inked share of the box is the packing's φ (plus the outlines), SVG
-# files that parse as XML, the 3D two-panel layout, the grading curve, the
+# files that parse as XML, the 3D two-panel layout (a tetfill result's mesh
+# edges in its section), the grading curve, the
 # plots (EDMD history, homogenization stress and residual: coloured curves
 # across the plot area), the worker's picture set, and the errors a user
 # meets.  The service's pictures are tested in test_serve.sh.
@@ -34,6 +35,17 @@ fill3=$(python3 "$SRC/tests/tools/png_fill.py" "$T/a.png" 37 55 755 773)
 check picture_3d_two_panels test "$(echo "$fill3" | cut -d' ' -f1)" = 1548
 # a section through grains at φ_eff = 0.316 inks about φ of the plane (area fraction = volume fraction)
 check picture_3d_section_ink python3 -c "f = float('$fill3'.split()[2]); assert 0.25 <= f <= 0.42, f"
+# a tetfill result: its tet mesh where the section cuts it, outlined in dark red (one
+# closed polygon per cut tet); a packing without a mesh has none
+(cd "$SRC" && "$PACKD" run examples/tetfill-box.json -o "$T/tb.h5" >/dev/null 2>&1)
+"$PACKD" picture "$T/tb.h5" -o "$T/tb.svg" && "$PACKD" picture "$T/a.h5" -o "$T/a.svg"
+mesh_cuts() { # FILE.svg: closed polygons of the mesh's stroke colour
+    python3 -c "
+import re, sys
+print(sum(p.count('Z') for p in re.findall(r'stroke:rgb\(70%,10%,10%\)[^>]*d=\"([^\"]*)\"', open(sys.argv[1]).read())))" "$1"
+}
+check picture_tetfill_mesh_section python3 -c "n = $(mesh_cuts "$T/tb.svg"); assert n >= 20, n"
+check picture_no_mesh_without_tetfill test "$(mesh_cuts "$T/a.svg")" = 0
 
 # plots: PNG curves reach across the plot area (coloured pixels in >= 80 % of
 # its columns; a legend alone spans < 40 %), SVG parses.  Plot areas (api/picture/

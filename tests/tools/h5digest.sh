@@ -3,6 +3,9 @@
 # its raw little-endian bytes (h5dump -b), skipping the wall-clock figures
 # (/observables/timing/*, *seconds*, *per_second) that differ run to run.
 # Two results of the same job with equal output computed the same numbers.
+# A dataset with a second name (the step and time an H5MD element shares
+# through hard links: h5ls says "Dataset, same as ...") is listed once, under
+# the name h5ls meets first.
 f=$1
 tmp=$(mktemp)
 trap 'rm -f "$tmp"' EXIT

@@ -8,6 +8,7 @@
 #include "check.h"
 #include "api/results/h5_inspect.h"
 #include "api/results/h5_result.h"
+#include "api/results/h5_units.h"
 
 static char dir[] = "/tmp/packd-h5-XXXXXX";
 
@@ -180,6 +181,82 @@ static void test_slice_view_and_link(void)
     unlink(path);
 }
 
+/* The unit attribute of path: scalar, ASCII, its text in out. */
+static int unit_of(hid_t f, const char *path, char *out, size_t n)
+{
+    hid_t d = H5Oopen(f, path, H5P_DEFAULT);
+    hid_t a = d >= 0 && H5Aexists(d, "unit") > 0 ? H5Aopen(d, "unit", H5P_DEFAULT) : -1;
+    hid_t t = a >= 0 ? H5Aget_type(a) : -1, sp = a >= 0 ? H5Aget_space(a) : -1;
+    int ok = t >= 0 && H5Tget_class(t) == H5T_STRING && H5Tget_cset(t) == H5T_CSET_ASCII &&
+        H5Sget_simple_extent_type(sp) == H5S_SCALAR && H5Tget_size(t) <= n &&
+        H5Aread(a, t, out) >= 0;
+    if (sp >= 0)
+        H5Sclose(sp);
+    if (t >= 0)
+        H5Tclose(t);
+    if (a >= 0)
+        H5Aclose(a);
+    if (d >= 0)
+        H5Oclose(d);
+    return ok ? 0 : -1;
+}
+
+/* H5MD elements: step/time/value, shared step and time, units module and
+ * unit strings, connectivity with its particles group, the author. */
+static void test_h5md_elements_units_author(void)
+{
+    pk_units u3, u2, none;
+    pk_units_init(&u3, "mm", 3);
+    pk_units_init(&u2, "mm", 2);
+    pk_units_init(&none, "1", 2);
+    CHECK(!strcmp(u3.stress, "N mm-2") && !strcmp(u2.stress, "N mm-1"));
+    CHECK(!strcmp(u3.volume, "mm+3") && !strcmp(u2.energy, "N mm"));
+    CHECK(!strcmp(pk_units_of("homogenize/E_n", &u2), "N mm-1"));
+    CHECK(!strcmp(pk_units_of("edmd/delta_d_reached", &u3), "mm"));
+    CHECK(pk_units_of("homogenize/E_n", &none) == NULL); /* no length unit: none */
+    CHECK(pk_units_of("homogenize/J", &u3) == NULL);
+
+    char path[256], err[256], buf[64];
+    snprintf(path, sizeof path, "%s/e.h5", dir);
+    pk_box b = {.dim = 2, .L = {1, 1}, .periodic = {true, true}};
+    pk_particles p;
+    fill(&p, 2, 3);
+    pk_h5_set_author("dora");
+    pk_h5 *h = pk_h5_create(path, err, sizeof err);
+    pk_h5_set_author(NULL);
+    CHECK(h != NULL);
+    CHECK(pk_h5_write_particles(h, &b, &p, "mm") == 0);
+    int64_t step[2] = {0, 1};
+    double time[2] = {0.5, 1}, P[8] = {1, 2, 3, 4, 5, 6, 7, 8}, J[2] = {1, 0.99};
+    size_t dP[3] = {2, 2, 2}, dJ[1] = {2};
+    CHECK(pk_h5_time_element(h, "/observables/x/P", NULL, step, time, NULL, PK_H5_F64, 3, dP, P,
+                             u2.stress) == 0);
+    CHECK(pk_h5_time_element(h, "/observables/x/J", "/observables/x/P", NULL, NULL, NULL, PK_H5_F64,
+                             1, dJ, J, NULL) == 0);
+    int64_t pairs[4] = {0, 1, 1, 2};
+    CHECK(pk_h5_connectivity(h, "/connectivity/contacts", pairs, 2, "/particles/grains") == 0);
+    CHECK(pk_h5_commit(h, err, sizeof err) == 0);
+    pk_particles_free(&p);
+
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    CHECK(unit_of(f, "/observables/x/P/value", buf, sizeof buf) == 0 && !strcmp(buf, "N mm-1"));
+    CHECK(unit_of(f, "/particles/grains/position", buf, sizeof buf) == 0 && !strcmp(buf, "mm"));
+    H5O_info_t a, c; /* J's step is P's step: one object */
+    CHECK(H5Oget_info_by_name(f, "/observables/x/J/step", &a, H5P_DEFAULT) >= 0);
+    CHECK(H5Oget_info_by_name(f, "/observables/x/P/step", &c, H5P_DEFAULT) >= 0);
+    CHECK(a.addr == c.addr);
+    CHECK(H5Aexists_by_name(f, "/h5md/modules/units", "system", H5P_DEFAULT) > 0);
+    CHECK(H5Aexists_by_name(f, "/connectivity/contacts", "particles_group", H5P_DEFAULT) > 0);
+    hid_t au = H5Aopen_by_name(f, "/h5md/author", "name", H5P_DEFAULT, H5P_DEFAULT);
+    hid_t at = H5Aget_type(au);
+    memset(buf, 0, sizeof buf);
+    CHECK(H5Tget_size(at) < sizeof buf && H5Aread(au, at, buf) >= 0 && !strcmp(buf, "dora"));
+    H5Tclose(at);
+    H5Aclose(au);
+    H5Fclose(f);
+    unlink(path);
+}
+
 static void test_read_rejects_non_result(void)
 {
     char path[256], err[256];
@@ -203,6 +280,7 @@ int main(void)
     RUN(test_abort_and_atomic_replace);
     RUN(test_slice_view_and_link);
     RUN(test_read_rejects_non_result);
+    RUN(test_h5md_elements_units_author);
     rmdir(dir);
     return check_summary();
 }
