@@ -31,6 +31,7 @@ typedef struct pk_homog_job {
     int friction;     /* "friction" given */
     pk_fric_law fric; /* E_t, tan ρ, h (E_t defaults to E_n) */
     double rho_deg;   /* friction angle ρ (fric.tan_rho = tan ρ) */
+    int quality;      /* "quality": pk_quality (api/schemas/option_table.h) */
     double tol, abs_tol;
     size_t max_iter;
     int lanczos_steps;
@@ -65,6 +66,10 @@ extern const pk_option_table pk_homog_options;
  * error). */
 size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_errors *errs);
 void pk_homog_job_free(pk_homog_job *job);
+/* What the run models and stores (the summary's "model", /observables/modelled;
+ * docs/presets.md): dim, quality, friction, tangent, the optional records
+ * (contacts, micro state) and whether the per-step frames were kept. */
+json_t *pk_homog_model_json(const pk_homog_job *job, int dim, int frames_kept);
 
 /* process table hooks (see process.h): parse returns a pk_homog_job */
 void *pk_homog_parse(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);

@@ -345,6 +345,7 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
     json_object_set_new(sum, "steps_not_converged", json_integer((json_int_t)not_converged));
     if (ck_loaded == 0)
         json_object_set_new(sum, "resumed_from_step", json_integer((json_int_t)first));
+    json_object_set_new(sum, "model", pk_homog_model_json(&job, dim, fr.keep && fr.count > 0));
     json_object_set_new(sum, "rve_particles", json_integer((json_int_t)rve.n));
     json_object_set_new(sum, "dr_iterations_total", json_integer((json_int_t)total_iter));
     json_object_set_new(sum, "dr_iterations_max", json_integer((json_int_t)max_iter_step));
@@ -405,6 +406,7 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
     w |= pk_h5_write_parameters(h, "homogenize", job_json, 0);
     w |= pk_h5_obs_json(h, "homogenize", rec);
     w |= pk_h5_obs_json(h, "audit", aud);
+    w |= pk_h5_obs_json(h, "modelled", json_object_get(sum, "model"));
     w |= pk_verdict_write_h5(h, sum);
     if (w != 0) {
         pk_h5_abort(h);

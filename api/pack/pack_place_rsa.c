@@ -29,7 +29,7 @@ static int place_rsa(const pk_pack_job *job, const pk_pack_plan *plan, const pk_
 static const char *const draws_names[] = {"open", "plain", NULL};
 static const pk_option rsa_rows[] = {
     {"/rsa/max_failed_draws", PK_OPT_INTEGER, PK_OPT_FIELD(pk_rsa_options, max_failed_draws),
-     .dflt = 1000000, .lo = 1, .hi = 1e10},
+     .dflt = 1000000, .lo = 1, .hi = 1e10, PK_OPT_QUALITY(1e5, 1e7)},
     {"/rsa/draws", PK_OPT_ENUM, PK_OPT_FIELD(pk_rsa_options, draws), .names = draws_names},
 };
 static const pk_option_table rsa_options =

@@ -1,0 +1,208 @@
+#!/usr/bin/env python3
+"""bench/presets/presets.py — the measurements behind the quality presets and
+the automatic algorithm choice (docs/presets.md).  Each case runs small jobs
+through `packd run` over several seeds and prints one machine-readable line
+per run:
+  bench=presets case=NAME knob=VALUE seed=S cpu_s=T metric=X [file_bytes=B]
+then one summary line per knob value: mean cost and the mean |error| against
+the reference (the finest value of the sweep).
+Usage: PACKD=build/packd python3 bench/presets/presets.py [case ...]
+Cases: edmd_gamma edmd_pmax rsa_nf rsa_reach homog_tol homog_solver homog_outputs
+       pack_outputs auto"""
+import json, os, resource, statistics, subprocess, sys, tempfile
+
+PACKD = os.environ.get("PACKD", "build/packd")
+SEEDS = [1, 2, 3]
+TMP = tempfile.mkdtemp(prefix="presets-bench-")
+
+
+def run(job, name):
+    """Run one job; (summary, CPU seconds of the child, file size)."""
+    path = os.path.join(TMP, name + ".json")
+    out = os.path.join(TMP, name + ".h5")
+    with open(path, "w") as f:
+        json.dump(job, f)
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    p = subprocess.run([PACKD, "run", path, "-o", out, "--json"], capture_output=True, text=True)
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+    if p.returncode not in (0, 3):
+        sys.exit(f"{name}: packd run failed ({p.returncode}): {p.stderr}")
+    return json.loads(p.stdout), cpu, os.path.getsize(out), out
+
+
+def line(**kv):
+    print("bench=presets " + " ".join(f"{k}={v}" for k, v in kv.items()), flush=True)
+
+
+def sweep(case, values, make_job, metric, ref_value):
+    """Every value × seed; then the mean cost and mean |metric − reference|."""
+    rows = {}
+    for v in values:
+        for s in SEEDS:
+            summ, cpu, size, _ = run(make_job(v, s), f"{case}-{v}-{s}")
+            m = metric(summ)
+            rows.setdefault(v, []).append((s, cpu, m))
+            line(case=case, knob=v, seed=s, cpu_s=f"{cpu:.3f}", metric=f"{m:.10g}", file_bytes=size)
+    ref = {s: m for s, _, m in rows[ref_value]}
+    for v in values:
+        errs = [abs(m - ref[s]) for s, _, m in rows[v]]
+        rel = [abs(m - ref[s]) / abs(ref[s]) if ref[s] else 0 for s, _, m in rows[v]]
+        line(case=case + "_summary", knob=v,
+             cpu_s_median=f"{statistics.median(c for _, c, _ in rows[v]):.3f}",
+             metric_mean=f"{statistics.mean(m for _, _, m in rows[v]):.8g}",
+             abs_err_mean=f"{statistics.mean(errs):.3g}", abs_err_max=f"{max(errs):.3g}",
+             rel_err_max=f"{max(rel):.3g}")
+    return rows
+
+
+def mono3d(seed, n=300, edmd=None, phi=0.3, alg="edmd"):
+    job = {"process": "pack", "inputs": {
+        "dim": 3, "domain": {"box": {"size": [10, 10, 10], "periodic": True}},
+        "grading": {"type": "classes", "classes": [{"d": 1, "volume_percent": 100}]},
+        "count": n, "phi": {"value": phi, "refers_to": "resolved"},
+        "algorithm": alg, "seed": seed}}
+    if edmd is not None:
+        job["inputs"]["edmd"] = edmd
+    return job
+
+
+def edmd_gamma():
+    sweep("edmd_gamma", [0.1, 0.03, 0.01, 0.003],
+          lambda g, s: mono3d(s, edmd={"until": "jammed", "growth_rate": g}),
+          lambda r: r["phi_resolved"], 0.003)
+
+
+def edmd_pmax():
+    sweep("edmd_pmax", [1e3, 1e4, 1e6, 1e9, 1e12],
+          lambda p, s: mono3d(s, edmd={"until": "jammed", "jamming": {"reduced_pressure": p}}),
+          lambda r: r["phi_resolved"], 1e12)
+
+
+def rsa_nf():
+    # equal spheres asked beyond RSA's saturation (0.384): N^F sets where it gives up
+    sweep("rsa_nf", [100, 1000, 10000, 100000, 1000000, 10000000],
+          lambda nf, s: {"process": "pack", "inputs": dict(
+              mono3d(s, n=3000, phi=0.45, alg="rsa")["inputs"], rsa={"max_failed_draws": nf})},
+          lambda r: r["phi_resolved"], 10000000)
+
+
+GRADINGS = {  # name: (dim, grading, d_min, box edge)
+    "mono3d": (3, {"type": "classes", "classes": [{"d": 4, "volume_percent": 100}]}, None, 40),
+    "two3d": (3, {"type": "classes", "classes": [{"d": 4, "volume_percent": 50},
+                                                 {"d": 2, "volume_percent": 50}]}, None, 40),
+    "a16_d4": (3, {"type": "preset", "name": "A16"}, 4, 100),
+    "a16_d2": (3, {"type": "preset", "name": "A16"}, 2, 60),
+    "fuller_d2": (3, {"type": "fuller", "q": 0.5, "d_max": 16}, 2, 60),
+    "mono2d": (2, {"type": "classes", "classes": [{"d": 1, "volume_percent": 100}]}, None, 40),
+    "quartz2d": (2, {"type": "classes", "classes": [
+        {"d": 0.25, "volume_percent": 2.5}, {"d": 0.16, "volume_percent": 39.72},
+        {"d": 0.125, "volume_percent": 44.22}, {"d": 0.1, "volume_percent": 9.58},
+        {"d": 0.063, "volume_percent": 3.70}, {"d": 0.05, "volume_percent": 0.28}]}, None, 6),
+}
+
+
+def graded(name, seed, phi, alg, extra=None):
+    dim, g, dmin, L = GRADINGS[name]
+    inp = {"dim": dim, "domain": {"box": {"size": [L] * dim, "periodic": True}}, "grading": g,
+           "phi": {"value": phi, "refers_to": "resolved"}, "algorithm": alg, "seed": seed}
+    if dmin:
+        inp["d_min"] = dmin
+    if name == "quartz2d":
+        inp["sampling"] = "continuous"
+    if extra:
+        inp.update(extra)
+    return {"process": "pack", "inputs": inp}
+
+
+def rsa_reach():
+    """How far RSA gets per grading: each target φ_eff (0.02 apart) over the
+    seeds, complete or not (N^F = 10^6, open draws); the reach is the largest
+    target every seed completes.  With the size spread d_max/d_min: the rule of
+    the automatic choice."""
+    targets = {"mono3d": [0.34, 0.36, 0.38], "two3d": [0.36, 0.38, 0.40, 0.42],
+               "a16_d4": [0.40, 0.42, 0.44, 0.46, 0.48, 0.50],
+               "a16_d2": [0.42, 0.44, 0.46, 0.48, 0.50, 0.52, 0.54],
+               "fuller_d2": [0.42, 0.44, 0.46, 0.48, 0.50, 0.52, 0.54],
+               "mono2d": [0.50, 0.52, 0.54], "quartz2d": [0.52, 0.54, 0.56, 0.58, 0.60]}
+    for name, phis in targets.items():
+        for phi in phis:
+            done = []
+            for s in SEEDS:
+                summ, cpu, _, _ = run(graded(name, s, phi, "rsa"), f"reach-{name}-{phi}-{s}")
+                cls = summ["classes"]
+                spread = max(c["d_hi"] for c in cls) / min(c["d_lo"] for c in cls)
+                done.append(bool(summ["complete"]))
+                line(case="rsa_reach", grading=name, phi_target=phi, seed=s, cpu_s=f"{cpu:.3f}",
+                     phi=f"{summ['phi_resolved']:.5f}", spread=f"{spread:.3g}",
+                     placed=summ["count_placed"], complete=str(summ["complete"]).lower())
+            line(case="rsa_reach_summary", grading=name, phi_target=phi,
+                 complete=f"{sum(done)}/{len(done)}")
+            if not any(done):
+                break
+
+
+def auto():
+    """Time to a target φ_eff: RSA against EDMD (RSA start, relative growth)."""
+    for name, phis in (("a16_d4", [0.45, 0.5, 0.55, 0.6]), ("mono3d", [0.3, 0.35, 0.38])):
+        for phi in phis:
+            for alg in ("rsa", "edmd"):
+                for s in SEEDS:
+                    summ, cpu, _, _ = run(graded(name, s, phi, alg), f"auto-{name}-{phi}-{alg}-{s}")
+                    line(case="auto", grading=name, phi_target=phi, algorithm=alg, seed=s,
+                         cpu_s=f"{cpu:.3f}", phi=f"{summ['phi_resolved']:.5f}",
+                         complete=str(summ["complete"]).lower())
+
+
+def rve(seed):
+    job = json.load(open(os.path.join(os.path.dirname(__file__), "../../examples/homogenize/rve-rsa-2d.json")))
+    job["inputs"]["seed"] = seed
+    _, _, _, out = run(job, f"rve-{seed}")
+    return out
+
+
+def homog_job(rvefile, relax, extra=None):
+    inp = {"rve": {"file": rvefile}, "boundary_condition": "periodic",
+           "load": {"type": "uniaxial_compression", "axis": 1, "strain": 0.02, "steps": 20},
+           "contact": {"E_n": 50}, "relaxation": relax,
+           "initial_state": {"policy": "radius_inflation", "value": 0.3}}
+    if extra:
+        inp.update(extra)
+    return {"process": "homogenize", "inputs": inp}
+
+
+def sigma_norm(r):
+    return sum(x * x for x in r["sigma"]) ** 0.5
+
+
+def homog_tol():
+    rves = {s: rve(s) for s in SEEDS}
+    for solver in ("dr", "newton"):
+        sweep("homog_tol_" + solver, [1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12],
+              lambda t, s: homog_job(rves[s], {"tol": t, "solver": solver}), sigma_norm, 1e-12)
+
+
+def homog_outputs():
+    """What unrequested outputs cost: tangent, contacts, micro state, friction."""
+    rves = {s: rve(s) for s in SEEDS}
+    variants = {"none": {}, "contacts": {"output": {"contacts": True}},
+                "micro_state": {"output": {"micro_state": True}}, "tangent": {"tangent": True},
+                "friction": {"friction": {"rho_deg": 30}}}
+    for name, extra in variants.items():
+        for s in SEEDS:
+            _, cpu, size, _ = run(homog_job(rves[s], {"tol": 1e-8}, extra), f"hout-{name}-{s}")
+            line(case="homog_outputs", variant=name, seed=s, cpu_s=f"{cpu:.3f}", file_bytes=size)
+
+
+def pack_outputs():
+    """2D against 3D and EDMD to jamming with and without its contact record."""
+    for name in ("mono2d", "mono3d"):
+        for s in SEEDS:
+            _, cpu, size, _ = run(graded(name, s, 0.3, "rsa"), f"pout-{name}-{s}")
+            line(case="pack_outputs", variant=name, seed=s, cpu_s=f"{cpu:.3f}", file_bytes=size)
+
+
+CASES = {f.__name__: f for f in (edmd_gamma, edmd_pmax, rsa_nf, rsa_reach, auto, homog_tol,
+                                 homog_outputs, pack_outputs)}
+for c in sys.argv[1:] or CASES:
+    CASES[c]()
