@@ -120,11 +120,10 @@ def rsa_reach():
     seeds, complete or not (N^F = 10^6, open draws); the reach is the largest
     target every seed completes.  With the size spread d_max/d_min: the rule of
     the automatic choice."""
-    targets = {"mono3d": [0.34, 0.36, 0.38], "two3d": [0.36, 0.38, 0.40, 0.42],
-               "a16_d4": [0.40, 0.42, 0.44, 0.46, 0.48, 0.50],
-               "a16_d2": [0.42, 0.44, 0.46, 0.48, 0.50, 0.52, 0.54],
-               "fuller_d2": [0.42, 0.44, 0.46, 0.48, 0.50, 0.52, 0.54],
-               "mono2d": [0.50, 0.52, 0.54], "quartz2d": [0.52, 0.54, 0.56, 0.58, 0.60]}
+    start = {"mono3d": 0.34, "two3d": 0.40, "a16_d4": 0.48, "a16_d2": 0.52, "fuller_d2": 0.52,
+             "mono2d": 0.50, "quartz2d": 0.58}
+    targets = {k: [round(v + 0.02 * j, 2) for j in range(int((0.8 - v) / 0.02) + 1)]
+               for k, v in start.items()}
     for name, phis in targets.items():
         for phi in phis:
             done = []
@@ -154,10 +153,13 @@ def auto():
                          complete=str(summ["complete"]).lower())
 
 
-def rve(seed):
+def rve(seed, count=150):
     job = json.load(open(os.path.join(os.path.dirname(__file__), "../../examples/homogenize/rve-rsa-2d.json")))
     job["inputs"]["seed"] = seed
-    _, _, _, out = run(job, f"rve-{seed}")
+    if count != 150:  # the same RVE, larger: the box grows with the count
+        edge = 20.0 * (count / 150) ** 0.5
+        job["inputs"].update(count=count, domain={"box": {"size": [edge, edge], "periodic": True}})
+    _, _, _, out = run(job, f"rve-{seed}-{count}")
     return out
 
 
@@ -183,26 +185,56 @@ def homog_tol():
 
 
 def homog_outputs():
-    """What unrequested outputs cost: tangent, contacts, micro state, friction."""
-    rves = {s: rve(s) for s in SEEDS}
-    variants = {"none": {}, "contacts": {"output": {"contacts": True}},
-                "micro_state": {"output": {"micro_state": True}}, "tangent": {"tangent": True},
-                "friction": {"friction": {"rho_deg": 30}}}
-    for name, extra in variants.items():
+    """What the optional outputs cost on a 2000-grain RVE: contacts, micro
+    state, tangent (periodic), friction (taylor, its own boundary condition)."""
+    rves = {s: rve(s, 2000) for s in SEEDS}
+    variants = {"none": ("periodic", {}), "contacts": ("periodic", {"output": {"contacts": True}}),
+                "micro_state": ("periodic", {"output": {"micro_state": True}}),
+                "tangent": ("periodic", {"tangent": True}),
+                "taylor_none": ("taylor", {}),
+                "taylor_friction": ("taylor", {"friction": {"rho_deg": 30}})}
+    for name, (bc, extra) in variants.items():
         for s in SEEDS:
-            _, cpu, size, _ = run(homog_job(rves[s], {"tol": 1e-8}, extra), f"hout-{name}-{s}")
-            line(case="homog_outputs", variant=name, seed=s, cpu_s=f"{cpu:.3f}", file_bytes=size)
+            job = homog_job(rves[s], {"tol": 1e-8}, dict(extra, boundary_condition=bc))
+            summ, cpu, size, _ = run(job, f"hout-{name}-{s}")
+            line(case="homog_outputs", variant=name, seed=s, cpu_s=f"{cpu:.3f}", file_bytes=size,
+                 model=json.dumps(summ["model"], separators=(",", ":")))
 
 
 def pack_outputs():
-    """2D against 3D and EDMD to jamming with and without its contact record."""
-    for name in ("mono2d", "mono3d"):
+    """2D against 3D at the same count (20 000 grains, RSA at φ 0.3)."""
+    for dim in (2, 3):
         for s in SEEDS:
-            _, cpu, size, _ = run(graded(name, s, 0.3, "rsa"), f"pout-{name}-{s}")
-            line(case="pack_outputs", variant=name, seed=s, cpu_s=f"{cpu:.3f}", file_bytes=size)
+            job = {"process": "pack", "inputs": {
+                "dim": dim, "domain": {"box": {"size": [100] * dim, "periodic": True}},
+                "grading": {"type": "classes", "classes": [{"d": 1, "volume_percent": 100}]},
+                "count": 20000, "phi": {"value": 0.3, "refers_to": "resolved"},
+                "algorithm": "rsa", "seed": s}}
+            _, cpu, size, _ = run(job, f"pout-{dim}-{s}")
+            line(case="pack_outputs", dim=dim, seed=s, cpu_s=f"{cpu:.3f}", file_bytes=size)
+
+
+QUALITIES = ["draft", "standard", "fine"]
+
+
+def presets():
+    """Each preset as a job sends it (only "quality" set): cost and error
+    against the fine run of the same seed."""
+    sweep("preset_edmd_jammed", QUALITIES,
+          lambda q, s: dict(mono3d(s, edmd={"until": "jammed"}),
+                            inputs=dict(mono3d(s, edmd={"until": "jammed"})["inputs"], quality=q)),
+          lambda r: r["phi_resolved"], "fine")
+    sweep("preset_rsa_saturation", QUALITIES,
+          lambda q, s: dict(mono3d(s, n=3000, phi=0.45, alg="rsa"),
+                            inputs=dict(mono3d(s, n=3000, phi=0.45, alg="rsa")["inputs"], quality=q)),
+          lambda r: r["phi_resolved"], "fine")
+    rves = {s: rve(s) for s in SEEDS}
+    sweep("preset_homog", QUALITIES,
+          lambda q, s: dict(homog_job(rves[s], {}), inputs=dict(homog_job(rves[s], {})["inputs"], quality=q)),
+          sigma_norm, "fine")
 
 
 CASES = {f.__name__: f for f in (edmd_gamma, edmd_pmax, rsa_nf, rsa_reach, auto, homog_tol,
-                                 homog_outputs, pack_outputs)}
+                                 homog_outputs, pack_outputs, presets)}
 for c in sys.argv[1:] or CASES:
     CASES[c]()
