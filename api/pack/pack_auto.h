@@ -5,9 +5,11 @@
  * {"until": "jammed"} → edmd (only EDMD jams); else rsa when the target
  * φ_eff, counted with the Δd shells, lies below the threshold, edmd above.
  * The threshold is RSA's measured saturation for the grading's size spread
- * d_max/d_min (interpolated in ln spread, PK_AUTO_REACH_MARGIN below it: RSA
- * slows sharply near saturation), capped at the measured RSA/EDMD
- * break-even PK_AUTO_BREAK_EVEN. */
+ * d_max/d_min (interpolated in ln spread), PK_AUTO_REACH_MARGIN below it
+ * (RSA slows sharply in the last few hundredths: the measured break-even
+ * with EDMD sits there), capped at PK_AUTO_BREAK_EVEN, the break-even of wide
+ * gradings whose reach lies beyond it (measured ≈ 0.63 for A16 above 2 mm;
+ * Titscher & Unger: 62.5 %). */
 #ifndef PK_PACK_AUTO_H
 #define PK_PACK_AUTO_H
 
@@ -15,8 +17,8 @@
 
 #include "pack_job.h"
 
-#define PK_AUTO_BREAK_EVEN 0.57
-#define PK_AUTO_REACH_MARGIN 0.02
+#define PK_AUTO_BREAK_EVEN 0.625
+#define PK_AUTO_REACH_MARGIN 0.04
 
 /* RSA's saturation φ_eff (measured, docs/presets.md) for a grading whose
  * resolved sizes span d_max/d_min = spread, in dim 2 or 3. */

@@ -7,13 +7,14 @@ per run:
 then one summary line per knob value: mean cost and the mean |error| against
 the reference (the finest value of the sweep).
 Usage: PACKD=build/packd python3 bench/presets/presets.py [case ...]
-Cases: edmd_gamma edmd_pmax rsa_nf rsa_reach homog_tol homog_solver homog_outputs
-       pack_outputs auto"""
-import json, os, resource, statistics, subprocess, sys, tempfile
+Cases: edmd_gamma edmd_pmax rsa_nf rsa_reach auto homog_tol homog_outputs pack_outputs
+       presets (preset_homog alone: its homogenize part)"""
+import atexit, json, os, resource, shutil, statistics, subprocess, sys, tempfile
 
 PACKD = os.environ.get("PACKD", "build/packd")
 SEEDS = [1, 2, 3]
 TMP = tempfile.mkdtemp(prefix="presets-bench-")
+atexit.register(shutil.rmtree, TMP, True)
 
 
 def run(job, name):
@@ -43,7 +44,9 @@ def sweep(case, values, make_job, metric, ref_value):
             summ, cpu, size, _ = run(make_job(v, s), f"{case}-{v}-{s}")
             m = metric(summ)
             rows.setdefault(v, []).append((s, cpu, m))
-            line(case=case, knob=v, seed=s, cpu_s=f"{cpu:.3f}", metric=f"{m:.10g}", file_bytes=size)
+            extra = {"dr_iterations": summ["dr_iterations_total"]} if "dr_iterations_total" in summ else {}
+            line(case=case, knob=v, seed=s, cpu_s=f"{cpu:.3f}", metric=f"{m:.10g}", file_bytes=size,
+                 **extra)
     ref = {s: m for s, _, m in rows[ref_value]}
     for v in values:
         errs = [abs(m - ref[s]) for s, _, m in rows[v]]
@@ -122,8 +125,10 @@ def rsa_reach():
     the automatic choice."""
     start = {"mono3d": 0.34, "two3d": 0.40, "a16_d4": 0.48, "a16_d2": 0.52, "fuller_d2": 0.52,
              "mono2d": 0.50, "quartz2d": 0.58}
-    targets = {k: [round(v + 0.02 * j, 2) for j in range(int((0.8 - v) / 0.02) + 1)]
-               for k, v in start.items()}
+    top = 0.7  # RSA takes over 10 s per 3500 grains beyond: far past the break-even
+    targets = {k: [round(v + 0.02 * j, 2) for j in range(int((top - v) / 0.02 + 1e-9) + 1)]
+               for k, v in start.items()
+               if not os.environ.get("REACH_GRADINGS") or k in os.environ["REACH_GRADINGS"]}
     for name, phis in targets.items():
         for phi in phis:
             done = []
@@ -143,7 +148,11 @@ def rsa_reach():
 
 def auto():
     """Time to a target φ_eff: RSA against EDMD (RSA start, relative growth)."""
-    for name, phis in (("a16_d4", [0.45, 0.5, 0.55, 0.6]), ("mono3d", [0.3, 0.35, 0.38])):
+    cases = {"a16_d4": [0.45, 0.5, 0.55, 0.6], "mono3d": [0.3, 0.35, 0.38],
+             "a16_d2": [0.58, 0.62, 0.66], "fuller_d2": [0.58, 0.62, 0.66]}
+    for name, phis in cases.items():
+        if os.environ.get("AUTO_GRADINGS") and name not in os.environ["AUTO_GRADINGS"].split(","):
+            continue
         for phi in phis:
             for alg in ("rsa", "edmd"):
                 for s in SEEDS:
@@ -228,13 +237,17 @@ def presets():
           lambda q, s: dict(mono3d(s, n=3000, phi=0.45, alg="rsa"),
                             inputs=dict(mono3d(s, n=3000, phi=0.45, alg="rsa")["inputs"], quality=q)),
           lambda r: r["phi_resolved"], "fine")
-    rves = {s: rve(s) for s in SEEDS}
+    preset_homog()
+
+
+def preset_homog():
+    rves = {s: rve(s, 2000) for s in SEEDS}
     sweep("preset_homog", QUALITIES,
           lambda q, s: dict(homog_job(rves[s], {}), inputs=dict(homog_job(rves[s], {})["inputs"], quality=q)),
           sigma_norm, "fine")
 
 
 CASES = {f.__name__: f for f in (edmd_gamma, edmd_pmax, rsa_nf, rsa_reach, auto, homog_tol,
-                                 homog_outputs, pack_outputs, presets)}
+                                 homog_outputs, pack_outputs, presets, preset_homog)}
 for c in sys.argv[1:] or CASES:
     CASES[c]()

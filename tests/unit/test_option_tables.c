@@ -327,11 +327,46 @@ static void test_quality_columns(void)
     CHECK(columns >= 4); /* EDMD growth rate and pressure, RSA N^F, DR tolerance */
 }
 
+/* The knob values docs/presets.md documents for each preset. */
+static void test_documented_presets(void)
+{
+    static const struct {
+        const char *quality;
+        double gamma, p_max, nf, tol;
+    } doc[] = {
+        {"draft", 0.03, 1e4, 1e5, 1e-5},
+        {"standard", 0.01, 1e12, 1e6, 1e-8},
+        {"fine", 0.003, 1e12, 1e7, 1e-10},
+    };
+    for (int q = 0; q < 3; q++) {
+        pk_schema_errors errs = {0};
+        pk_pack_job job;
+        pk_homog_job hj;
+        char text[256];
+        snprintf(text, sizeof text, "{\"algorithm\": \"edmd\", \"quality\": \"%s\"}",
+                 doc[q].quality);
+        json_t *in = json_loads(text, 0, NULL);
+        pk_pack_job_from_json(in, &job, &errs);
+        CHECK_MSG(job.opt.edmd.prm.growth_rate == doc[q].gamma, "%s γ %g", doc[q].quality,
+                  job.opt.edmd.prm.growth_rate);
+        CHECK_MSG(job.opt.edmd.prm.p_max == doc[q].p_max, "%s p %g", doc[q].quality,
+                  job.opt.edmd.prm.p_max);
+        json_object_set_new(in, "algorithm", json_string("rsa"));
+        pk_pack_job_from_json(in, &job, &errs);
+        CHECK_MSG((double)job.opt.rsa.max_failed_draws == doc[q].nf, "%s N^F", doc[q].quality);
+        pk_options_fill(&pk_homog_options, in, &hj, &errs);
+        CHECK_MSG(hj.tol == doc[q].tol, "%s tol %g", doc[q].quality, hj.tol);
+        pk_schema_errors_free(&errs);
+        json_decref(in);
+    }
+}
+
 int main(void)
 {
     collect_tables();
     RUN(test_tables_match_schemas);
     RUN(test_quality_columns);
+    RUN(test_documented_presets);
     RUN(test_bad_values_named);
     RUN(test_empty_sieve_refused);
     return check_summary();
