@@ -44,6 +44,7 @@ static const pk_option homog_rows[] = {
     {"/initial_state/value", PK_OPT_NUMBER, F(initial_value)},
     {"/output/micro_state", PK_OPT_BOOL, F(out_micro)},
     {"/output/contacts", PK_OPT_BOOL, F(out_contacts)},
+    {"/output/frames", PK_OPT_BOOL, F(out_frames), .dflt = 1},
     {"/limits/wall_time_s", PK_OPT_NUMBER, F(wall_time_s), PK_OPT_IMPLICIT},
     {"/load/type", PK_OPT_ENUM, F(load.type), PK_OPT_IMPLICIT, .names = load_names},
     {"/load/precompression", PK_OPT_NUMBER, F(load.precompression), .dflt = 0.01},

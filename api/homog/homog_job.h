@@ -41,6 +41,7 @@ typedef struct pk_homog_job {
     size_t newton_max_iter;
     int tangent;
     int out_micro, out_contacts;
+    int out_frames;     /* "output": {"frames"}: 0 = no per-step frames (homog_frames.h) */
     int initial_policy; /* initial_state policy: 0 as_generated, 1 radius_inflation,
                                 * 2 precompress */
     double initial_value;

@@ -166,6 +166,7 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
     pk_homog_opts o;
     opts_of(&job, &rve, &o);
     pk_homog_frames_init(&fr, &rve, job.nstep);
+    fr.keep &= job.out_frames; /* not asked: neither recorded nor written */
     /* a contact pattern seen in an earlier factorisation of this job (elastic
      * load steps) reuses its analysis; without a context (NULL on failure)
      * every factorisation is analysed afresh — the same numbers either way */

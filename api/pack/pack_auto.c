@@ -8,18 +8,17 @@
 
 #include "pack_placer.h"
 
-/* RSA's saturation φ_eff against the size spread d_max/d_min: the mean φ
- * where 3 seeds stopped short (periodic box, N^F = 10^6, open draws;
- * bench/presets/presets.py rsa_reach, docs/presets.md); a row whose
- * saturation lies beyond the break-even holds the highest target all seeds
- * reached.  Ascending spread per dim. */
+/* RSA's reach against the size spread d_max/d_min: the highest target φ_eff,
+ * on a grid 0.02 apart, that 3 seeds all placed (periodic box, N^F = 10^6,
+ * open draws; bench/presets/presets.py rsa_reach, docs/presets.md).
+ * Ascending spread per dim. */
 static const struct {
     int dim;
     double spread, phi;
 } reach[] = {
-    {2, 1, 0.5395}, {2, 5, 0.62},   /* equal disks; Meier's quartz sand */
-    {3, 1, 0.3697}, {3, 2, 0.4579}, /* equal spheres; two classes d, d/2 */
-    {3, 4, 0.5901}, {3, 8, 0.66},   /* A16 above 4 mm; A16 and Fuller above 2 mm */
+    {2, 1, 0.52}, {2, 5, 0.66}, /* equal disks; Meier's quartz sand (continuous) */
+    {3, 1, 0.36}, {3, 2, 0.44}, /* equal spheres; two classes d, d/2 */
+    {3, 4, 0.58}, {3, 8, 0.66}, /* A16 above 4 mm; Fuller (A16: 0.68) above 2 mm */
 };
 
 double pk_auto_rsa_reach(int dim, double spread)

@@ -4,7 +4,7 @@
  * Rule: a mesh domain → tetfill (the only placer of a mesh); "edmd":
  * {"until": "jammed"} → edmd (only EDMD jams); else rsa when the target
  * φ_eff, counted with the Δd shells, lies below the threshold, edmd above.
- * The threshold is RSA's measured saturation for the grading's size spread
+ * The threshold is RSA's measured reach for the grading's size spread
  * d_max/d_min (interpolated in ln spread), PK_AUTO_REACH_MARGIN below it
  * (RSA slows sharply in the last few hundredths: the measured break-even
  * with EDMD sits there), capped at PK_AUTO_BREAK_EVEN, the break-even of wide
@@ -18,9 +18,9 @@
 #include "pack_job.h"
 
 #define PK_AUTO_BREAK_EVEN 0.625
-#define PK_AUTO_REACH_MARGIN 0.04
+#define PK_AUTO_REACH_MARGIN 0.03
 
-/* RSA's saturation φ_eff (measured, docs/presets.md) for a grading whose
+/* RSA's reach φ_eff (measured, docs/presets.md) for a grading whose
  * resolved sizes span d_max/d_min = spread, in dim 2 or 3. */
 double pk_auto_rsa_reach(int dim, double spread);
 

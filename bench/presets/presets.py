@@ -200,9 +200,13 @@ def homog_outputs():
     variants = {"none": ("periodic", {}), "contacts": ("periodic", {"output": {"contacts": True}}),
                 "micro_state": ("periodic", {"output": {"micro_state": True}}),
                 "tangent": ("periodic", {"tangent": True}),
+                "no_frames": ("periodic", {"output": {"frames": False}}),
                 "taylor_none": ("taylor", {}),
                 "taylor_friction": ("taylor", {"friction": {"rho_deg": 30}})}
+    only = os.environ.get("OUTPUT_VARIANTS")
     for name, (bc, extra) in variants.items():
+        if only and name not in only.split(","):
+            continue
         for s in SEEDS:
             job = homog_job(rves[s], {"tol": 1e-8}, dict(extra, boundary_condition=bc))
             summ, cpu, size, _ = run(job, f"hout-{name}-{s}")

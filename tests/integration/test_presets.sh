@@ -54,10 +54,12 @@ check model_fines_left_out test "$(jget "$T/fines.out" 'abs(d["model"]["fines_ph
 cat >"$T/h.json" <<JOB
 {"process": "homogenize", "inputs": {"rve": {"file": "$T/rve-2d.h5"}, "boundary_condition": "periodic",
  "load": {"type": "uniaxial_compression", "axis": 1, "strain": 0.01, "steps": 3}, "contact": {"E_n": 50},
- "initial_state": {"policy": "radius_inflation", "value": 0.3}, "quality": "draft"}}
+ "initial_state": {"policy": "radius_inflation", "value": 0.3}, "quality": "draft",
+ "output": {"frames": false}}}
 JOB
 run "$T/h.json" "$T/h.h5" "$T/h.out"
-check model_homog test "$(jget "$T/h.out" '[d["model"][k] for k in ("dim", "friction", "tangent", "contacts_stored", "tolerance")] == [2, False, False, False, 1e-5]')" = True
+check model_homog test "$(jget "$T/h.out" '[d["model"][k] for k in ("dim", "friction", "tangent", "contacts_stored", "frames_stored", "tolerance")] == [2, False, False, False, False, 1e-5]')" = True
+check homog_no_frames_written sh -c "! h5ls -r '$T/h.h5' | grep -q '^/particles/rve'"
 check model_homog_in_file test "$(obs "$T/h.h5" '["modelled/tolerance"]')" = 1e-05
 
 # 4. one auto job through the daemon: the choice in the job's summary
