@@ -26,7 +26,8 @@ static const pk_option homog_rows[] = {
     {"/friction/E_t", PK_OPT_NUMBER, F(fric.E_t), PK_OPT_IMPLICIT, .dflt = NAN}, /* NAN: E_n */
     {"/friction/rho_deg", PK_OPT_NUMBER, F(rho_deg), PK_OPT_IMPLICIT},
     {"/friction/h", PK_OPT_NUMBER, F(fric.h)},
-    {"/relaxation/tol", PK_OPT_NUMBER, F(tol), .dflt = 1e-8},
+    {"/quality", PK_OPT_ENUM, F(quality), .dflt = PK_QUALITY_STANDARD, .names = pk_quality_names},
+    {"/relaxation/tol", PK_OPT_NUMBER, F(tol), .dflt = 1e-8, PK_OPT_QUALITY(1e-5, 1e-10)},
     {"/relaxation/abs_tol", PK_OPT_NUMBER, F(abs_tol), .dflt = 1e-13},
     {"/relaxation/max_iter", PK_OPT_INTEGER, F(max_iter), .dflt = 1000000, .lo = 1, .hi = 1e9},
     {"/relaxation/solver", PK_OPT_ENUM, F(newton), .names = solver_names},
@@ -43,6 +44,7 @@ static const pk_option homog_rows[] = {
     {"/initial_state/value", PK_OPT_NUMBER, F(initial_value)},
     {"/output/micro_state", PK_OPT_BOOL, F(out_micro)},
     {"/output/contacts", PK_OPT_BOOL, F(out_contacts)},
+    {"/output/frames", PK_OPT_BOOL, F(out_frames), .dflt = 1},
     {"/limits/wall_time_s", PK_OPT_NUMBER, F(wall_time_s), PK_OPT_IMPLICIT},
     {"/load/type", PK_OPT_ENUM, F(load.type), PK_OPT_IMPLICIT, .names = load_names},
     {"/load/precompression", PK_OPT_NUMBER, F(load.precompression), .dflt = 0.01},
@@ -58,6 +60,15 @@ static const pk_option homog_rows[] = {
 #undef F
 const pk_option_table pk_homog_options =
     PK_OPT_TABLE("homogenize.inputs.schema.json", pk_homog_job, homog_rows, NULL);
+
+json_t *pk_homog_model_json(const pk_homog_job *job, int dim, int frames_kept)
+{
+    return json_pack("{s:i,s:s,s:b,s:b,s:s,s:f,s:b,s:b,s:b}", "dim", dim, "quality",
+                     pk_quality_names[job->quality], "friction", job->friction, "tangent",
+                     job->tangent, "solver", job->newton ? "newton" : "dr", "tolerance", job->tol,
+                     "contacts_stored", job->out_contacts, "micro_state_stored", job->out_micro,
+                     "frames_stored", frames_kept);
+}
 
 void pk_homog_job_free(pk_homog_job *job)
 {

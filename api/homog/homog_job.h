@@ -32,6 +32,7 @@ typedef struct pk_homog_job {
     int friction;     /* "friction" given */
     pk_fric_law fric; /* E_t, tan ρ, h (E_t defaults to E_n) */
     double rho_deg;   /* friction angle ρ (fric.tan_rho = tan ρ) */
+    int quality;      /* "quality": pk_quality (api/schemas/option_table.h) */
     double tol, abs_tol;
     size_t max_iter;
     int lanczos_steps;
@@ -41,6 +42,7 @@ typedef struct pk_homog_job {
     size_t newton_max_iter;
     int tangent;
     int out_micro, out_contacts;
+    int out_frames;     /* "output": {"frames"}: 0 = no per-step frames (homog_frames.h) */
     int initial_policy; /* initial_state policy: 0 as_generated, 1 radius_inflation,
                                 * 2 precompress */
     double initial_value;
@@ -66,6 +68,10 @@ extern const pk_option_table pk_homog_options;
  * error). */
 size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_errors *errs);
 void pk_homog_job_free(pk_homog_job *job);
+/* What the run models and stores (the summary's "model", /observables/modelled;
+ * docs/presets.md): dim, quality, friction, tangent, the optional records
+ * (contacts, micro state) and whether the per-step frames were kept. */
+json_t *pk_homog_model_json(const pk_homog_job *job, int dim, int frames_kept);
 
 /* The relaxation options of job for the RVE rve (homog_run.c; also the
  * RVEs of 'fe2'). */

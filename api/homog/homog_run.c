@@ -166,6 +166,7 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
     pk_homog_opts o;
     pk_homog_opts_of(&job, &rve, &o);
     pk_homog_frames_init(&fr, &rve, job.nstep);
+    fr.keep &= job.out_frames; /* not asked: neither recorded nor written */
     /* a contact pattern seen in an earlier factorisation of this job (elastic
      * load steps) reuses its analysis; without a context (NULL on failure)
      * every factorisation is analysed afresh — the same numbers either way */
@@ -345,6 +346,7 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
     json_object_set_new(sum, "steps_not_converged", json_integer((json_int_t)not_converged));
     if (ck_loaded == 0)
         json_object_set_new(sum, "resumed_from_step", json_integer((json_int_t)first));
+    json_object_set_new(sum, "model", pk_homog_model_json(&job, dim, fr.keep && fr.count > 0));
     json_object_set_new(sum, "rve_particles", json_integer((json_int_t)rve.n));
     json_object_set_new(sum, "dr_iterations_total", json_integer((json_int_t)total_iter));
     json_object_set_new(sum, "dr_iterations_max", json_integer((json_int_t)max_iter_step));
@@ -410,6 +412,7 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
     w |= pk_homog_frames_write(h, &fr, &rve, &units);
     w |= pk_h5_write_parameters(h, "homogenize", job_json, 0);
     w |= pk_homog_record_write(h, rec, aud, dim, first, job.nstep, &units);
+    w |= pk_h5_obs_json(h, "modelled", json_object_get(sum, "model"));
     w |= pk_verdict_write_h5(h, sum);
     if (w != 0) {
         pk_h5_abort(h);

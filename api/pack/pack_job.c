@@ -1,6 +1,7 @@
 /* pack_job.c — the 'pack' process's inputs: its option table, the grading
  * and box readers, the feasibility plan and the parse hook (pack_job.h). */
 #include "pack_job.h"
+#include "pack_auto.h"
 #include "pack_placer.h"
 
 #include <math.h>
@@ -23,6 +24,7 @@ static const pk_option pack_rows[] = {
     {"/count", PK_OPT_INTEGER, F(count), PK_OPT_IMPLICIT, .lo = 1, .hi = PK_PACK_MAX_COUNT},
     {"/delta_d", PK_OPT_NUMBER, F(delta_d)},
     {"/algorithm", PK_OPT_STRING, F(algorithm), .sdefault = "rsa"},
+    {"/quality", PK_OPT_ENUM, F(quality), .dflt = PK_QUALITY_STANDARD, .names = pk_quality_names},
     {"/seed", PK_OPT_INTEGER, F(seed), .dflt = 1, .lo = 0, .hi = 9007199254740991LL},
     {"/limits/max_particles", PK_OPT_INTEGER, F(max_particles), .dflt = 20000000, .lo = 1,
      .hi = PK_PACK_MAX_COUNT},
@@ -165,6 +167,24 @@ static int grading_from_json(json_t *g, pk_grading *out, int *default_discrete,
     return -1;
 }
 
+/* "algorithm": "auto" (pack_auto.h): what is decided before the plan — a mesh
+ * takes tetfill, "until": "jammed" edmd; else rsa until the plan's figures
+ * decide (pk_pack_auto_resolve). */
+static void auto_without_plan(json_t *in, pk_pack_job *job, int box)
+{
+    job->choice.threshold = job->choice.phi_shell = job->choice.spread = NAN;
+    if (strcmp(job->algorithm, "auto") != 0)
+        return;
+    job->choice.requested = 1;
+    const char *until = json_string_value(pk_json_at(in, "/edmd/until"));
+    const char *why = !box ? "the domain is a mesh: tet filling is the placer of a mesh"
+        : until && !strcmp(until, "jammed")
+        ? "edmd.until is jammed: only EDMD grows a packing until it jams"
+        : NULL;
+    snprintf(job->algorithm, sizeof job->algorithm, "%s", !box ? "tetfill" : why ? "edmd" : "rsa");
+    snprintf(job->choice.reason, sizeof job->choice.reason, "%s", why ? why : "");
+}
+
 size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *errs)
 {
     size_t before = errs->n;
@@ -215,6 +235,7 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
     }
 
     job->has_phi = json_object_get(in, "phi") != NULL;
+    auto_without_plan(in, job, box != NULL);
     const pk_placer *placer = pk_placer_find(job->algorithm);
     if (!placer)
         pk_schema_errors_add(errs, "/algorithm", "enum", "no placer named \"%s\"", job->algorithm);
@@ -419,7 +440,8 @@ void *pk_pack_parse(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *e
     if (pk_pack_job_from_json(inputs, &t->job, errs) == 0) {
         t->job.service = ctx->service;
         t->job.prepare = !ctx->service;
-        if (pk_pack_plan_make(&t->job, &t->plan, errs) == 0)
+        if (pk_pack_plan_make(&t->job, &t->plan, errs) == 0 &&
+            pk_pack_auto_resolve(inputs, &t->job, &t->plan, errs) == 0)
             return t;
         pk_pack_free(t);
         return NULL;

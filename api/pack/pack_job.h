@@ -31,7 +31,13 @@ typedef struct pk_pack_job {
     double phi;   /* target value as given */
     size_t count; /* 0 = not given */
     double delta_d;
-    char algorithm[16];    /* placer name, see pack_placer.h */
+    char algorithm[16]; /* placer name, see pack_placer.h ("auto": resolved, pack_auto.h) */
+    int quality;        /* "quality": pk_quality (api/schemas/option_table.h) */
+    struct {            /* "algorithm": "auto" (pack_auto.h) */
+        int requested;
+        char reason[256];
+        double threshold, phi_shell, spread; /* NAN where the rule did not use them */
+    } choice;
     pk_placer_options opt; /* the placer's options (its table, pack_placer.h) */
     json_t *mesh;          /* borrowed "domain": {"mesh"} of the inputs, or NULL */
     uint64_t seed;

@@ -35,7 +35,7 @@ static const char *const draws_names[] = {"open", "plain", NULL};
 static const char *const wall_gap_names[] = {"half", "none", NULL};
 static const pk_option rsa_rows[] = {
     {"/rsa/max_failed_draws", PK_OPT_INTEGER, PK_OPT_FIELD(pk_rsa_options, max_failed_draws),
-     .dflt = 1000000, .lo = 1, .hi = 1e10},
+     .dflt = 1000000, .lo = 1, .hi = 1e10, PK_OPT_QUALITY(1e5, 1e7)},
     {"/rsa/draws", PK_OPT_ENUM, PK_OPT_FIELD(pk_rsa_options, draws), .names = draws_names},
     {"/rsa/wall_gap", PK_OPT_ENUM, PK_OPT_FIELD(pk_rsa_options, wall_gap), .names = wall_gap_names},
 };

@@ -9,7 +9,9 @@
 #include "api/results/h5_result.h"
 #include "api/results/h5_units.h"
 #include "api/job_verdict.h"
+#include "pack_auto.h"
 #include "pack_job.h"
+#include "pack_model.h"
 #include "pack_placer.h"
 #include "core/space/particles.h"
 #include "core/base/rng.h"
@@ -66,6 +68,16 @@ static size_t grains_outside_walls(const pk_box *b, const pk_particles *p, doubl
                 break;
             }
     return n;
+}
+
+/* What was modelled and, for "auto", the choice: /observables/modelled,
+ * /observables/auto (the summary's "model" and "auto"). */
+static int write_scene(pk_h5 *h, json_t *summary)
+{
+    int rc = pk_h5_obs_json(h, "modelled", json_object_get(summary, "model"));
+    if (json_object_get(summary, "auto"))
+        rc |= pk_h5_obs_json(h, "auto", json_object_get(summary, "auto"));
+    return rc;
 }
 
 static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const char *job_json,
@@ -203,6 +215,12 @@ done:
         pk_h5_abort(h);
         return -1;
     }
+    rc = write_scene(h, summary);
+    if (rc != 0) {
+        snprintf(err, errlen, "writing %s failed", out_path);
+        pk_h5_abort(h);
+        return -1;
+    }
     json_object_set_new(summary, "phi_resolved", json_real(phi));
     json_object_set_new(summary, "phi_mix", json_real(phi / (1 - plan->mass_cut)));
     if (pk_verdict_write_h5(h, summary) != 0) {
@@ -283,6 +301,10 @@ int pk_pack_run(const void *task, int threads, const char *job_json, const char 
     json_object_set_new(sum, "process", json_string("pack"));
     json_object_set_new(sum, "algorithm", json_string(job.algorithm));
     json_object_set_new(sum, "termination_reason", json_string(pk_stop_reason_name(st.reason)));
+    json_t *choice = pk_pack_auto_json(&job);
+    if (choice)
+        json_object_set_new(sum, "auto", choice);
+    json_object_set_new(sum, "model", pk_pack_model_json(&job, &plan));
     json_object_set_new(sum, "complete",
                         json_false()); /* here in the listing; pk_pack_verdict sets it */
     json_object_set_new(sum, "count_placed", json_integer((json_int_t)st.placed));

@@ -34,13 +34,35 @@ static void put_int(void *field, size_t size, long long x)
     }
 }
 
+const char *const pk_quality_names[] = {"draft", "standard", "fine", NULL};
+
+pk_quality pk_quality_of(json_t *root)
+{
+    const char *s = json_string_value(pk_json_at(root, "/quality"));
+    for (int i = 0; s && pk_quality_names[i]; i++)
+        if (!strcmp(pk_quality_names[i], s))
+            return (pk_quality)i;
+    return PK_QUALITY_STANDARD;
+}
+
+static void put_number(const pk_option *o, char *field, double x)
+{
+    switch (o->type) {
+    case PK_OPT_NUMBER: memcpy(field, &x, sizeof x); break;
+    case PK_OPT_INTEGER: put_int(field, o->size, (long long)x); break;
+    case PK_OPT_BOOL:
+    case PK_OPT_ENUM: put_int(field, sizeof(int), (long long)x); break;
+    case PK_OPT_STRING: break;
+    }
+}
+
 static void put_default(const pk_option *o, char *field)
 {
     switch (o->type) {
-    case PK_OPT_NUMBER: memcpy(field, &o->dflt, sizeof o->dflt); break;
-    case PK_OPT_INTEGER: put_int(field, o->size, (long long)o->dflt); break;
+    case PK_OPT_NUMBER:
+    case PK_OPT_INTEGER:
     case PK_OPT_BOOL:
-    case PK_OPT_ENUM: put_int(field, sizeof(int), (long long)o->dflt); break;
+    case PK_OPT_ENUM: put_number(o, field, o->dflt); break;
     case PK_OPT_STRING: snprintf(field, o->size, "%s", o->sdefault ? o->sdefault : ""); break;
     }
 }
@@ -112,6 +134,7 @@ static int put_value(const pk_option *o, json_t *v, char *field, pk_schema_error
 size_t pk_options_fill(const pk_option_table *t, json_t *root, void *dst, pk_schema_errors *errs)
 {
     size_t before = errs->n;
+    const pk_quality q = pk_quality_of(root);
     if (t->preset)
         t->preset(dst);
     for (size_t i = 0; i < t->n; i++) {
@@ -120,7 +143,9 @@ size_t pk_options_fill(const pk_option_table *t, json_t *root, void *dst, pk_sch
         json_t *v = pk_json_at(root, o->pointer);
         if (v && put_value(o, v, field, errs) == 0)
             continue;
-        if (o->how != PK_OPT_PRESET)
+        if (o->by_quality && q != PK_QUALITY_STANDARD)
+            put_number(o, field, q == PK_QUALITY_DRAFT ? o->draft : o->fine);
+        else if (o->how != PK_OPT_PRESET)
             put_default(o, field);
     }
     return errs->n - before;

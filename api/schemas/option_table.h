@@ -27,6 +27,12 @@ typedef enum pk_opt_default {
                        * own default, e.g. pk_edmd_params_default); NAN there = implicit */
 } pk_opt_default;
 
+/* The job's "quality" (schemas: "draft" | "standard" | "fine"): which
+ * default an absent option takes where its row has a quality column
+ * (docs/presets.md).  "standard" is the row's own default. */
+typedef enum pk_quality { PK_QUALITY_DRAFT, PK_QUALITY_STANDARD, PK_QUALITY_FINE } pk_quality;
+extern const char *const pk_quality_names[]; /* in that order, NULL-terminated */
+
 typedef struct pk_option {
     const char *pointer; /* JSON pointer from the object the table reads, "/edmd/skin" */
     pk_opt_type type;
@@ -36,7 +42,13 @@ typedef struct pk_option {
     const char *sdefault;     /* STRING */
     double lo, hi;            /* INTEGER: the admitted range (the schema's minimum, maximum) */
     const char *const *names; /* ENUM: the values, NULL-terminated */
+    int by_quality;           /* 1: absent, a draft / fine job takes draft / fine instead of
+                               * the default (NUMBER, INTEGER, BOOL, ENUM index) */
+    double draft, fine;
 } pk_option;
+
+/* The quality column of a row: PK_OPT_QUALITY(draft value, fine value). */
+#define PK_OPT_QUALITY(d, f) .by_quality = 1, .draft = (d), .fine = (f)
 
 typedef struct pk_option_table {
     const char *schema; /* the embedded schema the pointers live in */
@@ -55,8 +67,13 @@ typedef struct pk_option_table {
 /* The value at a JSON pointer ("/a/b", "" = root) of plain object keys, or NULL. */
 json_t *pk_json_at(json_t *root, const char *pointer);
 
+/* The quality root asks for ("/quality"; absent: standard). */
+pk_quality pk_quality_of(json_t *root);
+
 /* Fill dst from root (the object the pointers start from): preset, then
- * every row; an absent value takes the row's default.  A present value of
+ * every row; an absent value takes the row's default, or its quality
+ * column's value when root's "quality" is draft or fine (an explicit value
+ * always wins).  A present value of
  * the wrong kind (an integer out of range, a name not in the enum) is an
  * error naming the field (the schema normally catches it first).  Returns
  * the number of errors appended. */

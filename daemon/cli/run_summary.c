@@ -96,6 +96,9 @@ void pk_run_summary_print(FILE *f, const json_t *s, double seconds, int utf8)
         fe2_lines(f, s);
     else
         pack_lines(f, s, utf8 ? "φ        " : "phi      "); /* 9 columns */
+    json_t *choice = json_object_get(s, "auto");            /* "algorithm": "auto": what and why */
+    if (choice)
+        fprintf(f, "  auto      %s: %s\n", str(choice, "algorithm"), str(choice, "reason"));
     char t[32];
     pk_run_line_duration(seconds, t, sizeof t);
     fprintf(f, "  time      %s\n", t);

@@ -262,10 +262,114 @@ static void test_empty_sieve_refused(void)
     json_decref(in);
 }
 
+/* root[pointer] = v (objects made on the way). */
+static void set_at(json_t *root, const char *pointer, json_t *v)
+{
+    char key[128];
+    const char *p = pointer + 1, *end;
+    json_t *o = root;
+    while ((end = strchr(p, '/'))) {
+        snprintf(key, sizeof key, "%.*s", (int)(end - p), p);
+        if (!json_object_get(o, key))
+            json_object_set_new(o, key, json_object());
+        o = json_object_get(o, key);
+        p = end + 1;
+    }
+    json_object_set_new(o, p, v);
+}
+
+static double field_number(const pk_option *o, const void *filled)
+{
+    json_t *v = pk_option_default_json(o, filled);
+    double x = json_number_value(v);
+    json_decref(v);
+    return x;
+}
+
+/* Each quality column: a draft / fine job takes its value, a standard job the
+ * row's default, and an explicit value wins over every preset. */
+static void test_quality_columns(void)
+{
+    int columns = 0;
+    for (size_t i = 0; i < ntables; i++) {
+        const pk_option_table *t = tables[i];
+        void *plain = calloc(1, t->size), *filled = calloc(1, t->size);
+        pk_schema_errors errs = {0};
+        json_t *empty = json_object(), *std = json_pack("{s:s}", "quality", "standard");
+        pk_options_fill(t, empty, plain, &errs);
+        pk_options_fill(t, std, filled, &errs);
+        CHECK_MSG(!memcmp(plain, filled, t->size), "%s: standard is the default", t->schema);
+        for (size_t j = 0; j < t->n; j++) {
+            const pk_option *o = &t->rows[j];
+            if (!o->by_quality)
+                continue;
+            columns++;
+            CHECK_MSG(o->type == PK_OPT_NUMBER || o->type == PK_OPT_INTEGER, "%s", o->pointer);
+            const char *q[] = {"draft", "fine"};
+            const double want[] = {o->draft, o->fine};
+            for (int k = 0; k < 2; k++) {
+                json_t *in = json_pack("{s:s}", "quality", q[k]);
+                pk_options_fill(t, in, filled, &errs);
+                CHECK_MSG(field_number(o, filled) == want[k], "%s %s: %g, column %g", o->pointer,
+                          q[k], field_number(o, filled), want[k]);
+                /* an explicit value (the other column's) wins */
+                set_at(in, o->pointer, json_real(want[1 - k]));
+                pk_options_fill(t, in, filled, &errs);
+                CHECK_MSG(field_number(o, filled) == want[1 - k], "%s explicit under %s",
+                          o->pointer, q[k]);
+                json_decref(in);
+            }
+        }
+        CHECK(errs.n == 0);
+        pk_schema_errors_free(&errs);
+        json_decref(empty);
+        json_decref(std);
+        free(plain);
+        free(filled);
+    }
+    CHECK(columns >= 4); /* EDMD growth rate and pressure, RSA N^F, DR tolerance */
+}
+
+/* The knob values docs/presets.md documents for each preset. */
+static void test_documented_presets(void)
+{
+    static const struct {
+        const char *quality;
+        double gamma, p_max, nf, tol;
+    } doc[] = {
+        {"draft", 0.03, 1e4, 1e5, 1e-5},
+        {"standard", 0.01, 1e12, 1e6, 1e-8},
+        {"fine", 0.003, 1e12, 1e7, 1e-10},
+    };
+    for (int q = 0; q < 3; q++) {
+        pk_schema_errors errs = {0};
+        pk_pack_job job;
+        pk_homog_job hj;
+        char text[256];
+        snprintf(text, sizeof text, "{\"algorithm\": \"edmd\", \"quality\": \"%s\"}",
+                 doc[q].quality);
+        json_t *in = json_loads(text, 0, NULL);
+        pk_pack_job_from_json(in, &job, &errs);
+        CHECK_MSG(job.opt.edmd.prm.growth_rate == doc[q].gamma, "%s γ %g", doc[q].quality,
+                  job.opt.edmd.prm.growth_rate);
+        CHECK_MSG(job.opt.edmd.prm.p_max == doc[q].p_max, "%s p %g", doc[q].quality,
+                  job.opt.edmd.prm.p_max);
+        json_object_set_new(in, "algorithm", json_string("rsa"));
+        pk_pack_job_from_json(in, &job, &errs);
+        CHECK_MSG((double)job.opt.rsa.max_failed_draws == doc[q].nf, "%s N^F", doc[q].quality);
+        pk_options_fill(&pk_homog_options, in, &hj, &errs);
+        CHECK_MSG(hj.tol == doc[q].tol, "%s tol %g", doc[q].quality, hj.tol);
+        pk_schema_errors_free(&errs);
+        json_decref(in);
+    }
+}
+
 int main(void)
 {
     collect_tables();
     RUN(test_tables_match_schemas);
+    RUN(test_quality_columns);
+    RUN(test_documented_presets);
     RUN(test_bad_values_named);
     RUN(test_empty_sieve_refused);
     return check_summary();
