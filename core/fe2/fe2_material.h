@@ -19,8 +19,8 @@ typedef struct pk_fe2_gp_info {
     double energy;       /* Φ̄ (energy density of the RVE), 0 if n/a */
     double coordination; /* contacts per grain, 0 if n/a */
     size_t rattlers;
-    size_t relax_iter;   /* iterations of the micro relaxation */
-    double seconds;      /* CPU/wall of this evaluation */
+    size_t relax_iter; /* iterations of the micro relaxation */
+    double seconds;    /* CPU/wall of this evaluation */
 } pk_fe2_gp_info;
 
 typedef struct pk_fe2_material {

@@ -14,9 +14,11 @@
 
 typedef struct pk_fe2_mesh {
     size_t nnode, nelem;
-    double *xy;        /* [nnode][2] reference coordinates */
-    int32_t *conn;     /* [nelem][4]; conn[e][3] = −1 for a triangle */
-    size_t *gp_first;  /* [nelem + 1], filled by pk_fe2_mesh_finish */
+    double *xy;       /* [nnode][2] reference coordinates */
+    int32_t *conn;    /* [nelem][4]; conn[e][3] = −1 for a triangle */
+    size_t *gp_first; /* [nelem + 1], filled by pk_fe2_mesh_finish */
+    /* The arrays are owned by the mesh (malloc'ed; pk_fe2_mesh_free frees
+     * them); gp_first is NULL until pk_fe2_mesh_finish. */
 } pk_fe2_mesh;
 
 /* Nodes of element e (3 or 4). */
@@ -31,10 +33,22 @@ size_t pk_fe2_gauss_count(const pk_fe2_mesh *m);
 int pk_fe2_mesh_finish(pk_fe2_mesh *m, char *err, size_t errlen);
 
 /* A rectangle [0, lx] × [0, ly] in nx × ny Q1 elements (nodes row by row
- * from the lower-left corner: node = j·(nx+1) + i).  0 / −1 (memory). */
+ * from the lower-left corner: node = j·(nx+1) + i).  0 / −1 (memory, or
+ * an empty rectangle). */
 int pk_fe2_mesh_rectangle(double lx, double ly, size_t nx, size_t ny, pk_fe2_mesh *m);
 
 void pk_fe2_mesh_free(pk_fe2_mesh *m);
+
+/* Gauss points of element e (1 for a triangle, 4 for a Q1). */
+int pk_fe2_elem_gauss(const pk_fe2_mesh *m, size_t e);
+
+/* Shape functions of element e at its local Gauss point q: N[a], their
+ * reference gradients dNdX[2·a + J] = ∂N_a/∂X_J (a < pk_fe2_elem_nodes) and
+ * the Gauss weight × det J (the reference area the point carries).
+ * Q1: ξ, η = ±1/√3, weights 1, points in the order of the nodes
+ * (−−, +−, ++, −+); triangle: the centroid, weight ½.  0, or −1 when
+ * det J <= 0 (clockwise or degenerate). */
+int pk_fe2_shape(const pk_fe2_mesh *m, size_t e, int q, double N[4], double dNdX[8], double *wdet);
 
 /* Reference position of Gauss point g (its element and weight·|J| too, any
  * of them NULL). */

@@ -11,7 +11,12 @@
  * prescribed displacements are values of listed degrees of freedom.  A load
  * step moves both linearly from the last converged values to the step's
  * targets; a cut step does the same in smaller parts.  The material is
- * committed (Remark 4.4) only when a (part of a) step converged. */
+ * committed (Remark 4.4) only when a (part of a) step converged.
+ *
+ * K is assembled from (Ā + Āᵀ)/2 at each Gauss point: the frictionless RVE
+ * tangent has major symmetry (Meier (2.13); test_homog_tangent: defect
+ * < 1e-12), so this only removes round-off, and the LDLᵀ solver stores one
+ * triangle. */
 #ifndef PK_FE2_SOLVER_H
 #define PK_FE2_SOLVER_H
 
@@ -36,27 +41,29 @@ typedef struct pk_fe2_problem {
     const pk_fe2_mesh *mesh;
     const pk_fe2_material *mat;
     size_t nfix;
-    const int32_t *fix_dof; /* [nfix] prescribed degrees of freedom, distinct */
+    const int32_t *fix_dof;         /* [nfix] prescribed degrees of freedom, distinct */
     const pk_sparse_solver *solver; /* factorises K over the free dofs (LDLᵀ) */
     pk_par *par;                    /* Gauss points in parallel (NULL: serial) */
 } pk_fe2_problem;
 
 typedef struct pk_fe2_newton_opts {
-    double rtol;        /* |R_free| / |R_free of iteration 1| below which a step converged */
-    double atol;        /* |R_free| below which a step converged regardless */
-    int max_iter;       /* Newton iterations per (part of a) step */
-    int line_search;    /* 1: line search on R·Δu (FEAP's rule) */
-    int max_cuts;       /* halvings of a step before the job fails */
+    double rtol;     /* |R_free| / |R_free of iteration 1| below which a step converged */
+    double atol;     /* |R_free| below which a step converged regardless */
+    int max_iter;    /* Newton iterations per (part of a) step */
+    int line_search; /* 1: line search on R·Δu (FEAP's rule) */
+    int max_cuts;    /* halvings of a step before the job fails */
 } pk_fe2_newton_opts;
 
 /* The converged macro state: displacements, the prescribed values and
  * f_ext reached, and the Gauss-point fields of the last converged state. */
 typedef struct pk_fe2_state {
     size_t ndof, ngp;
-    double *u;      /* [ndof] */
-    double *fext;   /* [ndof] */
-    double *F, *P;  /* [ngp][4] */
-    double *A;      /* [ngp][16] */
+    double *u;          /* [ndof] */
+    double *fext;       /* [ndof] */
+    double *fint;       /* [ndof] internal forces; the reactions of a set of
+                       prescribed dofs are Σ (fint − fext) over it */
+    double *F, *P;      /* [ngp][4] */
+    double *A;          /* [ngp][16] */
     pk_fe2_gp_info *gp; /* [ngp] */
 } pk_fe2_state;
 
@@ -65,21 +72,23 @@ void pk_fe2_state_free(pk_fe2_state *s);
 
 /* One Newton solve (one converged part of a load step). */
 typedef struct pk_fe2_iterations {
-    double t0, t1;        /* the part of the step, as fractions of it */
-    int n;                /* iterations */
-    double res[64];       /* relative residual norms, res[0] = 1 */
-    double abs_res0;      /* |R_free| of iteration 1 */
-    double ls_eta[64];    /* line-search factor of each iteration (1 = full step) */
+    double t0, t1;     /* the part of the step, as fractions of it */
+    int n;             /* residual norms recorded (the thesis tables' "iter"
+                             column): n − 1 Newton corrections */
+    double res[64];    /* relative residual norms |R_free| / abs_res0, res[0] = 1 */
+    double abs_res0;   /* |R_free| of iteration 1 */
+    double ls_eta[64]; /* line-search factor of each iteration (1 = full step) */
     int converged;
 } pk_fe2_iterations;
 
 typedef struct pk_fe2_step_report {
-    int converged;        /* the whole step */
-    int cuts;             /* halvings used */
-    size_t nparts;        /* parts tried (converged or not), ≤ cap */
+    int converged; /* the whole step */
+    int cuts;      /* halvings used */
+    size_t nparts; /* parts tried (converged or not), ≤ cap */
     pk_fe2_iterations parts[32];
-    double reaction[2];   /* Σ of the internal forces over the prescribed dofs, by component */
-    char why[256];        /* the reason a step failed */
+    double reaction[2]; /* Σ (f_int − f_ext) over the prescribed dofs, by component
+                             (the internal forces when no load acts on them) */
+    char why[256];      /* the reason a step failed */
 } pk_fe2_step_report;
 
 /* Move from the state *s to the targets uD_target [nfix] (values of
@@ -95,8 +104,9 @@ int pk_fe2_step(const pk_fe2_problem *pb, const pk_fe2_newton_opts *o, pk_fe2_st
 /* The global residual R(u) = f_int(u) − f_ext and, with K non-NULL, the
  * stiffness over all dofs (upper triangle) at the displacement u, from trial
  * evaluations of the material (nothing committed): the macro tangent test
- * compares K with finite differences of R.  0, or non-zero when a Gauss
- * point failed. */
+ * compares K with finite differences of R.  K->n is set to 2·nnode and its
+ * triplets replaced (K->nnz reset, storage reused).  fext may be NULL
+ * (R = f_int).  0, 1 when a Gauss point failed (why says which), −1 memory. */
 int pk_fe2_residual(const pk_fe2_problem *pb, const double *u, const double *fext, double *R,
                     pk_sparse_sym *K, char *why, size_t whylen);
 
