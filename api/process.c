@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "api/fe2/fe2_job.h"
 #include "api/homog/homog_job.h"
 #include "api/inputs/input_links.h"
 #include "job_verdict.h"
@@ -35,7 +36,23 @@ static const pk_process homogenize_process = {
     .run = pk_homog_run,
 };
 
-const pk_process *const pk_processes[] = {&pack_process, &homogenize_process, NULL};
+static const pk_process fe2_process = {
+    .id = "fe2",
+    .title = "FE²: a plane-strain boundary value problem with a DEM RVE at every Gauss point",
+    .description = "Solve a 2D plane-strain finite-element problem (Q1 and triangles; a rectangle, "
+                   "an inline mesh or a Gmsh file) whose material at every Gauss point is a "
+                   "packing homogenized as a DEM RVE (Meier 2009 ch. 6): load stages of "
+                   "prescribed displacements, pressures, tractions, forces and gravity, "
+                   "Newton–Raphson with the consistent tangent, a line search and load-step "
+                   "cutting; writes an H5MD result file with the mesh, the fields per converged "
+                   "load step and the Newton histories.",
+    .inputs_schema = "fe2.inputs.schema.json",
+    .parse = pk_fe2_parse,
+    .free_job = pk_fe2_free,
+    .run = pk_fe2_run,
+};
+
+const pk_process *const pk_processes[] = {&pack_process, &homogenize_process, &fe2_process, NULL};
 
 const pk_process *pk_process_find(const char *id)
 {

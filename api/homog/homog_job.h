@@ -8,6 +8,7 @@
 
 #include "api/inputs/check_ctx.h"
 #include "core/homog/homog_bc.h"
+#include "core/homog/homog_rve.h"
 #include "api/schemas/json_schema.h"
 #include "api/schemas/option_table.h"
 #include "core/base/progress.h"
@@ -65,6 +66,10 @@ extern const pk_option_table pk_homog_options;
  * error). */
 size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_errors *errs);
 void pk_homog_job_free(pk_homog_job *job);
+
+/* The relaxation options of job for the RVE rve (homog_run.c; also the
+ * RVEs of 'fe2'). */
+void pk_homog_opts_of(const pk_homog_job *job, const pk_homog_rve *rve, pk_homog_opts *o);
 
 /* process table hooks (see process.h): parse returns a pk_homog_job */
 void *pk_homog_parse(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);

@@ -20,7 +20,7 @@
 #include "api/process.h"
 #include "api/solver/sparse_cholmod.h"
 
-static void opts_of(const pk_homog_job *job, const pk_homog_rve *rve, pk_homog_opts *o)
+void pk_homog_opts_of(const pk_homog_job *job, const pk_homog_rve *rve, pk_homog_opts *o)
 {
     double rmean = 0;
     for (size_t i = 0; i < rve->n; i++)
@@ -164,7 +164,7 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
             goto out;
         }
     pk_homog_opts o;
-    opts_of(&job, &rve, &o);
+    pk_homog_opts_of(&job, &rve, &o);
     pk_homog_frames_init(&fr, &rve, job.nstep);
     /* a contact pattern seen in an earlier factorisation of this job (elastic
      * load steps) reuses its analysis; without a context (NULL on failure)

@@ -934,8 +934,8 @@ static int add_to_group(pk_mesh2d *m, const phys_names *pn, int dim, long long p
 }
 
 static int raw2d_to_mesh(const raw_mesh *nodes, const raw2d *w, const ent_tab *et,
-                         const phys_names *pn, int major, const char *path, pk_mesh2d *m,
-                         char *err, size_t errlen)
+                         const phys_names *pn, int major, const char *path, pk_mesh2d *m, char *err,
+                         size_t errlen)
 {
     size_t ne = 0;
     for (size_t k = 0; k < w->n; k++)

@@ -248,6 +248,77 @@ static int steps_grid(FILE *f, hid_t h, const char *ref)
     return 1;
 }
 
+/* An fe2 result's macro mesh over its converged load steps: a temporal
+ * collection of the deformed mesh (Quadrilateral, Triangle or Mixed from
+ * /observables/fe2/mesh/xdmf_topology) with the displacement per node and
+ * the element-averaged von Mises stress per cell, through the per-step
+ * views /observables/fe2/views/<name>/<k>. */
+static int fe2_grid(FILE *f, hid_t h, const char *ref)
+{
+    const char *top = "/observables/fe2/mesh/xdmf_topology", *el = "/observables/fe2/mesh/elements",
+               *tim = "/observables/fe2/load_steps/time";
+    hsize_t dt[3], de[3], dk[3], dn[3];
+    if (dims_of(h, top, dt) != 1 || dims_of(h, el, de) != 2 || dims_of(h, tim, dk) != 1 || !dk[0] ||
+        dims_of(h, "/observables/fe2/views/position/0", dn) != 2)
+        return 0;
+    /* the flat topology's length tells the kind: 4 or 3 per element, else Mixed */
+    const char *kind = dt[0] == 4 * de[0] ? "Quadrilateral"
+        : dt[0] == 3 * de[0]              ? "Triangle"
+                                          : "Mixed";
+    double *t = malloc(dk[0] * sizeof *t);
+    hid_t ds = H5Dopen2(h, tim, H5P_DEFAULT);
+    int ok = t && ds >= 0 && H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, t) >= 0;
+    if (ds >= 0)
+        H5Dclose(ds);
+    if (!ok) {
+        free(t);
+        return 0;
+    }
+    const unsigned long long ne = de[0], nn = dn[0];
+    int npe = !strcmp(kind, "Triangle") ? 3 : !strcmp(kind, "Quadrilateral") ? 4 : 0;
+    char s[64], view[96];
+    fprintf(f,
+            "    <Grid Name=\"load steps\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
+    for (hsize_t k = 0; k < dk[0]; k++) {
+        fprintf(f,
+                "      <Grid Name=\"step %llu\" GridType=\"Uniform\">\n"
+                "        <Time Value=\"%.17g\"/>\n",
+                (unsigned long long)k, t[k]);
+        if (npe)
+            fprintf(f,
+                    "        <Topology TopologyType=\"%s\" NumberOfElements=\"%llu\" "
+                    "NodesPerElement=\"%d\">\n",
+                    kind, ne, npe);
+        else
+            fprintf(f, "        <Topology TopologyType=\"Mixed\" NumberOfElements=\"%llu\">\n", ne);
+        snprintf(s, sizeof s, "%llu", (unsigned long long)dt[0]);
+        item(f, "          ", s, "Int", 8, ref, top);
+        fprintf(f, "        </Topology>\n        <Geometry GeometryType=\"XY\">\n");
+        snprintf(view, sizeof view, "/observables/fe2/views/position/%llu", (unsigned long long)k);
+        snprintf(s, sizeof s, "%llu 2", nn);
+        item(f, "          ", s, "Float", 8, ref, view);
+        fprintf(f,
+                "        </Geometry>\n"
+                "        <Attribute Name=\"displacement\" AttributeType=\"Vector\" "
+                "Center=\"Node\">\n");
+        snprintf(view, sizeof view, "/observables/fe2/views/displacement/%llu",
+                 (unsigned long long)k);
+        item(f, "          ", s, "Float", 8, ref, view);
+        fprintf(
+            f,
+            "        </Attribute>\n"
+            "        <Attribute Name=\"von_mises\" AttributeType=\"Scalar\" Center=\"Cell\">\n");
+        snprintf(view, sizeof view, "/observables/fe2/views/von_mises_element/%llu",
+                 (unsigned long long)k);
+        snprintf(s, sizeof s, "%llu", ne);
+        item(f, "          ", s, "Float", 8, ref, view);
+        fprintf(f, "        </Attribute>\n      </Grid>\n");
+    }
+    fprintf(f, "    </Grid>\n");
+    free(t);
+    return 1;
+}
+
 int pk_xdmf_write(const char *h5_path, const char *h5_ref, const char *xdmf_path, char *err,
                   size_t errlen)
 {
@@ -287,7 +358,7 @@ int pk_xdmf_write(const char *h5_path, const char *h5_ref, const char *xdmf_path
             ref);
     /* a load path replaces the reference grains: the Xdmf3 reader shows only
      * the temporal collection of a domain that has one */
-    if (!steps_grid(f, h, ref))
+    if (!fe2_grid(f, h, ref) && !steps_grid(f, h, ref))
         grains_grid(f, h, ref, n, b.dim);
     mesh_grid(f, h, ref);
     fprintf(f, "  </Domain>\n</Xdmf>\n");

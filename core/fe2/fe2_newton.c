@@ -61,13 +61,14 @@ typedef struct step_ws {
     const pk_fe2_newton_opts *o;
     pk_monitor *mon;
     size_t ndof, nfree, evals;
-    int32_t *map; /* [ndof] free index or −1 */
-    double *u;    /* [ndof] the iterate */
-    double *utry; /* [ndof] a line-search trial */
-    double *fext; /* [ndof] f_ext of the part's end */
-    double *fint; /* [ndof] */
-    double *rhs;  /* [nfree] −R_free */
-    double *du;   /* [nfree] */
+    int32_t *map;  /* [ndof] free index or −1 */
+    double *u;     /* [ndof] the iterate */
+    double *utry;  /* [ndof] a line-search trial */
+    double *fext;  /* [ndof] f_ext of the part's end */
+    double *fint;  /* [ndof] */
+    double *rhs;   /* [nfree] −R_free */
+    double *du;    /* [nfree] */
+    double *delta; /* [ndof] the part's prescribed increments, 0 on free dofs */
     pk_sparse_sym K;
     fe2_gp_buf b;
     char why[256];
@@ -177,18 +178,81 @@ static int line_search(step_ws *w, double *eta)
     return PART_CONVERGED;
 }
 
-/* Newton from w->u (prescribed dofs already at the part's end) to
- * equilibrium under w->fext. */
-static int newton(step_ws *w, pk_fe2_iterations *it)
+/* The tangent predictor of the part (fe2_solver.h): from the converged
+ * state s (its A and fint), the prescribed increments delta [ndof] (0 on the
+ * free dofs) and w->fext: w->u = s->u + Δu_D, the linearised −R in rhs, its
+ * norm in *r_ref, and with *have_du the correction Δu_f in du (none when
+ * the start has no usable tangent, e.g. a loose packing). */
+static int predictor(step_ws *w, const pk_fe2_state *s, const double *delta, double *r_ref,
+                     int *have_du)
+{
+    const pk_fe2_problem *pb = w->pb;
+    *have_du = 0;
+    memcpy(w->b.A, s->A, 16 * w->b.ngp * sizeof *s->A);
+    double *Kd = w->utry; /* scratch: K·Δu_D over all dofs */
+    if (fe2_stiffness(pb, &w->b, NULL, w->ndof, &w->K) != 0)
+        return PART_FATAL;
+    pk_sparse_sym_mv(&w->K, delta, Kd);
+    double r2 = 0;
+    for (size_t d = 0; d < w->ndof; d++) {
+        w->u[d] = s->u[d] + delta[d];
+        if (w->map[d] >= 0) {
+            const double R = s->fint[d] - w->fext[d] + Kd[d];
+            w->rhs[w->map[d]] = -R;
+            r2 += R * R;
+        }
+    }
+    *r_ref = sqrt(r2);
+    if (!(*r_ref > 0) || w->nfree == 0)
+        return PART_CONVERGED;
+    if (fe2_stiffness(pb, &w->b, w->map, w->nfree, &w->K) != 0)
+        return PART_FATAL;
+    pk_sparse_info info;
+    pk_sparse_factor *f = pb->solver->factor(&w->K, &info);
+    if (!f)
+        return info.status == PK_SPARSE_FAILED ? PART_FATAL : PART_CONVERGED;
+    int src = pb->solver->solve(f, 1, w->rhs, w->du);
+    pb->solver->release(f);
+    if (src != 0)
+        return PART_FATAL;
+    *have_du = 1;
+    return PART_CONVERGED;
+}
+
+static double norm_free(const step_ws *w)
+{
+    double r = 0;
+    for (size_t q = 0; q < w->nfree; q++)
+        r += w->rhs[q] * w->rhs[q];
+    return sqrt(r);
+}
+
+/* One part: the predictor from s, then Newton to equilibrium under w->fext. */
+static int newton(step_ws *w, const pk_fe2_state *s, const double *delta, pk_fe2_iterations *it)
 {
     const pk_fe2_problem *pb = w->pb;
     const pk_fe2_newton_opts *o = w->o;
-    int rc = round_at(w, w->u);
+    double r0, r, eta = 1;
+    int have_du, rc = predictor(w, s, delta, &r0, &have_du);
+    if (rc != PART_CONVERGED) {
+        snprintf(w->why, sizeof w->why, "out of memory or solver failure (predictor)");
+        return rc;
+    }
+    it->abs_res0 = r0;
+    it->res[it->n++] = 1;
+    /* the predictor's correction takes the line search too: g(0) is the
+     * linearised residual's R·Δu */
+    if (have_du)
+        rc = line_search(w, &eta);
+    else if ((rc = round_at(w, w->u)) == PART_CONVERGED)
+        free_residual(w);
     if (rc != PART_CONVERGED)
         return rc;
-    double r = free_residual(w), r0 = r;
-    it->abs_res0 = r0;
-    for (int k = 0;; k++) {
+    it->ls_eta[0] = eta;
+    r = norm_free(w);
+    if (!(r0 > 0))
+        r0 = r;
+    for (int k = 1;; k++) {
         const double rel = r0 > 0 ? r / r0 : 0;
         if (it->n < 64)
             it->res[it->n++] = rel;
@@ -196,11 +260,11 @@ static int newton(step_ws *w, pk_fe2_iterations *it)
             snprintf(w->why, sizeof w->why, "residual not finite");
             return PART_FAILED;
         }
-        if (r <= o->atol || (k > 0 && rel <= o->rtol) || r0 == 0) {
+        if (r <= o->atol || rel <= o->rtol) {
             it->converged = 1;
             return PART_CONVERGED;
         }
-        if (k >= o->max_iter) {
+        if (k > o->max_iter) {
             snprintf(w->why, sizeof w->why,
                      "no convergence in %d iterations (relative residual %.3g)", o->max_iter, rel);
             return PART_FAILED;
@@ -221,22 +285,19 @@ static int newton(step_ws *w, pk_fe2_iterations *it)
             snprintf(w->why, sizeof w->why, "macro solve failed");
             return PART_FATAL;
         }
-        double eta = 1;
+        eta = 1;
         if ((rc = line_search(w, &eta)) != PART_CONVERGED)
             return rc;
         if (k < 64)
             it->ls_eta[k] = eta;
-        r = 0;
-        for (size_t q = 0; q < w->nfree; q++)
-            r += w->rhs[q] * w->rhs[q];
-        r = sqrt(r);
+        r = norm_free(w);
     }
 }
 
 static void ws_free(step_ws *w)
 {
     free(w->map), free(w->u), free(w->utry), free(w->fext), free(w->fint), free(w->rhs);
-    free(w->du);
+    free(w->du), free(w->delta);
     pk_sparse_sym_free(&w->K);
     fe2_gp_buf_free(&w->b);
 }
@@ -251,7 +312,8 @@ static int ws_init(step_ws *w, const pk_fe2_problem *pb)
     w->fint = calloc(nd, sizeof *w->fint);
     w->rhs = calloc(nd, sizeof *w->rhs);
     w->du = calloc(nd, sizeof *w->du);
-    if (!w->map || !w->u || !w->utry || !w->fext || !w->fint || !w->rhs || !w->du ||
+    w->delta = calloc(nd, sizeof *w->delta);
+    if (!w->delta || !w->map || !w->u || !w->utry || !w->fext || !w->fint || !w->rhs || !w->du ||
         fe2_gp_buf_init(&w->b, pb->mesh) != 0) {
         snprintf(w->why, sizeof w->why, "out of memory");
         return -1;
@@ -272,6 +334,17 @@ static int ws_init(step_ws *w, const pk_fe2_problem *pb)
     return 0;
 }
 
+/* The last round's Gauss-point fields and f_int into s. */
+static void keep_round(const step_ws *w, pk_fe2_state *s)
+{
+    memcpy(s->fint, w->fint, w->ndof * sizeof *s->fint);
+    memcpy(s->F, w->b.F, 4 * w->b.ngp * sizeof *s->F);
+    memcpy(s->P, w->b.P, 4 * w->b.ngp * sizeof *s->P);
+    memcpy(s->A, w->b.A, 16 * w->b.ngp * sizeof *s->A);
+    memcpy(s->gp, w->b.info, w->b.ngp * sizeof *s->gp);
+    s->evaluated = 1;
+}
+
 /* The converged part becomes the state: commit every Gauss point. */
 static int accept_part(step_ws *w, pk_fe2_state *s)
 {
@@ -283,12 +356,21 @@ static int accept_part(step_ws *w, pk_fe2_state *s)
         }
     memcpy(s->u, w->u, w->ndof * sizeof *s->u);
     memcpy(s->fext, w->fext, w->ndof * sizeof *s->fext);
-    memcpy(s->fint, w->fint, w->ndof * sizeof *s->fint);
-    memcpy(s->F, w->b.F, 4 * w->b.ngp * sizeof *s->F);
-    memcpy(s->P, w->b.P, 4 * w->b.ngp * sizeof *s->P);
-    memcpy(s->A, w->b.A, 16 * w->b.ngp * sizeof *s->A);
-    memcpy(s->gp, w->b.info, w->b.ngp * sizeof *s->gp);
+    keep_round(w, s);
     return 0;
+}
+
+/* A state never evaluated (the first step): the material at s->u, a trial
+ * from the committed history at the same F̄ (nothing committed), for the
+ * predictor's tangent and f_int. */
+static int evaluate_state(step_ws *w, pk_fe2_state *s)
+{
+    int rc = round_at(w, s->u);
+    if (rc != PART_CONVERGED)
+        return rc;
+    fe2_internal_force(w->pb, &w->b, w->fint);
+    keep_round(w, s);
+    return PART_CONVERGED;
 }
 
 int pk_fe2_step(const pk_fe2_problem *pb, const pk_fe2_newton_opts *o, pk_fe2_state *s,
@@ -307,19 +389,28 @@ int pk_fe2_step(const pk_fe2_problem *pb, const pk_fe2_newton_opts *o, pk_fe2_st
     for (size_t k = 0; k < pb->nfix; k++)
         uD0[k] = s->u[pb->fix_dof[k]];
     memcpy(fext0, s->fext, s->ndof * sizeof *fext0);
+    if (!s->evaluated) {
+        int rc = evaluate_state(&w, s);
+        if (rc != PART_CONVERGED) {
+            snprintf(rep->why, sizeof rep->why, "the start state: %.230s", w.why);
+            ret = rc == PART_CANCELLED ? 2 : rc == PART_FAILED ? 1 : -1;
+            goto out;
+        }
+    }
     double t0 = 0, dt = 1;
     while (t0 < 1) {
         const double t1 = fmin(t0 + dt, 1.0);
         pk_fe2_iterations scratch, *it = rep->nparts < 32 ? &rep->parts[rep->nparts++] : &scratch;
         memset(it, 0, sizeof *it);
         it->t0 = t0, it->t1 = t1;
-        memcpy(w.u, s->u, s->ndof * sizeof *w.u);
-        for (size_t k = 0; k < pb->nfix; k++)
-            w.u[pb->fix_dof[k]] = uD0[k] + t1 * (uD_target[k] - uD0[k]);
+        for (size_t k = 0; k < pb->nfix; k++) {
+            const int32_t d = pb->fix_dof[k];
+            w.delta[d] = uD0[k] + t1 * (uD_target[k] - uD0[k]) - s->u[d];
+        }
         for (size_t d = 0; d < s->ndof; d++)
             w.fext[d] = fext0[d] + t1 * (fext_target[d] - fext0[d]);
         w.why[0] = 0;
-        int rc = newton(&w, it);
+        int rc = newton(&w, s, w.delta, it);
         if (rc == PART_CONVERGED) {
             if (accept_part(&w, s) != 0) {
                 snprintf(rep->why, sizeof rep->why, "%s", w.why);

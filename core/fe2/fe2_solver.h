@@ -65,9 +65,13 @@ typedef struct pk_fe2_state {
     double *F, *P;      /* [ngp][4] */
     double *A;          /* [ngp][16] */
     pk_fe2_gp_info *gp; /* [ngp] */
+    int evaluated;      /* fint, F, P, A, gp belong to u (set by pk_fe2_step; 0
+                           after init: the first step evaluates the material at
+                           u once, without commit, for its tangent) */
 } pk_fe2_state;
 
-int pk_fe2_state_init(pk_fe2_state *s, const pk_fe2_mesh *m); /* zeros; 0 / −1 */
+/* u = fext = 0, F = 1, not evaluated.  0 / −1. */
+int pk_fe2_state_init(pk_fe2_state *s, const pk_fe2_mesh *m);
 void pk_fe2_state_free(pk_fe2_state *s);
 
 /* One Newton solve (one converged part of a load step). */
@@ -77,7 +81,8 @@ typedef struct pk_fe2_iterations {
                              column): n − 1 Newton corrections */
     double res[64];    /* relative residual norms |R_free| / abs_res0, res[0] = 1 */
     double abs_res0;   /* |R_free| of iteration 1 */
-    double ls_eta[64]; /* line-search factor of each iteration (1 = full step) */
+    double ls_eta[64]; /* line-search factor of the correction after res[k]
+                          (1 = full step; ls_eta[0] = 1, the predictor) */
     int converged;
 } pk_fe2_iterations;
 
@@ -91,7 +96,13 @@ typedef struct pk_fe2_step_report {
     char why[256];      /* the reason a step failed */
 } pk_fe2_step_report;
 
-/* Move from the state *s to the targets uD_target [nfix] (values of
+/* Each part starts with the tangent predictor (the last converged state's
+ * K and f_int, the prescribed increments Δu_D moved to the right-hand side:
+ * K_ff Δu_f = −(f_int − f_ext(t1) + K_fD Δu_D)), so the material's first
+ * trial of a part is already near equilibrium; then Newton iterations
+ * evaluate the material until the residual converges.
+ *
+ * Move from the state *s to the targets uD_target [nfix] (values of
  * problem->fix_dof) and fext_target [ndof].  On success *s holds the new
  * converged state and the material is committed; on failure *s and the
  * material keep the last converged part (the report says how far it got).

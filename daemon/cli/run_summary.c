@@ -58,6 +58,25 @@ static void homogenize_lines(FILE *f, const json_t *s)
                                                                  : ", audit FAILED");
 }
 
+static void fe2_lines(FILE *f, const json_t *s)
+{
+    fprintf(f, "  mesh      %lld nodes, %lld elements, %lld Gauss points × %lld grains\n",
+            (long long)json_integer_value(json_object_get(s, "nodes")),
+            (long long)json_integer_value(json_object_get(s, "elements")),
+            (long long)json_integer_value(json_object_get(s, "gauss_points")),
+            (long long)json_integer_value(json_object_get(s, "rve_particles")));
+    json_t *d = json_object_get(s, "dilatancy_percent_per_step");
+    fprintf(f, "  steps     %lld of %lld, %lld Newton iterations, %lld cuts",
+            (long long)json_integer_value(json_object_get(s, "steps")),
+            (long long)json_integer_value(json_object_get(s, "steps_requested")),
+            (long long)json_integer_value(json_object_get(s, "newton_iterations_total")),
+            (long long)json_integer_value(json_object_get(s, "step_cuts_total")));
+    if (json_array_size(d))
+        fprintf(f, "; dilatancy %.4g %%",
+                json_number_value(json_array_get(d, json_array_size(d) - 1)));
+    fputc('\n', f);
+}
+
 void pk_run_summary_print(FILE *f, const json_t *s, double seconds, int utf8)
 {
     const char *process = str(s, "process"), *algo = str(s, "algorithm");
@@ -73,6 +92,8 @@ void pk_run_summary_print(FILE *f, const json_t *s, double seconds, int utf8)
     fputc('\n', f);
     if (!strcmp(process, "homogenize"))
         homogenize_lines(f, s);
+    else if (!strcmp(process, "fe2"))
+        fe2_lines(f, s);
     else
         pack_lines(f, s, utf8 ? "φ        " : "phi      "); /* 9 columns */
     char t[32];

@@ -8,6 +8,7 @@
  *            checks it: caps, server paths (refused, then confined to an
  *            input directory), the process checks in the service context
  *   gmsh     a Gmsh .msh file through pk_mesh_from_json (read + mesh check)
+ *            and through the 2D reader of the fe2 macro mesh (pk_mesh2d_read_msh)
  *   tetgen   a TetGen pair: the bytes up to the first NUL are <base>.node,
  *            the rest <base>.ele
  *   h5_rve   an HDF5 file through the RVE reader pk_h5_read_particles; the
@@ -124,8 +125,13 @@ static inline void fuzz_gmsh(const uint8_t *data, size_t size)
 {
     char p[128];
     snprintf(p, sizeof p, "%s/f.msh", fuzz_dir());
-    if (fuzz_write(p, data, size) == 0)
+    if (fuzz_write(p, data, size) == 0) {
         fuzz_mesh_file(p);
+        pk_mesh2d m2;
+        char err[512];
+        if (pk_mesh2d_read_msh(p, 100000, &m2, err, sizeof err) == 0)
+            pk_mesh2d_free(&m2);
+    }
 }
 
 static inline void fuzz_tetgen(const uint8_t *data, size_t size)

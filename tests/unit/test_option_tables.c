@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "api/fe2/fe2_job.h"
 #include "api/homog/homog_job.h"
 #include "api/pack/pack_job.h"
 #include "api/pack/pack_placer.h"
@@ -144,6 +145,7 @@ static void collect_tables(void)
 {
     tables[ntables++] = &pk_pack_options;
     tables[ntables++] = &pk_homog_options;
+    tables[ntables++] = &pk_fe2_options;
     for (size_t i = 0; pk_placers[i]; i++)
         if (pk_placers[i]->options)
             tables[ntables++] = pk_placers[i]->options;
@@ -210,8 +212,9 @@ static void test_tables_match_schemas(void)
         free(filled);
     }
     static const char *const schemas[] = {"pack.inputs.schema.json",
-                                          "homogenize.inputs.schema.json"};
-    for (int s = 0; s < 2; s++)
+                                          "homogenize.inputs.schema.json",
+                                          "fe2.inputs.schema.json"};
+    for (int s = 0; s < 3; s++)
         bad += defaults_covered(schemas[s], pk_schema_get(schemas[s]), pk_schema_get(schemas[s]),
                                 "", 0);
     CHECK_MSG(bad == 0, "%d mismatches between the option tables and the schemas", bad);

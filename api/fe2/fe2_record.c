@@ -1,0 +1,307 @@
+/* fe2_record.c — the fe2 run's record and its H5MD-style layout; the
+ * contract is in fe2_record.h. */
+#include "fe2_record.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int push(pk_fe2_dbuf *d, const double *v, size_t n)
+{
+    if (d->n + n > d->cap) {
+        size_t c = d->cap ? 2 * d->cap : 64;
+        while (c < d->n + n)
+            c *= 2;
+        double *p = realloc(d->v, c * sizeof *p);
+        if (!p)
+            return -1;
+        d->v = p;
+        d->cap = c;
+    }
+    if (n)
+        memcpy(d->v + d->n, v, n * sizeof *v);
+    d->n += n;
+    return 0;
+}
+
+static int push1(pk_fe2_dbuf *d, double v) { return push(d, &v, 1); }
+
+/* The area of the mesh with nodes at x (Σ of the elements' polygons). */
+static double mesh_area(const pk_fe2_mesh *m, const double *x)
+{
+    double a = 0;
+    for (size_t e = 0; e < m->nelem; e++) {
+        int nen = pk_fe2_elem_nodes(m, e);
+        for (int i = 0; i < nen; i++) {
+            size_t p = (size_t)m->conn[4 * e + i], q = (size_t)m->conn[4 * e + (i + 1) % nen];
+            a += 0.5 * (x[2 * p] * x[2 * q + 1] - x[2 * q] * x[2 * p + 1]);
+        }
+    }
+    return a;
+}
+
+int pk_fe2_record_init(pk_fe2_record *r, const pk_fe2_setup *s, const size_t *micro_gp,
+                       size_t nmicro, size_t ngrain)
+{
+    memset(r, 0, sizeof *r);
+    r->s = s;
+    r->ngp = pk_fe2_gauss_count(&s->mesh);
+    r->micro_gp = micro_gp;
+    r->nmicro = nmicro;
+    r->ngrain = ngrain;
+    r->area0 = mesh_area(&s->mesh, s->mesh.xy);
+    return 0;
+}
+
+static pk_fe2_dbuf *bufs(pk_fe2_record *r, size_t *n)
+{
+    *n = (size_t)(&r->it_eta - &r->step) + 1;
+    return &r->step;
+}
+
+void pk_fe2_record_free(pk_fe2_record *r)
+{
+    size_t n;
+    pk_fe2_dbuf *b = bufs(r, &n);
+    for (size_t i = 0; i < n; i++)
+        free(b[i].v);
+    memset(r, 0, sizeof *r);
+}
+
+int pk_fe2_record_newton(pk_fe2_record *r, size_t step, const pk_fe2_step_report *rep)
+{
+    int rc = 0;
+    for (size_t p = 0; p < rep->nparts; p++) {
+        const pk_fe2_iterations *it = &rep->parts[p];
+        double part = (double)r->part_step.n;
+        rc |= push1(&r->part_step, (double)step) | push1(&r->part_t0, it->t0) |
+            push1(&r->part_t1, it->t1) | push1(&r->part_n, it->n) |
+            push1(&r->part_abs0, it->abs_res0) | push1(&r->part_conv, it->converged);
+        for (int k = 0; k < it->n && k < 64; k++)
+            rc |= push1(&r->it_part, part) | push1(&r->it_res, it->res[k]) |
+                push1(&r->it_eta, it->ls_eta[k]);
+    }
+    return rc ? -1 : 0;
+}
+
+void pk_fe2_cauchy(const double F[4], const double P[4], double sigma[4])
+{
+    const double J = F[0] * F[3] - F[1] * F[2];
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 2; j++)
+            sigma[2 * i + j] = (P[2 * i] * F[2 * j] + P[2 * i + 1] * F[2 * j + 1]) / J;
+}
+
+double pk_fe2_mises(const double s[4])
+{
+    const double h = 0.5 * (s[0] + s[3]);
+    const double d0 = s[0] - h, d3 = s[3] - h;
+    return sqrt(1.5 * (d0 * d0 + d3 * d3 + s[1] * s[1] + s[2] * s[2]));
+}
+
+int pk_fe2_record_step(pk_fe2_record *r, size_t step, double time, size_t stage, int cuts,
+                       const pk_fe2_state *st, const double *const *micro_pos)
+{
+    const pk_fe2_setup *s = r->s;
+    const pk_fe2_mesh *m = &s->mesh;
+    int rc = push1(&r->step, (double)step) | push1(&r->time, time) |
+        push1(&r->stage, (double)stage) | push1(&r->cuts, cuts);
+    rc |= push(&r->u, st->u, s->ndof);
+    double *x = malloc(s->ndof * sizeof *x), *el = calloc(m->nelem + 1, sizeof *el),
+           *we = calloc(m->nelem + 1, sizeof *we);
+    if (!x || !el || !we) {
+        free(x), free(el), free(we);
+        return -1;
+    }
+    for (size_t d = 0; d < s->ndof; d++)
+        x[d] = m->xy[d] + st->u[d];
+    rc |= push(&r->x, x, s->ndof);
+    rc |= push(&r->F, st->F, 4 * r->ngp) | push(&r->P, st->P, 4 * r->ngp);
+    for (size_t g = 0; g < r->ngp; g++) {
+        double sig[4], w;
+        size_t e;
+        pk_fe2_cauchy(&st->F[4 * g], &st->P[4 * g], sig);
+        double vm = pk_fe2_mises(sig);
+        rc |= push(&r->sigma, sig, 4) | push1(&r->mises, vm);
+        pk_fe2_gauss_point(m, g, NULL, &e, &w);
+        el[e] += w * vm;
+        we[e] += w;
+        const pk_fe2_gp_info *gi = &st->gp[g];
+        rc |= push1(&r->energy, gi->energy) | push1(&r->coordination, gi->coordination) |
+            push1(&r->rattlers, (double)gi->rattlers) |
+            push1(&r->relax_iter, (double)gi->relax_iter);
+    }
+    for (size_t e = 0; e < m->nelem; e++)
+        el[e] = we[e] > 0 ? el[e] / we[e] : 0;
+    rc |= push(&r->mises_elem, el, m->nelem);
+    /* reactions of each displacement condition: Σ (f_int − f_ext) over its nodes */
+    for (size_t k = 0; k < s->nbc; k++) {
+        double re[2] = {0, 0};
+        for (size_t i = 0; s->bc[k].type == PK_FE2_DISPLACEMENT && i < s->bc[k].set->nnode; i++)
+            for (int c = 0; c < 2; c++) {
+                size_t d = 2 * (size_t)s->bc[k].set->node[i] + (size_t)c;
+                re[c] += st->fint[d] - st->fext[d];
+            }
+        rc |= push(&r->reaction, re, 2);
+    }
+    double a = mesh_area(m, x);
+    rc |= push1(&r->area, a) | push1(&r->dilatancy, (a / r->area0 - 1) * 100);
+    for (size_t i = 0; micro_pos && i < r->nmicro; i++)
+        for (size_t j = 0; j < r->ngrain; j++)
+            rc |= push(&r->micro_x, &micro_pos[i][3 * j], 2);
+    free(x), free(el), free(we);
+    r->nstep += rc == 0;
+    return rc ? -1 : 0;
+}
+
+/* ---- writing */
+
+static int arr(pk_h5 *h, const char *path, int rank, const size_t *dims, const double *v,
+               const char *unit)
+{
+    size_t n = 1;
+    for (int i = 0; i < rank; i++)
+        n *= dims[i];
+    return pk_h5_write_array(h, path, PK_H5_F64, rank, dims, n ? v : (const double[]){0}, unit);
+}
+
+static int iarr(pk_h5 *h, const char *path, const double *v, size_t n)
+{
+    int64_t *a = malloc((n + 1) * sizeof *a);
+    if (!a)
+        return -1;
+    for (size_t i = 0; i < n; i++)
+        a[i] = (int64_t)v[i];
+    int rc = pk_h5_write_array(h, path, PK_H5_I64, 1, &n, a, NULL);
+    free(a);
+    return rc;
+}
+
+/* An H5MD time series: <name>/step, <name>/time, <name>/value [nstep]×dims. */
+static int series(pk_h5 *h, const pk_fe2_record *r, const char *name, const pk_fe2_dbuf *d,
+                  int rank, const size_t *dims)
+{
+    char p[200];
+    size_t all[3] = {r->nstep, 0, 0};
+    for (int i = 0; i < rank && i < 2; i++)
+        all[i + 1] = dims[i];
+    snprintf(p, sizeof p, "/observables/fe2/%s/step", name);
+    int rc = iarr(h, p, r->step.v, r->nstep);
+    snprintf(p, sizeof p, "/observables/fe2/%s/time", name);
+    rc |= arr(h, p, 1, &r->nstep, r->time.v, NULL);
+    snprintf(p, sizeof p, "/observables/fe2/%s/value", name);
+    rc |= arr(h, p, rank + 1, all, d->v, NULL);
+    return rc;
+}
+
+/* Per-step views of a series (what the XDMF sidecar reads). */
+static int views(pk_h5 *h, const pk_fe2_record *r, const char *name)
+{
+    int rc = 0;
+    char src[160], dst[160];
+    snprintf(src, sizeof src, "/observables/fe2/%s/value", name);
+    for (size_t k = 0; k < r->nstep && !rc; k++) {
+        snprintf(dst, sizeof dst, "/observables/fe2/views/%s/%zu", name, k);
+        rc = pk_h5_slice_view(h, src, k, dst);
+    }
+    return rc;
+}
+
+int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r)
+{
+    const pk_fe2_setup *s = r->s;
+    const pk_fe2_mesh *m = &s->mesh;
+    int rc = 0;
+    /* the mesh and its Gauss points */
+    size_t d2[2] = {m->nnode, 2}, d4[2] = {m->nelem, 4};
+    rc |= arr(h, "/observables/fe2/mesh/nodes", 2, d2, m->xy, NULL);
+    rc |= pk_h5_write_array(h, "/observables/fe2/mesh/elements", PK_H5_I32, 2, d4, m->conn, NULL);
+    /* the XDMF topology: one array per element kind, or Mixed (4 triangle, 5 quadrilateral) */
+    size_t ntri = 0, nflat = 0;
+    for (size_t e = 0; e < m->nelem; e++)
+        ntri += m->conn[4 * e + 3] < 0;
+    int64_t *flat = malloc((5 * m->nelem + 1) * sizeof *flat);
+    double *gx = malloc((2 * r->ngp + 1) * sizeof *gx), *gw = malloc((r->ngp + 1) * sizeof *gw),
+           *ge = malloc((r->ngp + 1) * sizeof *ge);
+    if (!flat || !gx || !gw || !ge) {
+        free(flat), free(gx), free(gw), free(ge);
+        return -1;
+    }
+    for (size_t e = 0; e < m->nelem; e++) {
+        int nen = pk_fe2_elem_nodes(m, e);
+        if (ntri && ntri < m->nelem)
+            flat[nflat++] = nen == 3 ? 4 : 5;
+        for (int a = 0; a < nen; a++)
+            flat[nflat++] = m->conn[4 * e + a];
+    }
+    const char *kind = ntri == 0 ? "Quadrilateral" : ntri == m->nelem ? "Triangle" : "Mixed";
+    rc |= pk_h5_write_array(h, "/observables/fe2/mesh/xdmf_topology", PK_H5_I64, 1, &nflat, flat,
+                            NULL);
+    rc |= pk_h5_obs_string(h, "fe2/mesh/xdmf_topology_type", kind);
+    for (size_t g = 0; g < r->ngp; g++) {
+        size_t e;
+        pk_fe2_gauss_point(m, g, &gx[2 * g], &e, &gw[g]);
+        ge[g] = (double)e;
+    }
+    size_t dg[2] = {r->ngp, 2};
+    rc |= arr(h, "/observables/fe2/mesh/gauss_position", 2, dg, gx, NULL);
+    rc |= arr(h, "/observables/fe2/mesh/gauss_weight", 1, &r->ngp, gw, NULL);
+    rc |= iarr(h, "/observables/fe2/mesh/gauss_element", ge, r->ngp);
+    free(flat), free(gx), free(gw), free(ge);
+    /* the load steps */
+    rc |= iarr(h, "/observables/fe2/load_steps/step", r->step.v, r->nstep);
+    rc |= arr(h, "/observables/fe2/load_steps/time", 1, &r->nstep, r->time.v, NULL);
+    rc |= iarr(h, "/observables/fe2/load_steps/stage", r->stage.v, r->nstep);
+    rc |= iarr(h, "/observables/fe2/load_steps/cuts", r->cuts.v, r->nstep);
+    /* fields per converged step */
+    const size_t n2[2] = {m->nnode, 2}, g4[2] = {r->ngp, 4}, g1[1] = {r->ngp}, e1[1] = {m->nelem},
+                 b2[2] = {s->nbc, 2};
+    rc |= series(h, r, "displacement", &r->u, 2, n2);
+    rc |= series(h, r, "position", &r->x, 2, n2);
+    rc |= series(h, r, "deformation_gradient", &r->F, 2, g4);
+    rc |= series(h, r, "piola_stress", &r->P, 2, g4);
+    rc |= series(h, r, "cauchy_stress", &r->sigma, 2, g4);
+    rc |= series(h, r, "von_mises", &r->mises, 1, g1);
+    rc |= series(h, r, "von_mises_element", &r->mises_elem, 1, e1);
+    rc |= series(h, r, "rve/energy_density", &r->energy, 1, g1);
+    rc |= series(h, r, "rve/coordination", &r->coordination, 1, g1);
+    rc |= series(h, r, "rve/rattlers", &r->rattlers, 1, g1);
+    rc |= series(h, r, "rve/relaxation_iterations", &r->relax_iter, 1, g1);
+    rc |= series(h, r, "reaction", &r->reaction, 2, b2);
+    rc |= series(h, r, "area", &r->area, 0, NULL);
+    rc |= series(h, r, "dilatancy_percent", &r->dilatancy, 0, NULL);
+    rc |= pk_h5_obs_double(h, "fe2/reference_area", r->area0, NULL);
+    /* the names of the conditions (rows of reaction) */
+    char names[4096] = "";
+    for (size_t k = 0; k < s->nbc; k++)
+        snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", k ? "\n" : "",
+                 s->bc[k].name);
+    rc |= pk_h5_obs_string(h, "fe2/reaction/names", names);
+    for (size_t i = 0; i < r->nmicro && r->nstep; i++) {
+        char name[64];
+        snprintf(name, sizeof name, "micro/gauss_point_%zu", r->micro_gp[i]);
+        pk_fe2_dbuf one = {0};
+        for (size_t k = 0; !rc && k < r->nstep; k++)
+            rc |= push(&one, &r->micro_x.v[((k * r->nmicro) + i) * 2 * r->ngrain], 2 * r->ngrain);
+        const size_t dm[2] = {r->ngrain, 2};
+        rc |= series(h, r, name, &one, 2, dm);
+        free(one.v);
+    }
+    /* the Newton histories: one row per solve (part of a load step), one
+     * per residual norm */
+    size_t np = r->part_step.n, ni = r->it_res.n;
+    rc |= iarr(h, "/observables/fe2/newton/solves/step", r->part_step.v, np);
+    rc |= arr(h, "/observables/fe2/newton/solves/t0", 1, &np, r->part_t0.v, NULL);
+    rc |= arr(h, "/observables/fe2/newton/solves/t1", 1, &np, r->part_t1.v, NULL);
+    rc |= iarr(h, "/observables/fe2/newton/solves/iterations", r->part_n.v, np);
+    rc |= arr(h, "/observables/fe2/newton/solves/abs_residual_0", 1, &np, r->part_abs0.v, NULL);
+    rc |= iarr(h, "/observables/fe2/newton/solves/converged", r->part_conv.v, np);
+    rc |= iarr(h, "/observables/fe2/newton/iterations/solve", r->it_part.v, ni);
+    rc |= arr(h, "/observables/fe2/newton/iterations/relative_residual", 1, &ni, r->it_res.v, NULL);
+    rc |= arr(h, "/observables/fe2/newton/iterations/line_search", 1, &ni, r->it_eta.v, NULL);
+    if (!rc)
+        rc |= views(h, r, "position") | views(h, r, "displacement") |
+            views(h, r, "von_mises_element");
+    return rc ? -1 : 0;
+}

@@ -1,0 +1,295 @@
+/* fe2_run.c — run an 'fe2' job: the macro problem (fe2_setup.c), the RVE
+ * (a packd result file read as 'homogenize' does, or a nested 'pack' job
+ * run once), the stages' load steps solved by core/fe2's Newton step with
+ * the RVE material at every Gauss point, and the result file
+ * (fe2_record.c). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "api/job_verdict.h"
+#include "api/process.h"
+#include "api/results/h5_result.h"
+#include "api/solver/sparse_cholmod.h"
+#include "core/base/par.h"
+#include "core/fe2/fe2_rve.h"
+#include "fe2_job.h"
+#include "fe2_record.h"
+
+/* Progress: core/fe2 ticks once per evaluation round (every Gauss point of
+ * the mesh evaluated once); this adds the load step. */
+typedef struct progress_ctx {
+    pk_monitor *outer;
+    size_t step, nstep, ngp, rounds0;
+    const char *stage;
+    char msg[200];
+} progress_ctx;
+
+static int fe2_progress(const pk_progress *p, void *vctx)
+{
+    progress_ctx *c = vctx;
+    if (!c->outer || !c->outer->fn)
+        return 0;
+    pk_progress q = *p;
+    size_t rounds = !strcmp(p->stage ? p->stage : "", "fe2") ? p->done : 0;
+    if (rounds < c->rounds0)
+        c->rounds0 = 0;
+    snprintf(c->msg, sizeof c->msg,
+             "load step %zu of %zu (stage %s): %zu Newton evaluation rounds, %zu Gauss-point "
+             "evaluations",
+             c->step, c->nstep, c->stage, rounds, rounds * c->ngp);
+    q.stage = "fe2";
+    q.done = c->step ? c->step - 1 : 0;
+    q.total = c->nstep;
+    q.fraction = c->nstep ? (double)q.done / (double)c->nstep : -1;
+    q.message = c->msg;
+    return c->outer->fn(&q, c->outer->ctx);
+}
+
+/* The RVE's grains: the file, or the nested pack job run into a temporary
+ * file beside the result (removed once read). */
+static int load_rve(const pk_fe2_job *job, int threads, const char *out_path, pk_monitor *mon,
+                    pk_box *box, pk_particles *p, char *err, size_t errlen)
+{
+    if (!job->pack_job)
+        return pk_h5_read_particles(job->micro.rve_file, box, p, err, errlen);
+    char tmp[4200];
+    snprintf(tmp, sizeof tmp, "%s.rve.%ld.h5", out_path, (long)getpid());
+    const pk_process *pack = pk_process_find("pack");
+    char *text = json_dumps(job->pack_inputs, JSON_SORT_KEYS | JSON_COMPACT);
+    json_t *sum = NULL;
+    char e2[400] = "";
+    int rc = text ? pack->run(job->pack_job, threads, text, tmp, mon, &sum, e2, sizeof e2) : -1;
+    free(text);
+    if (rc == 0 && pk_verdict_failed(sum)) {
+        snprintf(err, errlen, "the nested pack job (micro.rve.pack) failed: %s",
+                 json_string_value(json_object_get(sum, "failure")));
+        rc = -1;
+    } else if (rc != 0)
+        snprintf(err, errlen, "the nested pack job (micro.rve.pack): %s", e2);
+    json_decref(sum);
+    if (rc == 0)
+        rc = pk_h5_read_particles(tmp, box, p, err, errlen);
+    remove(tmp);
+    return rc;
+}
+
+static json_t *series_json(const double *v, size_t n, size_t stride, size_t off)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; i < n; i++)
+        json_array_append_new(a, json_real(v[i * stride + off]));
+    return a;
+}
+
+int pk_fe2_run(const void *parsed, int threads, const char *job_json, const char *out_path,
+               pk_monitor *mon, json_t **summary, char *err, size_t errlen)
+{
+    *summary = NULL;
+    const pk_fe2_job *job = parsed;
+    pk_monitor_start(mon, job->wall_time_s);
+    pk_fe2_setup s;
+    pk_schema_errors errs = {0};
+    pk_box box;
+    pk_particles p = {0};
+    pk_homog_rve rve = {0};
+    pk_fe2_rve mr = {0};
+    pk_fe2_state st = {0};
+    pk_fe2_record rec = {0};
+    pk_par *pool = NULL;
+    json_t *sum = NULL;
+    double *uD = NULL, *fext = NULL, *f0 = NULL;
+    const double **micro = NULL;
+    int rc = -1, have_rve = 0, have_mr = 0;
+    if (pk_fe2_setup_build(job, &s, &errs) != 0) { /* a mesh file read only now (service) */
+        snprintf(err, errlen, "%s: %s", errs.items[0].pointer, errs.items[0].message);
+        goto out;
+    }
+    const size_t ngp = pk_fe2_gauss_count(&s.mesh);
+    for (size_t i = 0; i < job->n_micro_gp; i++)
+        if (job->micro_gp[i] >= ngp) {
+            snprintf(err, errlen, "/output/micro_states/%zu: Gauss point %zu, the mesh has %zu", i,
+                     job->micro_gp[i], ngp);
+            goto out;
+        }
+    if (load_rve(job, threads, out_path, mon, &box, &p, err, errlen) != 0)
+        goto out;
+    if (box.dim != 2) {
+        snprintf(err, errlen, "the RVE is %dD: fe2 is plane strain and needs a 2D packing",
+                 box.dim);
+        goto out;
+    }
+    if ((double)ngp * (double)p.n > (double)job->max_grains_total) {
+        snprintf(err, errlen,
+                 "%zu Gauss points × %zu grains = %.0f: over limits.max_grains_total %zu", ngp, p.n,
+                 (double)ngp * (double)p.n, job->max_grains_total);
+        goto out;
+    }
+    if (pk_homog_rve_build(&box, &p, job->micro.bc, job->micro.radius_factor, &rve, err, errlen))
+        goto out;
+    have_rve = 1;
+    pk_homog_opts o;
+    pk_homog_opts_of(&job->micro, &rve, &o);
+    o.par = pool = pk_par_new(threads);
+    if (pk_fe2_rve_init(&mr, &rve, 1, &o, &pk_sparse_cholmod, ngp, mon, err, errlen) != 0)
+        goto out;
+    have_mr = 1;
+    pk_fe2_material mat = pk_fe2_rve_material(&mr);
+    const pk_fe2_problem pb = {.mesh = &s.mesh,
+                               .mat = &mat,
+                               .nfix = s.nfix,
+                               .fix_dof = s.fix_dof,
+                               .solver = &pk_sparse_cholmod,
+                               .par = pool};
+    uD = calloc(s.nfix + 1, sizeof *uD);
+    fext = calloc(s.ndof + 1, sizeof *fext);
+    micro = calloc(job->n_micro_gp + 1, sizeof *micro);
+    if (!uD || !fext || !micro || pk_fe2_state_init(&st, &s.mesh) != 0 ||
+        pk_fe2_record_init(&rec, &s, job->micro_gp, job->n_micro_gp, rve.n) != 0) {
+        snprintf(err, errlen, "out of memory");
+        goto out;
+    }
+    for (size_t i = 0; i < job->n_micro_gp; i++)
+        micro[i] = mr.committed[job->micro_gp[i]].x;
+    /* initial_stress balanced: f_int of the start state at u = 0 joins every
+     * load (a trial evaluation, nothing committed) */
+    if (job->balanced) {
+        char why[256] = "";
+        f0 = calloc(s.ndof + 1, sizeof *f0);
+        int r0 = f0 ? pk_fe2_residual(&pb, st.u, NULL, f0, NULL, why, sizeof why) : -1;
+        if (r0 != 0) {
+            snprintf(err, errlen, "initial_stress balanced: the start state: %s",
+                     r0 > 0 ? why : "out of memory");
+            goto out;
+        }
+    }
+
+    size_t nstep = 0, done = 0, cuts_total = 0, iters_total = 0;
+    for (size_t k = 0; k < s.nstage; k++)
+        nstep += s.increments[k];
+    progress_ctx pc = {.outer = mon, .nstep = nstep, .ngp = ngp};
+    pk_monitor wm = mon ? *mon : (pk_monitor){0};
+    wm.fn = fe2_progress;
+    wm.ctx = &pc;
+    char failure[700] = "";
+    const char *reason = "complete";
+    for (size_t k = 0; k < s.nstage && !failure[0]; k++) {
+        char sname[80];
+        snprintf(sname, sizeof sname, s.stage_name[k][0] ? "%zu \"%s\"" : "%zu", k,
+                 s.stage_name[k]);
+        pc.stage = sname;
+        for (size_t i = 1; i <= s.increments[k]; i++) {
+            pc.step = done + 1;
+            double t = (double)i / (double)s.increments[k];
+            pk_fe2_setup_targets(&s, k, t, uD, fext);
+            for (size_t d = 0; f0 && d < s.ndof; d++)
+                fext[d] += f0[d];
+            pk_fe2_step_report rep;
+            memset(&rep, 0, sizeof rep);
+            int r = pk_fe2_step(&pb, &job->newton, &st, uD, fext, &rep, &wm);
+            if (pk_fe2_record_newton(&rec, done + 1, &rep) != 0) {
+                snprintf(err, errlen, "out of memory");
+                goto out;
+            }
+            for (size_t q = 0; q < rep.nparts; q++)
+                iters_total += (size_t)(rep.parts[q].n > 0 ? rep.parts[q].n - 1 : 0);
+            cuts_total += (size_t)rep.cuts;
+            if (r == 0) {
+                if (pk_fe2_record_step(&rec, done + 1, (double)k + t, k, rep.cuts, &st, micro) !=
+                    0) {
+                    snprintf(err, errlen, "out of memory");
+                    goto out;
+                }
+                done++;
+                continue;
+            }
+            if (r == 2) {
+                reason = mon && mon->cancel && *mon->cancel ? "cancelled" : "wall_time";
+                snprintf(failure, sizeof failure,
+                         "%s in load step %zu of %zu (stage %s, increment %zu of %zu)",
+                         !strcmp(reason, "cancelled") ? "cancelled"
+                                                      : "ran out of wall time (limits.wall_time_s)",
+                         done + 1, nstep, sname, i, s.increments[k]);
+            } else {
+                reason = r == 1 ? "not_converged" : "solver_failure";
+                snprintf(failure, sizeof failure,
+                         "load step %zu of %zu (stage %s, increment %zu of %zu) did not converge "
+                         "after %d cuts: %s",
+                         done + 1, nstep, sname, i, s.increments[k], rep.cuts,
+                         rep.why[0] ? rep.why : "solver failure or out of memory");
+            }
+            break;
+        }
+    }
+
+    sum = json_object();
+    json_object_set_new(sum, "process", json_string("fe2"));
+    json_object_set_new(sum, "termination_reason", json_string(reason));
+    json_object_set_new(sum, "complete", json_boolean(done == nstep));
+    json_object_set_new(sum, "steps", json_integer((json_int_t)done));
+    json_object_set_new(sum, "steps_requested", json_integer((json_int_t)nstep));
+    json_object_set_new(sum, "nodes", json_integer((json_int_t)s.mesh.nnode));
+    json_object_set_new(sum, "elements", json_integer((json_int_t)s.mesh.nelem));
+    json_object_set_new(sum, "gauss_points", json_integer((json_int_t)ngp));
+    json_object_set_new(sum, "rve_particles", json_integer((json_int_t)rve.n));
+    json_object_set_new(sum, "boundary_condition", json_string(pk_homog_bc_name(job->micro.bc)));
+    json_object_set_new(sum, "newton_iterations_total", json_integer((json_int_t)iters_total));
+    json_object_set_new(sum, "step_cuts_total", json_integer((json_int_t)cuts_total));
+    json_object_set_new(sum, "threads", json_integer(pk_par_threads(pool)));
+    /* the figures per converged step: reactions of the displacement
+     * conditions and the dilatancy Δ = (v/V − 1)·100 % of the specimen */
+    json_t *reac = json_object();
+    for (size_t b = 0; b < s.nbc; b++)
+        if (s.bc[b].type == PK_FE2_DISPLACEMENT)
+            json_object_set_new(
+                reac, s.bc[b].name,
+                series_json(rec.reaction.v, done, 2 * s.nbc, 2 * b + (size_t)s.bc[b].comp));
+    json_object_set_new(sum, "reaction_per_step", reac);
+    json_object_set_new(sum, "dilatancy_percent_per_step",
+                        series_json(rec.dilatancy.v, done, 1, 0));
+    json_object_set_new(sum, "time_per_step", series_json(rec.time.v, done, 1, 0));
+    if (failure[0])
+        pk_verdict_fail(sum, "%s (the result file holds the %zu converged load steps before it)",
+                        failure, done);
+
+    pk_h5 *h = pk_h5_create(out_path, err, errlen);
+    if (!h)
+        goto out;
+    int w = pk_h5_write_particles(h, &box, &p, "1");
+    w |= pk_h5_write_parameters(h, "fe2", job_json, 0);
+    w |= pk_fe2_record_write(h, &rec);
+    w |= pk_h5_obs_string(h, "fe2/termination_reason", reason);
+    w |= pk_h5_obs_string(h, "fe2/boundary_condition", pk_homog_bc_name(job->micro.bc));
+    w |= pk_h5_obs_int(h, "fe2/rve_particles", (int64_t)rve.n);
+    w |= pk_h5_obs_double(h, "fe2/E_n", job->micro.E_n, NULL);
+    w |= pk_verdict_write_h5(h, sum);
+    if (w != 0) {
+        pk_h5_abort(h);
+        snprintf(err, errlen, "writing %s failed", out_path);
+        goto out;
+    }
+    if (pk_h5_commit(h, err, errlen) != 0)
+        goto out;
+    *summary = sum;
+    sum = NULL;
+    rc = 0;
+out:
+    pk_schema_errors_free(&errs);
+    json_decref(sum);
+    free(uD);
+    free(fext);
+    free(f0);
+    free(micro);
+    pk_fe2_record_free(&rec);
+    pk_fe2_state_free(&st);
+    if (have_mr)
+        pk_fe2_rve_free(&mr);
+    if (have_rve)
+        pk_homog_rve_free(&rve);
+    pk_par_free(pool);
+    pk_particles_free(&p);
+    pk_fe2_setup_free(&s);
+    return rc;
+}
