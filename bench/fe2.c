@@ -22,7 +22,10 @@
  * PACKD_BENCH_CASE=TEXT runs only the cases whose name ("gp_eval_taylor",
  * "example1_taylor_t2", …) contains TEXT; PACKD_BENCH_SEED=S makes the RVE
  * from seed S (default 1); PACKD_BENCH_FE2_BCS=taylor,periodic picks the
- * boundary conditions (default all three for gp_eval, taylor for example1). */
+ * boundary conditions (default all three for gp_eval, taylor for example1);
+ * PACKD_BENCH_FE2_INFLATE=V the radius inflation of the RVE (default 0.001,
+ * as in examples/fe2: an RVE just jammed has no stiffness under the relaxing
+ * boundary conditions). */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -53,7 +56,21 @@ static int wanted(const char *name)
 static int bc_wanted(const char *bc, int by_default)
 {
     const char *f = getenv("PACKD_BENCH_FE2_BCS");
-    return f && *f ? strstr(f, bc) != NULL : by_default;
+    if (!f || !*f)
+        return by_default;
+    size_t n = strlen(bc);
+    for (const char *q = f; (q = strstr(q, bc)) != NULL; q += n)
+        if ((q == f || q[-1] == ',') && (q[n] == 0 || q[n] == ','))
+            return 1;
+    return 0;
+}
+
+/* The RVE's initial state (the fe2 jobs' initial_state radius_inflation):
+ * every radius × (1 + PACKD_BENCH_FE2_INFLATE), default 0.001. */
+static double inflation(void)
+{
+    const char *e = getenv("PACKD_BENCH_FE2_INFLATE");
+    return e && *e ? strtod(e, NULL) : 0.001;
 }
 
 static uint64_t seed(void)
@@ -188,7 +205,7 @@ typedef struct rve_mat {
 static int rve_mat_init(rve_mat *r, const pk_box *b, const pk_particles *p, const char *bc,
                         size_t ngp, char *err, size_t errlen)
 {
-    if (pk_homog_rve_build(b, p, bc_of(bc), 1.0, &r->rve, err, errlen) != 0)
+    if (pk_homog_rve_build(b, p, bc_of(bc), 1.0 + inflation(), &r->rve, err, errlen) != 0)
         return -1;
     double rmean = 0;
     for (size_t i = 0; i < r->rve.n; i++)

@@ -43,9 +43,19 @@ def rve_pack(n, seed):
     }
 
 
+# An RVE grown to jamming has contacts at zero overlap: under the relaxing
+# boundary conditions (restricted Taylor, periodic) it has no stiffness at
+# F̄ = 1, and the first macro tangent is singular.  Inflating every radius by
+# 0.1 % jams it with a small prestress (P̄₀ ≈ 0.05 E_n·0.1 %); initial_stress
+# "balanced" makes that prestress the equilibrium at u = 0 (the reactions
+# count from it), as the thesis's loading starts from rest.
+INFLATION = 0.001
+
+
 def micro(n, bc, seed, E_n):
     return {"rve": {"pack": rve_pack(n, seed)}, "boundary_condition": bc,
-            "contact": {"E_n": E_n}, "relaxation": {"tol": 1e-10}}
+            "contact": {"E_n": E_n}, "relaxation": {"tol": 1e-10},
+            "initial_state": {"policy": "radius_inflation", "value": INFLATION}}
 
 
 def newton():
@@ -94,6 +104,7 @@ def block(out, bc, p, seed):
                   {"name": "confine", "increments": 5, "targets": {"side_pressure": p, "top": 0}},
                   {"name": "compress", "increments": 30, "targets": {"top": -3}},
               ],
+              "initial_stress": "balanced",
               "micro": micro(150, bc, seed, 50),
               "newton": newton(),
           })
@@ -122,6 +133,7 @@ def biaxial(out, bc, seed):
                    "targets": {"confine_left": 0.2, "confine_right": 0.2, "top": 0}},
                   {"name": "compress", "increments": 20, "targets": {"top": -4}},
               ],
+              "initial_stress": "balanced",
               "micro": micro(88, bc, seed, 50),
               "newton": newton(),
           })
@@ -193,6 +205,7 @@ def slope(out, seed, n_grains=700):
                   {"name": "gravity", "increments": 1, "targets": {"gravity": [0, -9.81]}},
                   {"name": "footing", "increments": 20, "targets": targets},
               ],
+              "initial_stress": "balanced",
               "micro": micro(n_grains, "taylor", seed, 2.8e7),
               "newton": newton(),
           })
