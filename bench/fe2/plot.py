@@ -145,7 +145,7 @@ def mises_panel(ax, r, step, title, scale=1.0):
     vm = h5(r.path, "von_mises_element/value")[step]
     d = r.disp[step]
     xy = [(x + scale * d[a][0], y + scale * d[a][1]) for a, (x, y) in enumerate(r.nodes)]
-    polys = [[xy[a] for a in e if a >= 0] for e in elems]
+    polys = [[xy[int(a)] for a in e if a >= 0] for e in elems]
     pc = PolyCollection(polys, array=vm, cmap="viridis", edgecolors="k", linewidths=0.2)
     ax.add_collection(pc)
     ax.autoscale()

@@ -14,7 +14,8 @@
 #   service        block, Taylor, p = 0.2 through `packd serve` + `packd submit`
 # Every run writes OUT_DIR/<example>-<bc>[-p<p>]-s<seed>.{h5,json,err}; a run
 # whose .h5 exists is skipped.  THREADS (default 2) threads per run; SEEDS
-# (default "1 2 3").  Then /usr/bin/python3 bench/fe2/plot.py OUT_DIR OUT_DIR.
+# (default "1 2 3"); WALL=S limits each run to S seconds (limits.wall_time_s:
+# the run then ends failed with its converged steps).  Then /usr/bin/python3 bench/fe2/plot.py OUT_DIR OUT_DIR.
 set -u
 PACKD=${PACKD:-build/packd}
 SRC=${PACKD_SRC:-$(pwd)}
@@ -48,6 +49,12 @@ import json, sys; j = json.load(open('$j')); m = j['inputs']['micro']['rve']['pa
 m['count'] = $SLOPE_GRAINS; m['domain']['box']['size'] = [3.457 * ($SLOPE_GRAINS / 700) ** 0.5] * 2
 json.dump(j, open('$OUT/jobs/slope-$SLOPE_GRAINS.json', 'w'))"
         j="$OUT/jobs/slope-$SLOPE_GRAINS.json"
+    fi
+    if [ -n "${WALL:-}" ]; then # a wall-time limit: the job fails with its converged steps
+        python3 -c "
+import json; j = json.load(open('$j')); j['inputs']['limits'] = {'wall_time_s': $WALL}
+json.dump(j, open('$OUT/jobs/$name.json', 'w'))"
+        j="$OUT/jobs/$name.json"
     fi
     t0=$(date +%s)
     "$PACKD" run "$j" -o "$OUT/$name.h5" --threads "$THREADS" --json >"$OUT/$name.json" 2>"$OUT/$name.err"
