@@ -59,6 +59,7 @@ class Result:
         self.disp = h5(path, "displacement/value")  # [step][node][x, y]
         self.nodes = h5(path, "mesh/nodes")
         self.dil = h5(path, "dilatancy_percent/value")
+        self.area = h5(path, "area/value")
         ymax = max(y for _, y in self.nodes)
         self.top = [a for a, (_, y) in enumerate(self.nodes) if abs(y - ymax) < 1e-9 * max(1, ymax)]
 
@@ -155,17 +156,25 @@ def mises_panel(ax, r, step, title, scale=1.0):
 
 
 def plot_mises(rs, out, name, steps_of):
+    """One panel per (BC, step): steps_of(r) -> [(step index, displacement scale)]."""
     rs = sorted(rs, key=lambda r: (r.bc, r.seed))
     rs = [r for k, r in enumerate(rs) if k == 0 or r.bc != rs[k - 1].bc]  # one seed per BC
-    if not rs:
+    panels = [(r, st, sc) for r in rs for st, sc in steps_of(r)]
+    if not panels:
         return
-    fig, ax = plt.subplots(1, len(rs), figsize=(4.5 * len(rs), 5), squeeze=False)
-    for a, r in zip(ax[0], rs):
-        step, scale = steps_of(r)
-        mises_panel(a, r, step, "%s, load step %d (u × %g)" % (BC_LABEL[r.bc], step + 1, scale), scale)
+    fig, ax = plt.subplots(1, len(panels), figsize=(3.6 * len(panels), 4.6), squeeze=False)
+    for a, (r, step, scale) in zip(ax[0], panels):
+        title = "%s, seed %d\nu_v = %.2f mm (u × %g)" % (BC_LABEL[r.bc], r.seed, r.u_top()[step], scale)
+        mises_panel(a, r, step, title, scale)
     fig.tight_layout()
     fig.savefig(os.path.join(out, name), dpi=110)
     plt.close(fig)
+
+
+def step_at(r, u):
+    """The load step whose u_v is nearest to u."""
+    ut = r.u_top()
+    return min(range(len(ut)), key=lambda i: abs(ut[i] - u))
 
 
 def residual_table(r, steps):
@@ -189,8 +198,8 @@ def main():
     slope = [r for r in rs if r.example == "slope"]
     plot_block(block, out)
     plot_biaxial(biax, out)
-    plot_mises(biax, out, "biaxial_mises.png", lambda r: (len(r.disp) - 1, 3.0))
-    plot_mises(slope, out, "slope_mises.png", lambda r: (len(r.disp) - 1, 1.0))
+    plot_mises(biax, out, "biaxial_mises.png", lambda r: [(step_at(r, 1.25), 3.0), (len(r.disp) - 1, 3.0)])
+    plot_mises(slope, out, "slope_mises.png", lambda r: [(len(r.disp) - 1, 1.0)])
     seed0 = min((r.seed for r in rs), default=1)
     for r in block:
         if r.p == 0.2 and r.seed == seed0:
@@ -201,16 +210,18 @@ def main():
             print("\n#### %s, %s, seed %d\n" % (r.example, BC_LABEL[r.bc], r.seed))
             print(residual_table(r, [2, 6, 10, 17] if r.example == "biaxial" else [6, 10, 15, 18]))
     print("\n#### summary per run\n")
-    print("| run | steps | f_v end [N/mm] | Δ end [%] | Δ min [%] at u_v [mm] |")
-    print("|---|---|---|---|---|")
+    print("| run | steps | f_v end [N/mm] | Δ end [%] | Δ min [%] at u_v [mm] | Δ' min [%] |")
+    print("|---|---|---|---|---|---|")
     for r in rs:
         idx = r.last_stage()
         u = r.u_top()
         bottom = "bottom_roller" if r.example == "block" else "bottom_y"
         fv = r.reaction_y(bottom) if bottom in r.rnames else [float("nan")] * len(u)
         i = min(idx, key=lambda k: r.dil[k])
-        print("| %s | %d | %.2f | %.3f | %.3f at %.2f |" % (os.path.basename(r.path)[:-3], len(r.disp),
-                                                         fv[-1], r.dil[-1], r.dil[i], u[i]))
+        # Δ' counts from the state before the last stage (after the confinement)
+        dconf = 100 * (r.area[i] / r.area[idx[0]] - 1)
+        print("| %s | %d | %.2f | %.3f | %.3f at %.2f | %.3f |" % (
+            os.path.basename(r.path)[:-3], len(r.disp), fv[-1], r.dil[-1], r.dil[i], u[i], dconf))
 
 
 if __name__ == "__main__":
