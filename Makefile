@@ -52,7 +52,7 @@ LIB_OBJ    := $(DAEMON_OBJ) $(API_OBJ) $(CORE_OBJ)
 UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 BENCH_BIN  := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
-.PHONY: all deps test sanitize bench run clean check-schemas install format
+.PHONY: all deps test sanitize bench bench-fe2 run clean check-schemas install format
 .SECONDARY:
 
 all: $(DEPS_OK) $(BUILD)/packd $(BENCH_BIN)
@@ -117,6 +117,10 @@ sanitize:
 bench: $(DEPS_OK) $(BUILD)/packd $(BENCH_BIN)
 	@for b in $(BENCH_BIN); do echo "== $$b"; $$b || exit 1; done
 	@echo "== bench/service.sh"; PACKD=$(BUILD)/packd sh bench/service.sh
+
+# Only the FE² bench (bench/fe2.c; the examples themselves: bench/fe2/run_examples.sh).
+bench-fe2: $(DEPS_OK) $(BUILD)/bench/fe2
+	$(BUILD)/bench/fe2
 
 run: $(DEPS_OK) $(BUILD)/packd
 	$(BUILD)/packd serve

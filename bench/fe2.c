@@ -2,11 +2,13 @@
  * (Meier 2009 §6.4.1: a 100 × 100 mm block in 3 × 3 Q1, 36 RVEs of 150
  * grains, E_n = 50; examples/fe2/block-*.json).  Prints one line per case:
  *   bench=fe2 case=gp_eval bc=BC grains=N gps=36 threads=2 evals_per_s=R
- *     serial_evals_per_s=R1 efficiency=R/(2·R1) cpu_ratio=C rounds=K load=L
+ *     serial_evals_per_s=R1 efficiency=R/(2·R1) cpu_evals_per_s=Rc cpu_ratio=C
+ *     parallelism=Q rounds=K load=L
  *     (one evaluation round of every Gauss point — pk_fe2_residual, the trial
  *     evaluations plus f_int — at a fixed compressed state, alternating the
  *     serial and the 2-thread pool, medians of the wall times; efficiency is
- *     the parallel efficiency on 2 cores, the bar ≥ 0.85; cpu_ratio the CPU
+ *     the parallel efficiency on 2 cores, the bar ≥ 0.85; cpu_evals_per_s the
+ *     serial rate in CPU time (what one idle core gives); cpu_ratio the CPU
  *     time of a 2-thread round over a serial one: the work parallelism adds,
  *     which bounds the efficiency at 1/cpu_ratio on two idle cores;
  *     parallelism the CPU time over the wall time of a 2-thread round: below
@@ -277,10 +279,11 @@ static void case_gp_eval(const block *k, const pk_box *b, const pk_particles *p,
     else {
         double s1 = median(t1, ROUNDS), s2 = median(t2, ROUNDS);
         printf("bench=fe2 case=gp_eval bc=%s grains=%d gps=%zu threads=2 evals_per_s=%.1f "
-               "serial_evals_per_s=%.1f efficiency=%.3f cpu_ratio=%.3f parallelism=%.2f rounds=%d "
-               "load=%.2f\n",
+               "serial_evals_per_s=%.1f efficiency=%.3f cpu_evals_per_s=%.1f cpu_ratio=%.3f "
+               "parallelism=%.2f rounds=%d load=%.2f\n",
                bc, GRAINS, ngp, (double)ngp / s2, (double)ngp / s1, s1 / (2 * s2),
-               median(c2, ROUNDS) / median(c1, ROUNDS), median(c2, ROUNDS) / s2, ROUNDS, ld);
+               (double)ngp / median(c1, ROUNDS), median(c2, ROUNDS) / median(c1, ROUNDS),
+               median(c2, ROUNDS) / s2, ROUNDS, ld);
     }
     fflush(stdout);
     free(u);
