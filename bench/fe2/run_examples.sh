@@ -6,8 +6,9 @@
 #
 # SETs (default: block_taylor block_rt biaxial_taylor):
 #   block_taylor   block, Taylor, p = 0.1 0.2 0.3, seeds $SEEDS      (~10 s each)
-#   block_rt       block, restricted Taylor, p = 0.1 0.2 0.3, seed 1  (minutes each)
-#   block_periodic block, periodic, p = 0.1 0.2 0.3, seed 1           (minutes each)
+#   block_rt       block, restricted Taylor, p = 0.2 0.1 0.3, seeds $RT_SEEDS (default 1;
+#                  minutes each)
+#   block_periodic block, periodic, p = 0.2 0.1 0.3, seeds $RT_SEEDS   (minutes each)
 #   biaxial_taylor biaxial, Taylor, seeds $SEEDS
 #   biaxial_rt     biaxial, restricted Taylor, seed 1                  (minutes)
 #   slope          slope, Taylor, seed 1, 700-grain RVEs (SLOPE_GRAINS to reduce)
@@ -91,8 +92,8 @@ service() {
 for s in $SETS; do
     case $s in
     block_taylor) for seed in $SEEDS; do for p in 0.1 0.2 0.3; do run block taylor $p $seed; done; done ;;
-    block_rt) for p in 0.2 0.1 0.3; do run block restricted_taylor $p 1; done ;;
-    block_periodic) for p in 0.2 0.1 0.3; do run block periodic $p 1; done ;;
+    block_rt) for seed in ${RT_SEEDS:-1}; do for p in 0.2 0.1 0.3; do run block restricted_taylor $p $seed; done; done ;;
+    block_periodic) for seed in ${RT_SEEDS:-1}; do for p in 0.2 0.1 0.3; do run block periodic $p $seed; done; done ;;
     biaxial_taylor) for seed in $SEEDS; do run biaxial taylor 0.2 $seed; done ;;
     biaxial_rt) run biaxial restricted_taylor 0.2 1 ;;
     slope) run slope taylor 0.2 1 ;;
