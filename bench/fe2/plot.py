@@ -152,19 +152,20 @@ def mises_panel(ax, r, step, title, scale=1.0):
     ax.autoscale()
     ax.set_aspect("equal")
     ax.set_title(title, fontsize=9)
-    plt.colorbar(pc, ax=ax, shrink=0.8, label="σ_mises")
+    plt.colorbar(pc, ax=ax, shrink=0.6, label="σ_mises")
 
 
-def plot_mises(rs, out, name, steps_of):
+def plot_mises(rs, out, name, steps_of, size=(3.6, 4.6), unit="mm"):
     """One panel per (BC, step): steps_of(r) -> [(step index, displacement scale)]."""
     rs = sorted(rs, key=lambda r: (r.bc, r.seed))
     rs = [r for k, r in enumerate(rs) if k == 0 or r.bc != rs[k - 1].bc]  # one seed per BC
     panels = [(r, st, sc) for r in rs for st, sc in steps_of(r)]
     if not panels:
         return
-    fig, ax = plt.subplots(1, len(panels), figsize=(3.6 * len(panels), 4.6), squeeze=False)
+    fig, ax = plt.subplots(1, len(panels), figsize=(size[0] * len(panels), size[1]), squeeze=False)
     for a, (r, step, scale) in zip(ax[0], panels):
-        title = "%s, seed %d\nu_v = %.2f mm (u × %g)" % (BC_LABEL[r.bc], r.seed, r.u_top()[step], scale)
+        title = "%s, seed %d, load step %d\nu_v (top) = %.2f %s (u × %g)" % (
+            BC_LABEL[r.bc], r.seed, step + 1, r.u_top()[step], unit, scale)
         mises_panel(a, r, step, title, scale)
     fig.tight_layout()
     fig.savefig(os.path.join(out, name), dpi=110)
@@ -199,7 +200,7 @@ def main():
     plot_block(block, out)
     plot_biaxial(biax, out)
     plot_mises(biax, out, "biaxial_mises.png", lambda r: [(step_at(r, 1.25), 3.0), (len(r.disp) - 1, 3.0)])
-    plot_mises(slope, out, "slope_mises.png", lambda r: [(len(r.disp) - 1, 1.0)])
+    plot_mises(slope, out, "slope_mises.png", lambda r: [(len(r.disp) - 1, 1.0)], (9, 3.6), "m")
     seed0 = min((r.seed for r in rs), default=1)
     for r in block:
         if r.p == 0.2 and r.seed == seed0:
