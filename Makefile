@@ -52,7 +52,7 @@ LIB_OBJ    := $(DAEMON_OBJ) $(API_OBJ) $(CORE_OBJ)
 UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 BENCH_BIN  := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
-.PHONY: all deps test sanitize bench run clean check-schemas install format tradeoffs tradeoff-plots
+.PHONY: all deps test sanitize bench bench-fe2 run clean check-schemas install format tradeoffs tradeoff-plots
 .SECONDARY:
 
 all: $(DEPS_OK) $(BUILD)/packd $(BENCH_BIN)
@@ -131,6 +131,10 @@ tradeoffs: $(DEPS_OK) $(BUILD)/packd
 
 tradeoff-plots: $(DEPS_OK)
 	$(PYTHON3) bench/tradeoff/plot.py --data docs/tradeoffs/data --out docs/tradeoffs --doc docs/tradeoffs.md >/dev/null
+
+# Only the FE² bench (bench/fe2.c; the examples themselves: bench/fe2/run_examples.sh).
+bench-fe2: $(DEPS_OK) $(BUILD)/bench/fe2
+	$(BUILD)/bench/fe2
 
 run: $(DEPS_OK) $(BUILD)/packd
 	$(BUILD)/packd serve

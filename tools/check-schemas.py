@@ -3,7 +3,7 @@
 validator (Debian's python3-jsonschema), for CI (`make check-schemas`).
 
   1. every schemas/*.json is a valid JSON Schema 2020-12 document;
-  2. every examples/*.json job file {"process": P, "inputs": {...}} is valid:
+  2. every examples/*.json and examples/*/*.json job file {"process": P, "inputs": {...}} is valid:
      the file against schemas/job.schema.json (if present) and its "inputs"
      against schemas/P.inputs.schema.json;
   3. every tests/data/invalid/*.json job file is rejected by one of those.
@@ -137,6 +137,16 @@ def json_files(d):
     return [os.path.join(d, f) for f in sorted(os.listdir(full)) if f.endswith(".json")]
 
 
+def example_files():
+    """examples/*.json and the job files one folder down (examples/fe2/, ...)."""
+    files = json_files("examples")
+    top = os.path.join(ROOT, "examples")
+    for d in sorted(os.listdir(top)) if os.path.isdir(top) else []:
+        if os.path.isdir(os.path.join(top, d)):
+            files += json_files(os.path.join("examples", d))
+    return files
+
+
 def report(ok, name, details=()):
     print("%s %s" % ("PASS" if ok else "FAIL", name))
     if not ok:
@@ -162,7 +172,7 @@ def main():
         except (OSError, ValueError) as e:
             ok = report(False, rel, ["not readable JSON: %s" % e])
         failed += not ok
-    for rel in json_files("examples"):
+    for rel in example_files():
         errs = job_errors(os.path.join(ROOT, rel))
         failed += not report(not errs, rel, errs)
     for rel in json_files(os.path.join("tests", "data", "invalid")):
