@@ -12,11 +12,12 @@ done
 start_daemon d || { fail serve_starts; exit 1; }
 c "$B/processes/pack" >"$T/pack.json"
 c "$B/processes/homogenize" >"$T/homogenize.json"
+c "$B/processes/fe2" >"$T/fe2.json"
 check input_schemas_standalone "$PY" - "$T" "$SRC/examples" <<'PYEOF'
 import glob, json, os, sys
 from jsonschema import validators
 T, ex = sys.argv[1], sys.argv[2]
-docs = {p: json.load(open(os.path.join(T, p + ".json"))) for p in ("pack", "homogenize")}
+docs = {p: json.load(open(os.path.join(T, p + ".json"))) for p in ("pack", "homogenize", "fe2")}
 checked = 0
 for path in sorted(glob.glob(ex + "/*.json") + glob.glob(ex + "/*/*.json")):
     job = json.load(open(path))
