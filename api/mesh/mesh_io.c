@@ -270,21 +270,32 @@ static int msh22_nodes(reader *r, raw_mesh *w, char *err, size_t errlen)
     return 0;
 }
 
+/* The head of a version-2.2 element record: number, type, tag count and
+ * tags; *phys is the first tag (the physical group), unchanged without tags. */
+static int msh22_element_head(reader *r, long long *type, long long *ntags, long long *phys,
+                              char *err, size_t errlen)
+{
+    long long tag, t;
+    if (next_int(r, &tag, err, errlen) || next_int(r, type, err, errlen) ||
+        next_int(r, ntags, err, errlen))
+        return -1;
+    for (long long k = 0; k < *ntags; k++) {
+        if (next_int(r, &t, err, errlen))
+            return -1;
+        if (k == 0)
+            *phys = t;
+    }
+    return 0;
+}
+
 static int msh22_elements(reader *r, raw_mesh *w, size_t max_tets, char *err, size_t errlen)
 {
-    long long n, tag, type, ntags, t, region = 0;
+    long long n, type, ntags, region = 0;
     if (next_int(r, &n, err, errlen))
         return -1;
     for (long long i = 0; i < n; i++) {
-        if (next_int(r, &tag, err, errlen) || next_int(r, &type, err, errlen) ||
-            next_int(r, &ntags, err, errlen))
+        if (msh22_element_head(r, &type, &ntags, &region, err, errlen))
             return -1;
-        for (long long k = 0; k < ntags; k++) {
-            if (next_int(r, &t, err, errlen))
-                return -1;
-            if (k == 0)
-                region = t; /* physical tag */
-        }
         if (msh_element(r, w, type, (int32_t)region, max_tets, err, errlen))
             return -1;
     }
@@ -350,6 +361,29 @@ static int msh41_elements(reader *r, raw_mesh *w, size_t max_tets, char *err, si
     return 0;
 }
 
+/* The $MeshFormat section: ASCII, version 2.2 or 4.1; *major = 2 or 4. */
+static int msh_format(reader *r, int *major, char *err, size_t errlen)
+{
+    double version = 0, ftype = 0, dsize = 0;
+    if (!next_tok(r) || strcmp(r->tok, "$MeshFormat") != 0) {
+        snprintf(err, errlen, "%s: not a Gmsh MSH file (no $MeshFormat)", r->path);
+        return -1;
+    }
+    if (next_num(r, &version, err, errlen) || next_num(r, &ftype, err, errlen) ||
+        next_num(r, &dsize, err, errlen))
+        return -1;
+    if (ftype != 0) {
+        snprintf(err, errlen, "%s: binary MSH is not supported (save as ASCII)", r->path);
+        return -1;
+    }
+    if (!(version == 2.2 || (version >= 4.1 && version < 5))) {
+        snprintf(err, errlen, "%s: MSH version %g is not supported (2.2 or 4.1)", r->path, version);
+        return -1;
+    }
+    *major = (int)version; /* in range now (a forged 2e11 would not fit an int) */
+    return msh_skip_section(r, "$MeshFormat", err, errlen);
+}
+
 int pk_mesh_read_msh(const char *path, size_t max_tets, pk_mesh *m, char *err, size_t errlen)
 {
     reader r = {.path = path};
@@ -358,24 +392,7 @@ int pk_mesh_read_msh(const char *path, size_t max_tets, pk_mesh *m, char *err, s
         return -1;
     raw_mesh w = {0};
     int rc = -1, major = 0;
-    double version = 0, ftype = 0, dsize = 0;
-    if (!next_tok(&r) || strcmp(r.tok, "$MeshFormat") != 0) {
-        snprintf(err, errlen, "%s: not a Gmsh MSH file (no $MeshFormat)", path);
-        goto out;
-    }
-    if (next_num(&r, &version, err, errlen) || next_num(&r, &ftype, err, errlen) ||
-        next_num(&r, &dsize, err, errlen))
-        goto out;
-    if (ftype != 0) {
-        snprintf(err, errlen, "%s: binary MSH is not supported (save as ASCII)", path);
-        goto out;
-    }
-    if (!(version == 2.2 || (version >= 4.1 && version < 5))) {
-        snprintf(err, errlen, "%s: MSH version %g is not supported (2.2 or 4.1)", path, version);
-        goto out;
-    }
-    major = (int)version; /* in range now (a forged 2e11 would not fit an int) */
-    if (msh_skip_section(&r, "$MeshFormat", err, errlen))
+    if (msh_format(&r, &major, err, errlen))
         goto out;
     int have_nodes = 0, have_elems = 0;
     while (next_tok(&r)) {
@@ -809,20 +826,13 @@ static int msh2d_elements(reader *r, int major, raw2d *w, size_t max_elems, char
                           size_t errlen)
 {
     size_t nelem = 0;
-    long long n, tag, type, ntags, t, ent = 0;
+    long long n, tag, type, ntags, ent = 0;
     if (major == 2) {
         if (next_int(r, &n, err, errlen))
             return -1;
         for (long long i = 0; i < n; i++) {
-            if (next_int(r, &tag, err, errlen) || next_int(r, &type, err, errlen) ||
-                next_int(r, &ntags, err, errlen))
+            if (msh22_element_head(r, &type, &ntags, &ent, err, errlen))
                 return -1;
-            for (long long k = 0; k < ntags; k++) {
-                if (next_int(r, &t, err, errlen))
-                    return -1;
-                if (k == 0)
-                    ent = t; /* physical tag */
-            }
             if (msh2d_element(r, w, type, ntags ? ent : 0, max_elems, &nelem, err, errlen))
                 return -1;
         }
@@ -1008,28 +1018,11 @@ int pk_mesh2d_read_msh(const char *path, size_t max_elems, pk_mesh2d *m, char *e
     ent_tab et = {0};
     phys_names *pn = calloc(1, sizeof *pn);
     int rc = -1, major = 0;
-    double version = 0, ftype = 0, dsize = 0;
     if (!pn) {
         snprintf(err, errlen, "%s: out of memory", path);
         goto out;
     }
-    if (!next_tok(&r) || strcmp(r.tok, "$MeshFormat") != 0) {
-        snprintf(err, errlen, "%s: not a Gmsh MSH file (no $MeshFormat)", path);
-        goto out;
-    }
-    if (next_num(&r, &version, err, errlen) || next_num(&r, &ftype, err, errlen) ||
-        next_num(&r, &dsize, err, errlen))
-        goto out;
-    if (ftype != 0) {
-        snprintf(err, errlen, "%s: binary MSH is not supported (save as ASCII)", path);
-        goto out;
-    }
-    if (!(version == 2.2 || (version >= 4.1 && version < 5))) {
-        snprintf(err, errlen, "%s: MSH version %g is not supported (2.2 or 4.1)", path, version);
-        goto out;
-    }
-    major = (int)version;
-    if (msh_skip_section(&r, "$MeshFormat", err, errlen))
+    if (msh_format(&r, &major, err, errlen))
         goto out;
     int have_nodes = 0, have_elems = 0;
     while (next_tok(&r)) {
