@@ -73,3 +73,14 @@ int pk_verdict_write_h5(pk_h5 *h, const json_t *summary)
     free(text);
     return rc ? -1 : 0;
 }
+
+int pk_verdict_close_h5(pk_h5 *h, int failed, const json_t *summary, const char *out_path,
+                        char *err, size_t errlen)
+{
+    if (failed || pk_verdict_write_h5(h, summary) != 0) {
+        pk_h5_abort(h); /* a half-written file never takes the result's name */
+        snprintf(err, errlen, "writing %s failed", out_path);
+        return -1;
+    }
+    return pk_h5_commit(h, err, errlen);
+}

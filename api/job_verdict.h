@@ -35,4 +35,11 @@ const char *pk_verdict_status(const json_t *summary);
  * warnings as one string, one sentence per line.  0 on success. */
 int pk_verdict_write_h5(pk_h5 *h, const json_t *summary);
 
+/* The last step of every result file: unless an earlier write failed
+ * (failed != 0), write the verdict and commit h under its name; otherwise
+ * abort h (nothing appears at out_path) with "writing … failed" in err.
+ * 0 / −1. */
+int pk_verdict_close_h5(pk_h5 *h, int failed, const json_t *summary, const char *out_path,
+                        char *err, size_t errlen);
+
 #endif

@@ -413,13 +413,7 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
     w |= pk_h5_write_parameters(h, "homogenize", job_json, 0);
     w |= pk_homog_record_write(h, rec, aud, dim, first, job.nstep, &units);
     w |= pk_h5_obs_json(h, "modelled", json_object_get(sum, "model"));
-    w |= pk_verdict_write_h5(h, sum);
-    if (w != 0) {
-        pk_h5_abort(h);
-        snprintf(err, errlen, "writing %s failed", out_path);
-        goto out;
-    }
-    if (pk_h5_commit(h, err, errlen) != 0)
+    if (pk_verdict_close_h5(h, w, sum, out_path, err, errlen) != 0)
         goto out;
     *summary = sum;
     sum = NULL;

@@ -210,25 +210,10 @@ done:
     free(sieve);
     free(pass_t);
     free(pass_a);
-    if (rc != 0) {
-        snprintf(err, errlen, "writing %s failed", out_path);
-        pk_h5_abort(h);
-        return -1;
-    }
-    rc = write_scene(h, summary);
-    if (rc != 0) {
-        snprintf(err, errlen, "writing %s failed", out_path);
-        pk_h5_abort(h);
-        return -1;
-    }
+    rc |= write_scene(h, summary);
     json_object_set_new(summary, "phi_resolved", json_real(phi));
     json_object_set_new(summary, "phi_mix", json_real(phi / (1 - plan->mass_cut)));
-    if (pk_verdict_write_h5(h, summary) != 0) {
-        snprintf(err, errlen, "writing %s failed", out_path);
-        pk_h5_abort(h);
-        return -1;
-    }
-    return pk_h5_commit(h, err, errlen);
+    return pk_verdict_close_h5(h, rc, summary, out_path, err, errlen);
 }
 
 int pk_pack_run(const void *task, int threads, const char *job_json, const char *out_path,
