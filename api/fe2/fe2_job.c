@@ -13,6 +13,7 @@
 static const char *const initial_stress_names[] = {"free", "balanced", NULL};
 #define F(m) PK_OPT_FIELD(pk_fe2_job, m)
 static const pk_option fe2_rows[] = {
+    {"/unit", PK_OPT_STRING, F(unit), .sdefault = "mm"},
     {"/newton/rtol", PK_OPT_NUMBER, F(newton.rtol), .dflt = 1e-8},
     {"/newton/atol", PK_OPT_NUMBER, F(newton.atol), .dflt = 1e-12},
     {"/newton/max_iter", PK_OPT_INTEGER, F(newton.max_iter), .dflt = 20, .lo = 1, .hi = 64},
@@ -57,7 +58,19 @@ static void micro_parse(json_t *micro, const pk_check_ctx *ctx, pk_fe2_job *job,
         if (json_object_get(micro, keys[k]))
             json_object_set(h, keys[k], json_object_get(micro, keys[k]));
     json_t *rve = json_object_get(micro, "rve");
-    job->pack_inputs = json_object_get(rve, "pack");
+    /* a nested pack job states the fe2 job's unit, or none (it gets it) */
+    json_t *pack_in = json_object_get(rve, "pack");
+    const char *pu = json_string_value(json_object_get(pack_in, "unit"));
+    if (pu && strcmp(pu, job->unit) != 0)
+        pk_schema_errors_add(errs, "/micro/rve/pack/unit", "semantic",
+                             "the nested pack job's unit \"%s\" differs from the fe2 job's unit "
+                             "\"%s\": the RVE's lengths are in the job's unit; drop one or make "
+                             "them equal",
+                             pu, job->unit);
+    if (pack_in) {
+        job->pack_inputs = json_deep_copy(pack_in);
+        json_object_set_new(job->pack_inputs, "unit", json_string(job->unit));
+    }
     if (job->pack_inputs)
         json_object_set_new(h, "rve", json_pack("{s:s}", "file", "(nested pack)"));
     else
@@ -90,6 +103,7 @@ static void job_free(pk_fe2_job *job)
     pk_homog_job_free(&job->micro);
     if (job->pack_job)
         pk_process_find("pack")->free_job(job->pack_job);
+    json_decref(job->pack_inputs);
     free(job->micro_gp);
     free(job);
 }

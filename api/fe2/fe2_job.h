@@ -33,6 +33,7 @@ typedef struct pk_fe2_job {
     pk_fe2_newton_opts newton;
     double wall_time_s;
     int balanced; /* initial_stress: 0 free, 1 balanced */
+    char unit[8]; /* the length unit of the mesh, the loads and the RVE */
     size_t max_gauss_points, max_grains_total;
     /* borrowed from the inputs (they outlive the job: process.h) */
     json_t *mesh, *bcs, *stages;
@@ -40,8 +41,8 @@ typedef struct pk_fe2_job {
      * with a nested pack), and the nested pack job (or NULL) */
     pk_homog_job micro;
     void *pack_job;
-    json_t *pack_inputs;
-    size_t *micro_gp; /* output.micro_states */
+    json_t *pack_inputs; /* owned: a copy stating the job's unit */
+    size_t *micro_gp;    /* output.micro_states */
     size_t n_micro_gp;
 } pk_fe2_job;
 

@@ -186,20 +186,31 @@ static int iarr(pk_h5 *h, const char *path, const double *v, size_t n)
     return rc;
 }
 
-/* An H5MD time series: <name>/step, <name>/time, <name>/value [nstep]×dims. */
-static int series(pk_h5 *h, const pk_fe2_record *r, const char *name, const pk_fe2_dbuf *d,
-                  int rank, const size_t *dims)
+/* An H5MD time series /observables/fe2/<name> [nstep]×dims, its unit that
+ * of "fe2/<unit_name>" (NULL: name; h5_units.c); step and time are written with the
+ * first series (the clock) and linked from it by the others. */
+static int series(pk_h5 *h, const pk_fe2_record *r, char *clock, const char *name,
+                  const char *unit_name, const pk_fe2_dbuf *d, int rank, const size_t *dims,
+                  const pk_units *u)
 {
-    char p[200];
+    char p[200], un[200];
     size_t all[3] = {r->nstep, 0, 0};
     for (int i = 0; i < rank && i < 2; i++)
         all[i + 1] = dims[i];
-    snprintf(p, sizeof p, "/observables/fe2/%s/step", name);
-    int rc = iarr(h, p, r->step.v, r->nstep);
-    snprintf(p, sizeof p, "/observables/fe2/%s/time", name);
-    rc |= arr(h, p, 1, &r->nstep, r->time.v, NULL);
-    snprintf(p, sizeof p, "/observables/fe2/%s/value", name);
-    rc |= arr(h, p, rank + 1, all, d->v, NULL);
+    int64_t *step = malloc((r->nstep + 1) * sizeof *step);
+    if (!step)
+        return -1;
+    for (size_t k = 0; k < r->nstep; k++)
+        step[k] = (int64_t)r->step.v[k];
+    snprintf(p, sizeof p, "/observables/fe2/%s", name);
+    snprintf(un, sizeof un, "fe2/%s", unit_name ? unit_name : name);
+    static const double none[1] = {0};
+    int rc =
+        pk_h5_time_element(h, p, *clock ? clock : NULL, step, r->nstep ? r->time.v : none, NULL,
+                           PK_H5_F64, rank + 1, all, d->n ? d->v : none, pk_units_of(un, u));
+    free(step);
+    if (!*clock)
+        snprintf(clock, 200, "%s", p);
     return rc;
 }
 
@@ -216,14 +227,15 @@ static int views(pk_h5 *h, const pk_fe2_record *r, const char *name)
     return rc;
 }
 
-int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r)
+int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r, const pk_units *u)
 {
+    char clock[200] = "";
     const pk_fe2_setup *s = r->s;
     const pk_fe2_mesh *m = &s->mesh;
     int rc = 0;
     /* the mesh and its Gauss points */
     size_t d2[2] = {m->nnode, 2}, d4[2] = {m->nelem, 4};
-    rc |= arr(h, "/observables/fe2/mesh/nodes", 2, d2, m->xy, NULL);
+    rc |= arr(h, "/observables/fe2/mesh/nodes", 2, d2, m->xy, pk_units_of("fe2/mesh/nodes", u));
     rc |= pk_h5_write_array(h, "/observables/fe2/mesh/elements", PK_H5_I32, 2, d4, m->conn, NULL);
     /* the XDMF topology: one array per element kind, or Mixed (4 triangle, 5 quadrilateral) */
     size_t ntri = 0, nflat = 0;
@@ -253,8 +265,10 @@ int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r)
         ge[g] = (double)e;
     }
     size_t dg[2] = {r->ngp, 2};
-    rc |= arr(h, "/observables/fe2/mesh/gauss_position", 2, dg, gx, NULL);
-    rc |= arr(h, "/observables/fe2/mesh/gauss_weight", 1, &r->ngp, gw, NULL);
+    rc |= arr(h, "/observables/fe2/mesh/gauss_position", 2, dg, gx,
+              pk_units_of("fe2/mesh/gauss_position", u));
+    rc |= arr(h, "/observables/fe2/mesh/gauss_weight", 1, &r->ngp, gw,
+              pk_units_of("fe2/mesh/gauss_weight", u));
     rc |= iarr(h, "/observables/fe2/mesh/gauss_element", ge, r->ngp);
     free(flat), free(gx), free(gw), free(ge);
     /* the load steps */
@@ -265,21 +279,21 @@ int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r)
     /* fields per converged step */
     const size_t n2[2] = {m->nnode, 2}, g4[2] = {r->ngp, 4}, g1[1] = {r->ngp}, e1[1] = {m->nelem},
                  b2[2] = {s->nbc, 2};
-    rc |= series(h, r, "displacement", &r->u, 2, n2);
-    rc |= series(h, r, "position", &r->x, 2, n2);
-    rc |= series(h, r, "deformation_gradient", &r->F, 2, g4);
-    rc |= series(h, r, "piola_stress", &r->P, 2, g4);
-    rc |= series(h, r, "cauchy_stress", &r->sigma, 2, g4);
-    rc |= series(h, r, "von_mises", &r->mises, 1, g1);
-    rc |= series(h, r, "von_mises_element", &r->mises_elem, 1, e1);
-    rc |= series(h, r, "rve/energy_density", &r->energy, 1, g1);
-    rc |= series(h, r, "rve/coordination", &r->coordination, 1, g1);
-    rc |= series(h, r, "rve/rattlers", &r->rattlers, 1, g1);
-    rc |= series(h, r, "rve/relaxation_iterations", &r->relax_iter, 1, g1);
-    rc |= series(h, r, "reaction", &r->reaction, 2, b2);
-    rc |= series(h, r, "area", &r->area, 0, NULL);
-    rc |= series(h, r, "dilatancy_percent", &r->dilatancy, 0, NULL);
-    rc |= pk_h5_obs_double(h, "fe2/reference_area", r->area0, NULL);
+    rc |= series(h, r, clock, "displacement", NULL, &r->u, 2, n2, u);
+    rc |= series(h, r, clock, "position", NULL, &r->x, 2, n2, u);
+    rc |= series(h, r, clock, "deformation_gradient", NULL, &r->F, 2, g4, u);
+    rc |= series(h, r, clock, "piola_stress", NULL, &r->P, 2, g4, u);
+    rc |= series(h, r, clock, "cauchy_stress", NULL, &r->sigma, 2, g4, u);
+    rc |= series(h, r, clock, "von_mises", NULL, &r->mises, 1, g1, u);
+    rc |= series(h, r, clock, "von_mises_element", NULL, &r->mises_elem, 1, e1, u);
+    rc |= series(h, r, clock, "rve/energy_density", NULL, &r->energy, 1, g1, u);
+    rc |= series(h, r, clock, "rve/coordination", NULL, &r->coordination, 1, g1, u);
+    rc |= series(h, r, clock, "rve/rattlers", NULL, &r->rattlers, 1, g1, u);
+    rc |= series(h, r, clock, "rve/relaxation_iterations", NULL, &r->relax_iter, 1, g1, u);
+    rc |= series(h, r, clock, "reaction", NULL, &r->reaction, 2, b2, u);
+    rc |= series(h, r, clock, "area", NULL, &r->area, 0, NULL, u);
+    rc |= series(h, r, clock, "dilatancy_percent", NULL, &r->dilatancy, 0, NULL, u);
+    rc |= pk_h5_obs_double(h, "fe2/reference_area", r->area0, pk_units_of("fe2/reference_area", u));
     /* the names of the conditions (rows of reaction) */
     char names[4096] = "";
     for (size_t k = 0; k < s->nbc; k++)
@@ -298,7 +312,7 @@ int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r)
         for (size_t k = 0; !rc && k < r->nstep; k++)
             rc |= push(&one, &r->micro_x.v[((k * r->nmicro) + i) * 2 * r->ngrain], 2 * r->ngrain);
         const size_t dm[2] = {r->ngrain, 2};
-        rc |= series(h, r, name, &one, 2, dm);
+        rc |= series(h, r, clock, name, "micro", &one, 2, dm, u);
         free(one.v);
     }
     /* the Newton histories: one row per solve (part of a load step), one
@@ -308,7 +322,8 @@ int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r)
     rc |= arr(h, "/observables/fe2/newton/solves/t0", 1, &np, r->part_t0.v, NULL);
     rc |= arr(h, "/observables/fe2/newton/solves/t1", 1, &np, r->part_t1.v, NULL);
     rc |= iarr(h, "/observables/fe2/newton/solves/iterations", r->part_n.v, np);
-    rc |= arr(h, "/observables/fe2/newton/solves/abs_residual_0", 1, &np, r->part_abs0.v, NULL);
+    rc |= arr(h, "/observables/fe2/newton/solves/abs_residual_0", 1, &np, r->part_abs0.v,
+              pk_units_of("fe2/newton/solves/abs_residual_0", u));
     rc |= iarr(h, "/observables/fe2/newton/solves/converged", r->part_conv.v, np);
     rc |= iarr(h, "/observables/fe2/newton/iterations/solve", r->it_part.v, ni);
     rc |= arr(h, "/observables/fe2/newton/iterations/relative_residual", 1, &ni, r->it_res.v, NULL);

@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include "api/results/h5_result.h"
+#include "api/results/h5_units.h"
 #include "core/fe2/fe2_fields.h"
 #include "core/fe2/fe2_solver.h"
 #include "fe2_job.h"
@@ -48,6 +49,6 @@ int pk_fe2_record_step(pk_fe2_record *r, size_t step, double time, size_t stage,
 
 /* Everything under /observables/fe2 (and the per-step views of the XDMF
  * sidecar).  0 / −1. */
-int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r);
+int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r, const pk_units *u);
 
 #endif

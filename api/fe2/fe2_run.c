@@ -53,8 +53,20 @@ static int fe2_progress(const pk_progress *p, void *vctx)
 static int load_rve(const pk_fe2_job *job, int threads, const char *out_path, pk_monitor *mon,
                     pk_box *box, pk_particles *p, char *err, size_t errlen)
 {
-    if (!job->pack_job)
+    if (!job->pack_job) {
+        /* the file's lengths are in the job's unit: a file with another
+         * unit is refused, one without (unit "1") is read in the job's */
+        char fu[32] = "";
+        if (pk_h5_read_unit(job->micro.rve_file, fu, sizeof fu) == 0 && *fu && strcmp(fu, "1") &&
+            strcmp(fu, job->unit)) {
+            snprintf(err, errlen,
+                     "/micro/rve/file: the RVE's unit is \"%s\", the job's (/unit) \"%s\"; "
+                     "state \"unit\": \"%s\"",
+                     fu, job->unit, fu);
+            return -1;
+        }
         return pk_h5_read_particles(job->micro.rve_file, box, p, err, errlen);
+    }
     char tmp[4200];
     snprintf(tmp, sizeof tmp, "%s.rve.%ld.h5", out_path, (long)getpid());
     const pk_process *pack = pk_process_find("pack");
@@ -264,13 +276,15 @@ int pk_fe2_run(const void *parsed, int threads, const char *job_json, const char
     pk_h5 *h = pk_h5_create(out_path, err, errlen);
     if (!h)
         goto out;
-    int w = pk_h5_write_particles(h, &box, &p, "1");
+    pk_units units; /* lengths in the job's unit, forces in N, per unit thickness */
+    pk_units_init(&units, job->unit, 2);
+    int w = pk_h5_write_particles(h, &box, &p, job->unit);
     w |= pk_h5_write_parameters(h, "fe2", job_json, 0);
-    w |= pk_fe2_record_write(h, &rec);
+    w |= pk_fe2_record_write(h, &rec, &units);
     w |= pk_h5_obs_string(h, "fe2/termination_reason", reason);
     w |= pk_h5_obs_string(h, "fe2/boundary_condition", pk_homog_bc_name(job->micro.bc));
     w |= pk_h5_obs_int(h, "fe2/rve_particles", (int64_t)rve.n);
-    w |= pk_h5_obs_double(h, "fe2/E_n", job->micro.E_n, NULL);
+    w |= pk_h5_obs_double(h, "fe2/E_n", job->micro.E_n, pk_units_of("fe2/E_n", &units));
     w |= pk_verdict_write_h5(h, sum);
     if (w != 0) {
         pk_h5_abort(h);

@@ -16,9 +16,23 @@ void pk_units_init(pk_units *u, const char *length, int dim)
     snprintf(u->stiffness, sizeof u->stiffness, "N %s-1", length);
     snprintf(u->stress, sizeof u->stress, "N %s-%d", length, dim - 1);
     snprintf(u->energy, sizeof u->energy, "N %s", length);
+    snprintf(u->plane_stress, sizeof u->plane_stress, "N %s-2", length);
+    snprintf(u->force_per_thickness, sizeof u->force_per_thickness, "N %s-1", length);
 }
 
-typedef enum { U_LENGTH, U_VOLUME, U_STIFF, U_STRESS, U_ENERGY, U_FORCE, U_S, U_HZ } kind;
+typedef enum {
+    U_LENGTH,
+    U_VOLUME,
+    U_STIFF,
+    U_STRESS,
+    U_ENERGY,
+    U_FORCE,
+    U_S,
+    U_HZ,
+    U_AREA,
+    U_PSTRESS,
+    U_FORCE_T
+} kind;
 
 /* Observables with a unit; every other one is a count, a ratio, a flag or
  * in reduced units (EDMD's time, d̄/u). */
@@ -54,6 +68,22 @@ static const struct {
     {"homogenize/tangent/seconds", U_S},
     {"homogenize/final_state/position", U_LENGTH},
     {"homogenize/final_state/fluctuation", U_LENGTH},
+    {"fe2/mesh/nodes", U_LENGTH},
+    {"fe2/mesh/gauss_position", U_LENGTH},
+    {"fe2/mesh/gauss_weight", U_AREA},
+    {"fe2/displacement", U_LENGTH},
+    {"fe2/position", U_LENGTH},
+    {"fe2/piola_stress", U_PSTRESS},
+    {"fe2/cauchy_stress", U_PSTRESS},
+    {"fe2/von_mises", U_PSTRESS},
+    {"fe2/von_mises_element", U_PSTRESS},
+    {"fe2/rve/energy_density", U_PSTRESS},
+    {"fe2/reaction", U_FORCE_T},
+    {"fe2/area", U_AREA},
+    {"fe2/reference_area", U_AREA},
+    {"fe2/micro", U_LENGTH}, /* the RVE centres micro/gauss_point_<g> */
+    {"fe2/newton/solves/abs_residual_0", U_FORCE_T},
+    {"fe2/E_n", U_STIFF},
 };
 
 const char *pk_units_of(const char *name, const void *ctx)
@@ -71,6 +101,9 @@ const char *pk_units_of(const char *name, const void *ctx)
         case U_STIFF: return u->length[0] ? u->stiffness : NULL;
         case U_STRESS: return u->length[0] ? u->stress : NULL;
         case U_ENERGY: return u->length[0] ? u->energy : NULL;
+        case U_AREA: return u->length[0] ? u->area : NULL;
+        case U_PSTRESS: return u->length[0] ? u->plane_stress : NULL;
+        case U_FORCE_T: return u->length[0] ? u->force_per_thickness : NULL;
         }
     }
     return NULL;

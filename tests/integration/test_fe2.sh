@@ -48,6 +48,7 @@ bad("loaded", lambda i: i["boundary_conditions"].append({"name": "q", "type": "p
 bad("edges", lambda i: i["boundary_conditions"][3].update(on="upper_right"))
 bad("rigid", lambda i: i.update(boundary_conditions=i["boundary_conditions"][3:]) or
     i["stages"][1]["targets"].clear())
+bad("unit", lambda i: i["micro"]["rve"]["pack"].update(unit="m"))
 bad("inverted", lambda i: i.update(mesh={"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]],
     "elements": [[0, 3, 2, 1]], "sets": {"left": {"nodes": [0, 3], "edges": [[0, 3]]}}}))
 # the push in one increment to 95 % compression, no cuts allowed: the RVE cannot follow
@@ -90,6 +91,11 @@ check xdmf_sidecar sh -c "grep -q 'TopologyType=\"Quadrilateral\"' r.xdmf &&
 "$PACKD" picture r.h5 -o resp.svg --kind response >/dev/null 2>&1
 check picture_response test -s resp.svg
 check xdmf_items_match python3 "$SRC/tests/tools/xdmf_check.py" r.xdmf --steps 3 --mesh2d 4
+# H5MD 1.1: the job's unit (mm) on the RVE, the mesh, the fields; plane-strain stress in N mm-2
+check h5md_fe2 python3 "$SRC/tests/tools/h5md_check.py" r.h5
+check fe2_units sh -c "h5dump -a /particles/grains/box/edges/unit r.h5 | grep -q '\"mm\"' &&
+    h5dump -a /observables/fe2/cauchy_stress/value/unit r.h5 | grep -q '\"N mm-2\"' &&
+    h5dump -a /observables/fe2/reaction/value/unit r.h5 | grep -q '\"N mm-1\"'"
 
 # 1a. the Gauss points on 2 threads: the same result, bit for bit (the result digest)
 "$PACKD" run job.json -o r2.h5 --threads 2 --json >r2.json 2>r2.err
@@ -159,7 +165,8 @@ has_error() { grep -A1 "\"pointer\": \"$2\"" "$1" | grep -q "\"rule\": \"$3\""; 
 for case in set:/inputs/boundary_conditions/3/on:set target:/inputs/stages/1/targets/top:target \
     friction:/inputs/micro/friction:friction conflict:/inputs/boundary_conditions/4:conflict \
     loaded:/inputs/boundary_conditions/4:loadOnPrescribed edges:/inputs/boundary_conditions/3:edges \
-    rigid:/inputs/boundary_conditions:rigidMotion inverted:/inputs/mesh:mesh; do
+    rigid:/inputs/boundary_conditions:rigidMotion inverted:/inputs/mesh:mesh \
+    unit:/inputs/micro/rve/pack/unit:semantic; do
     name=${case%%:*}
     rest=${case#*:}
     code=$(post "bad_$name.json" "bad_$name.out")

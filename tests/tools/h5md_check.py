@@ -29,6 +29,10 @@ DIMENSIONAL = [
     r"/observables/homogenize/(P|sigma|sigma_skew|energy|energy_density|energy_tangential"
     r"|dissipation|sum_force|rve_volume|E_n|friction/E_t|dr/residual|dr/residual_initial"
     r"|tangent/A|tangent/seconds|final_state/position|final_state/fluctuation)",
+    r"/observables/fe2/mesh/(nodes|gauss_position|gauss_weight)",
+    r"/observables/fe2/(displacement|position|piola_stress|cauchy_stress|von_mises"
+    r"|von_mises_element|rve/energy_density|reaction|area|reference_area|E_n"
+    r"|newton/solves/abs_residual_0|micro/gauss_point_\d+)",
     r"/connectivity/contact_(overlap|normal_force|branch)",
 ]
 UNIT = re.compile(r"^(\d+(\.\d+)? )?[A-Za-z]+([+-]\d+)?( [A-Za-z]+([+-]\d+)?)*$")
