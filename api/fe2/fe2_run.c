@@ -285,13 +285,7 @@ int pk_fe2_run(const void *parsed, int threads, const char *job_json, const char
     w |= pk_h5_obs_string(h, "fe2/boundary_condition", pk_homog_bc_name(job->micro.bc));
     w |= pk_h5_obs_int(h, "fe2/rve_particles", (int64_t)rve.n);
     w |= pk_h5_obs_double(h, "fe2/E_n", job->micro.E_n, pk_units_of("fe2/E_n", &units));
-    w |= pk_verdict_write_h5(h, sum);
-    if (w != 0) {
-        pk_h5_abort(h);
-        snprintf(err, errlen, "writing %s failed", out_path);
-        goto out;
-    }
-    if (pk_h5_commit(h, err, errlen) != 0)
+    if (pk_verdict_close_h5(h, w, sum, out_path, err, errlen) != 0)
         goto out;
     *summary = sum;
     sum = NULL;
