@@ -211,9 +211,8 @@ static void test_tables_match_schemas(void)
             bad += check_row(doc, t, &t->rows[j], filled);
         free(filled);
     }
-    static const char *const schemas[] = {"pack.inputs.schema.json",
-                                          "homogenize.inputs.schema.json",
-                                          "fe2.inputs.schema.json"};
+    static const char *const schemas[] = {
+        "pack.inputs.schema.json", "homogenize.inputs.schema.json", "fe2.inputs.schema.json"};
     for (int s = 0; s < 3; s++)
         bad += defaults_covered(schemas[s], pk_schema_get(schemas[s]), pk_schema_get(schemas[s]),
                                 "", 0);
