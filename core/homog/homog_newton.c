@@ -546,8 +546,8 @@ void pk_hybrid_fire_merge(pk_dr_stats *st, const pk_dr_stats *fs, const pk_dr_pa
 
 /* FIRE from DR's point after a failed attempt (the attempts go on from
  * FIRE's points through the same hook) to the step's target; st (DR's
- * statistics so far) gets FIRE's iterations added and its end.  (What was
- * tried instead of FIRE here: docs/perf/homog.md, fire_on.) */
+ * statistics so far) gets FIRE's iterations added and its end (the
+ * alternatives measured against it: docs/perf/homog.md, fire_on). */
 static int fire_on(const newton_run *sy, double *x, double target, pk_dr_hook *hook,
                    pk_dr_stats *st, pk_newton_stats *ns)
 {
