@@ -104,6 +104,19 @@ static void item(FILE *f, const char *ind, const char *dims, const char *type, i
             ind, dims, type, prec, ref, path);
 }
 
+/* <Attribute> holding one DataItem; ind is the attribute's indentation. */
+static void attribute(FILE *f, const char *ind, const char *name, const char *atype,
+                      const char *center, const char *dims, const char *type, int prec,
+                      const char *ref, const char *path)
+{
+    char inner[32];
+    snprintf(inner, sizeof inner, "%s  ", ind);
+    fprintf(f, "%s<Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"%s\">\n", ind, name, atype,
+            center);
+    item(f, inner, dims, type, prec, ref, path);
+    fprintf(f, "%s</Attribute>\n", ind);
+}
+
 /* The grains: one vertex cell per grain (the Xdmf3 reader makes no cells
  * without the connectivity 0..N-1: /particles/grains/id, inline for files
  * without it). */
@@ -133,20 +146,13 @@ static void grains_grid(FILE *f, hid_t h, const char *ref, size_t n, int dim)
     snprintf(s, sizeof s, "%zu %d", n, dim);
     item(f, "        ", s, "Float", 8, ref, "/particles/grains/position");
     snprintf(s, sizeof s, "%zu", n);
-    fprintf(f,
-            "      </Geometry>\n"
-            "      <Attribute Name=\"radius\" AttributeType=\"Scalar\" Center=\"Node\">\n");
-    item(f, "        ", s, "Float", 8, ref, "/particles/grains/radius");
-    fprintf(f,
-            "      </Attribute>\n"
-            "      <Attribute Name=\"species\" AttributeType=\"Scalar\" Center=\"Node\">\n");
-    item(f, "        ", s, "Int", 4, ref, "/particles/grains/species");
-    fprintf(f, "      </Attribute>\n");
-    if (dims_of(h, "/particles/grains/id", d) == 1) {
-        fprintf(f, "      <Attribute Name=\"id\" AttributeType=\"Scalar\" Center=\"Node\">\n");
-        item(f, "        ", s, "Int", 8, ref, "/particles/grains/id");
-        fprintf(f, "      </Attribute>\n");
-    }
+    fprintf(f, "      </Geometry>\n");
+    attribute(f, "      ", "radius", "Scalar", "Node", s, "Float", 8, ref,
+              "/particles/grains/radius");
+    attribute(f, "      ", "species", "Scalar", "Node", s, "Int", 4, ref,
+              "/particles/grains/species");
+    if (dims_of(h, "/particles/grains/id", d) == 1)
+        attribute(f, "      ", "id", "Scalar", "Node", s, "Int", 8, ref, "/particles/grains/id");
     fprintf(f, "    </Grid>\n");
 }
 
@@ -187,10 +193,8 @@ static void mesh_grid(FILE *f, hid_t h, const char *ref)
     item(f, "        ", s, "Float", 8, ref, nodes);
     fprintf(f, "      </Geometry>\n");
     if (dims_of(h, regions, dr) == 1 && dr[0] == nt) {
-        fprintf(f, "      <Attribute Name=\"region\" AttributeType=\"Scalar\" Center=\"Cell\">\n");
         snprintf(s, sizeof s, "%llu", (unsigned long long)dr[0]);
-        item(f, "        ", s, "Int", 8, ref, regions);
-        fprintf(f, "      </Attribute>\n");
+        attribute(f, "      ", "region", "Scalar", "Cell", s, "Int", 8, ref, regions);
     }
     fprintf(f, "    </Grid>\n");
 }
@@ -239,21 +243,14 @@ static int steps_grid(FILE *f, hid_t h, const char *ref)
         snprintf(view, sizeof view, "/particles/rve/views/position/%llu", (unsigned long long)k);
         snprintf(s, sizeof s, "%llu %llu", n, (unsigned long long)dx[2]);
         item(f, "          ", s, "Float", 8, ref, view);
-        fprintf(f,
-                "        </Geometry>\n"
-                "        <Attribute Name=\"radius\" AttributeType=\"Scalar\" Center=\"Node\">\n");
+        fprintf(f, "        </Geometry>\n");
         snprintf(s, sizeof s, "%llu", n);
-        item(f, "          ", s, "Float", 8, ref, "/particles/rve/radius");
-        fprintf(f, "        </Attribute>\n");
+        attribute(f, "        ", "radius", "Scalar", "Node", s, "Float", 8, ref,
+                  "/particles/rve/radius");
         if (with_force) {
-            fprintf(f,
-                    "        <Attribute Name=\"contact_force\" AttributeType=\"Scalar\" "
-                    "Center=\"Node\">\n");
             snprintf(view, sizeof view, "/particles/rve/views/contact_force/%llu",
                      (unsigned long long)k);
-            snprintf(s, sizeof s, "%llu", n);
-            item(f, "          ", s, "Float", 8, ref, view);
-            fprintf(f, "        </Attribute>\n");
+            attribute(f, "        ", "contact_force", "Scalar", "Node", s, "Float", 8, ref, view);
         }
         fprintf(f, "      </Grid>\n");
     }
@@ -311,22 +308,15 @@ static int fe2_grid(FILE *f, hid_t h, const char *ref)
         snprintf(view, sizeof view, "/observables/fe2/views/position/%llu", (unsigned long long)k);
         snprintf(s, sizeof s, "%llu 2", nn);
         item(f, "          ", s, "Float", 8, ref, view);
-        fprintf(f,
-                "        </Geometry>\n"
-                "        <Attribute Name=\"displacement\" AttributeType=\"Vector\" "
-                "Center=\"Node\">\n");
+        fprintf(f, "        </Geometry>\n");
         snprintf(view, sizeof view, "/observables/fe2/views/displacement/%llu",
                  (unsigned long long)k);
-        item(f, "          ", s, "Float", 8, ref, view);
-        fprintf(
-            f,
-            "        </Attribute>\n"
-            "        <Attribute Name=\"von_mises\" AttributeType=\"Scalar\" Center=\"Cell\">\n");
+        attribute(f, "        ", "displacement", "Vector", "Node", s, "Float", 8, ref, view);
         snprintf(view, sizeof view, "/observables/fe2/views/von_mises_element/%llu",
                  (unsigned long long)k);
         snprintf(s, sizeof s, "%llu", ne);
-        item(f, "          ", s, "Float", 8, ref, view);
-        fprintf(f, "        </Attribute>\n      </Grid>\n");
+        attribute(f, "        ", "von_mises", "Scalar", "Cell", s, "Float", 8, ref, view);
+        fprintf(f, "      </Grid>\n");
     }
     fprintf(f, "    </Grid>\n");
     free(t);
