@@ -41,9 +41,11 @@ static hid_t string_type(size_t len)
     return t;
 }
 
-static int attr_string(hid_t obj, const char *name, const char *v)
+/* A scalar fixed-length string attribute in character set cset. */
+static int attr_text(hid_t obj, const char *name, const char *v, H5T_cset_t cset)
 {
     hid_t t = string_type(strlen(v) + 1), s = H5Screate(H5S_SCALAR);
+    H5Tset_cset(t, cset);
     hid_t a = H5Acreate2(obj, name, t, s, H5P_DEFAULT, H5P_DEFAULT);
     herr_t rc = a < 0 ? -1 : H5Awrite(a, t, v);
     if (a >= 0)
@@ -53,19 +55,13 @@ static int attr_string(hid_t obj, const char *name, const char *v)
     return rc < 0 ? -1 : 0;
 }
 
-/* An H5MD unit attribute (units module 1.0: scalar, fixed-length, ASCII). */
-static int attr_unit(hid_t obj, const char *v)
+static int attr_string(hid_t obj, const char *name, const char *v)
 {
-    hid_t t = string_type(strlen(v) + 1), s = H5Screate(H5S_SCALAR);
-    H5Tset_cset(t, H5T_CSET_ASCII);
-    hid_t a = H5Acreate2(obj, "unit", t, s, H5P_DEFAULT, H5P_DEFAULT);
-    herr_t rc = a < 0 ? -1 : H5Awrite(a, t, v);
-    if (a >= 0)
-        H5Aclose(a);
-    H5Sclose(s);
-    H5Tclose(t);
-    return rc < 0 ? -1 : 0;
+    return attr_text(obj, name, v, H5T_CSET_UTF8);
 }
+
+/* An H5MD unit attribute (units module 1.0: scalar, fixed-length, ASCII). */
+static int attr_unit(hid_t obj, const char *v) { return attr_text(obj, "unit", v, H5T_CSET_ASCII); }
 
 static int attr_ints(hid_t obj, const char *name, const int *v, hsize_t n, int scalar)
 {

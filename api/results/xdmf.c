@@ -104,6 +104,21 @@ static void item(FILE *f, const char *ind, const char *dims, const char *type, i
             ind, dims, type, prec, ref, path);
 }
 
+/* The n doubles of the 1-D dataset path (a time axis), malloc'd; NULL on failure. */
+static double *read_doubles(hid_t h, const char *path, hsize_t n)
+{
+    double *v = malloc((n ? n : 1) * sizeof *v);
+    hid_t ds = H5Dopen2(h, path, H5P_DEFAULT);
+    int ok = v && ds >= 0 && H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) >= 0;
+    if (ds >= 0)
+        H5Dclose(ds);
+    if (!ok) {
+        free(v);
+        return NULL;
+    }
+    return v;
+}
+
 /* <Attribute> holding one DataItem; ind is the attribute's indentation. */
 static void attribute(FILE *f, const char *ind, const char *name, const char *atype,
                       const char *center, const char *dims, const char *type, int prec,
@@ -215,15 +230,9 @@ static int steps_grid(FILE *f, hid_t h, const char *ref)
         return 0;
     int with_force = dims_of(h, frc, df) == 2 && df[0] == dx[0] && df[1] == dx[1] &&
         dims_of(h, "/particles/rve/views/contact_force/0", dd) == 1;
-    double *t = malloc(dt[0] * sizeof *t);
-    hid_t ds = H5Dopen2(h, tim, H5P_DEFAULT);
-    int ok = t && ds >= 0 && H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, t) >= 0;
-    if (ds >= 0)
-        H5Dclose(ds);
-    if (!ok) {
-        free(t);
+    double *t = read_doubles(h, tim, dt[0]);
+    if (!t)
         return 0;
-    }
     const unsigned long long n = dx[1];
     char s[64];
     fprintf(f,
@@ -276,15 +285,9 @@ static int fe2_grid(FILE *f, hid_t h, const char *ref)
     const char *kind = dt[0] == 4 * de[0] ? "Quadrilateral"
         : dt[0] == 3 * de[0]              ? "Triangle"
                                           : "Mixed";
-    double *t = malloc(dk[0] * sizeof *t);
-    hid_t ds = H5Dopen2(h, tim, H5P_DEFAULT);
-    int ok = t && ds >= 0 && H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, t) >= 0;
-    if (ds >= 0)
-        H5Dclose(ds);
-    if (!ok) {
-        free(t);
+    double *t = read_doubles(h, tim, dk[0]);
+    if (!t)
         return 0;
-    }
     const unsigned long long ne = de[0], nn = dn[0];
     int npe = !strcmp(kind, "Triangle") ? 3 : !strcmp(kind, "Quadrilateral") ? 4 : 0;
     char s[64], view[96];
