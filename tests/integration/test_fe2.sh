@@ -4,7 +4,8 @@
 # pressure and pushed down in 3 load steps, through `packd run` and through
 # a real daemon on 127.0.0.1; the result read back with h5dump (mesh,
 # fields per step, Newton histories, reactions in balance with the load)
-# and its XDMF sidecar; invalid inputs refused with 422 naming the field;
+# and its XDMF sidecar; invalid inputs refused with 422 naming the field (server paths for the RVE
+# and the mesh among them: the daemon never opens a file on a request's word);
 # a load step that cannot converge ends the job failed with the step and
 # the reason, its partial file kept.
 . "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
@@ -40,6 +41,8 @@ def bad(name, edit):
 bad("set", lambda i: i["boundary_conditions"][3].update(on="rigth"))
 bad("target", lambda i: i["stages"][1]["targets"].update(top=-1))
 bad("friction", lambda i: i["micro"].update(friction={"rho_deg": 20}))
+bad("rvepath", lambda i: i["micro"].update(rve={"file": "/etc/passwd"}))
+bad("meshpath", lambda i: i.update(mesh={"file": "/etc/passwd"}))
 bad("conflict", lambda i: i["boundary_conditions"].append(
     {"name": "corner", "type": "displacement", "on": "lower_left", "component": "x"}) or
     i["stages"][0]["targets"].update(corner=0.5))
@@ -166,7 +169,8 @@ for case in set:/inputs/boundary_conditions/3/on:set target:/inputs/stages/1/tar
     friction:/inputs/micro/friction:friction conflict:/inputs/boundary_conditions/4:conflict \
     loaded:/inputs/boundary_conditions/4:loadOnPrescribed edges:/inputs/boundary_conditions/3:edges \
     rigid:/inputs/boundary_conditions:rigidMotion inverted:/inputs/mesh:mesh \
-    unit:/inputs/micro/rve/pack/unit:semantic; do
+    unit:/inputs/micro/rve/pack/unit:semantic rvepath:/inputs/micro/rve/file:serverPath \
+    meshpath:/inputs/mesh/file:serverPath; do
     name=${case%%:*}
     rest=${case#*:}
     code=$(post "bad_$name.json" "bad_$name.out")
