@@ -2,7 +2,10 @@
  * Contract: api/inputs/input_links.h. */
 #include "input_links.h"
 
+#include "json_depth.h"
+
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 typedef struct {
@@ -11,12 +14,35 @@ typedef struct {
     const char *key; /* the string member looked for */
     int alone;       /* 1: only objects with no other member */
     size_t count;
-    char ptr[256];
+    char *ptr; /* the JSON pointer of the current value, grown with the walk */
+    size_t cap;
+    int oom;
 } walker;
 
-static void walk(walker *w, json_t *v)
+/* Room for need more bytes after len (and the terminator). */
+static int reserve(walker *w, size_t len, size_t need)
 {
-    size_t len = strlen(w->ptr);
+    if (len + need + 1 <= w->cap)
+        return 0;
+    size_t cap = w->cap ? w->cap : 64;
+    while (cap < len + need + 1)
+        cap *= 2;
+    char *p = realloc(w->ptr, cap);
+    if (!p) {
+        w->oom = 1;
+        return -1;
+    }
+    w->ptr = p;
+    w->cap = cap;
+    return 0;
+}
+
+static void walk(walker *w, json_t *v, size_t len, int depth)
+{
+    /* Bodies are depth-checked before they reach here (PK_JSON_MAX_DEPTH);
+     * job files from disk are not, so the walk stops there too. */
+    if (w->oom || depth > PK_JSON_MAX_DEPTH)
+        return;
     if (json_is_object(v)) {
         json_t *s = json_object_get(v, w->key);
         if (json_is_string(s) && (!w->alone || json_object_size(v) == 1)) {
@@ -29,9 +55,11 @@ static void walk(walker *w, json_t *v)
         json_object_foreach (v, key, child) {
             if (!json_is_object(child) && !json_is_array(child))
                 continue;
+            if (reserve(w, len, 1 + 2 * strlen(key)) != 0)
+                return;
             size_t o = len; /* RFC 6901 escaping of the key */
             w->ptr[o++] = '/';
-            for (const char *c = key; *c && o + 3 < sizeof w->ptr; c++) {
+            for (const char *c = key; *c; c++) {
                 if (*c == '~' || *c == '/') {
                     w->ptr[o++] = '~';
                     w->ptr[o++] = *c == '~' ? '0' : '1';
@@ -40,7 +68,7 @@ static void walk(walker *w, json_t *v)
                 }
             }
             w->ptr[o] = 0;
-            walk(w, child);
+            walk(w, child, o, depth + 1);
             w->ptr[len] = 0;
         }
     } else if (json_is_array(v)) {
@@ -49,11 +77,23 @@ static void walk(walker *w, json_t *v)
         json_array_foreach (v, i, child) {
             if (!json_is_object(child) && !json_is_array(child))
                 continue;
-            snprintf(w->ptr + len, sizeof w->ptr - len, "/%zu", i);
-            walk(w, child);
+            if (reserve(w, len, 24) != 0)
+                return;
+            int n = snprintf(w->ptr + len, w->cap - len, "/%zu", i);
+            walk(w, child, len + (size_t)n, depth + 1);
             w->ptr[len] = 0;
         }
     }
+}
+
+static size_t walk_all(walker *w, json_t *inputs)
+{
+    if (reserve(w, 0, 0) == 0) {
+        w->ptr[0] = 0;
+        walk(w, inputs, 0, 0);
+    }
+    free(w->ptr);
+    return w->count;
 }
 
 size_t pk_input_links_each(json_t *inputs,
@@ -62,8 +102,7 @@ size_t pk_input_links_each(json_t *inputs,
                            void *ctx)
 {
     walker w = {.fn = fn, .ctx = ctx, .key = "href", .alone = 1};
-    walk(&w, inputs);
-    return w.count;
+    return walk_all(&w, inputs);
 }
 
 size_t pk_input_files_each(json_t *inputs,
@@ -72,8 +111,7 @@ size_t pk_input_files_each(json_t *inputs,
                            void *ctx)
 {
     walker w = {.fn = fn, .ctx = ctx, .key = "file", .alone = 0};
-    walk(&w, inputs);
-    return w.count;
+    return walk_all(&w, inputs);
 }
 
 static void refuse(json_t *link, const char *href, const char *pointer, void *ctx)

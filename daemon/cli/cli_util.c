@@ -5,6 +5,8 @@
 
 #include "cli.h"
 
+#include "api/inputs/json_depth.h"
+
 static void print_json(json_t *out)
 {
     json_dumpf(out, stdout, JSON_INDENT(2));
@@ -22,6 +24,14 @@ json_t *cli_load_json(const char *path)
         pk_schema_errors_add(&errs, "", "json", "line %d, column %d: %s", e.line, e.column, e.text);
         cli_print_errors(path, &errs);
         pk_schema_errors_free(&errs);
+    } else if (!pk_json_depth_within(j, PK_JSON_MAX_DEPTH)) {
+        pk_schema_errors errs = {0};
+        pk_schema_errors_add(&errs, "", "depth", "objects and arrays nest deeper than %d levels",
+                             PK_JSON_MAX_DEPTH);
+        cli_print_errors(path, &errs);
+        pk_schema_errors_free(&errs);
+        json_decref(j);
+        j = NULL;
     }
     return j;
 }

@@ -31,8 +31,8 @@ static const struct {
      NULL},
     {"serve", cmd_serve,
      "serve [--config F] [--bind A] [--port N] [--data DIR] run the job service", cmd_serve_help},
-    {"picture", cmd_picture,
-     "picture OUT.h5 -o FILE.svg|png [--kind KIND]  draw a result", own_help},
+    {"picture", cmd_picture, "picture OUT.h5 -o FILE.svg|png [--kind KIND]  draw a result",
+     own_help},
     {"token", cmd_token,
      "token add NAME [--admin] | list | revoke NAME [--config F] [--data DIR]\n"
      "                                                    the service's bearer tokens",

@@ -20,6 +20,7 @@
 #include "api/http/http_process_doc.h"
 #include "api/http/http_status_info.h"
 #include "api/inputs/input_confine.h"
+#include "api/inputs/json_depth.h"
 #include "daemon/log.h"
 #include "api/digest.h"
 
@@ -152,6 +153,13 @@ enum MHD_Result route_execute(pk_req *r)
                      jerr.line, jerr.column);
         else
             snprintf(d, sizeof d, "the body is empty; expected {\"inputs\": {...}}");
+        return pk_send_problem(r, 400, PK_PROBLEM_GENERIC, "Bad Request", d, NULL, 0);
+    }
+    if (!pk_json_depth_within(body, PK_JSON_MAX_DEPTH)) {
+        json_decref(body);
+        char d[120];
+        snprintf(d, sizeof d, "the body nests objects and arrays deeper than %d levels (limit)",
+                 PK_JSON_MAX_DEPTH);
         return pk_send_problem(r, 400, PK_PROBLEM_GENERIC, "Bad Request", d, NULL, 0);
     }
     json_t *inputs = json_object_get(body, "inputs");
