@@ -12,17 +12,20 @@
 #include "job_verdict.h"
 #include "api/pack/pack_job.h"
 
+static const char *const pack_pictures[] = {"packing", "grading", "history", NULL};
 static const pk_process pack_process = {
     .id = "pack",
     .title = "Pack grains from a grading curve",
     .description = "Draw grain sizes from a grading (sieve) curve and place them in a 2D or 3D "
                    "box (periodic or walled) with a minimum gap; writes an H5MD result file.",
     .inputs_schema = "pack.inputs.schema.json",
+    .pictures = pack_pictures,
     .parse = pk_pack_parse,
     .free_job = pk_pack_free,
     .run = pk_pack_run,
 };
 
+static const char *const homogenize_pictures[] = {"packing", "stress", "residual", NULL};
 static const pk_process homogenize_process = {
     .id = "homogenize",
     .title = "Homogenize a packing (DEM RVE)",
@@ -31,11 +34,13 @@ static const pk_process homogenize_process = {
                    "conditions; per step the Piola and Cauchy stress, energies, relaxation "
                    "figures and optionally the tangent (Meier 2009); writes an H5MD result file.",
     .inputs_schema = "homogenize.inputs.schema.json",
+    .pictures = homogenize_pictures,
     .parse = pk_homog_parse,
     .free_job = pk_homog_free,
     .run = pk_homog_run,
 };
 
+static const char *const fe2_pictures[] = {"packing", "response", NULL};
 static const pk_process fe2_process = {
     .id = "fe2",
     .title = "FE²: a plane-strain boundary value problem with a DEM RVE at every Gauss point",
@@ -47,6 +52,7 @@ static const pk_process fe2_process = {
                    "cutting; writes an H5MD result file with the mesh, the fields per converged "
                    "load step and the Newton histories.",
     .inputs_schema = "fe2.inputs.schema.json",
+    .pictures = fe2_pictures,
     .parse = pk_fe2_parse,
     .free_job = pk_fe2_free,
     .run = pk_fe2_run,

@@ -16,6 +16,9 @@ typedef struct pk_process {
     const char *title;
     const char *description;
     const char *inputs_schema; /* file name in schemas/ */
+    /* The picture kinds (api/picture/picture.h) its results may hold,
+     * NULL-terminated: the pictures its description declares as outputs. */
+    const char *const *pictures;
     /* Schema-valid inputs → the parsed job (the process's option table
      * filled, semantic checks beyond the schema: cross-field rules,
      * feasibility), released by free_job; NULL with errors appended (JSON

@@ -335,7 +335,21 @@ static int place_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, const
     return 0;
 }
 
+/* Its observables with a unit. */
+static const pk_unit_row tetfill_units[] = {
+    {"r_min", PK_U_LENGTH},
+    {"r_max", PK_U_LENGTH},
+    {"overlap_bound", PK_U_LENGTH},
+    {"mesh_volume", PK_U_VOLUME},
+    {"mesh_edge_mean", PK_U_LENGTH},
+    {"mesh_origin", PK_U_LENGTH},
+    {"seconds_geometric", PK_U_SECONDS},
+    {NULL},
+};
+
 const pk_placer pk_placer_tetfill = {.name = "tetfill",
+                                     .fills_mesh = 1,
+                                     .units = tetfill_units,
                                      .own_sizes = 1,
                                      .options = &tetfill_options,
                                      .check = check_tetfill,

@@ -22,3 +22,11 @@ const pk_placer *pk_placer_find(const char *name)
             return pk_placers[i];
     return NULL;
 }
+
+const pk_placer *pk_placer_filling_mesh(void)
+{
+    size_t i = 0;
+    while (pk_placers[i + 1] && !pk_placers[i]->fills_mesh)
+        i++;
+    return pk_placers[i];
+}

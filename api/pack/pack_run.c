@@ -80,6 +80,22 @@ static int write_scene(pk_h5 *h, json_t *summary)
     return rc;
 }
 
+/* The unit of a placer observable: "<algorithm>/<name>" looked up in the
+ * placer's table (a pk_h5_unit_fn). */
+typedef struct placer_units {
+    const pk_placer *placer;
+    pk_units units;
+} placer_units;
+
+static const char *placer_unit_of(const char *name, const void *ctx)
+{
+    const placer_units *pu = ctx;
+    size_t n = strlen(pu->placer->name);
+    if (strncmp(name, pu->placer->name, n) != 0 || name[n] != '/')
+        return NULL;
+    return pk_unit_in(pu->placer->units, name + n + 1, &pu->units);
+}
+
 static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const char *job_json,
                         const pk_box *box, double V, const pk_particles *p, const pk_sizes *sz,
                         double scale, const pk_place_stats *st, const pk_gap_report *gap,
@@ -111,14 +127,14 @@ static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const 
     rc |= pk_h5_obs_string(h, "algorithm", job->algorithm);
     if (st->obs) {
         /* a history {events, time, ...} as H5MD time-dependent elements */
-        pk_units units;
-        pk_units_init(&units, u, dim);
+        placer_units pu = {.placer = pk_placer_find(job->algorithm)};
+        pk_units_init(&pu.units, u, dim);
         json_t *obs = json_copy(st->obs), *hist = json_object_get(st->obs, "history");
         char hp[64];
         snprintf(hp, sizeof hp, "%s/history", job->algorithm);
         if (hist && json_object_del(obs, "history") == 0)
             rc |= pk_h5_obs_history(h, hp, hist, "events", "time");
-        rc |= obs ? pk_h5_obs_json_units(h, job->algorithm, obs, pk_units_of, &units) : -1;
+        rc |= obs ? pk_h5_obs_json_units(h, job->algorithm, obs, placer_unit_of, &pu) : -1;
         json_decref(obs);
     }
     if (st->write_extra)

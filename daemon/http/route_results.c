@@ -95,7 +95,8 @@ static json_t *results_document(pk_req *r, json_t *row, const pk_exec_opts *o)
 {
     const char *id = json_string_value(json_object_get(row, "id"));
     json_t *doc = pk_results_document(row);
-    for (const pk_output *out = pk_outputs; out->id; out++) {
+    const pk_output *out;
+    for (size_t i = 0; (out = pk_output_at(i)); i++) {
         char path[1300], href[200];
         job_file(r, id, out->id, path, sizeof path);
         if (out->optional && access(path, R_OK) == 0) {
@@ -188,11 +189,12 @@ enum MHD_Result route_results(pk_req *r)
 enum MHD_Result route_result_file(pk_req *r)
 {
     const pk_output *out = pk_output_find(r->seg[3]);
-    if (!out)
-        return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output",
-                               "outputs: summary, result, xdmf, picture, grading, history, "
-                               "stress, residual, response .png/.svg",
+    if (!out) {
+        char all[600];
+        pk_outputs_list(all, sizeof all);
+        return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output", all,
                                NULL, 0);
+    }
     json_t *row = pk_job_visible(r, r->seg[1]);
     if (!row)
         return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);

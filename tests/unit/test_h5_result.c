@@ -211,10 +211,11 @@ static void test_h5md_elements_units_author(void)
     pk_units_init(&none, "1", 2);
     CHECK(!strcmp(u3.stress, "N mm-2") && !strcmp(u2.stress, "N mm-1"));
     CHECK(!strcmp(u3.volume, "mm+3") && !strcmp(u2.energy, "N mm"));
-    CHECK(!strcmp(pk_units_of("homogenize/E_n", &u2), "N mm-1"));
-    CHECK(!strcmp(pk_units_of("edmd/delta_d_reached", &u3), "mm"));
-    CHECK(pk_units_of("homogenize/E_n", &none) == NULL); /* no length unit: none */
-    CHECK(pk_units_of("homogenize/J", &u3) == NULL);
+    static const pk_unit_row rows[] = {{"E_n", PK_U_STIFFNESS}, {"d", PK_U_LENGTH}, {NULL}};
+    CHECK(!strcmp(pk_unit_in(rows, "E_n", &u2), "N mm-1"));
+    CHECK(!strcmp(pk_unit_in(rows, "d", &u3), "mm"));
+    CHECK(pk_unit_in(rows, "E_n", &none) == NULL); /* no length unit: none */
+    CHECK(pk_unit_in(rows, "J", &u3) == NULL);
 
     char path[256], err[256], buf[64];
     snprintf(path, sizeof path, "%s/e.h5", dir);
