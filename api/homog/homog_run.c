@@ -149,9 +149,11 @@ static json_t *tensor_json(const double T[9], int dim)
     return a;
 }
 
-int pk_homog_run(const void *parsed, int threads, const char *job_json, const char *out_path,
-                 pk_monitor *mon, json_t **summary, char *err, size_t errlen)
+int pk_homog_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
+                 const char *out_path, json_t **summary, char *err, size_t errlen)
 {
+    const int threads = run->threads;
+    pk_monitor *mon = run->mon;
     *summary = NULL;
     const pk_homog_job job = *(const pk_homog_job *)parsed; /* its arrays stay the caller's */
     pk_monitor_start(mon, job.wall_time_s);
@@ -213,9 +215,9 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
     /* a re-queued job continues after its last saved step (checkpoint file
      * of `packd run --checkpoint`: committed state, record, counters) */
     pk_homog_ckpt ck = {0};
-    const char *ck_digest;
-    double ck_every, ck_last = pk_wall_seconds();
-    const char *ck_path = pk_job_checkpoint(&ck_digest, &ck_every);
+    const char *ck_digest = run->checkpoint.digest ? run->checkpoint.digest : "";
+    double ck_every = run->checkpoint.interval_s, ck_last = pk_wall_seconds();
+    const char *ck_path = run->checkpoint.path;
     char ck_err[300] = "";
     int ck_loaded = ck_path
         ? pk_homog_ckpt_load(ck_path, ck_digest, &ck, &com, &rec, ck_err, sizeof ck_err)
@@ -421,7 +423,7 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
         }
     }
 
-    pk_h5 *h = pk_h5_create(out_path, err, errlen);
+    pk_h5 *h = pk_h5_create(out_path, run->author, err, errlen);
     if (!h)
         goto out;
     /* lengths in the RVE file's unit, forces in N (E_n per length unit) */
