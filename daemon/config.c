@@ -69,7 +69,7 @@ static const struct key {
     {"public_url", K_STR, F(public_url), 0, 0,
      "base URL of absolute links (reverse proxy); unset: http://<Host header>"},
     {"auth", K_AUTH, F(auth), 0, 0,
-     "bearer tokens required: auto (unless bind is loopback) | on | off"},
+     "bearer tokens required: auto (on unless bind is loopback without trusted_proxy) | on | off"},
     {"trusted_proxy", K_ADDR, F(trusted_proxy), 0, 0,
      "address of the reverse proxy whose X-Packd-Owner is honoured"},
 #undef F

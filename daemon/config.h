@@ -9,7 +9,7 @@
 #include <stddef.h>
 
 typedef enum { PK_LOG_DEBUG, PK_LOG_INFO, PK_LOG_WARN, PK_LOG_ERROR } pk_log_level;
-/* auto: on unless bind is a loopback address */
+/* auto: on unless bind is a loopback address and no trusted proxy is configured */
 typedef enum { PK_AUTH_AUTO, PK_AUTH_ON, PK_AUTH_OFF } pk_auth_mode;
 
 typedef struct pk_config {
