@@ -18,6 +18,7 @@
 #include <sys/resource.h>
 
 #include "auth.h"
+#include "conn_guard.h"
 #include "http.h"
 #include "http_park.h"
 #include "daemon/log.h"
@@ -175,6 +176,12 @@ static enum MHD_Result on_headers(pk_req *r)
     }
     r->answered = 0;
     r->route = rt;
+    if (strcmp(rt->method, "POST") == 0) { /* the body's deadline grows with its size */
+        double allow = cfg.body_timeout_s;
+        if (cl && cfg.head_timeout_s + (double)strtoll(cl, NULL, 10) / cfg.body_min_rate < allow)
+            allow = cfg.head_timeout_s + (double)strtoll(cl, NULL, 10) / cfg.body_min_rate;
+        pk_conn_guard_body(r->conn, allow);
+    }
     return MHD_YES;
 }
 
@@ -228,7 +235,10 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
         r->method = !strcmp(method, "HEAD") ? "GET" : method;
         r->started = pk_queue_now();
         *con_cls = r;
-        return on_headers(r);
+        enum MHD_Result rc = on_headers(r);
+        if (!r->route || strcmp(r->route->method, "POST") != 0)
+            pk_conn_guard_response(conn);
+        return rc;
     }
     if (*upload_size) {
         enum MHD_Result rc = on_body(r, upload, *upload_size);
@@ -239,6 +249,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
         return MHD_YES;
     if (r->resume)
         return r->resume(r);
+    pk_conn_guard_response(conn);
     if (r->too_large) {
         pk_config cfg = pk_service_config(svc);
         char d[128];
@@ -252,6 +263,7 @@ static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
                          enum MHD_RequestTerminationCode toe)
 {
     pk_req *r = *con_cls;
+    pk_conn_guard_head(conn); /* kept alive: the next head has head_timeout_s */
     if (r) {
         if (r->wait_free)
             r->wait_free(r->wait);
@@ -311,14 +323,21 @@ struct MHD_Daemon *pk_http_start(pk_service *svc, int *port, char *err, size_t e
         return NULL;
     }
     unsigned limit = connection_limit(&cfg);
+    if (pk_conn_guard_start(svc, limit) != 0) {
+        pk_park_stop();
+        snprintf(err, errlen, "cannot start the connection deadline thread");
+        return NULL;
+    }
     struct MHD_Daemon *d = MHD_start_daemon(
         MHD_USE_EPOLL_INTERNAL_THREAD | MHD_ALLOW_SUSPEND_RESUME | MHD_USE_ERROR_LOG,
         (uint16_t)cfg.port, NULL, NULL, on_request, svc, MHD_OPTION_EXTERNAL_LOGGER, mhd_log, NULL,
         MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr, MHD_OPTION_NOTIFY_COMPLETED, on_completed,
         NULL, MHD_OPTION_THREAD_POOL_SIZE, (unsigned)cfg.http_threads, MHD_OPTION_CONNECTION_LIMIT,
         limit, MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)cfg.max_connections_per_ip,
-        MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg.idle_timeout_s, MHD_OPTION_END);
+        MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg.idle_timeout_s, MHD_OPTION_NOTIFY_CONNECTION,
+        pk_conn_guard_notify, NULL, MHD_OPTION_END);
     if (!d) {
+        pk_conn_guard_stop();
         pk_park_stop();
         snprintf(err, errlen, "cannot listen on %s:%d (in use or not permitted)", cfg.bind,
                  cfg.port);
@@ -326,14 +345,17 @@ struct MHD_Daemon *pk_http_start(pk_service *svc, int *port, char *err, size_t e
     }
     const union MHD_DaemonInfo *info = MHD_get_daemon_info(d, MHD_DAEMON_INFO_BIND_PORT);
     *port = info ? info->port : cfg.port;
-    pk_log(PK_LOG_INFO, "http", "{s:i,s:i,s:i,s:i}", "threads", cfg.http_threads, "max_connections",
-           (int)limit, "max_connections_per_ip", cfg.max_connections_per_ip, "idle_timeout_s",
-           cfg.idle_timeout_s);
+    pk_log(PK_LOG_INFO, "http", "{s:i,s:i,s:i,s:i,s:i,s:f}", "threads", cfg.http_threads,
+           "max_connections", (int)limit, "evict_slowest_above",
+           (int)pk_conn_guard_threshold(limit), "max_connections_per_ip",
+           cfg.max_connections_per_ip, "idle_timeout_s", cfg.idle_timeout_s, "head_timeout_s",
+           cfg.head_timeout_s);
     return d;
 }
 
 void pk_http_stop(struct MHD_Daemon *d)
 {
     pk_park_stop(); /* resumes every parked stream: MHD must not stop with suspended ones */
+    pk_conn_guard_stop();
     MHD_stop_daemon(d);
 }
