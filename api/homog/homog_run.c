@@ -50,6 +50,24 @@ static const char *eval_error(int rc)
                     : "out of memory";
 }
 
+/* The rule a periodic RVE breaks when its pair search cannot tell a grain's
+ * neighbours from their periodic images (core/dem/dem_pairs.c): every edge
+ * longer than twice the largest contact reach at F̄ = I. */
+static void periodic_box_rule(const pk_homog_rve *rve, double skin, char *err, size_t errlen)
+{
+    double rmax = 0;
+    for (size_t i = 0; i < rve->n; i++)
+        rmax = fmax(rmax, rve->r[i]);
+    double need = 2 * (2 * rmax + skin), shortest = INFINITY;
+    for (int k = 0; k < rve->dim; k++)
+        shortest = fmin(shortest, rve->L[k]);
+    snprintf(err, errlen,
+             "/rve: the periodic box is too small for its grains: every edge must exceed 2 x "
+             "(largest diameter %.6g + pair-list skin %.6g) = %.6g, the shortest edge is %.6g "
+             "(rule periodic_box: a contact and its periodic image must not both be in reach)",
+             2 * rmax, skin, need, shortest);
+}
+
 /* An object of the n named values (taking their references). */
 static json_t *object_of(const char *const *names, json_t *const *vals, size_t n)
 {
@@ -175,7 +193,11 @@ int pk_homog_run(const void *parsed, const pk_run_ctx *run, const char *job_json
     if (o.newton && o.newton->ctx_new)
         o.newton_ctx = nctx = o.newton->ctx_new();
     o.par = pool = pk_par_new(threads);
-    if (pk_homog_state_init(&rve, &o, &com) != 0) {
+    int irc = pk_homog_state_init(&rve, &o, &com);
+    if (irc == -2) {
+        periodic_box_rule(&rve, o.dr.skin, err, errlen);
+        goto out;
+    } else if (irc != 0) {
         snprintf(err, errlen, "out of memory");
         goto out;
     }
