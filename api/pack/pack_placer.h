@@ -1,8 +1,8 @@
 /* pack_placer.h — the placement algorithms of the 'pack' process.
  *
  * The pack process draws sizes (core/psd/psd), hands them to one placer, audits
- * the result and writes the file.  A placer is one row in pk_placers[]
- * (api/pack/pack_placers.c) plus one file api/pack/pack_place_<name>.c: its
+ * the result and writes the file.  A placer is one row of the table
+ * (api/pack/pack_placers.c, or pk_placer_register) plus one file api/pack/pack_place_<name>.c: its
  * option table fills its options struct (pack_options.h) from its parameter
  * object of the inputs (e.g. "edmd": {...}) once per job, and the placer reads
  * them from job->opt; it runs its core/ algorithm and reports common statistics plus any algorithm-specific
@@ -91,9 +91,15 @@ void pk_pack_verdict(const pk_pack_job *job, const pk_pack_plan *plan, const pk_
                      const pk_particles *p, const pk_gap_report *gap, double phi, double delta_d,
                      json_t *summary);
 
-/* NULL-terminated table. */
-extern const pk_placer *const pk_placers[];
+/* The i-th placer of the table (from 0; NULL past the last): the built-in
+ * ones (pack_placers.c), then the registered ones. */
+const pk_placer *pk_placer_at(size_t i);
 const pk_placer *pk_placer_find(const char *name);
+/* Add a placer to the table and its name to the "algorithm" enum of the pack
+ * inputs schema (so validation and the process description offer it).  At
+ * start-up only, before any thread reads the table or the schema.  0, or -1
+ * when p lacks a name or place, its name is taken or the table is full. */
+int pk_placer_register(const pk_placer *p);
 /* The first placer of the table that fills a mesh (there is one). */
 const pk_placer *pk_placer_filling_mesh(void);
 
