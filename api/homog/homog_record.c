@@ -425,8 +425,8 @@ static int final_state(const writer *w, json_t *fs, int dim)
                 ((int64_t *)a)[i] = (int64_t)json_integer_value(e);
         }
         size_t dims[2] = {vec ? n / (size_t)dim : n, (size_t)dim};
-        rc |= pk_h5_write_array(w->h, path, vec ? PK_H5_F64 : PK_H5_I64, vec ? 2 : 1, dims, a,
-                                pk_homog_unit_of(path + strlen(OBS), w->u));
+        pk_h5_write_array(w->h, path, vec ? PK_H5_F64 : PK_H5_I64, vec ? 2 : 1, dims, a,
+                          pk_homog_unit_of(path + strlen(OBS), w->u));
         free(a);
     }
     return rc;
@@ -455,12 +455,11 @@ static int final_contacts(const writer *w, json_t *fc, int dim)
         }
         size_t d2[2] = {n, (size_t)dim};
         rc = pk_h5_connectivity(w->h, "/connectivity/contacts", pairs, n, "/particles/rve");
-        rc |= pk_h5_write_array(w->h, "/connectivity/contact_overlap", PK_H5_F64, 1, d2, ov,
-                                w->u->length[0] ? w->u->length : NULL);
-        rc |= pk_h5_write_array(w->h, "/connectivity/contact_normal_force", PK_H5_F64, 1, d2, fn,
-                                "N");
-        rc |= pk_h5_write_array(w->h, "/connectivity/contact_branch", PK_H5_F64, 2, d2, br,
-                                w->u->length[0] ? w->u->length : NULL);
+        pk_h5_write_array(w->h, "/connectivity/contact_overlap", PK_H5_F64, 1, d2, ov,
+                          w->u->length[0] ? w->u->length : NULL);
+        pk_h5_write_array(w->h, "/connectivity/contact_normal_force", PK_H5_F64, 1, d2, fn, "N");
+        pk_h5_write_array(w->h, "/connectivity/contact_branch", PK_H5_F64, 2, d2, br,
+                          w->u->length[0] ? w->u->length : NULL);
     }
     free(pairs);
     free(br);
@@ -525,12 +524,12 @@ int pk_homog_record_write(pk_h5 *h, json_t *rec, json_t *aud, int dim, size_t au
         rc |= final_contacts(&w, fc, dim);
     json_object_del(r, "final_state");
     json_object_del(r, "final_contacts");
-    rc |= pk_h5_obs_json_units(h, "homogenize", r, pk_homog_unit_of, u);
+    pk_h5_obs_json_units(h, "homogenize", r, pk_homog_unit_of, u);
     /* the audit: one entry per audited step (from audit_first on) */
     const char *aclock = NULL;
     char abuf[256];
     rc |= series_of(&w, OBS "audit", a, &aclock, abuf, astep, atime);
-    rc |= pk_h5_obs_json(h, "audit", a);
+    pk_h5_obs_json(h, "audit", a);
 out:
     json_decref(r);
     json_decref(a);
