@@ -108,7 +108,17 @@ $(BUILD)/bench/%: bench/%.c $(LIB_OBJ)
 	@mkdir -p $(@D)
 	$(CC) $(EXT_CFLAGS) -o $@ $< $(LIB_OBJ) $(EXT_LIBS)
 
-test: $(DEPS_OK) $(BUILD)/packd $(UNIT_BIN) $(BENCH_BIN)
+# The dashboard test's browser driver, playwright-core from npm, fetched once
+# per build folder by this dependency step, not in the middle of the suite
+# (without npm or network, test_dashboard.sh skips its browser part).
+NODE_PW := $(BUILD)/node/node_modules/playwright-core/package.json
+$(NODE_PW): | $(DEPS_OK)
+	@mkdir -p $(BUILD)/node
+	-@command -v npm >/dev/null && PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm install --prefix $(BUILD)/node \
+	    --no-audit --no-fund --silent playwright-core@1 >$(BUILD)/node/npm.log 2>&1 || \
+	    echo "npm install playwright-core failed ($(BUILD)/node/npm.log): the dashboard test skips the browser"
+
+test: $(DEPS_OK) $(BUILD)/packd $(UNIT_BIN) $(BENCH_BIN) $(NODE_PW)
 	@sh tests/run.sh $(BUILD)
 
 sanitize:
