@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/base/grow.h"
+
 #include "core/dem/dem_contact.h"
 
 void pk_homog_frames_init(pk_homog_frames *fr, const pk_homog_rve *rve, size_t nstep)
@@ -49,20 +51,10 @@ int pk_homog_frames_add(pk_homog_frames *fr, const pk_homog_rve *rve, const pk_h
         return 0;
     const size_t n = fr->n, dim = (size_t)fr->dim;
     if (fr->count == fr->cap) {
-        size_t cap = fr->cap ? 2 * fr->cap : 8;
-        int64_t *st = realloc(fr->step, cap * sizeof *st);
-        if (st)
-            fr->step = st;
-        double *t = realloc(fr->time, cap * sizeof *t);
-        if (t)
-            fr->time = t;
-        double *x = realloc(fr->x, cap * n * dim * sizeof *x);
-        if (x)
-            fr->x = x;
-        double *f = realloc(fr->force, cap * n * sizeof *f);
-        if (f)
-            fr->force = f;
-        if (!st || !t || !x || !f)
+        const size_t cap = pk_grow_cap(fr->cap, fr->count + 1, 8);
+        const pk_grow_item arrays[] = {PK_GROW_ITEM(fr->step, 1), PK_GROW_ITEM(fr->time, 1),
+                                       PK_GROW_ITEM(fr->x, n * dim), PK_GROW_ITEM(fr->force, n)};
+        if (pk_grow(arrays, 4, cap) != 0)
             return -1;
         fr->cap = cap;
     }
