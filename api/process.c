@@ -22,6 +22,7 @@ static const pk_process pack_process = {
     .pictures = pack_pictures,
     .parse = pk_pack_parse,
     .free_job = pk_pack_free,
+    .plan = pk_pack_plan_json,
     .run = pk_pack_run,
 };
 
@@ -92,19 +93,6 @@ size_t pk_process_validate_inputs(const pk_process *p, json_t *inputs, const pk_
 }
 
 /* Prefix the pointers of errors [from, n) with "/inputs". */
-static void prefix_inputs(pk_schema_errors *errs, size_t from)
-{
-    for (size_t i = from; i < errs->n; i++) {
-        char *ptr = errs->items[i].pointer;
-        size_t len = strlen(ptr), cap = sizeof errs->items[i].pointer;
-        if (len + 8 > cap) /* keep the tail of very deep pointers */
-            len = cap - 8;
-        memmove(ptr + 7, ptr, len);
-        memcpy(ptr, "/inputs", 7);
-        ptr[len + 7] = 0;
-    }
-}
-
 size_t pk_job_parse(json_t *job, const pk_check_ctx *ctx, const pk_process **proc, void **parsed,
                     pk_schema_errors *errs)
 {
@@ -122,7 +110,7 @@ size_t pk_job_parse(json_t *job, const pk_check_ctx *ctx, const pk_process **pro
     size_t mark = errs->n;
     if (pk_input_links_refuse(json_object_get(job, "inputs"), errs) == 0)
         pk_process_parse_inputs(p, json_object_get(job, "inputs"), ctx, parsed, errs);
-    prefix_inputs(errs, mark);
+    pk_schema_errors_prefix(errs, mark, "/inputs");
     if (errs->n == before)
         *proc = p;
     return errs->n - before;

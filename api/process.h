@@ -25,6 +25,9 @@ typedef struct pk_process {
      * pointers relative to the inputs object).  Borrows from inputs. */
     void *(*parse)(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
     void (*free_job)(void *job);
+    /* What a parsed job implies, for `packd validate` to show before a run
+     * (a new object, e.g. pack's expected grains); NULL: nothing to show. */
+    json_t *(*plan)(const void *job);
     /* Run a parsed job in the run context run (run_ctx.h: threads, monitor,
      * checkpoint, author), write the result file, return a summary object
      * (new reference) in *summary carrying the verdict (job_verdict.h).  0

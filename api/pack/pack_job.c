@@ -413,6 +413,15 @@ void *pk_pack_parse(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *e
     return NULL;
 }
 
+json_t *pk_pack_plan_json(const void *task)
+{
+    const pk_pack_plan *plan = &((const pk_pack_task *)task)->plan;
+    return json_pack("{s:f,s:f,s:f,s:f,s:f,s:i}", "expected_grains", plan->expected_n,
+                     "phi_target_mix", plan->phi_mix, "phi_target_resolved", plan->phi_resolved,
+                     "mass_cut_fraction", plan->mass_cut, "d_max", plan->d_max, "size_classes",
+                     plan->resolved.nclass);
+}
+
 void pk_pack_free(void *task)
 {
     pk_pack_task *t = task;
