@@ -170,4 +170,20 @@ import json; lines=[l for l in open('$T/progress') if l.startswith('{')]
 assert lines, 'no progress'
 for l in lines: d=json.loads(l); assert d['stage']=='rsa' and 0 <= d['fraction'] <= 1
 "
+# 9. `packd --help`: every description starts in one column (on the synopsis's
+#    line after two spaces or more, or alone on the next line under a long one)
+"$PACKD" --help >"$T/help.txt"
+check help_descriptions_aligned python3 -c "
+import re
+lines = [l.rstrip('\\n') for l in open('$T/help.txt') if l.startswith('  ')]
+cols = []
+for l in lines:
+    if l.startswith('  packd '):
+        m = re.search(r'\\S( {2,})\\S', l[2:])
+        if m: cols.append(2 + m.end(1))
+    else:
+        cols.append(len(l) - len(l.lstrip(' ')))
+assert len(cols) >= 12 and len(set(cols)) == 1, sorted(set(cols))
+"
+
 exit 0
