@@ -36,7 +36,8 @@ static size_t pack_jobs(const char *dir, char ***out)
         if (len < 6 || strcmp(e->d_name + len - 5, ".json") != 0)
             continue;
         char path[4096];
-        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        if (snprintf(path, sizeof path, "%s/%s", dir, e->d_name) >= (int)sizeof path)
+            continue;
         json_t *job = json_load_file(path, 0, NULL);
         const char *process = json_string_value(json_object_get(job, "process"));
         int pack = process && !strcmp(process, "pack");
