@@ -2,7 +2,7 @@
 # test_dashboard.sh — the browser dashboard: GET / negotiates (a browser gets
 # the page, a JSON client the landing document as before), its assets carry
 # the Content-Security-Policy, and headless Chromium (Debian's chromium,
-# driven by playwright-core from npm, installed in the build folder by make) submits an
+# driven by playwright-core from npm, cached in the build folder) submits an
 # example, watches its bar reach 100 %, sees the picture and downloads the
 # result, which h5ls reads; then submits the EDMD example edited to run ~5 s
 # and sees its bar strictly between 0 and 100 % while it runs (the values the
@@ -44,8 +44,9 @@ if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
 fi
 NODE_DIR="$BUILD/node"
 PW="$NODE_DIR/node_modules/playwright-core"
-if [ ! -f "$PW/package.json" ]; then # installed by make's dependency step (Makefile NODE_PW)
-    skip dashboard_browser "no playwright-core in $NODE_DIR (make test installs it; $(tail -1 "$NODE_DIR/npm.log" 2>/dev/null))"
+if [ ! -f "$PW/package.json" ]; then # installed by make test's dependency step
+    why=$(tail -1 "$NODE_DIR/npm.log" 2>/dev/null)
+    skip dashboard_browser "playwright-core is not in $NODE_DIR: ${why:-make test installs it (sh tests/tools/playwright.sh $NODE_DIR)}"
     exit 0
 fi
 SHOTS="$BUILD/screenshots"
