@@ -116,12 +116,6 @@ size_t pk_job_parse(json_t *job, const pk_check_ctx *ctx, const pk_process **pro
     return errs->n - before;
 }
 
-size_t pk_job_validate(json_t *job, const pk_check_ctx *ctx, const pk_process **proc,
-                       pk_schema_errors *errs)
-{
-    return pk_job_parse(job, ctx, proc, NULL, errs);
-}
-
 int pk_job_run(json_t *job, const pk_run_ctx *run, const char *out_path, json_t **summary,
                pk_schema_errors *errs, char *err, size_t errlen)
 {

@@ -57,8 +57,6 @@ size_t pk_process_validate_inputs(const pk_process *p, json_t *inputs, const pk_
  * errors are relative to the job file root. */
 size_t pk_job_parse(json_t *job, const pk_check_ctx *ctx, const pk_process **proc, void **parsed,
                     pk_schema_errors *errs);
-size_t pk_job_validate(json_t *job, const pk_check_ctx *ctx, const pk_process **proc,
-                       pk_schema_errors *errs);
 
 /* Validate, parse once and run a job (the one code path of `packd run` and
  * the daemon's workers) in the run context run (NULL: PK_RUN_CTX_DEFAULT;
