@@ -36,6 +36,20 @@ CORE_CFLAGS := $(BASE_CFLAGS) -I.
 EXT_CFLAGS   = $(BASE_CFLAGS) $(shell pkg-config --cflags $(PKGS) 2>/dev/null) -I/usr/include/suitesparse -I. -I$(BUILD)/gen
 EXT_LIBS     = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lcholmod -lgomp -lm -lpthread
 
+# MPI is optional: with Debian's OpenMPI (libopenmpi-dev, pkg-config ompi-c)
+# `mpirun -np R packd run fe2.json` spreads the Gauss points over the ranks
+# (api/par/mpi_world.c, docs/fe2.md); without it packd is one process and
+# refuses a launch of several ranks.  `make MPI=0` builds without it anyway.
+MPI     ?= $(if $(shell pkg-config --exists ompi-c 2>/dev/null && echo y),1,0)
+ifeq ($(MPI),1)
+MPI_CFLAGS := -DPK_HAVE_MPI $(shell pkg-config --cflags ompi-c)
+MPI_LIBS   := $(shell pkg-config --libs ompi-c)
+endif
+EXT_CFLAGS += $(MPI_CFLAGS)
+EXT_LIBS   += $(MPI_LIBS)
+# the objects that differ with and without MPI are rebuilt when that changes
+MPI_STAMP  := $(BUILD)/.mpi-$(MPI)
+
 tree        = $(shell find $(1) -name '*.c' | sort)
 CORE_SRC   := $(call tree,core)
 API_SRC    := $(call tree,api)
@@ -69,6 +83,13 @@ deps: $(DEPS_OK)
 $(BUILD)/obj/core/%.o: core/%.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(CC) $(CORE_CFLAGS) -c $< -o $@
+
+$(MPI_STAMP):
+	@mkdir -p $(@D)
+	@rm -f $(BUILD)/.mpi-*
+	@touch $@
+
+$(BUILD)/obj/api/par/mpi_world.o: $(MPI_STAMP)
 
 $(BUILD)/obj/api/%.o: api/%.c | $(DEPS_OK)
 	@mkdir -p $(@D)

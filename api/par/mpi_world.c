@@ -1,0 +1,152 @@
+/* mpi_world.c — the ranks of an MPI launch.  Contract: mpi_world.h. */
+#include "mpi_world.h"
+
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "core/base/progress.h"
+
+int pk_mpi_launched_size(void)
+{
+    static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMIX_SIZE", "PMI_SIZE"};
+    for (size_t i = 0; i < sizeof vars / sizeof vars[0]; i++) {
+        const char *v = getenv(vars[i]);
+        long n = v ? strtol(v, NULL, 10) : 0;
+        if (n >= 1 && n <= INT_MAX)
+            return (int)n;
+    }
+    return 1;
+}
+
+/* A poll's pause: the rank waited for needs the core more than the waiter
+ * (2 ranks per core here); 100 µs is below 1 % of a Taylor round of 36
+ * Gauss points (6 ms of CPU). */
+static void pause_poll(void)
+{
+    struct timespec ts = {0, 100000};
+    nanosleep(&ts, NULL);
+}
+
+#ifdef PK_HAVE_MPI
+#include <mpi.h>
+
+static int world_rank, world_size = 1, joined, abandoned;
+
+int pk_mpi_built(void) { return 1; }
+
+int pk_mpi_init(char *err, size_t errlen)
+{
+    if (pk_mpi_launched_size() <= 1)
+        return 0;
+    int level;
+    if (MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &level) != MPI_SUCCESS) {
+        snprintf(err, errlen, "MPI_Init failed");
+        return -1;
+    }
+    joined = 1;
+    MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+    MPI_Comm_rank(MPI_COMM_WORLD, &world_rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &world_size);
+    return 0;
+}
+
+void pk_mpi_finish(int status)
+{
+    if (!joined)
+        return;
+    joined = 0;
+    if (abandoned)
+        MPI_Abort(MPI_COMM_WORLD, status ? status : 1);
+    else
+        MPI_Finalize();
+}
+
+int pk_mpi_exchange(pk_mpi_msg *m, size_t n, volatile sig_atomic_t *cancel, double deadline,
+                    int *stuck)
+{
+    MPI_Request *rq = calloc(n ? n : 1, sizeof *rq);
+    int rc = PK_MPI_OK;
+    *stuck = -1;
+    if (!rq)
+        return PK_MPI_LOST;
+    for (size_t i = 0; i < n; i++) {
+        int e = m[i].n > INT_MAX ? MPI_ERR_COUNT
+            : m[i].send          ? MPI_Isend(m[i].buf, (int)m[i].n, MPI_BYTE, m[i].peer, m[i].tag,
+                                             MPI_COMM_WORLD, &rq[i])
+                                 : MPI_Irecv(m[i].buf, (int)m[i].n, MPI_BYTE, m[i].peer, m[i].tag,
+                                             MPI_COMM_WORLD, &rq[i]);
+        if (e != MPI_SUCCESS) {
+            *stuck = m[i].peer;
+            rc = PK_MPI_LOST;
+            goto out;
+        }
+    }
+    for (size_t left = n; left > 0;) {
+        left = 0;
+        for (size_t i = 0; i < n; i++) {
+            int done = 1;
+            if (rq[i] != MPI_REQUEST_NULL && MPI_Test(&rq[i], &done, MPI_STATUS_IGNORE)) {
+                *stuck = m[i].peer;
+                rc = PK_MPI_LOST;
+                goto out;
+            }
+            if (!done) {
+                if (!left)
+                    *stuck = m[i].peer;
+                left++;
+            }
+        }
+        if (!left)
+            break;
+        if (cancel && *cancel) {
+            rc = PK_MPI_CANCELLED;
+            goto out;
+        }
+        if (deadline > 0 && pk_wall_seconds() > deadline) {
+            rc = PK_MPI_LOST;
+            goto out;
+        }
+        pause_poll();
+    }
+    *stuck = -1;
+out:
+    abandoned |= rc != PK_MPI_OK;
+    free(rq);
+    return rc;
+}
+
+#else
+
+int pk_mpi_built(void) { return 0; }
+
+int pk_mpi_init(char *err, size_t errlen)
+{
+    if (pk_mpi_launched_size() <= 1)
+        return 0;
+    snprintf(err, errlen,
+             "launched as one of %d MPI ranks, but this packd was built without MPI "
+             "(install libopenmpi-dev and run make again): every rank would run the whole job "
+             "and write the same file",
+             pk_mpi_launched_size());
+    return -1;
+}
+
+void pk_mpi_finish(int status) { (void)status; }
+
+int pk_mpi_exchange(pk_mpi_msg *m, size_t n, volatile sig_atomic_t *cancel, double deadline,
+                    int *stuck)
+{
+    (void)m, (void)cancel, (void)deadline;
+    *stuck = n ? m[0].peer : -1;
+    (void)pause_poll;
+    return n ? PK_MPI_LOST : PK_MPI_OK;
+}
+
+static const int world_rank = 0, world_size = 1;
+#endif
+
+int pk_mpi_rank(void) { return world_rank; }
+int pk_mpi_size(void) { return world_size; }
