@@ -67,11 +67,15 @@ static void run_help(FILE *f)
           "  --checkpoint FILE          save/resume the run's state in FILE\n"
           "  --checkpoint-interval S    seconds between checkpoints (default 30)\n"
           "  --author NAME              the result's /h5md/author (default $USER)\n\n"
+          "Under mpirun -np R (or srun with R tasks) an fe2 job spreads its Gauss points\n"
+          "over the R ranks, rank 0 alone writing and printing (docs/fe2.md); other\n"
+          "processes run on rank 0 alone.\n\n"
           "On a terminal, a live progress line on stderr and a short summary on stdout;\n"
           "otherwise (or with --json) the summary as JSON on stdout, without the time\n"
           "series (they are in the result file).  Exit 0 done, 1 invalid job, 2 error,\n"
           "3 the job failed (partial result written), 64 usage.\n",
           f);
+    fprintf(f, "This packd was built %s MPI.\n", pk_mpi_built() ? "with" : "without");
 }
 
 static int run_job(int argc, char **argv);
