@@ -40,15 +40,14 @@ EXT_LIBS     = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lcholmod -lgomp -
 # `mpirun -np R packd run fe2.json` spreads the Gauss points over the ranks
 # (api/par/mpi_world.c, docs/fe2.md); without it packd is one process and
 # refuses a launch of several ranks.  `make MPI=0` builds without it anyway.
-MPI     ?= $(if $(shell pkg-config --exists ompi-c 2>/dev/null && echo y),1,0)
-ifeq ($(MPI),1)
-MPI_CFLAGS := -DPK_HAVE_MPI $(shell pkg-config --cflags ompi-c)
-MPI_LIBS   := $(shell pkg-config --libs ompi-c)
-endif
-EXT_CFLAGS += $(MPI_CFLAGS)
-EXT_LIBS   += $(MPI_LIBS)
-# the objects that differ with and without MPI are rebuilt when that changes
-MPI_STAMP  := $(BUILD)/.mpi-$(MPI)
+# Looked for when a recipe runs, so the first make of a fresh machine finds the
+# OpenMPI its dependency step installed; only mpi_world.c includes <mpi.h>.
+MPI     ?= auto
+mpi_on   = $(if $(filter auto,$(MPI)),$(shell pkg-config --exists ompi-c 2>/dev/null && echo 1),$(filter 1,$(MPI)))
+EXT_LIBS += $(if $(mpi_on),$(shell pkg-config --libs ompi-c))
+$(BUILD)/obj/api/par/mpi_world.o: EXT_CFLAGS += $(if $(mpi_on),-DPK_HAVE_MPI $(shell pkg-config --cflags ompi-c))
+# mpi_world.o is rebuilt when that changes
+MPI_STAMP := $(BUILD)/.mpi-$(or $(mpi_on),0)
 
 tree        = $(shell find $(1) -name '*.c' | sort)
 CORE_SRC   := $(call tree,core)

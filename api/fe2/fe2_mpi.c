@@ -22,23 +22,30 @@ static void block_of(const pk_fe2_mpi *d, int r, size_t *lo, size_t *hi)
     pk_par_range(d->ngp, r, d->size, 1, lo, hi);
 }
 
-/* Why a wait for rank `stuck` ended (rc of pk_mpi_exchange). */
-static void lost(pk_fe2_mpi *d, int rc, int stuck, const char *what, char *why, size_t whylen)
+/* Why a wait ended (rc of pk_mpi_exchange): the ranks of its transfers not
+ * done — the lost rank among them — with their Gauss points. */
+static void lost(pk_fe2_mpi *d, int rc, const pk_mpi_msg *m, size_t n, const char *what, char *why,
+                 size_t whylen)
 {
-    size_t lo = 0, hi = 0;
-    if (stuck > 0)
-        block_of(d, stuck, &lo, &hi);
     d->broken = 1;
     const char *cause = rc == PK_MPI_CANCELLED
         ? "a signal came while waiting (the launcher signals every rank when one dies; or "
           "the job was cancelled)"
         : d->deadline > 0 && pk_wall_seconds() > d->deadline ? "no answer within the wall time"
-                                                             : "an MPI error (the rank is gone)";
-    if (stuck > 0)
-        snprintf(why, whylen, "MPI rank %d of %d (Gauss points %zu..%zu) lost during %s: %s", stuck,
-                 d->size, lo, hi - 1, what, cause);
-    else
-        snprintf(why, whylen, "MPI rank 0 of %d lost during %s: %s", d->size, what, cause);
+                                                             : "an MPI error (a rank is gone)";
+    int len = snprintf(why, whylen, "during %s, no answer from MPI rank", what);
+    int named = 0, last = -1;
+    for (size_t i = 0; i < n && len >= 0 && (size_t)len < whylen; i++) {
+        if (m[i].done || m[i].peer == last)
+            continue;
+        last = m[i].peer;
+        size_t lo = 0, hi = 0;
+        block_of(d, m[i].peer, &lo, &hi);
+        len += snprintf(why + len, whylen - (size_t)len, "%s %d of %d (Gauss points %zu..%zu)",
+                        named++ ? "," : "", m[i].peer, d->size, lo, hi - 1);
+    }
+    if (len >= 0 && (size_t)len < whylen)
+        snprintf(why + len, whylen - (size_t)len, "%s: %s", named ? "" : "s (none pending)", cause);
 }
 
 /* Rank 0: one message of n bytes (buf) to every other rank (tag). */
@@ -48,10 +55,10 @@ static int to_all(pk_fe2_mpi *d, int tag, void *buf, size_t n, const char *what,
     pk_mpi_msg m[PK_PAR_MAX];
     size_t k = 0;
     for (int r = 1; r < d->size; r++)
-        m[k++] = (pk_mpi_msg){r, tag, 1, buf, n};
-    int stuck, rc = pk_mpi_exchange(m, k, d->cancel, d->deadline, &stuck);
+        m[k++] = (pk_mpi_msg){r, tag, 1, buf, n, 0};
+    int rc = pk_mpi_exchange(m, k, d->cancel, d->deadline);
     if (rc != PK_MPI_OK) {
-        lost(d, rc, stuck, what, why, whylen);
+        lost(d, rc, m, k, what, why, whylen);
         return -1;
     }
     d->bytes_out += k * n;
@@ -84,12 +91,12 @@ static int round_finish(void *ctx, pk_fe2_gp_result *res, char *why, size_t whyl
     for (int r = 1; r < d->size; r++) {
         size_t lo, hi;
         block_of(d, r, &lo, &hi);
-        m[k++] = (pk_mpi_msg){r, TAG_RES, 0, &res[lo], (hi - lo) * sizeof *res};
+        m[k++] = (pk_mpi_msg){r, TAG_RES, 0, &res[lo], (hi - lo) * sizeof *res, 0};
         bytes += (hi - lo) * sizeof *res;
     }
-    int stuck, rc = pk_mpi_exchange(m, k, d->cancel, d->deadline, &stuck);
+    int rc = pk_mpi_exchange(m, k, d->cancel, d->deadline);
     if (rc != PK_MPI_OK) {
-        lost(d, rc, stuck, "a round", why, whylen);
+        lost(d, rc, m, k, "a round", why, whylen);
         return PK_FE2_DIST_LOST;
     }
     d->bytes_in += bytes;
@@ -105,10 +112,10 @@ static int commit_all(void *ctx, char *why, size_t whylen)
     pk_mpi_msg m[PK_PAR_MAX];
     size_t k = 0;
     for (int r = 1; r < d->size; r++)
-        m[k++] = (pk_mpi_msg){r, TAG_ACK, 0, &st[r], sizeof st[r]};
-    int stuck, rc = pk_mpi_exchange(m, k, d->cancel, d->deadline, &stuck);
+        m[k++] = (pk_mpi_msg){r, TAG_ACK, 0, &st[r], sizeof st[r], 0};
+    int rc = pk_mpi_exchange(m, k, d->cancel, d->deadline);
     if (rc != PK_MPI_OK) {
-        lost(d, rc, stuck, "a commit", why, whylen);
+        lost(d, rc, m, k, "a commit", why, whylen);
         return PK_FE2_DIST_LOST;
     }
     for (int r = 1; r < d->size; r++)
@@ -169,10 +176,10 @@ int pk_fe2_mpi_share_rve(pk_fe2_mpi *d, int ok, pk_box *box, pk_particles *p, ch
         free(body);
         return rc;
     }
-    pk_mpi_msg m = {0, TAG_RVE, 0, head, sizeof head};
-    int stuck, rc = pk_mpi_exchange(&m, 1, d->cancel, d->deadline, &stuck);
+    pk_mpi_msg m = {0, TAG_RVE, 0, head, sizeof head, 0};
+    int rc = pk_mpi_exchange(&m, 1, d->cancel, d->deadline);
     if (rc != PK_MPI_OK) {
-        lost(d, rc, 0, "the RVE's hand-over", err, errlen);
+        lost(d, rc, &m, 1, "the RVE's hand-over", err, errlen);
         return -1;
     }
     if (!head[0])
@@ -188,11 +195,11 @@ int pk_fe2_mpi_share_rve(pk_fe2_mpi *d, int ok, pk_box *box, pk_particles *p, ch
         snprintf(err, errlen, "out of memory");
         return -1;
     }
-    m = (pk_mpi_msg){0, TAG_RVE, 0, body, 5 * n * sizeof *body};
-    rc = pk_mpi_exchange(&m, 1, d->cancel, d->deadline, &stuck);
+    m = (pk_mpi_msg){0, TAG_RVE, 0, body, 5 * n * sizeof *body, 0};
+    rc = pk_mpi_exchange(&m, 1, d->cancel, d->deadline);
     if (rc != PK_MPI_OK) {
         free(body);
-        lost(d, rc, 0, "the RVE's hand-over", err, errlen);
+        lost(d, rc, &m, 1, "the RVE's hand-over", err, errlen);
         return -1;
     }
     for (size_t i = 0; i < n; i++)
@@ -209,12 +216,12 @@ int pk_fe2_mpi_serve(pk_fe2_mpi *d, const pk_fe2_problem *pb, char *err, size_t 
         snprintf(err, errlen, "out of memory");
         return -1;
     }
-    int rc = -1, stuck;
+    int rc = -1;
     for (;;) {
-        pk_mpi_msg m = {0, TAG_CMD, 0, d->cmd, cmd_bytes};
-        int w = pk_mpi_exchange(&m, 1, d->cancel, d->deadline, &stuck);
+        pk_mpi_msg m = {0, TAG_CMD, 0, d->cmd, cmd_bytes, 0};
+        int w = pk_mpi_exchange(&m, 1, d->cancel, d->deadline);
         if (w != PK_MPI_OK) {
-            lost(d, w, 0, "the wait for a command", err, errlen);
+            lost(d, w, &m, 1, "the wait for a command", err, errlen);
             break;
         }
         const int op = (int)d->cmd[0];
@@ -229,10 +236,10 @@ int pk_fe2_mpi_serve(pk_fe2_mpi *d, const pk_fe2_problem *pb, char *err, size_t 
                 res[i].rc = 1;
                 snprintf(res[i].why, sizeof res[i].why, "MPI rank %d: out of memory", d->rank);
             }
-            m = (pk_mpi_msg){0, TAG_RES, 1, res, nb * sizeof *res};
+            m = (pk_mpi_msg){0, TAG_RES, 1, res, nb * sizeof *res, 0};
         } else if (op == OP_COMMIT) {
             st = pk_fe2_commit_block(pb, d->lo, d->hi);
-            m = (pk_mpi_msg){0, TAG_ACK, 1, &st, sizeof st};
+            m = (pk_mpi_msg){0, TAG_ACK, 1, &st, sizeof st, 0};
         } else if (op == OP_CENTRES) {
             const size_t g = (size_t)d->cmd[1];
             if (g < d->lo || g >= d->hi) {
@@ -240,14 +247,14 @@ int pk_fe2_mpi_serve(pk_fe2_mpi *d, const pk_fe2_problem *pb, char *err, size_t 
                          g, d->lo, d->hi);
                 break;
             }
-            m = (pk_mpi_msg){0, TAG_CENTRES, 1, d->mr->committed[g].x,
-                             3 * d->ngrain * sizeof(double)};
+            m = (pk_mpi_msg){
+                0, TAG_CENTRES, 1, d->mr->committed[g].x, 3 * d->ngrain * sizeof(double), 0};
         } else {
             snprintf(err, errlen, "unknown command %d from rank 0", op);
             break;
         }
-        if ((w = pk_mpi_exchange(&m, 1, d->cancel, d->deadline, &stuck)) != PK_MPI_OK) {
-            lost(d, w, 0, "an answer", err, errlen);
+        if ((w = pk_mpi_exchange(&m, 1, d->cancel, d->deadline)) != PK_MPI_OK) {
+            lost(d, w, &m, 1, "an answer", err, errlen);
             break;
         }
     }
@@ -268,12 +275,12 @@ int pk_fe2_mpi_centres(pk_fe2_mpi *d, size_t g, double *x, char *err, size_t err
         if (g >= lo && g < hi)
             break;
     }
-    pk_mpi_msg m[2] = {{r, TAG_CMD, 1, d->cmd, (2 + d->ndof) * sizeof *d->cmd},
-                       {r, TAG_CENTRES, 0, x, bytes}};
+    pk_mpi_msg m[2] = {{r, TAG_CMD, 1, d->cmd, (2 + d->ndof) * sizeof *d->cmd, 0},
+                       {r, TAG_CENTRES, 0, x, bytes, 0}};
     d->cmd[0] = OP_CENTRES, d->cmd[1] = (double)g;
-    int stuck, rc = pk_mpi_exchange(m, 2, d->cancel, d->deadline, &stuck);
+    int rc = pk_mpi_exchange(m, 2, d->cancel, d->deadline);
     if (rc != PK_MPI_OK) {
-        lost(d, rc, stuck, "the output of a Gauss point's RVE", err, errlen);
+        lost(d, rc, m, 2, "the output of a Gauss point's RVE", err, errlen);
         return -1;
     }
     d->bytes_in += bytes;

@@ -64,12 +64,12 @@ void pk_mpi_finish(int status)
         MPI_Finalize();
 }
 
-int pk_mpi_exchange(pk_mpi_msg *m, size_t n, volatile sig_atomic_t *cancel, double deadline,
-                    int *stuck)
+int pk_mpi_exchange(pk_mpi_msg *m, size_t n, volatile sig_atomic_t *cancel, double deadline)
 {
     MPI_Request *rq = calloc(n ? n : 1, sizeof *rq);
     int rc = PK_MPI_OK;
-    *stuck = -1;
+    for (size_t i = 0; i < n; i++)
+        m[i].done = 0;
     if (!rq)
         return PK_MPI_LOST;
     for (size_t i = 0; i < n; i++) {
@@ -79,7 +79,6 @@ int pk_mpi_exchange(pk_mpi_msg *m, size_t n, volatile sig_atomic_t *cancel, doub
                                  : MPI_Irecv(m[i].buf, (int)m[i].n, MPI_BYTE, m[i].peer, m[i].tag,
                                              MPI_COMM_WORLD, &rq[i]);
         if (e != MPI_SUCCESS) {
-            *stuck = m[i].peer;
             rc = PK_MPI_LOST;
             goto out;
         }
@@ -87,17 +86,12 @@ int pk_mpi_exchange(pk_mpi_msg *m, size_t n, volatile sig_atomic_t *cancel, doub
     for (size_t left = n; left > 0;) {
         left = 0;
         for (size_t i = 0; i < n; i++) {
-            int done = 1;
-            if (rq[i] != MPI_REQUEST_NULL && MPI_Test(&rq[i], &done, MPI_STATUS_IGNORE)) {
-                *stuck = m[i].peer;
+            if (!m[i].done && MPI_Test(&rq[i], &m[i].done, MPI_STATUS_IGNORE) != MPI_SUCCESS) {
+                m[i].done = 0;
                 rc = PK_MPI_LOST;
                 goto out;
             }
-            if (!done) {
-                if (!left)
-                    *stuck = m[i].peer;
-                left++;
-            }
+            left += !m[i].done;
         }
         if (!left)
             break;
@@ -111,7 +105,6 @@ int pk_mpi_exchange(pk_mpi_msg *m, size_t n, volatile sig_atomic_t *cancel, doub
         }
         pause_poll();
     }
-    *stuck = -1;
 out:
     abandoned |= rc != PK_MPI_OK;
     free(rq);
@@ -136,11 +129,11 @@ int pk_mpi_init(char *err, size_t errlen)
 
 void pk_mpi_finish(int status) { (void)status; }
 
-int pk_mpi_exchange(pk_mpi_msg *m, size_t n, volatile sig_atomic_t *cancel, double deadline,
-                    int *stuck)
+int pk_mpi_exchange(pk_mpi_msg *m, size_t n, volatile sig_atomic_t *cancel, double deadline)
 {
-    (void)m, (void)cancel, (void)deadline;
-    *stuck = n ? m[0].peer : -1;
+    (void)cancel, (void)deadline;
+    for (size_t i = 0; i < n; i++)
+        m[i].done = 0;
     (void)pause_poll;
     return n ? PK_MPI_LOST : PK_MPI_OK;
 }

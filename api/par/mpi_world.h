@@ -41,18 +41,20 @@ void pk_mpi_finish(int status);
 /* A wait's outcome. */
 enum { PK_MPI_OK = 0, PK_MPI_LOST = -1, PK_MPI_CANCELLED = 2 };
 
-/* One transfer of a wait: n bytes to (send) or from (receive) rank peer. */
+/* One transfer of a wait: n bytes to (send) or from (receive) rank peer;
+ * done is set by the wait. */
 typedef struct pk_mpi_msg {
     int peer, tag, send;
     void *buf;
     size_t n;
+    int done;
 } pk_mpi_msg;
 
 /* Post the n transfers and wait until all are done: OK; LOST (an MPI error
- * or the deadline, pk_wall_seconds(), passed; 0 = none) with *stuck the
- * first rank not done; CANCELLED when *cancel was set while waiting.  A
- * wait that did not end OK leaves transfers posted: pk_mpi_finish(≠ 0). */
-int pk_mpi_exchange(pk_mpi_msg *m, size_t n, volatile sig_atomic_t *cancel, double deadline,
-                    int *stuck);
+ * or the deadline, pk_wall_seconds(), passed; 0 = none); CANCELLED when
+ * *cancel was set while waiting.  Otherwise than OK, the transfers not done
+ * name the ranks that did not answer (a killed rank is among them).  A wait
+ * that did not end OK leaves transfers posted: pk_mpi_finish(≠ 0). */
+int pk_mpi_exchange(pk_mpi_msg *m, size_t n, volatile sig_atomic_t *cancel, double deadline);
 
 #endif

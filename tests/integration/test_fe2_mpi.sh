@@ -1,0 +1,129 @@
+#!/bin/sh
+# test_fe2_mpi.sh — an fe2 run over MPI ranks (api/fe2/fe2_mpi.h) with Debian's
+# real mpirun: `mpirun -np 2` and `-np 3 --threads 2` of `packd run` on a
+# reduced block (2 × 2 Q1, 16 Gauss points, 40-grain Taylor RVE, 3 load steps)
+# write the same datasets, bit for bit, as `packd run --threads 1`, with the
+# same result digest, and the file passes its audit (stored digest, H5MD
+# rules); one rank killed (-9) mid-run ends the run failed within seconds —
+# the reason names the rank and its Gauss points, the converged steps are
+# kept, the file says incomplete — never a hang nor a successful-looking
+# result.  A packd built without MPI refuses a launch of several ranks.
+set -u
+PACKD=${PACKD:-build/packd}
+SRC=${PACKD_SRC:-$(pwd)}
+case "$PACKD" in /*) ;; *) PACKD="$PWD/$PACKD" ;; esac
+. "$SRC/tests/integration/check.inc"
+T=$(mktemp -d)
+MPIRUN_PID=""
+trap '[ -n "$MPIRUN_PID" ] && kill -9 "$MPIRUN_PID" 2>/dev/null; rm -rf "$T"' EXIT
+cd "$T" || exit 1
+
+python3 - <<'EOF'
+import json, copy
+job = {"process": "fe2", "inputs": {
+  "mesh": {"rectangle": {"size": [10, 10], "elements": [2, 2]}},
+  "boundary_conditions": [
+    {"name": "left_x", "type": "displacement", "on": "left", "component": "x"},
+    {"name": "bottom_y", "type": "displacement", "on": "bottom", "component": "y"},
+    {"name": "top_y", "type": "displacement", "on": "top", "component": "y"},
+    {"name": "p", "type": "pressure", "on": "right"}],
+  "stages": [
+    {"name": "confine", "increments": 1, "targets": {"p": 0.05}},
+    {"name": "push", "increments": 2, "targets": {"top_y": -0.1}}],
+  "micro": {
+    "rve": {"pack": {"dim": 2, "domain": {"box": {"size": [10, 10], "periodic": True}},
+       "grading": {"type": "classes", "classes": [{"d": 2.0, "volume_percent": 0},
+                   {"d": 1.6, "volume_percent": 60}, {"d": 1.2, "volume_percent": 40}]},
+       "sampling": "discrete", "count": 40, "phi": {"value": 0.5, "refers_to": "resolved"},
+       "algorithm": "rsa", "seed": 7}},
+    "boundary_condition": "taylor", "contact": {"E_n": 50},
+    "initial_state": {"policy": "radius_inflation", "value": 0.3}},
+  "output": {"micro_states": [0, 5, 15]}}}
+json.dump(job, open("job.json", "w"))
+# a long push (300 small increments, 36 Gauss points): killed long before its end
+k = copy.deepcopy(job)
+k["inputs"]["mesh"]["rectangle"]["elements"] = [3, 3]
+k["inputs"]["stages"][1] = {"name": "push", "increments": 300, "targets": {"top_y": -0.6}}
+json.dump(k, open("kill.json", "w"))
+EOF
+
+if "$PACKD" run --help 2>&1 | grep -q 'built without MPI'; then
+    # the launcher's environment of a second rank: refused, not run twice
+    OMPI_COMM_WORLD_SIZE=2 "$PACKD" run job.json -o x.h5 >x.out 2>x.err
+    rc=$?
+    check mpi_absent_refuses_ranks sh -c "[ $rc -eq 2 ] && [ ! -e x.h5 ] &&
+        grep -q 'built without MPI' x.err && grep -q 'libopenmpi-dev' x.err"
+    skip fe2_mpi_ranks "this packd was built without MPI (install libopenmpi-dev, make again)"
+    exit 0
+fi
+if ! command -v mpirun >/dev/null 2>&1; then
+    skip fe2_mpi_ranks "mpirun not installed (Debian's openmpi-bin)"
+    exit 0
+fi
+# root needs --allow-run-as-root; 3 ranks on a 2-core machine need --oversubscribe
+MPIRUN="mpirun --allow-run-as-root --oversubscribe"
+
+"$PACKD" run job.json -o s.h5 --threads 1 --json >s.json 2>s.err ||
+    { fail fe2_mpi_serial_reference "$(cat s.err)"; exit 1; }
+sh "$SRC/tests/tools/h5digest.sh" s.h5 >s.dig
+
+# ranks R, threads per rank: the same bits as one process with one thread
+for rt in 2:1 3:2; do
+    r=${rt%:*}
+    th=${rt#*:}
+    timeout 180 $MPIRUN -np "$r" "$PACKD" run job.json -o "m$r.h5" --threads "$th" --json \
+        >"m$r.json" 2>"m$r.err"
+    rc=$?
+    check "fe2_mpi_np${r}_completes" sh -c "[ $rc -eq 0 ] && python3 -c \"
+import json; s = json.load(open('m$r.json')); r = json.load(open('s.json'))
+assert s['complete'] and s['mpi_ranks'] == $r and s['threads'] == $th, s
+assert s['steps'] == r['steps'] == 3 and s['gauss_points'] == 16, s
+assert s['result_digest'] == r['result_digest'], (s['result_digest'], r['result_digest'])\"" ||
+        sed 's/^/  /' "m$r.err"
+    sh "$SRC/tests/tools/h5digest.sh" "m$r.h5" >"m$r.dig"
+    check "fe2_mpi_np${r}_datasets_bit_identical" sh -c \
+        "[ \$(wc -l <s.dig) -ge 60 ] && ! grep -q unreadable s.dig && cmp -s s.dig m$r.dig" ||
+        diff s.dig "m$r.dig" | head -5
+    check "fe2_mpi_np${r}_result_audited" sh -c "\"$PACKD\" inspect m$r.h5 | python3 -c \"
+import json, sys; i = json.load(sys.stdin)
+assert i['result_digest_verified'] is True, i.get('result_digest')\" &&
+        python3 \"$SRC/tests/tools/h5md_check.py\" m$r.h5 >/dev/null"
+done
+
+# one rank killed mid-run: the run ends failed, naming it, within seconds
+timeout 120 $MPIRUN -np 3 "$PACKD" run "$T/kill.json" -o k.h5 --json --progress-fd 2 \
+    >k.json 2>k.err &
+MPIRUN_PID=$!
+i=0 # a converged load step, then the kill (bounded: 60 s)
+while ! grep -qE '"stage":"fe2".*"done":[1-9]' k.err 2>/dev/null && kill -0 $MPIRUN_PID 2>/dev/null &&
+    [ $i -lt 600 ]; do
+    sleep 0.1
+    i=$((i + 1))
+done
+victim=""
+for p in $(pgrep -f "$T/kill.json"); do
+    tr '\0' '\n' <"/proc/$p/environ" 2>/dev/null | grep -qx 'OMPI_COMM_WORLD_RANK=2' && victim=$p
+done
+if [ -z "$victim" ]; then
+    fail fe2_mpi_rank_killed "rank 2 not found running (progress: $(tail -c 300 k.err))"
+else
+    t0=$(date +%s.%N)
+    kill -9 "$victim"
+    wait $MPIRUN_PID
+    rc=$?
+    MPIRUN_PID=""
+    dt=$(echo "$(date +%s.%N) - $t0" | bc)
+    echo "killed rank 2 (pid $victim): mpirun ended with $rc after $dt s"
+    check fe2_mpi_rank_killed_ends_failed_fast sh -c "[ $rc -ne 0 ] && [ $rc -ne 124 ] &&
+        [ \$(echo '$dt < 30' | bc) = 1 ]"
+    check fe2_mpi_rank_killed_reason_names_rank python3 -c "
+import json; s = json.load(open('k.json'))
+assert s['complete'] is False and s['termination_reason'] == 'rank_lost', s['termination_reason']
+assert 'MPI rank' in s['failure'] and ' 2 of 3 (Gauss points 24..35)' in s['failure'], s['failure']
+assert 1 <= s['steps'] < 301, s['steps']"
+    grep 'failed' k.err | grep -v '"stage"' | head -2 | sed 's/^/  /'
+    # the file: the converged steps, marked incomplete with the same reason
+    check fe2_mpi_rank_killed_file_incomplete sh -c "
+        h5dump -d /observables/verdict/complete k.h5 | grep -q '(0): 0' &&
+        h5dump -d /observables/fe2/termination_reason k.h5 | grep -q 'rank_lost'"
+fi
