@@ -4,7 +4,7 @@
 # build directory.  As root it runs apt-get itself, as another user through sudo when
 # sudo is installed; otherwise it prints the one command to run as root and fails.
 set -eu
-PKGS="build-essential pkg-config libmicrohttpd-dev libcurl4-openssl-dev libssl-dev libjansson-dev libsqlite3-dev libhdf5-dev hdf5-tools curl python3 python3-jsonschema python3-matplotlib python3-owslib libsuitesparse-dev libopenblas0-serial procps libcairo2-dev fonts-dejavu-core clang libclang-rt-14-dev chromium nodejs"
+PKGS="build-essential pkg-config libmicrohttpd-dev libcurl4-openssl-dev libssl-dev libjansson-dev libsqlite3-dev libhdf5-dev hdf5-tools curl python3 python3-jsonschema python3-matplotlib python3-owslib libsuitesparse-dev libopenblas0-serial openmpi-bin libopenmpi-dev procps libcairo2-dev fonts-dejavu-core clang libclang-rt-14-dev chromium nodejs"
 if ! command -v dpkg-query >/dev/null 2>&1 || ! command -v apt-get >/dev/null 2>&1; then
     echo "install-deps: not a Debian system; install the equivalents of these by hand:" >&2
     echo "  $PKGS" >&2
