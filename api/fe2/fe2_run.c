@@ -231,6 +231,8 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
     wm.ctx = &pc;
     char failure[700] = "";
     const char *reason = "complete";
+    size_t rounds_total = 0;
+    const double solve_t0 = pk_wall_seconds();
     for (size_t k = 0; k < s.nstage && !failure[0]; k++) {
         char sname[80];
         snprintf(sname, sizeof sname, s.stage_name[k][0] ? "%zu \"%s\"" : "%zu", k,
@@ -251,6 +253,7 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
             }
             for (size_t q = 0; q < rep.nparts; q++)
                 iters_total += (size_t)(rep.parts[q].n > 0 ? rep.parts[q].n - 1 : 0);
+            rounds_total += rep.rounds;
             cuts_total += (size_t)rep.cuts;
             if (r == 0) {
                 /* the committed centres of the output Gauss points (a commit
@@ -314,6 +317,14 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
     json_object_set_new(sum, "step_cuts_total", json_integer((json_int_t)cuts_total));
     json_object_set_new(sum, "threads", json_integer(pk_par_threads(pool)));
     json_object_set_new(sum, "mpi_ranks", json_integer(pk_mpi_size()));
+    /* what a round costs (docs/perf/fe2-mpi.md): wall time of the load steps
+     * (rounds, macro solves, commits) and, over ranks, the bytes rank 0 moved */
+    json_object_set_new(sum, "evaluation_rounds", json_integer((json_int_t)rounds_total));
+    json_object_set_new(sum, "steps_wall_s", json_real(pk_wall_seconds() - solve_t0));
+    if (have_mpi) {
+        json_object_set_new(sum, "mpi_bytes_sent", json_integer((json_int_t)mpi.bytes_out));
+        json_object_set_new(sum, "mpi_bytes_received", json_integer((json_int_t)mpi.bytes_in));
+    }
     /* the figures per converged step: reactions of the displacement
      * conditions and the dilatancy Δ = (v/V − 1)·100 % of the specimen */
     json_t *reac = json_object();

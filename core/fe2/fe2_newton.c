@@ -455,6 +455,7 @@ out:
         if (d >= 0 && (size_t)d < s->ndof)
             rep->reaction[d % 2] += s->fint[d] - s->fext[d];
     }
+    rep->rounds = w.b.ngp ? w.evals / w.b.ngp : 0;
     ws_free(&w);
     free(uD0), free(fext0);
     return ret;

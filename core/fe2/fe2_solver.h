@@ -96,6 +96,7 @@ typedef struct pk_fe2_step_report {
     pk_fe2_iterations parts[32];
     double reaction[2]; /* Σ (f_int − f_ext) over the prescribed dofs, by component
                              (the internal forces when no load acts on them) */
+    size_t rounds;      /* evaluation rounds (every Gauss point once), line searches included */
     char why[256];      /* the reason a step failed */
 } pk_fe2_step_report;
 
