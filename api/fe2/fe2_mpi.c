@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "api/par/mpi_world.h"
 #include "core/base/par.h"
@@ -208,6 +209,20 @@ int pk_fe2_mpi_share_rve(pk_fe2_mpi *d, int ok, pk_box *box, pk_particles *p, ch
     return 0;
 }
 
+/* A rank other than 0 that a signal interrupted: the launcher signals every
+ * rank when one dies (or the job is cancelled).  Rank 0 still writes its
+ * partial result and ends the launch (MPI_Abort); leaving first (an abort
+ * of our own) would kill it mid-write.  So wait for that end, at most
+ * LINGER_S: Slurm's default KillWait, after which the launcher kills anyway. */
+#define LINGER_S 30.0
+
+static void linger(void)
+{
+    const struct timespec ts = {0, 10000000};
+    for (double t0 = pk_wall_seconds(); pk_wall_seconds() - t0 < LINGER_S;)
+        nanosleep(&ts, NULL);
+}
+
 int pk_fe2_mpi_serve(pk_fe2_mpi *d, const pk_fe2_problem *pb, char *err, size_t errlen)
 {
     const size_t nb = d->hi - d->lo, cmd_bytes = (2 + d->ndof) * sizeof *d->cmd;
@@ -222,6 +237,8 @@ int pk_fe2_mpi_serve(pk_fe2_mpi *d, const pk_fe2_problem *pb, char *err, size_t 
         int w = pk_mpi_exchange(&m, 1, d->cancel, d->deadline);
         if (w != PK_MPI_OK) {
             lost(d, w, &m, 1, "the wait for a command", err, errlen);
+            if (w == PK_MPI_CANCELLED)
+                linger();
             break;
         }
         const int op = (int)d->cmd[0];
@@ -255,6 +272,8 @@ int pk_fe2_mpi_serve(pk_fe2_mpi *d, const pk_fe2_problem *pb, char *err, size_t 
         }
         if ((w = pk_mpi_exchange(&m, 1, d->cancel, d->deadline)) != PK_MPI_OK) {
             lost(d, w, &m, 1, "an answer", err, errlen);
+            if (w == PK_MPI_CANCELLED)
+                linger();
             break;
         }
     }

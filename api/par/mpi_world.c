@@ -11,7 +11,10 @@
 
 int pk_mpi_launched_size(void)
 {
-    static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMIX_SIZE", "PMI_SIZE"};
+    /* mpirun; srun's tasks of a step (whatever its --mpi plugin: pmix sets
+     * no size); PMI-2 launchers.  Not SLURM_NTASKS: a batch script has it
+     * and is one process. */
+    static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "SLURM_STEP_NUM_TASKS", "PMI_SIZE"};
     for (size_t i = 0; i < sizeof vars / sizeof vars[0]; i++) {
         const char *v = getenv(vars[i]);
         long n = v ? strtol(v, NULL, 10) : 0;
@@ -50,6 +53,16 @@ int pk_mpi_init(char *err, size_t errlen)
     MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
     MPI_Comm_rank(MPI_COMM_WORLD, &world_rank);
     MPI_Comm_size(MPI_COMM_WORLD, &world_size);
+    if (world_size != pk_mpi_launched_size()) {
+        /* srun without an MPI plugin: every task is a rank 0 of its own */
+        snprintf(err, errlen,
+                 "launched as %d tasks, but MPI sees %d rank%s: the launcher gave MPI no "
+                 "process manager (with srun: --mpi=pmix, or MpiDefault=pmix in slurm.conf)",
+                 pk_mpi_launched_size(), world_size, world_size == 1 ? "" : "s");
+        MPI_Finalize();
+        joined = 0, world_rank = 0, world_size = 1;
+        return -1;
+    }
     return 0;
 }
 
@@ -58,9 +71,10 @@ void pk_mpi_finish(int status)
     if (!joined)
         return;
     joined = 0;
-    if (abandoned)
+    if (abandoned) {
+        fflush(NULL); /* the abort ends this process too: its summary first */
         MPI_Abort(MPI_COMM_WORLD, status ? status : 1);
-    else
+    } else
         MPI_Finalize();
 }
 

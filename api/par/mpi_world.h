@@ -18,15 +18,16 @@
 /* 1 when this packd was built with MPI. */
 int pk_mpi_built(void);
 
-/* The ranks the launcher started, from its environment (OpenMPI's
- * OMPI_COMM_WORLD_SIZE, PMIx's PMIX_SIZE… or PMI_SIZE): 1 when not launched
- * by an MPI launcher. */
+/* The ranks the launcher started, from its environment (mpirun's
+ * OMPI_COMM_WORLD_SIZE, srun's SLURM_STEP_NUM_TASKS, PMI-2's PMI_SIZE): 1
+ * when not launched by one. */
 int pk_mpi_launched_size(void);
 
 /* Join the launch when pk_mpi_launched_size() > 1 (nothing otherwise):
  * MPI calls come from the main thread only, the pool's threads never make
- * any (MPI_THREAD_FUNNELED).  0; −1 with err when this build has no MPI or
- * MPI_Init failed. */
+ * any (MPI_THREAD_FUNNELED).  0; −1 with err when this build has no MPI,
+ * MPI_Init failed, or MPI sees fewer ranks than were launched (srun with
+ * no --mpi plugin: each task would run the whole job). */
 int pk_mpi_init(char *err, size_t errlen);
 
 /* This process's rank and the number of ranks (0 and 1 outside a launch). */

@@ -6,8 +6,8 @@
 # same result digest, and the file passes its audit (stored digest, H5MD
 # rules); one rank killed (-9) mid-run ends the run failed within seconds —
 # the reason names the rank and its Gauss points, the converged steps are
-# kept, the file says incomplete — never a hang nor a successful-looking
-# result.  A packd built without MPI refuses a launch of several ranks.
+# kept, the file says incomplete; rank 0 killed leaves no result nor
+# summary — never a hang nor a successful-looking result.  A packd built without MPI refuses a launch of several ranks.
 set -u
 PACKD=${PACKD:-build/packd}
 SRC=${PACKD_SRC:-$(pwd)}
@@ -90,40 +90,52 @@ assert i['result_digest_verified'] is True, i.get('result_digest')\" &&
         python3 \"$SRC/tests/tools/h5md_check.py\" m$r.h5 >/dev/null"
 done
 
-# one rank killed mid-run: the run ends failed, naming it, within seconds
-timeout 120 $MPIRUN -np 3 "$PACKD" run "$T/kill.json" -o k.h5 --json --progress-fd 2 \
-    >k.json 2>k.err &
-MPIRUN_PID=$!
-i=0 # a converged load step, then the kill (bounded: 60 s)
-while ! grep -qE '"stage":"fe2".*"done":[1-9]' k.err 2>/dev/null && kill -0 $MPIRUN_PID 2>/dev/null &&
-    [ $i -lt 600 ]; do
-    sleep 0.1
-    i=$((i + 1))
-done
-victim=""
-for p in $(pgrep -f "$T/kill.json"); do
-    tr '\0' '\n' <"/proc/$p/environ" 2>/dev/null | grep -qx 'OMPI_COMM_WORLD_RANK=2' && victim=$p
-done
-if [ -z "$victim" ]; then
-    fail fe2_mpi_rank_killed "rank 2 not found running (progress: $(tail -c 300 k.err))"
-else
+# one rank killed (-9) mid-run, after a converged load step: sets rc (of
+# mpirun), dt (seconds from the kill to its end), victim ("" if not found)
+kill_rank() { # rank, output prefix
+    timeout 120 $MPIRUN -np 3 "$PACKD" run "$T/kill.json" -o "$2.h5" --json --progress-fd 2 \
+        >"$2.json" 2>"$2.err" &
+    MPIRUN_PID=$!
+    i=0 # bounded: 60 s
+    while ! grep -qE '"stage":"fe2".*"done":[1-9]' "$2.err" 2>/dev/null &&
+        kill -0 $MPIRUN_PID 2>/dev/null && [ $i -lt 600 ]; do
+        sleep 0.1
+        i=$((i + 1))
+    done
+    victim=""
+    for p in $(pgrep -f "$T/kill.json"); do
+        tr '\0' '\n' <"/proc/$p/environ" 2>/dev/null | grep -qx "OMPI_COMM_WORLD_RANK=$1" && victim=$p
+    done
+    [ -n "$victim" ] || { kill -9 $MPIRUN_PID; wait $MPIRUN_PID; MPIRUN_PID=""; return 1; }
     t0=$(date +%s.%N)
     kill -9 "$victim"
     wait $MPIRUN_PID
     rc=$?
     MPIRUN_PID=""
     dt=$(echo "$(date +%s.%N) - $t0" | bc)
-    echo "killed rank 2 (pid $victim): mpirun ended with $rc after $dt s"
-    check fe2_mpi_rank_killed_ends_failed_fast sh -c "[ $rc -ne 0 ] && [ $rc -ne 124 ] &&
-        [ \$(echo '$dt < 30' | bc) = 1 ]"
+    echo "killed rank $1 (pid $victim): mpirun ended with $rc after $dt s"
+}
+fast_end() { [ "$rc" -ne 0 ] && [ "$rc" -ne 124 ] && [ "$(echo "$dt < 30" | bc)" = 1 ]; }
+
+# rank 2: rank 0 names it, keeps the converged steps, marks the file incomplete
+if ! kill_rank 2 k2; then
+    fail fe2_mpi_rank_killed "rank 2 not found running (progress: $(tail -c 300 k2.err))"
+else
+    check fe2_mpi_rank_killed_ends_failed_fast fast_end
     check fe2_mpi_rank_killed_reason_names_rank python3 -c "
-import json; s = json.load(open('k.json'))
+import json; s = json.load(open('k2.json'))
 assert s['complete'] is False and s['termination_reason'] == 'rank_lost', s['termination_reason']
 assert 'MPI rank' in s['failure'] and ' 2 of 3 (Gauss points 24..35)' in s['failure'], s['failure']
 assert 1 <= s['steps'] < 301, s['steps']"
-    grep 'failed' k.err | grep -v '"stage"' | head -2 | sed 's/^/  /'
-    # the file: the converged steps, marked incomplete with the same reason
+    grep 'failed' k2.err | grep -v '"stage"' | head -2 | sed 's/^/  /'
     check fe2_mpi_rank_killed_file_incomplete sh -c "
-        h5dump -d /observables/verdict/complete k.h5 | grep -q '(0): 0' &&
-        h5dump -d /observables/fe2/termination_reason k.h5 | grep -q 'rank_lost'"
+        h5dump -d /observables/verdict/complete k2.h5 | grep -q '(0): 0' &&
+        h5dump -d /observables/fe2/termination_reason k2.h5 | grep -q 'rank_lost'"
+fi
+# rank 0 (the writer): the launch ends, no result file, no summary
+if ! kill_rank 0 k0; then
+    fail fe2_mpi_rank0_killed "rank 0 not found running (progress: $(tail -c 300 k0.err))"
+else
+    check fe2_mpi_rank0_killed_ends_fast fast_end
+    check fe2_mpi_rank0_killed_no_result sh -c "[ ! -s k0.json ] && [ ! -e k0.h5 ]"
 fi
