@@ -9,7 +9,9 @@
  * A rank that is lost — killed, its node gone — ends the run: rank 0's wait
  * for it ends on an MPI error, on the signal the launcher sends when a rank
  * dies (the cancel flag of packd run) or on the job's wall time, and the job
- * fails naming the ranks it was waiting for, its converged steps kept. */
+ * fails naming the ranks it was waiting for, its converged steps kept.
+ * The other ranks, signalled too, wait for rank 0 to write that and end the
+ * launch (at most 30 s) rather than end it first. */
 #ifndef PK_FE2_MPI_H
 #define PK_FE2_MPI_H
 
