@@ -17,6 +17,11 @@
 # compiler records which headers each object read (-MMD -MP, build/**/*.d).
 
 BUILD   ?= build
+# Build on every core unless the caller chose (-jN): a fresh `make run` compiles
+# ~200 files.
+ifeq ($(filter -j%,$(MAKEFLAGS))$(filter j,$(firstword $(MAKEFLAGS))),)
+MAKEFLAGS += -j$(shell nproc 2>/dev/null || echo 2)
+endif
 CC      ?= cc
 OPT     ?= -O2
 # Functions start on a cache line: the hot contact loops otherwise run 1.6x
