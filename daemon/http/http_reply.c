@@ -110,6 +110,7 @@ enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp)
     if (status < 600)
         __atomic_add_fetch(&r->svc->responses[status], 1, __ATOMIC_RELAXED);
     MHD_add_response_header(resp, "Server", "packd/" PACKD_VERSION);
+    MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
     enum MHD_Result rc = MHD_queue_response(r->conn, status, resp);
     MHD_destroy_response(resp);
     pk_log(PK_LOG_DEBUG, "request", "{s:s,s:s,s:i}", "method", r->method, "url", r->url, "status",
@@ -283,6 +284,8 @@ enum MHD_Result pk_send_file(pk_req *r, const char *path, const char *ctype, con
     MHD_add_response_header(resp, "Content-Type", ctype);
     MHD_add_response_header(resp, "ETag", etag);
     MHD_add_response_header(resp, "Accept-Ranges", "bytes");
+    /* a file is data: opened by mistake as a page, it runs no script */
+    MHD_add_response_header(resp, "Content-Security-Policy", "sandbox; default-src 'none'");
     if (download_name) {
         snprintf(disp, sizeof disp, "attachment; filename=\"%s\"", download_name);
         MHD_add_response_header(resp, "Content-Disposition", disp);

@@ -19,6 +19,7 @@
 
 #include "auth.h"
 #include "conn_guard.h"
+#include "host_check.h"
 #include "http.h"
 #include "http_park.h"
 #include "daemon/log.h"
@@ -123,6 +124,24 @@ static int wants_json_body(pk_req *r)
     return 0;
 }
 
+/* A media type a web page may post across origins without a preflight
+ * (the Fetch standard's CORS-safelisted Content-Type values), or none: an
+ * upload must name its data, so no page of another site can store a file. */
+static int is_form_media_type(const char *ct)
+{
+    static const char *const simple[] = {"text/plain", "application/x-www-form-urlencoded",
+                                         "multipart/form-data", NULL};
+    if (!ct)
+        return 1;
+    ct += strspn(ct, " \t");
+    for (const char *const *s = simple; *s; s++) {
+        size_t n = strlen(*s);
+        if (!strncasecmp(ct, *s, n) && strchr(" \t;", ct[n]))
+            return 1;
+    }
+    return !*ct;
+}
+
 /* Whether the request announces a body: a Content-Length above 0 or a
  * Transfer-Encoding (chunked). */
 static int has_body(pk_req *r)
@@ -156,6 +175,10 @@ static enum MHD_Result on_headers(pk_req *r)
     const pk_route *rt = find_route(r);
     enum MHD_Result refused;
     r->answered = 1;
+    if (!pk_host_allowed(&cfg, pk_header(r, "Host")))
+        return pk_send_problem(r, 421, PK_PROBLEM_GENERIC, "Misdirected Request",
+                               "this service does not answer to that Host name (allowed_hosts)",
+                               NULL, 0);
     if (!rt)
         return no_route(r);
     if (!pk_authorize(r, rt->access, &refused))
@@ -168,6 +191,13 @@ static enum MHD_Result on_headers(pk_req *r)
                                "this route takes a JSON body: Content-Type must be application/json"
                                " (a charset parameter is allowed)",
                                NULL, 0);
+    if (!strcmp(rt->pattern, "/files") && is_form_media_type(pk_header(r, "Content-Type")))
+        return pk_send_problem(
+            r, 415, PK_PROBLEM_GENERIC, "Unsupported Media Type",
+            "an upload names its data in Content-Type (application/octet-stream, "
+            "application/x-hdf5, ...); none, text/plain and form bodies are "
+            "refused",
+            NULL, 0);
     const char *cl = pk_header(r, "Content-Length");
     if (cl && strtoll(cl, NULL, 10) > cfg.max_body_bytes) {
         char d[128];
