@@ -18,6 +18,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "data_paths.h"
 #include "job_end.h"
 #include "log.h"
 #include "api/digest.h"
@@ -162,8 +163,12 @@ static void end_recorded(pk_supervisor *s, slot *sl, const char *ended)
 static const char *end_slot(pk_supervisor *s, slot *sl, const char *status, const char *msg,
                             const char *summary, const char *sha256, long long size)
 {
-    const char *ended =
-        pk_job_end_record(&sl->end, s->q, sl->id, status, msg, summary, sha256, size);
+    /* what clients read (status, SSE, problems) names no path of the data directory */
+    char *m = pk_hide_data_paths(msg, s->data), *sum = pk_hide_data_paths(summary, s->data);
+    const char *ended = pk_job_end_record(&sl->end, s->q, sl->id, status, m ? m : msg,
+                                          sum ? sum : summary, sha256, size);
+    free(m);
+    free(sum);
     if (ended)
         end_recorded(s, sl, ended);
     else

@@ -247,7 +247,14 @@ int pk_pack_run(const void *task, const pk_run_ctx *run, const char *job_json, c
         return -1;
     }
     pk_place_stats st = {0};
-    if (!placer || placer->place(&job, &plan, &sz, &rx, &p, &st, err, errlen) != 0) {
+    /* a limit that ran out while the sizes were drawn stops the job before
+     * the placer sets up (a large run's grids take seconds): nothing placed */
+    pk_progress at_sizes = {.stage = "sizes", .fraction = 1, .total = sz.n, .eta_s = -1};
+    int stop = placer && !placer->own_sizes ? pk_monitor_tick(mon, &at_sizes, 0) : 0;
+    if (stop)
+        st = (pk_place_stats){.reason = stop == 2 ? PK_STOP_WALL_TIME : PK_STOP_CANCELLED,
+                              .requested = sz.n};
+    else if (!placer || placer->place(&job, &plan, &sz, &rx, &p, &st, err, errlen) != 0) {
         if (!placer)
             snprintf(err, errlen, "no placer named %s", job.algorithm);
         pk_sizes_free(&sz);
@@ -305,6 +312,7 @@ int pk_pack_run(const void *task, const pk_run_ctx *run, const char *job_json, c
         json_object_set_new(sum, "smallest_wall_gap", json_real(gap.min_wall_gap));
     json_object_set_new(sum, "pairs_below_delta_d", json_integer((json_int_t)gap.pairs_below));
     json_object_set_new(sum, "size_scale", json_real(scale));
+    json_object_set_new(sum, "seconds_sizes", json_real(t_sizes));
     json_object_set_new(sum, "seconds_place", json_real(st.seconds));
 
     if (st.overlap_tol > 0)

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "http.h"
+#include "daemon/data_paths.h"
 #include "daemon/log.h"
 #include "api/digest.h"
 
@@ -87,6 +88,14 @@ void pk_absolute_links(pk_req *r, json_t *doc)
     absolute_hrefs(doc, base);
 }
 
+/* A document as a client sees it: no path of the data directory, links absolute. */
+static void client_view(pk_req *r, json_t *doc)
+{
+    pk_config cfg = pk_service_config(r->svc);
+    pk_hide_data_paths_json(doc, cfg.data);
+    pk_absolute_links(r, doc);
+}
+
 enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp)
 {
     if (!resp)
@@ -140,7 +149,7 @@ struct MHD_Response *pk_json_response(json_t *body, const char *ctype)
 
 enum MHD_Result pk_send_json(pk_req *r, unsigned status, json_t *body, const char *etag)
 {
-    pk_absolute_links(r, body);
+    client_view(r, body);
     struct MHD_Response *resp = pk_json_response(body, "application/json");
     if (resp && etag)
         MHD_add_response_header(resp, "ETag", etag);
@@ -158,7 +167,7 @@ enum MHD_Result pk_send_text(pk_req *r, unsigned status, const char *ctype, cons
 
 enum MHD_Result pk_send_problem_doc(pk_req *r, unsigned status, json_t *doc, int retry_after)
 {
-    pk_absolute_links(r, doc);
+    client_view(r, doc);
     struct MHD_Response *resp = pk_json_response(doc, "application/problem+json");
     if (resp && retry_after > 0) {
         char ra[32];
