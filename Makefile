@@ -185,7 +185,8 @@ FUZZ_CFLAGS   = $(CSTD) -O1 -g -MMD -MP $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no
                $(shell pkg-config --cflags $(PKGS) 2>/dev/null) -I/usr/include/suitesparse -I. -I$(FUZZ_BUILD)/gen
 FUZZ_OBJ     := $(CORE_SRC:%.c=$(FUZZ_BUILD)/obj/%.o) $(API_SRC:%.c=$(FUZZ_BUILD)/obj/%.o) \
                $(FUZZ_BUILD)/obj/gen/schemas_embedded.o \
-               $(DAEMON_SRC:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_BUILD)/obj/gen/web_embedded.o
+               $(patsubst %.c,$(FUZZ_BUILD)/obj/%.o,$(filter-out daemon/cli/%,$(DAEMON_SRC))) \
+               $(FUZZ_BUILD)/obj/gen/web_embedded.o
 FUZZ_BIN     := $(FUZZ_TARGETS:%=$(FUZZ_BUILD)/fuzz_%)
 FUZZ_OK      := $(FUZZ_BUILD)/.fuzzer-ok
 

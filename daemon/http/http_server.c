@@ -124,22 +124,31 @@ static int wants_json_body(pk_req *r)
     return 0;
 }
 
-/* A media type a web page may post across origins without a preflight
- * (the Fetch standard's CORS-safelisted Content-Type values), or none: an
- * upload must name its data, so no page of another site can store a file. */
-static int is_form_media_type(const char *ct)
+/* Why an upload's Content-Type is refused, or NULL.  A web page may post
+ * text/plain and form types across origins without a preflight (the Fetch
+ * standard's CORS-safelisted values), so no page of another site can store
+ * a file; the type is stored and echoed, so it must be printable ASCII. */
+static const char *upload_type_refused(const char *ct)
 {
     static const char *const simple[] = {"text/plain", "application/x-www-form-urlencoded",
                                          "multipart/form-data", NULL};
-    if (!ct)
-        return 1;
+    if (!ct || !*(ct + strspn(ct, " \t")))
+        return "an upload names its data in Content-Type (application/octet-stream, "
+               "application/x-hdf5, ...): none given";
+    size_t len = strlen(ct);
+    for (size_t i = 0; i < len; i++)
+        if ((unsigned char)ct[i] < 0x20 || (unsigned char)ct[i] > 0x7e)
+            return "Content-Type must be printable ASCII";
+    if (len > 255)
+        return "Content-Type is longer than 255 bytes";
     ct += strspn(ct, " \t");
     for (const char *const *s = simple; *s; s++) {
         size_t n = strlen(*s);
         if (!strncasecmp(ct, *s, n) && strchr(" \t;", ct[n]))
-            return 1;
+            return "an upload names its data in Content-Type (application/octet-stream, "
+                   "application/x-hdf5, ...); text/plain and form bodies are refused";
     }
-    return !*ct;
+    return NULL;
 }
 
 /* Whether the request announces a body: a Content-Length above 0 or a
@@ -191,13 +200,11 @@ static enum MHD_Result on_headers(pk_req *r)
                                "this route takes a JSON body: Content-Type must be application/json"
                                " (a charset parameter is allowed)",
                                NULL, 0);
-    if (!strcmp(rt->pattern, "/files") && is_form_media_type(pk_header(r, "Content-Type")))
-        return pk_send_problem(
-            r, 415, PK_PROBLEM_GENERIC, "Unsupported Media Type",
-            "an upload names its data in Content-Type (application/octet-stream, "
-            "application/x-hdf5, ...); none, text/plain and form bodies are "
-            "refused",
-            NULL, 0);
+    const char *bad_type =
+        strcmp(rt->pattern, "/files") ? NULL : upload_type_refused(pk_header(r, "Content-Type"));
+    if (bad_type)
+        return pk_send_problem(r, 415, PK_PROBLEM_GENERIC, "Unsupported Media Type", bad_type, NULL,
+                               0);
     const char *cl = pk_header(r, "Content-Length");
     if (cl && strtoll(cl, NULL, 10) > cfg.max_body_bytes) {
         char d[128];

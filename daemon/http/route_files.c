@@ -60,7 +60,8 @@ enum MHD_Result route_files_post(pk_req *r)
     json_t *doc = json_pack("{s:s,s:s,s:s,s:I,s:s}", "id", hex, "href", href, "sha256", hex, "size",
                             (json_int_t)r->body_len, "type", ct);
     struct MHD_Response *resp = pk_json_response(doc, "application/json");
-    MHD_add_response_header(resp, "Location", href);
+    if (resp)
+        MHD_add_response_header(resp, "Location", href);
     return pk_send(r, 201, resp);
 }
 

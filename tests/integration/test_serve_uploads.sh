@@ -41,6 +41,12 @@ check files_untyped_415 test "$code" = 415
 code=$(c -o /dev/null -w '%{http_code}' -H 'Content-Type: TEXT/PLAIN; charset=utf-8' \
     --data-binary "@$T/page.html" "$B/files")
 check files_text_plain_charset_415 test "$code" = 415
+# a type that is no printable ASCII (the http fuzz target's first find: the
+# 201 document could not hold it and the daemon crashed)
+code=$(c -o /dev/null -w '%{http_code}' -H "$(printf 'Content-Type: application/octet-st\377\377am')" \
+    --data-binary "@$T/page.html" "$B/files")
+check files_type_not_ascii_415 test "$code" = 415
+check daemon_alive_after_bad_type test "$(c -o /dev/null -w '%{http_code}' "$B/healthz")" = 200
 
 # a foreign Host name: 421 on every route, its name never echoed
 rebind() { # path [curl args]: status with Host: rebind.attacker.example
