@@ -186,6 +186,8 @@ static inline void fuzz_http(const uint8_t *data, size_t size)
             1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
         if (left <= 0 || poll(&p, 1, (int)(left * 1000) + 1) <= 0) {
             fprintf(stderr, "fuzz_http: no complete answer within %d s\n", FUZZ_HTTP_ANSWER_S);
+            if (getenv("PK_FUZZ_HTTP_HOLD")) /* leave the process to a debugger */
+                sleep(600);
             abort();
         }
         ssize_t r = recv(s, buf, sizeof buf, 0);
