@@ -249,8 +249,7 @@ int pk_pack_run(const void *task, const pk_run_ctx *run, const char *job_json, c
     pk_place_stats st = {0};
     /* a limit that ran out while the sizes were drawn stops the job before
      * the placer sets up (a large run's grids take seconds): nothing placed */
-    pk_progress at_sizes = {.stage = "sizes", .fraction = 1, .total = sz.n, .eta_s = -1};
-    int stop = placer && !placer->own_sizes ? pk_monitor_tick(mon, &at_sizes, 0) : 0;
+    int stop = placer && !placer->own_sizes ? pk_monitor_check(mon) : 0;
     if (stop)
         st = (pk_place_stats){.reason = stop == 2 ? PK_STOP_WALL_TIME : PK_STOP_CANCELLED,
                               .requested = sz.n};

@@ -23,6 +23,7 @@
 
 #include <arpa/inet.h>
 #include <dirent.h>
+#include <errno.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
@@ -184,7 +185,10 @@ static inline void fuzz_http(const uint8_t *data, size_t size)
         clock_gettime(CLOCK_MONOTONIC, &t1);
         double left = FUZZ_HTTP_ANSWER_S - (double)(t1.tv_sec - t0.tv_sec) -
             1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
-        if (left <= 0 || poll(&p, 1, (int)(left * 1000) + 1) <= 0) {
+        int ready = left > 0 ? poll(&p, 1, (int)(left * 1000) + 1) : 0;
+        if (ready < 0 && errno == EINTR) /* libFuzzer's -timeout alarm */
+            continue;
+        if (ready <= 0) {
             fprintf(stderr, "fuzz_http: no complete answer within %d s\n", FUZZ_HTTP_ANSWER_S);
             if (getenv("PK_FUZZ_HTTP_HOLD")) /* leave the process to a debugger */
                 sleep(600);
