@@ -218,12 +218,14 @@ check-schemas: $(DEPS_OK)
 FUZZ_BUILD   ?= build-fuzz
 FUZZ_CC      ?= clang
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS := request gmsh tetgen h5_rve
+FUZZ_TARGETS := request gmsh tetgen h5_rve http
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 FUZZ_CFLAGS   = $(CSTD) -O1 -g -MMD -MP $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -DPACKD_VERSION='"$(VERSION)"' \
                $(shell pkg-config --cflags $(PKGS) 2>/dev/null) -I/usr/include/suitesparse -I. -I$(FUZZ_BUILD)/gen
 FUZZ_OBJ     := $(CORE_SRC:%.c=$(FUZZ_BUILD)/obj/%.o) $(API_SRC:%.c=$(FUZZ_BUILD)/obj/%.o) \
-               $(FUZZ_BUILD)/obj/gen/schemas_embedded.o
+               $(FUZZ_BUILD)/obj/gen/schemas_embedded.o \
+               $(patsubst %.c,$(FUZZ_BUILD)/obj/%.o,$(filter-out daemon/cli/%,$(DAEMON_SRC))) \
+               $(FUZZ_BUILD)/obj/gen/web_embedded.o
 FUZZ_BIN     := $(FUZZ_TARGETS:%=$(FUZZ_BUILD)/fuzz_%)
 FUZZ_OK      := $(FUZZ_BUILD)/.fuzzer-ok
 
@@ -246,7 +248,11 @@ $(FUZZ_BUILD)/gen/schemas_embedded.c: $(SCHEMAS) tools/embed.sh
 	@mkdir -p $(@D)
 	sh tools/embed.sh api/schemas/schemas_embedded.h pk_embedded_schema pk_embedded_schemas char / $(SCHEMAS) > $@
 
-$(FUZZ_BUILD)/obj/gen/schemas_embedded.o: $(FUZZ_BUILD)/gen/schemas_embedded.c | $(DEPS_OK)
+$(FUZZ_BUILD)/gen/web_embedded.c: $(WEB) tools/embed.sh
+	@mkdir -p $(@D)
+	sh tools/embed.sh daemon/http/web_assets.h pk_web_asset pk_web_assets 'unsigned char' web/ $(WEB) > $@
+
+$(FUZZ_BUILD)/obj/gen/%.o: $(FUZZ_BUILD)/gen/%.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -c $< -o $@
 

@@ -75,6 +75,9 @@ static const struct key {
      "base URL of absolute links (reverse proxy); unset: http://<Host header>"},
     {"auth", K_AUTH, F(auth), 0, 0,
      "bearer tokens required: auto (on unless bind is loopback without trusted_proxy) | on | off"},
+    {"allowed_hosts", K_STR, F(allowed_hosts), 0, 0,
+     "Host names requests may carry, comma-separated, * = any (unset: bind address, localhost, "
+     "this machine's names and addresses, public_url's host); others get 421"},
     {"trusted_proxy", K_ADDR, F(trusted_proxy), 0, 0,
      "address of the reverse proxy whose X-Packd-Owner is honoured"},
 #undef F

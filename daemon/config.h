@@ -42,9 +42,10 @@ typedef struct pk_config {
     double
         checkpoint_interval_s; /* between two checkpoints of a long job (job dir checkpoint.h5) */
     pk_log_level log_level;
-    pk_auth_mode auth;      /* bearer tokens required (daemon/http/auth.c) */
-    char trusted_proxy[64]; /* peer whose X-Packd-Owner is honoured; "" = none */
-    char config_file[1024]; /* the file read, "" if none (kept for SIGHUP) */
+    pk_auth_mode auth;       /* bearer tokens required (daemon/http/auth.c) */
+    char trusted_proxy[64];  /* peer whose X-Packd-Owner is honoured; "" = none */
+    char allowed_hosts[512]; /* Host header names accepted, comma-separated ("" = this machine's) */
+    char config_file[1024];  /* the file read, "" if none (kept for SIGHUP) */
 } pk_config;
 
 /* Embedded defaults: 127.0.0.1:8080, data ./var, workers = online cores. */

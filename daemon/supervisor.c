@@ -18,6 +18,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "data_paths.h"
+#include "job_end.h"
 #include "log.h"
 #include "api/digest.h"
 #include "daemon/store/job_files.h"
@@ -38,6 +40,7 @@ typedef struct slot {
     size_t nline;
     double started, term_sent;
     int killed_for_time;
+    pk_job_end end; /* pending: the slot holds an end the queue has not recorded */
 } slot;
 
 struct pk_supervisor {
@@ -52,7 +55,8 @@ struct pk_supervisor {
     int stopping;
     double grace_deadline;
     int wake[2];
-    int busy;
+    int busy;       /* slots with a worker or a pending end */
+    int unrecorded; /* slots with a pending end */
     slot slots[MAX_SLOTS];
 };
 
@@ -140,6 +144,47 @@ static int cloexec_pipe(int p[2], int nonblock)
 
 static void set_nonblock(int fd) { fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK); }
 
+/* A slot's end recorded: the worker's files of a dismissed job go, the slot
+ * is free. */
+static void end_recorded(pk_supervisor *s, slot *sl, const char *ended)
+{
+    if (!strcmp(ended, "dismissed")) { /* nobody will download it */
+        char dir[1200], path[1300];
+        pk_job_dir(s->data, sl->id, dir, sizeof dir);
+        remove_tmp_files(dir);
+        pk_job_file_path(dir, PK_JOB_RESULT, path, sizeof path);
+        unlink(path);
+    }
+    __atomic_sub_fetch(&s->busy, 1, __ATOMIC_RELAXED);
+}
+
+/* Record a slot's end (the slot counts as busy); kept pending while the
+ * queue cannot write it.  Returns what the job ended with, or NULL. */
+static const char *end_slot(pk_supervisor *s, slot *sl, const char *status, const char *msg,
+                            const char *summary, const char *sha256, long long size)
+{
+    /* what clients read (status, SSE, problems) names no path of the data directory */
+    char *m = pk_hide_data_paths(msg, s->data), *sum = pk_hide_data_paths(summary, s->data);
+    const char *ended = pk_job_end_record(&sl->end, s->q, sl->id, status, m ? m : msg,
+                                          sum ? sum : summary, sha256, size);
+    free(m);
+    free(sum);
+    if (ended)
+        end_recorded(s, sl, ended);
+    else
+        __atomic_add_fetch(&s->unrecorded, 1, __ATOMIC_RELAXED);
+    return ended;
+}
+
+/* A claimed job that could not start fails (its end pending if need be). */
+static void launch_failed(pk_supervisor *s, slot *sl, const char *id, const char *why)
+{
+    memset(sl, 0, sizeof *sl);
+    snprintf(sl->id, sizeof sl->id, "%s", id);
+    __atomic_add_fetch(&s->busy, 1, __ATOMIC_RELAXED);
+    end_slot(s, sl, "failed", why, NULL, NULL, 0);
+}
+
 static int launch(pk_supervisor *s, slot *sl, json_t *job)
 {
     const char *id = json_string_value(json_object_get(job, "id"));
@@ -155,7 +200,7 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
     char why[1400];
     if (mkdirs(dir) != 0) {
         snprintf(why, sizeof why, "cannot create the job directory: %s", strerror(errno));
-        pk_queue_finish(s->q, id, "failed", why, NULL, NULL, 0);
+        launch_failed(s, sl, id, why);
         return -1;
     }
     remove_tmp_files(dir);
@@ -178,7 +223,7 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
     if (wrote != 0 || cloexec_pipe(p, 0) != 0) {
         snprintf(why, sizeof why, "cannot write the job file: %s",
                  strerror(wrote != 0 ? wrote_errno : errno));
-        pk_queue_finish(s->q, id, "failed", why, NULL, NULL, 0);
+        launch_failed(s, sl, id, why);
         return -1;
     }
     pid_t parent = getpid();
@@ -311,10 +356,9 @@ static void finished(pk_supervisor *s, slot *sl, int wstatus)
         struct stat st;
         pk_job_file_path(dir, PK_JOB_RESULT, path, sizeof path);
         if (pk_sha256_file_hex(path, hex) == 0 && stat(path, &st) == 0)
-            ended = pk_queue_finish(s->q, sl->id, status, msg, text, hex, (long long)st.st_size);
+            ended = end_slot(s, sl, status, msg, text, hex, (long long)st.st_size);
         else
-            ended = pk_queue_finish(s->q, sl->id, "failed", "the worker wrote no result file", text,
-                                    NULL, 0);
+            ended = end_slot(s, sl, "failed", "the worker wrote no result file", text, NULL, 0);
         free(text);
     } else {
         pk_job_file_path(dir, PK_JOB_LOG, path, sizeof path);
@@ -327,18 +371,27 @@ static void finished(pk_supervisor *s, slot *sl, int wstatus)
         else
             snprintf(msg, sizeof msg, "worker exited with status %d%s%s", WEXITSTATUS(wstatus),
                      tail[0] ? ": " : "", tail);
-        ended = pk_queue_finish(s->q, sl->id, "failed", msg, NULL, NULL, 0);
+        ended = end_slot(s, sl, "failed", msg, NULL, NULL, 0);
     }
-    if (!strcmp(ended, "dismissed")) { /* nobody will download it */
-        remove_tmp_files(dir);
-        pk_job_file_path(dir, PK_JOB_RESULT, path, sizeof path);
-        unlink(path);
-    }
-    pk_log(ended[0] == 'f' ? PK_LOG_WARN : PK_LOG_INFO, "worker ended", "{s:s,s:i,s:s,s:i,s:f}",
-           "job", sl->id, "pid", (int)sl->pid, "status", ended, "wait_status", wstatus, "seconds",
+    pk_log(!ended || ended[0] == 'f' ? PK_LOG_WARN : PK_LOG_INFO, "worker ended",
+           "{s:s,s:i,s:s,s:i,s:f}", "job", sl->id, "pid", (int)sl->pid, "status",
+           ended ? ended : "not recorded yet", "wait_status", wstatus, "seconds",
            pk_queue_now() - sl->started);
     sl->pid = 0;
-    __atomic_sub_fetch(&s->busy, 1, __ATOMIC_RELAXED);
+}
+
+/* Pending ends whose second has come are written again. */
+static void retry_ends(pk_supervisor *s)
+{
+    double now = pk_queue_now();
+    for (int k = 0; k < MAX_SLOTS && __atomic_load_n(&s->unrecorded, __ATOMIC_RELAXED); k++) {
+        slot *sl = &s->slots[k];
+        const char *ended = pk_job_end_retry(&sl->end, s->q, now);
+        if (ended) {
+            __atomic_sub_fetch(&s->unrecorded, 1, __ATOMIC_RELAXED);
+            end_recorded(s, sl, ended);
+        }
+    }
 }
 
 static void send_cancels(pk_supervisor *s)
@@ -394,6 +447,14 @@ static void *loop(void *arg)
         if (stopping && pk_queue_now() > deadline) {
             for (int k = 0; k < MAX_SLOTS; k++) {
                 slot *sl = &s->slots[k];
+                if (sl->end.pending) {
+                    pk_log(PK_LOG_ERROR,
+                           "job end not recorded at shutdown: re-queued at the next start",
+                           "{s:s,s:s}", "job", sl->id, "status", sl->end.status);
+                    pk_job_end_drop(&sl->end);
+                    __atomic_sub_fetch(&s->unrecorded, 1, __ATOMIC_RELAXED);
+                    __atomic_sub_fetch(&s->busy, 1, __ATOMIC_RELAXED);
+                }
                 if (!sl->pid)
                     continue;
                 kill(sl->pid, SIGKILL);
@@ -409,7 +470,7 @@ static void *loop(void *arg)
         }
         /* claim while there is room */
         for (int k = 0; !stopping && busy < workers && k < MAX_SLOTS; k++) {
-            if (s->slots[k].pid)
+            if (s->slots[k].pid || s->slots[k].end.pending)
                 continue;
             json_t *job = pk_queue_claim(s->q);
             if (!job)
@@ -443,6 +504,7 @@ static void *loop(void *arg)
             if (sl->pid && waitpid(sl->pid, &ws, WNOHANG) == sl->pid)
                 finished(s, sl, ws);
         }
+        retry_ends(s);
         send_cancels(s);
         enforce_wall_time(s, max_wall);
     }
@@ -497,6 +559,11 @@ void pk_supervisor_wake(pk_supervisor *s)
 int pk_supervisor_busy(const pk_supervisor *s)
 {
     return __atomic_load_n(&s->busy, __ATOMIC_RELAXED);
+}
+
+int pk_supervisor_unrecorded(const pk_supervisor *s)
+{
+    return __atomic_load_n(&s->unrecorded, __ATOMIC_RELAXED);
 }
 
 int pk_supervisor_capacity(const pk_supervisor *s)

@@ -38,6 +38,10 @@ void pk_supervisor_wake(pk_supervisor *s);
 int pk_supervisor_busy(const pk_supervisor *s);
 int pk_supervisor_capacity(const pk_supervisor *s);
 
+/* Ended jobs whose end the queue could not record yet (daemon/job_end.h):
+ * their slots stay taken and /healthz is not ready while any is left. */
+int pk_supervisor_unrecorded(const pk_supervisor *s);
+
 /* Stop claiming; give running jobs grace_s to finish, then kill their workers
  * and re-queue the jobs; join the thread.  The object stays readable (busy,
  * capacity, wake are harmless) until pk_supervisor_free. */

@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 
 #include "input_links.h"
+#include "input_open.h"
 
 typedef struct {
     const char *dir;     /* as configured */
@@ -98,7 +99,11 @@ static int confine(const confine_ctx *c, const char *file, char out[PATH_MAX + 8
         *why = "is not a file in the input directory";
         return -1;
     }
-    if (snprintf(out, n, "%s/%s", dir, name) >= (int)n) {
+    /* what the worker opens beneath the input directory (input_open.h) */
+    const char *rel = dir + strlen(c->root);
+    rel += *rel == '/';
+    if (snprintf(out, n, "%s" PK_INPUT_BENEATH "%s%s%s", strcmp(c->root, "/") ? c->root : "", rel,
+                 *rel ? "/" : "", name) >= (int)n) {
         *why = "is too long";
         return -1;
     }

@@ -1,11 +1,15 @@
 /* input_open.c — open a job's input file without trusting it (regular files
  * only, size-limited).  Contract: api/inputs/input_open.h. */
+#define _GNU_SOURCE /* O_PATH */
 #include "input_open.h"
 
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
+#include <linux/openat2.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
 static const char *kind(mode_t m)
@@ -18,11 +22,77 @@ static const char *kind(mode_t m)
                       : "not a regular file";
 }
 
+#define OPEN_FLAGS (O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC)
+
+/* Without openat2: each directory of rest opened with O_NOFOLLOW. */
+static int open_no_symlinks(int dir, const char *rest)
+{
+    char part[PATH_MAX];
+    int fd = dup(dir);
+    while (fd >= 0) {
+        rest += strspn(rest, "/");
+        size_t n = strcspn(rest, "/");
+        if (n == 0 || n >= sizeof part) {
+            close(fd);
+            errno = ENOENT;
+            return -1;
+        }
+        memcpy(part, rest, n);
+        part[n] = 0;
+        rest += n;
+        int last = rest[strspn(rest, "/")] == 0;
+        int next = !strcmp(part, "..")
+            ? (errno = EXDEV, -1)
+            : openat(fd, part, last ? OPEN_FLAGS | O_NOFOLLOW : O_PATH | O_DIRECTORY | O_NOFOLLOW);
+        int e = errno;
+        close(fd);
+        errno = e;
+        fd = next;
+        if (last)
+            return fd;
+    }
+    return -1;
+}
+
+/* path "<root>/./<rest>": rest opened beneath root. */
+static int open_beneath(const char *path, const char *marker)
+{
+    char root[PATH_MAX];
+    size_t n = (size_t)(marker - path);
+    if (n >= sizeof root) {
+        errno = ENAMETOOLONG;
+        return -1;
+    }
+    memcpy(root, path, n);
+    root[n] = 0;
+    int dir = open(n ? root : "/", O_PATH | O_DIRECTORY | O_CLOEXEC);
+    if (dir < 0)
+        return -1;
+    const char *rest = marker + strlen(PK_INPUT_BENEATH);
+    struct open_how how = {.flags = OPEN_FLAGS, .resolve = RESOLVE_BENEATH | RESOLVE_NO_MAGICLINKS};
+    int fd = (int)syscall(SYS_openat2, dir, rest, &how, sizeof how);
+    if (fd < 0 && (errno == ENOSYS || errno == EPERM))
+        fd = open_no_symlinks(dir, rest);
+    int e = errno;
+    close(dir);
+    errno = e;
+    return fd;
+}
+
 int pk_input_open(const char *path, long long max_bytes, char *err, size_t errlen)
 {
     if (max_bytes <= 0 || max_bytes > PK_INPUT_MAX_BYTES)
         max_bytes = PK_INPUT_MAX_BYTES;
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+    const char *beneath = strstr(path, PK_INPUT_BENEATH);
+    int fd = beneath ? open_beneath(path, beneath) : open(path, OPEN_FLAGS);
+    if (fd < 0 && beneath && errno == EXDEV) {
+        snprintf(err, errlen,
+                 "%s: leads outside its directory (a symlink or \"..\" changed since "
+                 "the job was accepted)",
+                 path);
+        errno = EXDEV;
+        return -1;
+    }
     if (fd < 0) {
         int e = errno; /* callers tell a missing file from a refused one */
         snprintf(err, errlen, "cannot open %s: %s", path, strerror(e));

@@ -7,6 +7,13 @@
 
 #include <stdio.h>
 
+/* A path "<root>/./<rest>" is opened beneath root: <rest> is resolved from
+ * root with openat2(RESOLVE_BENEATH), so no symlink or ".." swapped in after
+ * the path was checked can lead outside root (input_confine.c writes the
+ * paths of the service's input directory so).  Where openat2 is missing, no
+ * symlink is followed under root at all. */
+#define PK_INPUT_BENEATH "/./"
+
 /* The largest input file any reader accepts (the service's input_max_bytes
  * is usually smaller and is checked when a job is submitted). */
 #define PK_INPUT_MAX_BYTES (16LL << 30)

@@ -270,7 +270,13 @@ int pk_pack_run(const void *task, const pk_run_ctx *run, const char *job_json, c
         return -1;
     }
     pk_place_stats st = {0};
-    if (!placer || placer->place(&job, &plan, &sz, &rx, &p, &st, err, errlen) != 0) {
+    /* a limit that ran out while the sizes were drawn stops the job before
+     * the placer sets up (a large run's grids take seconds): nothing placed */
+    int stop = placer && !placer->own_sizes ? pk_monitor_check(mon) : 0;
+    if (stop)
+        st = (pk_place_stats){.reason = stop == 2 ? PK_STOP_WALL_TIME : PK_STOP_CANCELLED,
+                              .requested = sz.n};
+    else if (!placer || placer->place(&job, &plan, &sz, &rx, &p, &st, err, errlen) != 0) {
         if (!placer)
             snprintf(err, errlen, "no placer named %s", job.algorithm);
         pk_sizes_free(&sz);

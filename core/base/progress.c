@@ -36,7 +36,7 @@ void pk_monitor_start(pk_monitor *m, double wall_limit_s)
     pk_monitor_begin(m);
 }
 
-int pk_monitor_tick(pk_monitor *m, pk_progress *p, int force)
+int pk_monitor_check(pk_monitor *m)
 {
     if (!m)
         return 0;
@@ -46,9 +46,17 @@ int pk_monitor_tick(pk_monitor *m, pk_progress *p, int force)
         return m->cancelled;
     if (m->cancel && *m->cancel)
         return m->cancelled = 1;
-    double now = pk_wall_seconds();
-    if (m->wall_limit_s > 0 && now - m->t_job > m->wall_limit_s)
+    if (m->wall_limit_s > 0 && pk_wall_seconds() - m->t_job > m->wall_limit_s)
         return m->cancelled = 2;
+    return 0;
+}
+
+int pk_monitor_tick(pk_monitor *m, pk_progress *p, int force)
+{
+    int stop = pk_monitor_check(m);
+    if (!m || stop)
+        return stop;
+    double now = pk_wall_seconds();
     if (!force && now - m->t_last < m->interval_s)
         return 0;
     m->t_last = now;

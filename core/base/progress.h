@@ -56,4 +56,8 @@ void pk_monitor_start(pk_monitor *m, double wall_limit_s);
  * interval has not elapsed: call it every few hundred iterations. */
 int pk_monitor_tick(pk_monitor *m, pk_progress *p, int force);
 
+/* The same stop check as pk_monitor_tick (cancel flag, wall limit), without
+ * a report: for a stage boundary that has no progress to give. */
+int pk_monitor_check(pk_monitor *m);
+
 #endif

@@ -12,6 +12,7 @@
 
 #include "cli.h"
 #include "daemon/config.h"
+#include "daemon/store/migrations.h"
 
 void cmd_backup_help(const char *name, FILE *f)
 {
@@ -98,7 +99,9 @@ int cmd_backup(int argc, char **argv)
     }
     sqlite3_busy_timeout(src, 5000);
     remove(tmp);
-    if (sqlite3_open_v2(tmp, &dst, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, NULL) != SQLITE_OK) {
+    /* the copy holds inputs, owners and token hashes: 0640 at most, as the database */
+    if (pk_db_file_private(tmp) != 0 ||
+        sqlite3_open_v2(tmp, &dst, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, NULL) != SQLITE_OK) {
         fprintf(stderr, "packd backup: %s: %s\n", tmp, dst ? sqlite3_errmsg(dst) : "cannot open");
         goto out;
     }

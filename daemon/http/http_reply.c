@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "http.h"
+#include "daemon/data_paths.h"
 #include "daemon/log.h"
 #include "api/digest.h"
 
@@ -87,6 +88,14 @@ void pk_absolute_links(pk_req *r, json_t *doc)
     absolute_hrefs(doc, base);
 }
 
+/* A document as a client sees it: no path of the data directory, links absolute. */
+static void client_view(pk_req *r, json_t *doc)
+{
+    pk_config cfg = pk_service_config(r->svc);
+    pk_hide_data_paths_json(doc, cfg.data);
+    pk_absolute_links(r, doc);
+}
+
 enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp)
 {
     if (!resp)
@@ -110,6 +119,7 @@ enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp)
     if (status < 600)
         __atomic_add_fetch(&r->svc->responses[status], 1, __ATOMIC_RELAXED);
     MHD_add_response_header(resp, "Server", "packd/" PACKD_VERSION);
+    MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
     enum MHD_Result rc = MHD_queue_response(r->conn, status, resp);
     MHD_destroy_response(resp);
     pk_log(PK_LOG_DEBUG, "request", "{s:s,s:s,s:i}", "method", r->method, "url", r->url, "status",
@@ -139,7 +149,7 @@ struct MHD_Response *pk_json_response(json_t *body, const char *ctype)
 
 enum MHD_Result pk_send_json(pk_req *r, unsigned status, json_t *body, const char *etag)
 {
-    pk_absolute_links(r, body);
+    client_view(r, body);
     struct MHD_Response *resp = pk_json_response(body, "application/json");
     if (resp && etag)
         MHD_add_response_header(resp, "ETag", etag);
@@ -157,7 +167,7 @@ enum MHD_Result pk_send_text(pk_req *r, unsigned status, const char *ctype, cons
 
 enum MHD_Result pk_send_problem_doc(pk_req *r, unsigned status, json_t *doc, int retry_after)
 {
-    pk_absolute_links(r, doc);
+    client_view(r, doc);
     struct MHD_Response *resp = pk_json_response(doc, "application/problem+json");
     if (resp && retry_after > 0) {
         char ra[32];
@@ -288,6 +298,8 @@ enum MHD_Result pk_send_file(pk_req *r, const char *path, const char *ctype, con
     MHD_add_response_header(resp, "Content-Type", ctype);
     MHD_add_response_header(resp, "ETag", etag);
     MHD_add_response_header(resp, "Accept-Ranges", "bytes");
+    /* a file is data: opened by mistake as a page, it runs no script */
+    MHD_add_response_header(resp, "Content-Security-Policy", "sandbox; default-src 'none'");
     if (download_name) {
         snprintf(disp, sizeof disp, "attachment; filename=\"%s\"", download_name);
         MHD_add_response_header(resp, "Content-Disposition", disp);

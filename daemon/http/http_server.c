@@ -19,6 +19,7 @@
 
 #include "auth.h"
 #include "conn_guard.h"
+#include "host_check.h"
 #include "http.h"
 #include "http_park.h"
 #include "daemon/log.h"
@@ -123,6 +124,33 @@ static int wants_json_body(pk_req *r)
     return 0;
 }
 
+/* Why an upload's Content-Type is refused, or NULL.  A web page may post
+ * text/plain and form types across origins without a preflight (the Fetch
+ * standard's CORS-safelisted values), so no page of another site can store
+ * a file; the type is stored and echoed, so it must be printable ASCII. */
+static const char *upload_type_refused(const char *ct)
+{
+    static const char *const simple[] = {"text/plain", "application/x-www-form-urlencoded",
+                                         "multipart/form-data", NULL};
+    if (!ct || !*(ct + strspn(ct, " \t")))
+        return "an upload names its data in Content-Type (application/octet-stream, "
+               "application/x-hdf5, ...): none given";
+    size_t len = strlen(ct);
+    for (size_t i = 0; i < len; i++)
+        if ((unsigned char)ct[i] < 0x20 || (unsigned char)ct[i] > 0x7e)
+            return "Content-Type must be printable ASCII";
+    if (len > 255)
+        return "Content-Type is longer than 255 bytes";
+    ct += strspn(ct, " \t");
+    for (const char *const *s = simple; *s; s++) {
+        size_t n = strlen(*s);
+        if (!strncasecmp(ct, *s, n) && strchr(" \t;", ct[n]))
+            return "an upload names its data in Content-Type (application/octet-stream, "
+                   "application/x-hdf5, ...); text/plain and form bodies are refused";
+    }
+    return NULL;
+}
+
 /* Whether the request announces a body: a Content-Length above 0 or a
  * Transfer-Encoding (chunked). */
 static int has_body(pk_req *r)
@@ -156,6 +184,10 @@ static enum MHD_Result on_headers(pk_req *r)
     const pk_route *rt = find_route(r);
     enum MHD_Result refused;
     r->answered = 1;
+    if (!pk_host_allowed(&cfg, pk_header(r, "Host")))
+        return pk_send_problem(r, 421, PK_PROBLEM_GENERIC, "Misdirected Request",
+                               "this service does not answer to that Host name (allowed_hosts)",
+                               NULL, 0);
     if (!rt)
         return no_route(r);
     if (!pk_authorize(r, rt->access, &refused))
@@ -168,6 +200,11 @@ static enum MHD_Result on_headers(pk_req *r)
                                "this route takes a JSON body: Content-Type must be application/json"
                                " (a charset parameter is allowed)",
                                NULL, 0);
+    const char *bad_type =
+        strcmp(rt->pattern, "/files") ? NULL : upload_type_refused(pk_header(r, "Content-Type"));
+    if (bad_type)
+        return pk_send_problem(r, 415, PK_PROBLEM_GENERIC, "Unsupported Media Type", bad_type, NULL,
+                               0);
     const char *cl = pk_header(r, "Content-Length");
     if (cl && strtoll(cl, NULL, 10) > cfg.max_body_bytes) {
         char d[128];

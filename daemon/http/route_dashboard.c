@@ -90,7 +90,6 @@ static enum MHD_Result send_asset(pk_req *r, const pk_web_asset *a)
     if (resp) {
         MHD_add_response_header(resp, "Content-Type", media_type(a->name));
         MHD_add_response_header(resp, "Content-Security-Policy", CSP);
-        MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
         MHD_add_response_header(resp, "Cache-Control", "no-cache");
         MHD_add_response_header(resp, "Vary", "Accept");
     }

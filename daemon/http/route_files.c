@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -49,9 +50,7 @@ enum MHD_Result route_files_post(pk_req *r)
     snprintf(dir, sizeof dir, "%s/files", cfg.data);
     mkdir(dir, 0750);
     snprintf(path, sizeof path, "%s/%s", dir, hex);
-    const char *ct = pk_header(r, "Content-Type");
-    if (!ct || !*ct)
-        ct = "application/octet-stream";
+    const char *ct = pk_header(r, "Content-Type"); /* not a form type (http_server.c) */
     pk_owner(r, owner, sizeof owner);
     if (write_all(path, r->body, r->body_len) != 0 ||
         pk_queue_add_file(r->svc->q, hex, hex, (long long)r->body_len, ct, owner) != 0)
@@ -61,7 +60,8 @@ enum MHD_Result route_files_post(pk_req *r)
     json_t *doc = json_pack("{s:s,s:s,s:s,s:I,s:s}", "id", hex, "href", href, "sha256", hex, "size",
                             (json_int_t)r->body_len, "type", ct);
     struct MHD_Response *resp = pk_json_response(doc, "application/json");
-    MHD_add_response_header(resp, "Location", href);
+    if (resp)
+        MHD_add_response_header(resp, "Location", href);
     return pk_send(r, 201, resp);
 }
 
@@ -74,8 +74,14 @@ enum MHD_Result route_file_get(pk_req *r)
     pk_config cfg = pk_service_config(r->svc);
     char path[1200];
     snprintf(path, sizeof path, "%s/files/%s", cfg.data, r->seg[1]);
-    enum MHD_Result rc = pk_send_file(r, path, json_string_value(json_object_get(f, "media_type")),
-                                      json_string_value(json_object_get(f, "sha256")), NULL);
+    /* an upload is data, never a page: whatever type it was sent with, it
+     * goes back as bytes to save (pk_send_file adds nosniff and a sandbox) */
+    const char *sent = json_string_value(json_object_get(f, "media_type"));
+    const char *ctype = sent && !strcasecmp(sent, "application/x-hdf5")
+        ? "application/x-hdf5"
+        : "application/octet-stream";
+    enum MHD_Result rc =
+        pk_send_file(r, path, ctype, json_string_value(json_object_get(f, "sha256")), r->seg[1]);
     json_decref(f);
     return rc;
 }

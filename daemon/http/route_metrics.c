@@ -161,7 +161,8 @@ enum MHD_Result route_healthz(pk_req *r)
         json_is_true(json_object_get(st, "ok")) && pk_queue_writable(svc->q, why, sizeof why);
     json_decref(st);
     int draining = __atomic_load_n(&svc->draining, __ATOMIC_RELAXED);
-    int ready = db_ok && !draining;
+    int unrecorded = pk_supervisor_unrecorded(svc->sup); /* job ends waiting for the database */
+    int ready = db_ok && !draining && unrecorded == 0;
     json_t *doc =
         json_pack("{s:s,s:b,s:b,s:s,s:{s:i,s:i},s:f}", "status", ready ? "ok" : "unavailable",
                   "live", 1, "ready", ready, "database", db_ok ? "ok" : "error", "workers", "busy",
@@ -169,5 +170,7 @@ enum MHD_Result route_healthz(pk_req *r)
                   pk_queue_now() - svc->started);
     if (why[0])
         json_object_set_new(doc, "database_error", json_string(why));
+    if (unrecorded)
+        json_object_set_new(doc, "unrecorded_job_ends", json_integer(unrecorded));
     return pk_send_json(r, ready ? 200 : 503, doc, NULL);
 }

@@ -2,7 +2,12 @@
  * takes user_version i to i+1; never edit a released step, append one. */
 #include "migrations.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 static const char *const steps[] = {
     /* 0 -> 1: jobs, their events (SSE resume), idempotency keys, uploads */
@@ -116,9 +121,41 @@ int pk_migrate(sqlite3 *db, char *err, size_t errlen)
     return v;
 }
 
+/* Drop the group-write and every other-account bit of an open file. */
+static int tighten(int fd)
+{
+    struct stat st;
+    if (fstat(fd, &st) != 0)
+        return -1;
+    return (st.st_mode & 0137) ? fchmod(fd, st.st_mode & 0640) : 0;
+}
+
+int pk_db_file_private(const char *path)
+{
+    int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0640);
+    if (fd < 0)
+        return -1;
+    int rc = tighten(fd);
+    close(fd);
+    for (const char *const *sfx = (const char *const[]){"-wal", "-shm", NULL}; *sfx; sfx++) {
+        char side[4200];
+        snprintf(side, sizeof side, "%s%s", path, *sfx);
+        int sf = open(side, O_RDWR | O_CLOEXEC | O_NOFOLLOW);
+        if (sf >= 0) {
+            tighten(sf);
+            close(sf);
+        }
+    }
+    return rc;
+}
+
 sqlite3 *pk_db_open(const char *path, char *err, size_t errlen)
 {
     sqlite3 *db = NULL;
+    if (pk_db_file_private(path) != 0) {
+        snprintf(err, errlen, "%s: %s", path, strerror(errno));
+        return NULL;
+    }
     if (sqlite3_open_v2(path, &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX,
                         NULL) != SQLITE_OK) {
         snprintf(err, errlen, "%s: %s", path, db ? sqlite3_errmsg(db) : "cannot open");

@@ -459,42 +459,53 @@ void pk_queue_progress(pk_queue *q, const char *id, int percent, json_t *data)
 const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, const char *message,
                             const char *summary_json, const char *sha256, long long size)
 {
-    const char *ended = "dismissed";
+    const char *ended = NULL; /* not recorded, unless the commit below succeeds */
     double now = pk_queue_now();
     pthread_mutex_lock(&q->mu);
-    if (begin(q) == SQLITE_OK) {
-        int n = run(q,
-                    prep(q,
-                         "UPDATE jobs SET status=?, message=?, progress=CASE WHEN ?='successful'"
-                         " THEN 100 ELSE progress END, finished=?, updated=?, summary=?,"
-                         " result_sha256=?, result_size=?, worker_pid=NULL, rev=rev+1"
-                         " WHERE id=? AND status='running'",
-                         "sssddssIs", status, message, status, now, now, summary_json, sha256, size,
-                         id));
-        if (n == 1) {
-            ended = !strcmp(status, "successful") ? "successful" : "failed";
-            pk_metrics_job_ended(q->db, id, ended);
-        } else if (run(q,
-                       prep(q,
-                            "UPDATE jobs SET finished=?, updated=?, worker_pid=NULL, rev=rev+1,"
-                            " message='dismissed; worker stopped' WHERE id=? AND"
-                            " status='dismissed' AND finished IS NULL",
-                            "dds", now, now, id)) != 1) { /* not ours to end */
-            ended = "unchanged";
-            commit(q);
-            goto out;
-        } else {
-            pk_metrics_job_ended(q->db, id, "dismissed"); /* its worker stopped */
-        }
-        add_status_event(q, id);
-        /* History stays small: of the progress events only the last is kept. */
+    if (begin(q) != SQLITE_OK) {
+        note_write(q, 0);
+        goto out;
+    }
+    int n =
         run(q,
             prep(q,
-                 "DELETE FROM events WHERE job_id=?1 AND kind='progress' AND id <"
-                 " (SELECT max(id) FROM events WHERE job_id=?1 AND kind='progress')",
-                 "s", id));
-        commit(q);
+                 "UPDATE jobs SET status=?, message=?, progress=CASE WHEN ?='successful'"
+                 " THEN 100 ELSE progress END, finished=?, updated=?, summary=?,"
+                 " result_sha256=?, result_size=?, worker_pid=NULL, rev=rev+1"
+                 " WHERE id=? AND status='running'",
+                 "sssddssIs", status, message, status, now, now, summary_json, sha256, size, id));
+    const char *end = "dismissed";
+    if (n == 1) {
+        end = !strcmp(status, "successful") ? "successful" : "failed";
+        pk_metrics_job_ended(q->db, id, end);
+    } else if (n == 0) {
+        n = run(q,
+                prep(q,
+                     "UPDATE jobs SET finished=?, updated=?, worker_pid=NULL, rev=rev+1,"
+                     " message='dismissed; worker stopped' WHERE id=? AND"
+                     " status='dismissed' AND finished IS NULL",
+                     "dds", now, now, id));
+        if (n == 0) { /* not ours to end */
+            ended = commit(q) == 0 ? "unchanged" : NULL;
+            goto out;
+        }
+        if (n == 1)
+            pk_metrics_job_ended(q->db, id, "dismissed"); /* its worker stopped */
     }
+    if (n != 1) { /* the database took no write (full, I/O error) */
+        note_write(q, 0);
+        rollback(q);
+        goto out;
+    }
+    add_status_event(q, id);
+    /* History stays small: of the progress events only the last is kept. */
+    run(q,
+        prep(q,
+             "DELETE FROM events WHERE job_id=?1 AND kind='progress' AND id <"
+             " (SELECT max(id) FROM events WHERE job_id=?1 AND kind='progress')",
+             "s", id));
+    if (commit(q) == 0)
+        ended = end;
 out:
     pthread_mutex_unlock(&q->mu);
     notify(q);
@@ -681,20 +692,40 @@ json_t *pk_queue_stats(pk_queue *q)
     return metrics;
 }
 
+/* While writes fail, a write as large as a job's end with its summary and
+ * events (PROBE_BYTES, committed, then deleted) is tried at most once a
+ * second: the state clears only when such a write commits, so space freed
+ * makes /healthz ready by itself and a write that merely fits in the WAL's
+ * slack does not. */
+#define PROBE_BYTES 16384
+
+static void probe_write(pk_queue *q)
+{
+    const char *sql[] = {"INSERT INTO events(job_id, kind, data, created)"
+                         " VALUES ('', 'probe', hex(zeroblob(?)), 0)",
+                         "DELETE FROM events WHERE job_id='' AND kind='probe'"};
+    for (int i = 0; i < 2; i++) {
+        if (begin(q) != SQLITE_OK) {
+            note_write(q, 0);
+            return;
+        }
+        if (run(q, prep(q, sql[i], i ? NULL : "i", PROBE_BYTES / 2)) < 0) {
+            note_write(q, 0);
+            rollback(q);
+            return;
+        }
+        if (commit(q) != 0)
+            return;
+    }
+}
+
 int pk_queue_writable(pk_queue *q, char *why, size_t n)
 {
     pthread_mutex_lock(&q->mu);
     double now = pk_queue_now();
-    /* while writes fail, a real commit at most once a second says when they
-     * work again (space freed); rewriting page 1 with the same id is cheap */
     if (q->write_failed_at > 0 && now - q->probed_at >= 1.0) {
         q->probed_at = now;
-        if (begin(q) == SQLITE_OK &&
-            sqlite3_exec(q->db, "PRAGMA application_id = 1885889636", NULL, NULL, NULL) ==
-                SQLITE_OK)
-            commit(q);
-        else
-            rollback(q);
+        probe_write(q);
     }
     int ok = q->write_failed_at == 0;
     if (!ok)

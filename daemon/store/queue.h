@@ -70,8 +70,10 @@ void pk_queue_progress(pk_queue *q, const char *id, int percent, json_t *data);
  * dismissed (cancelled) keeps its status; its final event notes the stop.
  * Progress events of the job but the last are dropped (SSE history of a
  * finished job: its status events and final progress).
- * Returns the status the job ends with (static string), or "unchanged" when
- * the job was not running (already final: nothing is touched). */
+ * Returns the status the job ends with (static string), "unchanged" when
+ * the job was not running (already final: nothing is touched), or NULL when
+ * the end could not be recorded (database or disk full, I/O error: nothing
+ * changed; the caller tries again). */
 const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, const char *message,
                             const char *summary_json, const char *sha256, long long size);
 
@@ -107,8 +109,8 @@ void pk_queue_wake_all(pk_queue *q);
 json_t *pk_queue_stats(pk_queue *q);
 
 /* 1 when the last write committed; 0 while writes fail (why: the error and
- * how long), re-tried by a probe commit at most once a second so the state
- * clears by itself once space returns. */
+ * how long).  Meanwhile a probe as large as a job's end is written at most
+ * once a second, so the state clears by itself once space returns. */
 int pk_queue_writable(pk_queue *q, char *why, size_t n);
 
 /* Uploaded files: one row per (id, owner) — the bytes are stored once, each

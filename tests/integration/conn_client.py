@@ -95,7 +95,7 @@ def hold(args):
 
     def open_slow(a):
         s = connect(port, a)
-        s.send(b"GET /healthz HTTP/1.1\r\nHost: x\r\nX-Slow: ")
+        s.send(b"GET /healthz HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: ")
         slow[s] = None
         origin[s] = a
         sel.register(s, selectors.EVENT_READ)
@@ -172,7 +172,7 @@ def sse(args):
             s = connect(port, next(src))
         except OSError:
             continue
-        s.send(("GET %s HTTP/1.1\r\nHost: x\r\nAccept: text/event-stream\r\n\r\n" % path).encode())
+        s.send(("GET %s HTTP/1.1\r\nHost: 127.0.0.1\r\nAccept: text/event-stream\r\n\r\n" % path).encode())
         state[s] = {"buf": b"", "started": False, "ended": None}
         sel.register(s, selectors.EVENT_READ)
     t_ready = None
@@ -223,7 +223,7 @@ def probe(args):
     path, n, src = opt(args, "--path", "/healthz"), opt(args, "--n", 50), opt(args, "--src", "127.0.0.1")
     interval = opt(args, "--interval", 0.0)
     times, fail = [], 0
-    req = ("GET %s HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n" % path).encode()
+    req = ("GET %s HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n" % path).encode()
     for _ in range(n):
         t0 = time.perf_counter()
         try:

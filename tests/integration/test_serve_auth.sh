@@ -46,7 +46,7 @@ check no_token_refused_before_body python3 -c "
 import socket, sys, time
 host, port = '$B'.split('//')[1].split(':')
 s = socket.create_connection((host, int(port)), timeout=5)
-s.sendall(b'POST /files HTTP/1.1\\r\\nHost: x\\r\\nContent-Type: application/octet-stream\\r\\n'
+s.sendall(b'POST /files HTTP/1.1\\r\\nHost: 127.0.0.1\\r\\nContent-Type: application/octet-stream\\r\\n'
           b'Content-Length: 10000000\\r\\n\\r\\n' + b'x' * 1000)
 head = s.recv(200).decode('latin-1')
 assert head.startswith('HTTP/1.1 401'), head
@@ -62,7 +62,7 @@ chunked = len(sys.argv) > 5
 host, port = base.split('//')[1].split(':')
 s = socket.create_connection((host, int(port)), timeout=5)
 framing = b'Transfer-Encoding: chunked\r\n\r\n3e8\r\n' if chunked else b'Content-Length: 10000000\r\n\r\n'
-s.sendall(('%s %s HTTP/1.1\r\nHost: x\r\nContent-Type: application/octet-stream\r\n' % (method, path)).encode()
+s.sendall(('%s %s HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/octet-stream\r\n' % (method, path)).encode()
           + framing + b'x' * 1000)
 head = s.recv(200).decode('latin-1')
 assert head.startswith('HTTP/1.1 ' + want), head

@@ -91,4 +91,30 @@ check refusal_hides_target sh -c "! grep -q secret '$T/symlink_out.out'"
 
 # 30 hostile requests at once (a FIFO and /dev/zero), then /healthz within 1 s
 burst 30 "$T/fifo.json" "$T/symlink_dev_zero.json" after_input_dir
+
+# a file swapped for a symlink out of input_dir after the 201 (and a
+# directory swapped likewise) is not read: the worker opens beneath input_dir
+cp "$MESH" "$IN/swap.msh"
+mkdir -p "$IN/swapdir" && cp "$MESH" "$IN/swapdir/cyl.msh"
+sed 's|sub/cyl.msh|swap.msh|' "$T/inside.json" >"$T/swap.json"
+sed 's|sub/cyl.msh|swapdir/cyl.msh|' "$T/inside.json" >"$T/swapdir.json"
+chmod 600 "$OUT/secret.msh"
+printf 'workers = 0\ninput_dir = %s\n' "$IN" >"$T/swap.conf"
+start_daemon swap --config "$T/swap.conf" || { fail serve_starts_swap; exit 1; }
+code=$(post pack "$T/swap.json" "$T/o5.json")
+check swap_accepted test "$code" = 201
+S1=$(member "$T/o5.json" jobID)
+code=$(post pack "$T/swapdir.json" "$T/o6.json")
+check swapdir_accepted test "$code" = 201
+S2=$(member "$T/o6.json" jobID)
+code=$(post pack "$T/inside.json" "$T/o7.json")
+S3=$(member "$T/o7.json" jobID)
+rm "$IN/swap.msh" && ln -s "$OUT/secret.msh" "$IN/swap.msh"
+mv "$IN/swapdir" "$IN/swapdir.was" && ln -s "$OUT" "$IN/swapdir" && cp "$MESH" "$OUT/cyl.msh"
+printf 'workers = 1\ninput_dir = %s\n' "$IN" >"$T/swap.conf"
+kill -HUP "$DPID"
+check swap_file_not_read wait_status "$S1" failed 120
+check swap_file_reason grep -q 'leads outside its directory' "$T/st.json"
+check swap_dir_not_read wait_status "$S2" failed 120
+check unswapped_runs wait_status "$S3" successful 120
 exit 0

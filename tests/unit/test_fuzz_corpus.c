@@ -7,6 +7,7 @@
 #include <signal.h>
 
 #include "check.h"
+#include "fuzz/target_http.h"
 #include "fuzz/targets.h"
 
 FUZZ_SANITIZER_OPTIONS
@@ -58,6 +59,7 @@ static void test_request(void) { replay("request", fuzz_request); }
 static void test_gmsh(void) { replay("gmsh", fuzz_gmsh); }
 static void test_tetgen(void) { replay("tetgen", fuzz_tetgen); }
 static void test_h5_rve(void) { replay("h5_rve", fuzz_h5_rve); }
+static void test_http(void) { replay("http", fuzz_http); }
 
 int main(void)
 {
@@ -66,5 +68,6 @@ int main(void)
     RUN(test_gmsh);
     RUN(test_tetgen);
     RUN(test_h5_rve);
+    RUN(test_http);
     return check_summary();
 }

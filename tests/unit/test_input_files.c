@@ -157,8 +157,20 @@ static void test_confine(void)
     CHECK(confine("", "m.msh", rule, NULL) == 1 && !strcmp(rule, "serverPath"));
     /* accepted: relative, absolute inside, through the configured name, a TetGen base */
     CHECK(confine(in, "m.msh", NULL, out) == 0);
-    snprintf(want, sizeof want, "%s/m.msh", real);
+    snprintf(want, sizeof want, "%s/./m.msh", real); /* opened beneath in/ (input_open.h) */
     CHECK_MSG(!strcmp(out, want), "%s", out);
+    /* at run time: a symlink inside is followed, one out (out.msh) is not,
+     * nor ".." — whatever the path was when it was checked */
+    char err[512], p[PATH_MAX + 32];
+    snprintf(p, sizeof p, "%s/./link_in.msh", real);
+    int fd = pk_input_open(p, 0, err, sizeof err);
+    CHECK_MSG(fd >= 0, "%s", err);
+    if (fd >= 0)
+        close(fd);
+    snprintf(p, sizeof p, "%s/./out.msh", real);
+    CHECK_MSG(pk_input_open(p, 0, err, sizeof err) < 0 && strstr(err, "leads outside"), "%s", err);
+    snprintf(p, sizeof p, "%s/./../small.txt", real);
+    CHECK_MSG(pk_input_open(p, 0, err, sizeof err) < 0 && strstr(err, "leads outside"), "%s", err);
     CHECK(confine(in, at("in/m.msh"), NULL, NULL) == 0);
     CHECK(confine(in, "sub/../m.msh", rule, NULL) == 1 && !strcmp(rule, "inputDir"));
     CHECK(confine(in, "base", NULL, out) == 0);
