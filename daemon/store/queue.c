@@ -291,7 +291,7 @@ out:
 #define JOB_COLUMNS                                                                                \
     "id, process, inputs, owner, status, progress, message, created, started, "                    \
     "finished, updated, attempts, cancel_requested, worker_pid, rev, summary, "                    \
-    "result_sha256, result_size"
+    "result_sha256, result_size, executor_ref"
 
 json_t *pk_queue_get(pk_queue *q, const char *id)
 {
@@ -334,14 +334,21 @@ json_t *pk_queue_list(pk_queue *q, const pk_job_filter *f, int limit, int offset
     return r;
 }
 
-json_t *pk_queue_claim(pk_queue *q)
+json_t *pk_queue_claim(pk_queue *q) { return pk_queue_claim_by_wall(q, PK_CLAIM_ANY, 0); }
+
+json_t *pk_queue_claim_by_wall(pk_queue *q, pk_claim which, double bound_s)
 {
     json_t *r = NULL;
     pthread_mutex_lock(&q->mu);
     if (begin(q) != SQLITE_OK)
         goto out;
-    json_t *next =
-        one_row(prep(q, "SELECT id FROM jobs WHERE status='accepted' ORDER BY seq LIMIT 1", NULL));
+    /* a job a back end holds (executor_ref) is not claimable, even while accepted */
+    json_t *next = one_row(
+        prep(q,
+             "SELECT id FROM jobs WHERE status='accepted' AND executor_ref IS NULL AND"
+             " (?1=0 OR (coalesce(json_extract(inputs, '$.limits.wall_time_s') <= ?2, 0) = (?1=1)))"
+             " ORDER BY seq LIMIT 1",
+             "id", (int)which, bound_s));
     if (!next) {
         rollback(q);
         goto out;
@@ -392,13 +399,30 @@ void pk_queue_progress(pk_queue *q, const char *id, int percent, json_t *data)
     notify(q);
 }
 
+static const char *finish_tx(pk_queue *q, const char *id, const char *status, const char *message,
+                             const char *summary_json, const char *sha256, long long size);
+
 const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, const char *message,
                             const char *summary_json, const char *sha256, long long size)
 {
-    const char *ended = "dismissed";
-    double now = pk_queue_now();
+    const char *ended = "unchanged";
     pthread_mutex_lock(&q->mu);
     if (begin(q) == SQLITE_OK) {
+        ended = finish_tx(q, id, status, message, summary_json, sha256, size);
+        commit(q);
+    }
+    pthread_mutex_unlock(&q->mu);
+    notify(q);
+    return ended;
+}
+
+/* pk_queue_finish inside an open transaction. */
+static const char *finish_tx(pk_queue *q, const char *id, const char *status, const char *message,
+                             const char *summary_json, const char *sha256, long long size)
+{
+    const char *ended = "dismissed";
+    double now = pk_queue_now();
+    {
         int n = run(q,
                     prep(q,
                          "UPDATE jobs SET status=?, message=?, progress=CASE WHEN ?='successful'"
@@ -416,9 +440,7 @@ const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, con
                             " message='dismissed; worker stopped' WHERE id=? AND"
                             " status='dismissed' AND finished IS NULL",
                             "dds", now, now, id)) != 1) { /* not ours to end */
-            ended = "unchanged";
-            commit(q);
-            goto out;
+            return "unchanged";
         } else {
             pk_metrics_job_ended(q->db, id, "dismissed"); /* its worker stopped */
         }
@@ -429,11 +451,7 @@ const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, con
                  "DELETE FROM events WHERE job_id=?1 AND kind='progress' AND id <"
                  " (SELECT max(id) FROM events WHERE job_id=?1 AND kind='progress')",
                  "s", id));
-        commit(q);
     }
-out:
-    pthread_mutex_unlock(&q->mu);
-    notify(q);
     return ended;
 }
 
@@ -493,8 +511,9 @@ int pk_queue_recover(pk_queue *q, int max_attempts, int *failed)
     pthread_mutex_lock(&q->mu);
     if (begin(q) == SQLITE_OK) {
         json_t *left = rows(prep(q,
-                                 "SELECT id, attempts, status FROM jobs WHERE (status='running') OR"
-                                 " (cancel_requested=1 AND finished IS NULL)",
+                                 "SELECT id, attempts, status FROM jobs WHERE executor_ref IS NULL"
+                                 " AND (status='running' OR (cancel_requested=1 AND"
+                                 " finished IS NULL))",
                                  NULL));
         double now = pk_queue_now();
         size_t i;
@@ -662,4 +681,105 @@ json_t *pk_queue_get_file(pk_queue *q, const char *id, const char *owner)
                              "ss", id, owner));
     pthread_mutex_unlock(&q->mu);
     return r;
+}
+
+json_t *pk_queue_held_jobs(pk_queue *q, const char *backend)
+{
+    pthread_mutex_lock(&q->mu);
+    json_t *r = rows(prep(q,
+                          "SELECT id, status, attempts, progress, message, owner, inputs,"
+                          " executor_ref FROM jobs WHERE executor_ref LIKE ?1 || ':%' AND"
+                          " executor_ref NOT LIKE '%:ended' ORDER BY seq",
+                          "s", backend));
+    pthread_mutex_unlock(&q->mu);
+    return r;
+}
+
+/* One change of pk_queue_sync inside its transaction; 1 when a status or
+ * progress event was added. */
+static int sync_one(pk_queue *q, json_t *c, double now)
+{
+    const char *id = json_string_value(json_object_get(c, "id"));
+    const char *op = json_string_value(json_object_get(c, "op"));
+    const char *msg = json_string_value(json_object_get(c, "message"));
+    const char *ref = json_string_value(json_object_get(c, "ref"));
+    int attempts = (int)json_integer_value(json_object_get(c, "attempts"));
+    if (!id || !op)
+        return 0;
+    if (ref)
+        run(q, prep(q, "UPDATE jobs SET executor_ref=? WHERE id=?", "ss", ref, id));
+    if (!strcmp(op, "queued") || !strcmp(op, "running")) {
+        int queued = op[0] == 'q';
+        /* attempts 0: keep; a change of status or message is a status event */
+        int n =
+            run(q,
+                prep(q,
+                     "UPDATE jobs SET status=?1, message=?2,"
+                     " attempts=CASE WHEN ?3>0 THEN ?3 ELSE attempts END,"
+                     " started=CASE WHEN ?1='running' THEN coalesce(started, ?4) ELSE"
+                     " started END, updated=?4, rev=rev+1 WHERE id=?5 AND status IN"
+                     " ('accepted','running') AND (status<>?1 OR message<>?2 OR"
+                     " (?3>0 AND attempts<>?3))",
+                     "ssids", queued ? "accepted" : "running", msg ? msg : "", attempts, now, id));
+        if (n == 1)
+            add_status_event(q, id);
+        json_t *data = json_object_get(c, "progress");
+        if (!queued && json_is_object(data)) {
+            json_int_t pct = json_integer_value(json_object_get(data, "progress"));
+            if (run(q,
+                    prep(q,
+                         "UPDATE jobs SET progress=?, updated=?, rev=rev+1 WHERE id=? AND"
+                         " status='running' AND progress<>?",
+                         "idsi", (int)pct, now, id, (int)pct)) == 1) {
+                add_event(q, id, "progress", data);
+                n = 1;
+            }
+        }
+        return n == 1;
+    }
+    if (!strcmp(op, "finish")) {
+        run(q,
+            prep(q,
+                 "UPDATE jobs SET status='running', started=coalesce(started, ?) WHERE id=?"
+                 " AND status='accepted'",
+                 "ds", now, id));
+        const char *sum = json_string_value(json_object_get(c, "summary"));
+        const char *sha = json_string_value(json_object_get(c, "sha256"));
+        const char *status = json_string_value(json_object_get(c, "status"));
+        return strcmp(finish_tx(q, id, status ? status : "failed", msg ? msg : "", sum, sha,
+                                json_integer_value(json_object_get(c, "size"))),
+                      "unchanged") != 0;
+    }
+    if (!strcmp(op, "requeue")) {
+        if (run(q,
+                prep(q,
+                     "UPDATE jobs SET status='accepted', attempts=max(attempts-1, 0),"
+                     " progress=0, message=?, updated=?, rev=rev+1 WHERE id=? AND"
+                     " status='running' AND executor_ref IS NULL",
+                     "sds", msg ? msg : "re-queued", now, id)) == 1) {
+            add_status_event(q, id);
+            return 1;
+        }
+    }
+    return 0;
+}
+
+int pk_queue_sync(pk_queue *q, json_t *changes)
+{
+    if (!json_array_size(changes))
+        return 0;
+    int events = 0, rc = -1;
+    double now = pk_queue_now();
+    pthread_mutex_lock(&q->mu);
+    if (begin(q) == SQLITE_OK) {
+        size_t i;
+        json_t *c;
+        json_array_foreach (changes, i, c)
+            events += sync_one(q, c, now);
+        rc = commit(q);
+    }
+    pthread_mutex_unlock(&q->mu);
+    if (events)
+        notify(q);
+    return rc;
 }
