@@ -157,12 +157,12 @@ static int state_is(const char *state, const char *const *set)
     return 0;
 }
 
-static const char *const queued_states[] = {"PENDING",      "REQUEUED",     "REQUEUE_HOLD",
-                                            "REQUEUE_FED",  "RESV_DEL_HOLD", "SPECIAL_EXIT",
-                                            "CONFIGURING", NULL};
-static const char *const ended_states[] = {"COMPLETED", "FAILED",   "TIMEOUT",   "OUT_OF_MEMORY",
+static const char *const queued_states[] = {
+    "PENDING",       "REQUEUED",     "REQUEUE_HOLD", "REQUEUE_FED",
+    "RESV_DEL_HOLD", "SPECIAL_EXIT", "CONFIGURING",  NULL};
+static const char *const ended_states[] = {"COMPLETED", "FAILED",    "TIMEOUT",   "OUT_OF_MEMORY",
                                            "NODE_FAIL", "CANCELLED", "BOOT_FAIL", "DEADLINE",
-                                           "PREEMPTED", "REVOKED",  NULL};
+                                           "PREEMPTED", "REVOKED",   NULL};
 
 static json_t *change(const char *id, const char *op)
 {
@@ -171,8 +171,8 @@ static json_t *change(const char *id, const char *op)
 
 static double job_wall(json_t *job, double cap)
 {
-    double w = json_number_value(json_object_get(
-        json_object_get(json_object_get(job, "inputs"), "limits"), "wall_time_s"));
+    double w = json_number_value(
+        json_object_get(json_object_get(json_object_get(job, "inputs"), "limits"), "wall_time_s"));
     return w > 0 && w < cap ? w : cap;
 }
 
@@ -327,8 +327,7 @@ static void ask_slurm(const char *jid, char *state, size_t sn, char *node, size_
 }
 
 /* The change that ends a held job whose Slurm job is over (or gone). */
-static json_t *ended(json_t *job, const char *jid, const sq_entry *e,
-                     const pk_config *c)
+static json_t *ended(json_t *job, const char *jid, const sq_entry *e, const pk_config *c)
 {
     const char *id = json_string_value(json_object_get(job, "id"));
     char dir[1200], path[1300], msg[1600], tail[1024] = "";
@@ -373,11 +372,15 @@ static json_t *ended(json_t *job, const char *jid, const sq_entry *e,
     }
     pk_job_file_path(dir, PK_JOB_LOG, path, sizeof path);
     pk_worker_last_line(path, tail, sizeof tail);
-    if (slurm_exit == PK_SLURM_NO_DIR || code == PK_SLURM_NO_DIR)
+    pk_job_file_path(dir, PK_JOB_PROGRESS, path, sizeof path);
+    int started = access(path, F_OK) == 0; /* the script's first line is there */
+    if (slurm_exit == PK_SLURM_NO_DIR || code == PK_SLURM_NO_DIR ||
+        (!started && !strcmp(reason, "JobLaunchFailure")))
         snprintf(msg, sizeof msg,
-                 "failed: the job directory %s is not visible on node %s (it must be on a"
-                 " filesystem the nodes share)",
-                 dir, node[0] ? node : "(unknown)");
+                 "failed: the job directory %s is not visible on node %s (Slurm job %s, %s%s%s;"
+                 " it must be on a filesystem the nodes share)",
+                 dir, node[0] ? node : "(unknown)", jid, state[0] ? state : "ended",
+                 reason[0] ? ", " : "", reason);
     else if (code > 0)
         snprintf(msg, sizeof msg, "worker exited with status %d on node %s%s%s", code, node,
                  tail[0] ? ": " : "", tail);
@@ -624,7 +627,7 @@ static void destroy(pk_executor *e)
     free(s);
 }
 
-static const pk_executor_ops slurm_ops = {"slurm", configure, wake, busy,
+static const pk_executor_ops slurm_ops = {"slurm",  configure, wake, busy,
                                           capacity, healthy,   stop, destroy};
 
 pk_executor *pk_executor_slurm_start(pk_queue *q, const char *exe, const pk_config *c, char *err,

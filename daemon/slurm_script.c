@@ -10,7 +10,8 @@
 
 #include "daemon/store/job_files.h"
 
-#define TERM_BEFORE_S 60 /* SIGTERM this long before the limit: the worker saves its partial result */
+#define TERM_BEFORE_S                                                                              \
+    60 /* SIGTERM this long before the limit: the worker saves its partial result */
 
 long pk_slurm_minutes(double wall_s) { return (long)ceil((wall_s + TERM_BEFORE_S) / 60.0); }
 
@@ -38,8 +39,7 @@ int pk_slurm_script_write(const pk_slurm_job *j, const pk_config *c, char *path,
         snprintf(why, n, "job directory path too long");
         return -1;
     }
-    if (!one_line(c->slurm_partition) || !one_line(c->slurm_account) ||
-        !one_line(c->slurm_qos)) {
+    if (!one_line(c->slurm_partition) || !one_line(c->slurm_account) || !one_line(c->slurm_qos)) {
         snprintf(why, n, "slurm_partition, slurm_account and slurm_qos must be one line each");
         return -1;
     }
@@ -67,8 +67,9 @@ int pk_slurm_script_write(const pk_slurm_job *j, const pk_config *c, char *path,
     put_quoted(f, j->dir);
     fputs("\nnode=$(hostname)\n", f);
     /* without the directory Slurm would run the script in /tmp: stop here */
-    fprintf(f, "[ -r \"$dir/%s\" ] || { echo \"packd: job directory $dir not visible on $node\" >&2;"
-               " exit %d; }\n",
+    fprintf(f,
+            "[ -r \"$dir/%s\" ] || { echo \"packd: job directory $dir not visible on $node\" >&2;"
+            " exit %d; }\n",
             pk_job_file_name(PK_JOB_INPUT), PK_SLURM_NO_DIR);
     fputs("cd \"$dir\" || exit 96\nattempt=$((${SLURM_RESTART_COUNT:-0} + 1))\n", f);
     fprintf(f, "rm -f %s %s *.tmp\n", pk_job_file_name(PK_JOB_EXIT),
