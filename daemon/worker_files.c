@@ -118,8 +118,6 @@ void pk_worker_outcome_read(const char *dir, int code, pk_worker_outcome *o)
     memset(o, 0, sizeof *o);
     pk_job_file_path(dir, PK_JOB_SUMMARY, path, sizeof path);
     json_t *sum = json_load_file(path, 0, NULL);
-    json_object_del(sum, "output"); /* a path inside the data directory */
-    json_object_del(sum, "xdmf");
     o->summary = sum ? json_dumps(sum, JSON_COMPACT | JSON_REAL_PRECISION(10)) : NULL;
     o->status = code == 0 ? "successful" : "failed";
     json_t *w = json_object_get(sum, "warnings");
