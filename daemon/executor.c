@@ -43,6 +43,14 @@ int pk_executor_healthy(pk_executor *e, char *why, size_t n)
 
 const char *pk_executor_name(const pk_executor *e) { return e->ops->name; }
 
+int pk_executor_poll_stats(pk_executor *e, long long *cycles, double *seconds)
+{
+    if (!e->ops->poll_stats)
+        return 0;
+    e->ops->poll_stats(e, cycles, seconds);
+    return 1;
+}
+
 void pk_executor_stop(pk_executor *e, double grace_s)
 {
     if (e)

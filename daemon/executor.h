@@ -25,6 +25,8 @@ typedef struct pk_executor_ops {
     int (*healthy)(pk_executor *e, char *why, size_t n);
     void (*stop)(pk_executor *e, double grace_s);
     void (*destroy)(pk_executor *e);
+    /* poll cycles run and their seconds in all (NULL: the back end does not poll) */
+    void (*poll_stats)(pk_executor *e, long long *cycles, double *seconds);
 } pk_executor_ops;
 
 struct pk_executor {
@@ -52,6 +54,10 @@ int pk_executor_capacity(pk_executor *e);
  * unreachable: ...") while it cannot: jobs then stay accepted. */
 int pk_executor_healthy(pk_executor *e, char *why, size_t n);
 const char *pk_executor_name(const pk_executor *e);
+
+/* 1 with the poll cycles run so far and their wall seconds in all, for a
+ * back end that polls (slurm); 0 otherwise. */
+int pk_executor_poll_stats(pk_executor *e, long long *cycles, double *seconds);
 
 /* Stop claiming; give running jobs grace_s to finish (local) or leave them
  * to the cluster (slurm), join the thread.  busy/capacity/wake stay harmless

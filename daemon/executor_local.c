@@ -409,8 +409,8 @@ static void destroy(pk_executor *e)
     free(s);
 }
 
-static const pk_executor_ops local_ops = {"local",  configure, wake, busy,
-                                          capacity, healthy,   stop, destroy};
+static const pk_executor_ops local_ops = {"local", configure, wake,    busy, capacity,
+                                          healthy, stop,      destroy, NULL};
 
 pk_executor *pk_executor_local_start(pk_queue *q, const char *exe, const pk_config *c,
                                      int short_only)

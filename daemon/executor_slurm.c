@@ -46,9 +46,11 @@ typedef struct slurm_exec {
     pk_executor *local; /* short jobs (slurm_local_below_s) */
     char exe[1024];
     pthread_t thread;
-    pthread_mutex_t mu; /* cfg, degraded, why, held_running */
+    pthread_mutex_t mu; /* cfg, degraded, why, held_running, cycles, cycle_s */
     pk_config cfg;
     int stopping, degraded, held_running, held;
+    long long cycles;
+    double cycle_s;
     char why[300];
     int wake[2];
     char *squeue_out;
@@ -544,7 +546,12 @@ static void *loop(void *arg)
         pthread_mutex_unlock(&s->mu);
         if (stopping)
             break;
+        double t0 = pk_queue_now();
         cycle(s);
+        pthread_mutex_lock(&s->mu);
+        s->cycles++;
+        s->cycle_s += pk_queue_now() - t0;
+        pthread_mutex_unlock(&s->mu);
         struct pollfd pf = {s->wake[0], POLLIN, 0};
         if (poll(&pf, 1, (int)(POLL_S * 1000)) > 0) {
             char buf[64];
@@ -601,6 +608,15 @@ static int healthy(pk_executor *e, char *why, size_t n)
     return ok;
 }
 
+static void poll_stats(pk_executor *e, long long *cycles, double *seconds)
+{
+    slurm_exec *s = (slurm_exec *)e;
+    pthread_mutex_lock(&s->mu);
+    *cycles = s->cycles;
+    *seconds = s->cycle_s;
+    pthread_mutex_unlock(&s->mu);
+}
+
 /* Jobs on Slurm keep running: a restarted daemon adopts them. */
 static void stop(pk_executor *e, double grace_s)
 {
@@ -627,8 +643,8 @@ static void destroy(pk_executor *e)
     free(s);
 }
 
-static const pk_executor_ops slurm_ops = {"slurm",  configure, wake, busy,
-                                          capacity, healthy,   stop, destroy};
+static const pk_executor_ops slurm_ops = {"slurm", configure, wake,    busy,      capacity,
+                                          healthy, stop,      destroy, poll_stats};
 
 pk_executor *pk_executor_slurm_start(pk_queue *q, const char *exe, const pk_config *c, char *err,
                                      size_t errlen)

@@ -16,6 +16,9 @@ fi
 command -v npm >/dev/null 2>&1 || PKGS="$PKGS npm"
 # Optional: what bench/service.sh drives the daemon with (PACKD_BENCH_DEPS=1).
 [ "${PACKD_BENCH_DEPS:-0}" = 1 ] && PKGS="$PKGS wrk sqlite3"
+# Tests: the one-node Slurm of tests/integration/test_slurm.sh and bench/scale.sh (they
+# call this with PACKD_TEST_DEPS=1 and skip, naming why, when it cannot install).
+[ "${PACKD_TEST_DEPS:-0}" = 1 ] && PKGS="$PKGS slurm-wlm munge"
 missing=""
 for p in $PKGS; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

@@ -125,6 +125,21 @@ enum MHD_Result route_metrics(pk_req *r)
         pk_executor_capacity(svc->exec));
     put_job_counters(&b, st);
     put(&b,
+        "# HELP packd_queue_transactions_total Transactions the queue database committed.\n"
+        "# TYPE packd_queue_transactions_total counter\npackd_queue_transactions_total %lld\n",
+        pk_queue_transactions(svc->q));
+    long long cycles;
+    double cycle_s;
+    if (pk_executor_poll_stats(svc->exec, &cycles, &cycle_s))
+        put(&b,
+            "# HELP packd_executor_poll_cycles_total Poll cycles of the executor (slurm: one "
+            "squeue and one queue transaction each).\n"
+            "# TYPE packd_executor_poll_cycles_total counter\npackd_executor_poll_cycles_total "
+            "%lld\n# HELP packd_executor_poll_seconds_total Wall seconds the poll cycles took.\n"
+            "# TYPE packd_executor_poll_seconds_total counter\n"
+            "packd_executor_poll_seconds_total %.6f\n",
+            cycles, cycle_s);
+    put(&b,
         "# HELP packd_http_responses_total HTTP responses by status code.\n"
         "# TYPE packd_http_responses_total counter\n");
     for (int c = 100; c < 600; c++) {

@@ -38,6 +38,7 @@ struct pk_queue {
      * commit succeeds again: /healthz is not ready meanwhile. */
     double write_failed_at, probed_at;
     char write_error[160];
+    long long commits; /* transactions the writer committed (atomic) */
 };
 
 double pk_queue_now(void)
@@ -234,6 +235,19 @@ static int commit(pk_queue *q)
 }
 static void rollback(pk_queue *q) { sqlite3_exec(q->db, "ROLLBACK", NULL, NULL, NULL); }
 
+/* Every commit of the writer, explicit or autocommit: /metrics shows what
+ * a poll cycle or a progress line costs the database. */
+static int count_commit(void *arg)
+{
+    __atomic_add_fetch(&((pk_queue *)arg)->commits, 1, __ATOMIC_RELAXED);
+    return 0;
+}
+
+long long pk_queue_transactions(pk_queue *q)
+{
+    return __atomic_load_n(&q->commits, __ATOMIC_RELAXED);
+}
+
 pk_queue *pk_queue_open(const char *path, char *err, size_t errlen)
 {
     pk_queue *q = calloc(1, sizeof *q);
@@ -246,6 +260,7 @@ pk_queue *pk_queue_open(const char *path, char *err, size_t errlen)
         free(q);
         return NULL;
     }
+    sqlite3_commit_hook(q->db, count_commit, q);
     pthread_mutex_init(&q->mu, NULL);
     pthread_mutex_init(&q->ev_mu, NULL);
     pthread_cond_init(&q->ev_cond, NULL);

@@ -111,6 +111,9 @@ void pk_queue_wake_all(pk_queue *q);
  * pk_metrics_read (job_metrics.h)}. */
 json_t *pk_queue_stats(pk_queue *q);
 
+/* Transactions the writer committed since the queue was opened. */
+long long pk_queue_transactions(pk_queue *q);
+
 /* 1 when the last write committed; 0 while writes fail (why: the error and
  * how long), re-tried by a probe commit at most once a second so the state
  * clears by itself once space returns. */
