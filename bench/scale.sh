@@ -8,8 +8,9 @@
 #                 (what the daemon pays per submission) and submit -> start latency
 #   jobs_local    N small jobs (Meier's 2D quartz sand, ~0.2 s each) through 4 local
 #                 workers: wall s until all are successful, jobs/s
-#   jobs_slurm    the same N jobs through the Slurm executor (4 CPUs): jobs/s, and the
-#                 overhead per job = (wall_slurm - wall_local) * 4 / N (4 run at a time)
+#   jobs_slurm    the same N jobs through the Slurm executor (4 CPUs): jobs/s, the
+#                 overhead per job = (wall_slurm - wall_local) * 4 / N (4 run at a time),
+#                 the poll cycle's mean wall ms (/metrics) and queue transactions per job
 # N = 200 (BENCH_SCALE_JOBS).  Wall times on a shared machine: compare the two
 # cases of one run, not runs of different days.
 # Usage: PACKD=build/packd sh bench/scale.sh
@@ -35,22 +36,27 @@ wait_for 120 done_all
 t2=$(now_ms)
 out "case=sbatch calls=20 ms_per_call=$(((t1 - t0) / 20)) ms_until_all_completed=$((t2 - t0))"
 
-# N jobs through one daemon; prints the wall ms from the first submission to the last end
+# N jobs through one daemon: sets WALL_MS, from the first submission to the last end
 run_jobs() { # name config
     start_daemon "$1" --config "$2" >/dev/null || return 1
-    : >"$T/$1.ids"
     t0=$(now_ms)
-    for k in $(seq "$N"); do submit "$T/fast.json" >>"$T/$1.ids"; done
+    for k in $(seq "$N"); do submit "$T/fast.json" >/dev/null; done
     all_ended() {
         c -o "$T/list.json" "$B/jobs?limit=1000&status=successful" &&
             [ "$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['numberMatched'])" "$T/list.json" 2>/dev/null)" = "$N" ]
     }
     wait_for 1200 all_ended || { echo "bench=scale: $1 did not finish"; return 1; }
-    echo $(($(now_ms) - t0))
+    WALL_MS=$(($(now_ms) - t0))
 }
+metric() { c "$B/metrics" | awk -v m="$1" '$1 == m {print $2}'; }
 printf 'workers = 4\n' >"$T/local.conf"
-wl=$(run_jobs local "$T/local.conf") || exit 1
-out "case=jobs_local jobs=$N wall_s=$(awk "BEGIN{printf \"%.1f\", $wl/1000}") jobs_per_s=$(awk "BEGIN{printf \"%.2f\", $N*1000/$wl}")"
+run_jobs local "$T/local.conf" || exit 1
+wl=$WALL_MS
+out "case=jobs_local jobs=$N wall_s=$(awk "BEGIN{printf \"%.1f\", $wl/1000}") jobs_per_s=$(awk "BEGIN{printf \"%.2f\", $N*1000/$wl}") transactions_per_job=$(awk "BEGIN{printf \"%.1f\", $(metric packd_queue_transactions_total)/$N}")"
+kill "$DPID"
 printf 'executor = slurm\nworkers = 0\n' >"$T/slurm.conf"
-ws=$(run_jobs slurm "$T/slurm.conf") || exit 1
-out "case=jobs_slurm jobs=$N wall_s=$(awk "BEGIN{printf \"%.1f\", $ws/1000}") jobs_per_s=$(awk "BEGIN{printf \"%.2f\", $N*1000/$ws}") overhead_s_per_job=$(awk "BEGIN{printf \"%.2f\", ($ws-$wl)*4/1000/$N}")"
+run_jobs slurm "$T/slurm.conf" || exit 1
+ws=$WALL_MS
+cy=$(metric packd_executor_poll_cycles_total)
+cs=$(metric packd_executor_poll_seconds_total)
+out "case=jobs_slurm jobs=$N wall_s=$(awk "BEGIN{printf \"%.1f\", $ws/1000}") jobs_per_s=$(awk "BEGIN{printf \"%.2f\", $N*1000/$ws}") overhead_s_per_job=$(awk "BEGIN{printf \"%.2f\", ($ws-$wl)*4/1000/$N}") poll_cycles=$cy poll_ms_per_cycle=$(awk "BEGIN{printf \"%.1f\", 1000*$cs/$cy}") transactions_per_job=$(awk "BEGIN{printf \"%.1f\", $(metric packd_queue_transactions_total)/$N}")"
