@@ -143,7 +143,9 @@ done
 check slurm_script_term_before_limit grep -qx '#SBATCH --signal=TERM@60' "$T/d1/jobs/$J/slurm.sh"
 check slurm_script_srun_packd_run grep -q "^srun .*'$PWD/$PACKD' run job.json" "$T/d1/jobs/$J/slurm.sh"
 # the signal Slurm sends at TimeLimit - 60 s (to the steps: srun forwards it)
-# stops the worker, which keeps what it placed
+# stops the worker, which keeps what it placed (sent once the worker reports)
+reporting() { [ "$(wc -l 2>/dev/null <"$T/d1/jobs/$1/progress.jsonl")" -ge 2 ] 2>/dev/null; }
+wait_for 60 reporting "$J"
 scancel -s TERM "$(squeue -h -n "packd-$J" -o %i)"
 wait_status "$J" failed 60
 echo "TERM: $(member "$T/st.json" message)"
