@@ -21,10 +21,10 @@ N=${BENCH_SCALE_JOBS:-200}
 out() { echo "bench=scale $*"; }
 now_ms() { echo $(($(date +%s%N) / 1000000)); }
 
+trap 'slurm_cluster_stop; cleanup' EXIT
 slurm_cluster_start
 rc=$?
 [ $rc -eq 77 ] && { echo "bench=scale skipped: $SLURM_SKIP"; exit 0; }
-trap 'slurm_cluster_stop; cleanup' EXIT
 [ $rc -eq 0 ] || { echo "bench=scale: the Slurm cluster did not start"; exit 1; }
 
 # sbatch: the submission call alone, and submit -> RUNNING/COMPLETED latency

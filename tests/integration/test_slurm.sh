@@ -27,13 +27,13 @@
 
 mkdir -p "$T/hidden"
 SLURMD_HIDE="$T/hidden"
+trap 'slurm_cluster_stop; cleanup' EXIT # set first: a start cut short stops what it started
 slurm_cluster_start
 rc=$?
 if [ $rc -eq 77 ]; then
     skip slurm "$SLURM_SKIP"
     exit 0
 fi
-trap 'slurm_cluster_stop; cleanup' EXIT
 if [ $rc -ne 0 ]; then
     fail slurm_cluster_starts "$(tail -3 "$T/slurm/slurmctld.log" "$T/slurm/slurmd.log" 2>/dev/null)"
     exit 1
