@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "input_hint.h"
 #include "run_line.h"
 #include "run_summary.h"
 #include "api/picture/picture.h"
@@ -195,6 +196,7 @@ int cmd_run(int argc, char **argv)
     int status;
     if (rc == 1) {
         cli_print_errors(job_path, &errs);
+        cli_hint_missing_inputs(stderr, job_path, job, &errs);
         status = 1;
     } else if (rc != 0 && rc != 2) { /* 2: failed, partial file and summary (below) */
         fprintf(stderr, "packd run: %s\n", err);
