@@ -192,8 +192,9 @@ E=$(submit "$T/jam.body")
 checkpointed() { [ -s "$T/d1/jobs/$E/checkpoint.h5" ] && in_squeue "$E" RUNNING; }
 check slurm_preempt_checkpoint_before wait_for 120 checkpointed
 sbatch -Q -p high -n 4 -o /dev/null --wrap 'sleep 2' >/dev/null
+# a requeued job may be held 120 s (BeginTime), then waits for a scheduling pass
 requeued() { status_of "$E" >/dev/null; grep -q 'attempt 2' "$T/st.json"; }
-check slurm_preempt_requeued_attempt_2 wait_for 180 requeued
+check slurm_preempt_requeued_attempt_2 wait_for 300 requeued
 echo "after preemption: $(member "$T/st.json" status): $(member "$T/st.json" message)"
 check slurm_preempt_job_finishes wait_status "$E" successful 240
 SUM="$T/d1/jobs/$E/summary.json"
@@ -231,7 +232,7 @@ requeued_accepted() { [ "$(status_of "$F")" = accepted ] && grep -q 'requeued af
 check slurm_nodeloss_accepted_while_requeued wait_for 60 requeued_accepted
 echo "node lost: $(member "$T/st.json" message)"
 again() { status_of "$F" >/dev/null; grep -q 'attempt 2' "$T/st.json"; }
-check slurm_nodeloss_requeued_attempt_2 wait_for 240 again
+check slurm_nodeloss_requeued_attempt_2 wait_for 300 again
 echo "after node loss: $(member "$T/st.json" message)"
 check slurm_nodeloss_job_finishes wait_status "$F" successful 240
 wait "$ref"
