@@ -17,6 +17,11 @@
 # compiler records which headers each object read (-MMD -MP, build/**/*.d).
 
 BUILD   ?= build
+# Build on every core unless the caller chose (-jN): a fresh `make run` compiles
+# ~200 files.
+ifeq ($(filter -j%,$(MAKEFLAGS))$(filter j,$(firstword $(MAKEFLAGS))),)
+MAKEFLAGS += -j$(shell nproc 2>/dev/null || echo 2)
+endif
 CC      ?= cc
 OPT     ?= -O2
 # Functions start on a cache line: the hot contact loops otherwise run 1.6x
@@ -37,6 +42,19 @@ BASE_CFLAGS := $(CSTD) $(OPT) $(ALIGN) -g -MMD -MP $(WARN) $(SAN) -DPACKD_VERSIO
 CORE_CFLAGS := $(BASE_CFLAGS) -I.
 EXT_CFLAGS   = $(BASE_CFLAGS) $(shell pkg-config --cflags $(PKGS) 2>/dev/null) -I/usr/include/suitesparse -I. -I$(BUILD)/gen
 EXT_LIBS     = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lcholmod -lgomp -lm -lpthread
+
+# MPI is optional: with Debian's OpenMPI (libopenmpi-dev, pkg-config ompi-c)
+# `mpirun -np R packd run fe2.json` spreads the Gauss points over the ranks
+# (api/par/mpi_world.c, docs/fe2.md); without it packd is one process and
+# refuses a launch of several ranks.  `make MPI=0` builds without it anyway.
+# Looked for when a recipe runs, so the first make of a fresh machine finds the
+# OpenMPI its dependency step installed; only mpi_world.c includes <mpi.h>.
+MPI     ?= auto
+mpi_on   = $(if $(filter auto,$(MPI)),$(shell pkg-config --exists ompi-c 2>/dev/null && echo 1),$(filter 1,$(MPI)))
+EXT_LIBS += $(if $(mpi_on),$(shell pkg-config --libs ompi-c))
+$(BUILD)/obj/api/par/mpi_world.o: EXT_CFLAGS += $(if $(mpi_on),-DPK_HAVE_MPI $(shell pkg-config --cflags ompi-c))
+# mpi_world.o is rebuilt when that changes
+MPI_STAMP := $(BUILD)/.mpi-$(or $(mpi_on),0)
 
 tree        = $(shell find $(1) -name '*.c' | sort)
 CORE_SRC   := $(call tree,core)
@@ -79,6 +97,13 @@ $(BUILD)/obj/core/%.o: core/%.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(CC) $(CORE_CFLAGS) -c $< -o $@
 
+$(MPI_STAMP):
+	@mkdir -p $(@D)
+	@rm -f $(BUILD)/.mpi-*
+	@touch $@
+
+$(BUILD)/obj/api/par/mpi_world.o: $(MPI_STAMP)
+
 $(BUILD)/obj/api/%.o: api/%.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(CC) $(EXT_CFLAGS) -c $< -o $@
@@ -93,7 +118,7 @@ $(BUILD)/gen/schemas_embedded.c: $(SCHEMAS) tools/embed.sh
 	@mkdir -p $(@D)
 	sh tools/embed.sh api/schemas/schemas_embedded.h pk_embedded_schema pk_embedded_schemas char / $(SCHEMAS) > $@
 
-$(BUILD)/obj/gen/schemas_embedded.o: $(BUILD)/gen/schemas_embedded.c
+$(BUILD)/obj/gen/schemas_embedded.o: $(BUILD)/gen/schemas_embedded.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(CC) $(BASE_CFLAGS) -I. -c $< -o $@
 
@@ -102,7 +127,7 @@ $(BUILD)/gen/web_embedded.c: $(WEB) tools/embed.sh
 	@mkdir -p $(@D)
 	sh tools/embed.sh daemon/http/web_assets.h pk_web_asset pk_web_assets 'unsigned char' web/ $(WEB) > $@
 
-$(BUILD)/obj/gen/web_embedded.o: $(BUILD)/gen/web_embedded.c
+$(BUILD)/obj/gen/web_embedded.o: $(BUILD)/gen/web_embedded.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(CC) $(BASE_CFLAGS) -I. -c $< -o $@
 
@@ -221,7 +246,7 @@ $(FUZZ_BUILD)/gen/schemas_embedded.c: $(SCHEMAS) tools/embed.sh
 	@mkdir -p $(@D)
 	sh tools/embed.sh api/schemas/schemas_embedded.h pk_embedded_schema pk_embedded_schemas char / $(SCHEMAS) > $@
 
-$(FUZZ_BUILD)/obj/gen/schemas_embedded.o: $(FUZZ_BUILD)/gen/schemas_embedded.c
+$(FUZZ_BUILD)/obj/gen/schemas_embedded.o: $(FUZZ_BUILD)/gen/schemas_embedded.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -c $< -o $@
 

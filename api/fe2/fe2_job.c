@@ -26,6 +26,7 @@ static const pk_option fe2_rows[] = {
      .hi = 1000000},
     {"/limits/max_grains_total", PK_OPT_INTEGER, F(max_grains_total), .dflt = 20000000, .lo = 1,
      .hi = 1e9},
+    {"/parallel/mpi_ranks", PK_OPT_INTEGER, F(mpi_ranks), .dflt = 1, .lo = 1, .hi = 64},
 };
 #undef F
 const pk_option_table pk_fe2_options =

@@ -4,7 +4,7 @@
 # missing one on a fresh Debian:
 #   - every header the sources include, as cc (the build) and clang (the fuzz build)
 #     resolve it, comes from a listed package or one a listed package depends on: the
-#     build's from `run`, the rest (clang's, OpenMPI's) from `run` + `test`;
+#     build's from `run`, the rest (clang's, OpenMPI's: the build links it when present) from `run` + `test`;
 #   - every command the test scripts run comes from `run` + `test` or an Essential package.
 # Needs dpkg and apt-cache (a Debian system).
 . "${PACKD_SRC:-.}/tests/integration/check.inc"
@@ -53,7 +53,7 @@ resolve() {
         fail "headers_found_by_$1" "$(grep -m1 error "$T/h.err")"
     fi
 }
-# OpenMPI's <mpi.h> is an optional build dependency (Makefile: MPI=auto), in the test list
+# OpenMPI's <mpi.h> is an optional build dependency (Makefile: MPI=auto), in the run list
 grep -vx 'mpi.h' "$T/headers" >"$T/headers.build"
 grep -x 'mpi.h' "$T/headers" >"$T/headers.mpi"
 # package_in LIST FILES PURPOSE: every file of FILES belongs to a package of LIST
