@@ -11,17 +11,22 @@
 #include <string.h>
 #include <unistd.h>
 
-typedef enum { K_STR, K_INT, K_LONG, K_DOUBLE, K_LEVEL, K_AUTH, K_ADDR } key_type;
+typedef enum { K_STR, K_INT, K_LONG, K_DOUBLE, K_LEVEL, K_AUTH, K_ADDR, K_EXEC } key_type;
 
 /* Keys whose value is one of some names (stored as the enum's int). */
 static const char *const level_names[] = {"debug", "info", "warn", "error", NULL};
 static const char *const auth_names[] = {"auto", "on", "off", NULL};
-_Static_assert(sizeof(pk_auth_mode) == sizeof(int) && sizeof(pk_log_level) == sizeof(int),
+static const char *const executor_names[] = {"local", "slurm", NULL};
+_Static_assert(sizeof(pk_auth_mode) == sizeof(int) && sizeof(pk_log_level) == sizeof(int) &&
+                   sizeof(pk_executor_kind) == sizeof(int),
                "named values are stored as int");
 
 static const char *const *names_of(key_type t)
 {
-    return t == K_LEVEL ? level_names : t == K_AUTH ? auth_names : NULL;
+    return t == K_LEVEL ? level_names
+        : t == K_AUTH   ? auth_names
+        : t == K_EXEC   ? executor_names
+                        : NULL;
 }
 
 static const struct key {
@@ -80,12 +85,32 @@ static const struct key {
      "this machine's names and addresses, public_url's host); others get 421"},
     {"trusted_proxy", K_ADDR, F(trusted_proxy), 0, 0,
      "address of the reverse proxy whose X-Packd-Owner is honoured"},
+    {"executor", K_EXEC, F(executor), 0, 0,
+     "where jobs run: local (forked workers) | slurm (sbatch; docs/scale-out.md)"},
+    {"slurm_partition", K_STR, F(slurm_partition), 0, 0, "sbatch --partition (unset: default)"},
+    {"slurm_account", K_STR, F(slurm_account), 0, 0, "sbatch --account (unset: default)"},
+    {"slurm_qos", K_STR, F(slurm_qos), 0, 0, "sbatch --qos (unset: default)"},
+    {"slurm_options", K_STR, F(slurm_options), 0, 0,
+     "more sbatch options, split at blanks (e.g. --constraint=avx2)"},
+    {"slurm_packd", K_STR, F(slurm_packd), 0, 0,
+     "path of packd on the compute nodes (unset: this binary's path)"},
+    {"slurm_mem_mb", K_INT, F(slurm_mem_mb), 0, 1e8,
+     "sbatch --mem of each job in MB (0: the partition's default)"},
+    {"slurm_max_jobs", K_INT, F(slurm_max_jobs), 1, 1e6,
+     "jobs submitted to Slurm and not yet ended, at most"},
+    {"slurm_local_below_s", K_DOUBLE, F(slurm_local_below_s), 0, 1e9,
+     "jobs with limits.wall_time_s at most this run on local workers (0: none)"},
 #undef F
 };
 
 const char *pk_log_level_name(pk_log_level l)
 {
     return l >= PK_LOG_DEBUG && l <= PK_LOG_ERROR ? level_names[l] : "info";
+}
+
+const char *pk_executor_kind_name(pk_executor_kind k)
+{
+    return k == PK_EXECUTOR_SLURM ? "slurm" : "local";
 }
 
 void pk_config_defaults(pk_config *c)
@@ -115,6 +140,7 @@ void pk_config_defaults(pk_config *c)
     c->sync_wait_s = 10;
     c->checkpoint_interval_s = 30;
     c->log_level = PK_LOG_INFO;
+    c->slurm_max_jobs = 1000;
 }
 
 static const struct key *find_key(const char *name)
@@ -318,7 +344,8 @@ void pk_config_print_keys(void *file)
         case K_LONG: snprintf(def, sizeof def, "%ld", *(const long *)field); break;
         case K_DOUBLE: snprintf(def, sizeof def, "%g", *(const double *)field); break;
         case K_LEVEL:
-        case K_AUTH: snprintf(def, sizeof def, "%s", names_of(k->type)[*(const int *)field]); break;
+        case K_AUTH:
+        case K_EXEC: snprintf(def, sizeof def, "%s", names_of(k->type)[*(const int *)field]); break;
         case K_ADDR: snprintf(def, sizeof def, "%s", *field ? field : "none"); break;
         }
         char flag[64];

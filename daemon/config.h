@@ -11,6 +11,8 @@
 typedef enum { PK_LOG_DEBUG, PK_LOG_INFO, PK_LOG_WARN, PK_LOG_ERROR } pk_log_level;
 /* auto: on unless bind is a loopback address and no trusted proxy is configured */
 typedef enum { PK_AUTH_AUTO, PK_AUTH_ON, PK_AUTH_OFF } pk_auth_mode;
+/* where jobs run (daemon/executor.h) */
+typedef enum { PK_EXECUTOR_LOCAL, PK_EXECUTOR_SLURM } pk_executor_kind;
 
 typedef struct pk_config {
     char bind[64]; /* listen address (IPv4 dotted quad) */
@@ -45,7 +47,16 @@ typedef struct pk_config {
     pk_auth_mode auth;       /* bearer tokens required (daemon/http/auth.c) */
     char trusted_proxy[64];  /* peer whose X-Packd-Owner is honoured; "" = none */
     char allowed_hosts[512]; /* Host header names accepted, comma-separated ("" = this machine's) */
-    char config_file[1024];  /* the file read, "" if none (kept for SIGHUP) */
+    pk_executor_kind executor;  /* local workers or a Slurm cluster */
+    char slurm_partition[64];   /* sbatch --partition; "" = the cluster's default */
+    char slurm_account[64];     /* sbatch --account; "" = the user's default */
+    char slurm_qos[64];         /* sbatch --qos; "" = the default */
+    char slurm_options[512];    /* more sbatch options, split at blanks */
+    char slurm_packd[1024];     /* packd on the nodes; "" = this binary's path */
+    int slurm_mem_mb;           /* sbatch --mem per job; 0 = the partition's default */
+    int slurm_max_jobs;         /* jobs on Slurm at once (submitted, not ended) */
+    double slurm_local_below_s; /* limits.wall_time_s at most this: run locally (0 = never) */
+    char config_file[1024];     /* the file read, "" if none (kept for SIGHUP) */
 } pk_config;
 
 /* Embedded defaults: 127.0.0.1:8080, data ./var, workers = online cores. */
@@ -65,6 +76,7 @@ int pk_config_load_env(pk_config *c, char *err, size_t errlen);
 int pk_config_from_args(pk_config *c, int argc, char **argv, char *err, size_t errlen);
 
 const char *pk_log_level_name(pk_log_level l);
+const char *pk_executor_kind_name(pk_executor_kind k);
 
 /* Print the keys with their defaults (for --help). */
 void pk_config_print_keys(void *file);

@@ -1,13 +1,13 @@
 /* service.h — the state one `packd serve` shares between its HTTP threads,
- * the supervisor thread and the signal loop. */
+ * the executor's threads and the signal loop. */
 #ifndef PK_SERVICE_H
 #define PK_SERVICE_H
 
 #include <pthread.h>
 
 #include "config.h"
+#include "executor.h"
 #include "daemon/store/queue.h"
-#include "supervisor.h"
 #include "daemon/store/tokens.h"
 
 typedef struct pk_service {
@@ -15,9 +15,9 @@ typedef struct pk_service {
     pk_config cfg;
     pk_queue *q;
     pk_tokens *tokens; /* bearer tokens (auth.c); its own connection to queue.db */
-    pk_supervisor *sup;
-    int draining; /* SIGTERM received: refuse new jobs (atomic) */
-    int stopping; /* streams must end now (atomic) */
+    pk_executor *exec; /* where jobs run (local workers or Slurm) */
+    int draining;      /* SIGTERM received: refuse new jobs (atomic) */
+    int stopping;      /* streams must end now (atomic) */
     double started;
     unsigned long long responses[600]; /* by HTTP status (atomic) */
 } pk_service;

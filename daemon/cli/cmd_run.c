@@ -63,6 +63,7 @@ static void run_help(FILE *f)
           "  --json                     print the summary as JSON even on a terminal\n"
           "  --progress                 progress as JSON lines on stderr\n"
           "  --progress-fd N            progress as JSON lines on file descriptor N\n"
+          "  --progress-file F          progress as JSON lines appended to file F\n"
           "  --threads N                threads of the parallel sections (1..64, default 1)\n"
           "  --checkpoint FILE          save/resume the run's state in FILE\n"
           "  --checkpoint-interval S    seconds between checkpoints (default 30)\n"
@@ -110,6 +111,7 @@ static int run_job(int argc, char **argv)
     const char *ckpt_path = NULL, *author = getenv("USER");
     double ckpt_interval = 30;
     int progress_fd = -1, json_summary = 0;
+    const char *progress_file = NULL; /* the Slurm executor reads it (no pipe across nodes) */
     /* the parallel sections' threads (the daemon passes its job_threads):
      * the results are the same for any number.  Default 1: on this 2-core
      * VM a whole 10⁴-grain step gains only 1.0–1.2x on 2 threads and loses
@@ -131,6 +133,8 @@ static int run_job(int argc, char **argv)
             progress_fd = 2;
         else if (!strcmp(argv[i], "--progress-fd") && i + 1 < argc)
             progress_fd = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--progress-file") && i + 1 < argc)
+            progress_file = argv[++i];
         else if (!strcmp(argv[i], "--checkpoint") && i + 1 < argc)
             ckpt_path = argv[++i];
         else if (!strcmp(argv[i], "--author") && i + 1 < argc)
@@ -181,9 +185,15 @@ static int run_job(int argc, char **argv)
     sigaction(SIGTERM, &sa, NULL);
 
     progress_sink sink = {NULL};
-    if (other_rank) /* rank 0 reports the progress */
+    if (other_rank) { /* rank 0 reports the progress */
         progress_fd = -1;
-    if (progress_fd >= 0) {
+        progress_file = NULL;
+    }
+    if (progress_file) {
+        sink.out = fopen(progress_file, "a");
+        if (!sink.out)
+            fprintf(stderr, "packd run: --progress-file %s: %s\n", progress_file, strerror(errno));
+    } else if (progress_fd >= 0) {
         sink.out = progress_fd == 2 ? stderr : fdopen(progress_fd, "w");
         if (!sink.out)
             fprintf(stderr, "packd run: --progress-fd %d: %s\n", progress_fd, strerror(errno));

@@ -1,6 +1,6 @@
 /* cmd_serve.c — `packd serve`: the job service (docs/service.md).
  * Life cycle: configuration -> data directory lock -> queue (migrations,
- * recovery of jobs a dead daemon left running) -> supervisor thread -> HTTP
+ * recovery of jobs a dead daemon left running) -> executor thread -> HTTP
  * threads; the main thread then only waits for signals:
  *   SIGHUP           reload the configuration (all but bind/port/data)
  *   SIGTERM, SIGINT  refuse new jobs, give running ones grace_s, re-queue the
@@ -22,7 +22,7 @@
 #include "daemon/log.h"
 #include "daemon/store/queue.h"
 #include "daemon/sd_notify.h"
-#include "daemon/supervisor.h"
+#include "daemon/executor.h"
 
 static int usage(FILE *f)
 {
@@ -78,8 +78,10 @@ static void reload(pk_service *svc, int argc, char **argv)
     svc->cfg = next;
     pthread_mutex_unlock(&svc->mu);
     pk_log_set_level(next.log_level);
-    pk_supervisor_configure(svc->sup, next.workers, next.max_wall_time_s, next.job_threads);
-    pk_supervisor_set_checkpoint_interval(svc->sup, next.checkpoint_interval_s);
+    if (next.executor != svc->cfg.executor)
+        pk_log(PK_LOG_WARN, "executor needs a restart; kept", NULL);
+    next.executor = svc->cfg.executor;
+    pk_executor_configure(svc->exec, &next);
     log_auth(svc);
     pk_log(PK_LOG_INFO, "configuration reloaded", "{s:s,s:i,s:s}", "file", next.config_file,
            "workers", next.workers, "log_level", pk_log_level_name(next.log_level));
@@ -87,7 +89,7 @@ static void reload(pk_service *svc, int argc, char **argv)
 
 int cmd_serve(int argc, char **argv)
 {
-    static pk_service svc; /* shared with the HTTP and supervisor threads */
+    static pk_service svc; /* shared with the HTTP and executor threads */
     char err[1200];
     int rc = pk_config_from_args(&svc.cfg, argc, argv, err, sizeof err);
     if (rc == 1)
@@ -112,7 +114,7 @@ int cmd_serve(int argc, char **argv)
                "error", strerror(errno));
         return 2;
     }
-    /* One daemon per data directory: the queue's claims assume a single supervisor. */
+    /* One daemon per data directory: the queue's claims assume a single executor. */
     snprintf(path, sizeof path, "%s/packd.lock", svc.cfg.data);
     int lock = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0640);
     if (lock < 0 || flock(lock, LOCK_EX | LOCK_NB) != 0) {
@@ -139,11 +141,6 @@ int cmd_serve(int argc, char **argv)
         pk_queue_close(svc.q);
         return 2;
     }
-    int failed = 0, requeued = pk_queue_recover(svc.q, svc.cfg.max_attempts, &failed);
-    if (requeued || failed)
-        pk_log(PK_LOG_WARN, "recovered jobs of a previous run", "{s:i,s:i}", "requeued", requeued,
-               "failed", failed);
-
     /* Signals go to this thread only (sigwait below); threads inherit the mask. */
     sigset_t set;
     sigemptyset(&set);
@@ -153,23 +150,20 @@ int cmd_serve(int argc, char **argv)
     pthread_sigmask(SIG_BLOCK, &set, NULL);
     signal(SIGPIPE, SIG_IGN);
 
-    svc.sup = pk_supervisor_start(svc.q, exe, svc.cfg.data, svc.cfg.workers,
-                                  svc.cfg.max_wall_time_s, svc.cfg.job_threads);
-    if (svc.sup)
-        pk_supervisor_set_checkpoint_interval(svc.sup, svc.cfg.checkpoint_interval_s);
+    svc.exec = pk_executor_start(svc.q, exe, &svc.cfg, err, sizeof err);
     int port = 0;
-    struct MHD_Daemon *http = svc.sup ? pk_http_start(&svc, &port, err, sizeof err) : NULL;
+    struct MHD_Daemon *http = svc.exec ? pk_http_start(&svc, &port, err, sizeof err) : NULL;
     if (!http) {
-        pk_log(PK_LOG_ERROR, "cannot start", "{s:s}", "error", svc.sup ? err : "supervisor thread");
-        pk_supervisor_stop(svc.sup, 0);
-        pk_supervisor_free(svc.sup);
+        pk_log(PK_LOG_ERROR, "cannot start", "{s:s}", "error", err);
+        pk_executor_stop(svc.exec, 0);
+        pk_executor_free(svc.exec);
         pk_tokens_close(svc.tokens);
         pk_queue_close(svc.q);
         return 2;
     }
-    pk_log(PK_LOG_INFO, "listening", "{s:s,s:i,s:s,s:i,s:s,s:i}", "bind", svc.cfg.bind, "port",
-           port, "data", svc.cfg.data, "workers", svc.cfg.workers, "version", PACKD_VERSION, "pid",
-           (int)getpid());
+    pk_log(PK_LOG_INFO, "listening", "{s:s,s:i,s:s,s:s,s:i,s:s,s:i}", "bind", svc.cfg.bind, "port",
+           port, "data", svc.cfg.data, "executor", pk_executor_name(svc.exec), "workers",
+           svc.cfg.workers, "version", PACKD_VERSION, "pid", (int)getpid());
     log_auth(&svc);
     pk_sd_notify("READY=1"); /* Type=notify: systemd starts dependants now */
 
@@ -189,12 +183,12 @@ int cmd_serve(int argc, char **argv)
     pk_sd_notify("STOPPING=1");
     __atomic_store_n(&svc.draining, 1, __ATOMIC_RELAXED);
     pk_log(PK_LOG_INFO, "stopping: running jobs get the grace period", "{s:f,s:i}", "grace_s",
-           cfg.grace_s, "running", pk_supervisor_busy(svc.sup));
-    pk_supervisor_stop(svc.sup, cfg.grace_s);
+           cfg.grace_s, "running", pk_executor_busy(svc.exec));
+    pk_executor_stop(svc.exec, cfg.grace_s);
     __atomic_store_n(&svc.stopping, 1, __ATOMIC_RELAXED);
     pk_queue_wake_all(svc.q);
     pk_http_stop(http);
-    pk_supervisor_free(svc.sup);
+    pk_executor_free(svc.exec);
     pk_tokens_close(svc.tokens);
     pk_queue_close(svc.q);
     close(lock);

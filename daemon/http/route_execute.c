@@ -247,7 +247,7 @@ enum MHD_Result route_execute(pk_req *r)
     case PK_Q_OK:
         pk_log(PK_LOG_INFO, "job accepted", "{s:s,s:s,s:s}", "job", id, "process", p->id, "owner",
                owner);
-        pk_supervisor_wake(svc->sup);
+        pk_executor_wake(svc->exec);
         return answer(r, id, 0, &opts);
     case PK_Q_EXISTING: return answer(r, id, 1, &opts);
     case PK_Q_KEY_CONFLICT:

@@ -58,7 +58,7 @@ enum MHD_Result route_job_delete(pk_req *r)
     if (!mine || pk_queue_dismiss(r->svc->q, r->seg[1], was) != 0)
         return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
     if (!strcmp(was, "running")) {
-        pk_supervisor_wake(r->svc->sup); /* SIGTERM to the worker now */
+        pk_executor_wake(r->svc->exec); /* SIGTERM to the worker (scancel) now */
     } else if (!strcmp(was, "successful") || !strcmp(was, "failed")) {
         pk_config cfg = pk_service_config(r->svc);
         remove_job_files(cfg.data, r->seg[1]);

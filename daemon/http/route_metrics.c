@@ -118,12 +118,27 @@ enum MHD_Result route_metrics(pk_req *r)
     put(&b,
         "# HELP packd_workers_busy Worker processes running.\n# TYPE packd_workers_busy gauge\n"
         "packd_workers_busy %d\n",
-        pk_supervisor_busy(svc->sup));
+        pk_executor_busy(svc->exec));
     put(&b,
         "# HELP packd_workers_max Configured maximum of worker processes.\n"
         "# TYPE packd_workers_max gauge\npackd_workers_max %d\n",
-        pk_supervisor_capacity(svc->sup));
+        pk_executor_capacity(svc->exec));
     put_job_counters(&b, st);
+    put(&b,
+        "# HELP packd_queue_transactions_total Transactions the queue database committed.\n"
+        "# TYPE packd_queue_transactions_total counter\npackd_queue_transactions_total %lld\n",
+        pk_queue_transactions(svc->q));
+    long long cycles;
+    double cycle_s;
+    if (pk_executor_poll_stats(svc->exec, &cycles, &cycle_s))
+        put(&b,
+            "# HELP packd_executor_poll_cycles_total Poll cycles of the executor (slurm: one "
+            "squeue and one queue transaction each).\n"
+            "# TYPE packd_executor_poll_cycles_total counter\npackd_executor_poll_cycles_total "
+            "%lld\n# HELP packd_executor_poll_seconds_total Wall seconds the poll cycles took.\n"
+            "# TYPE packd_executor_poll_seconds_total counter\n"
+            "packd_executor_poll_seconds_total %.6f\n",
+            cycles, cycle_s);
     put(&b,
         "# HELP packd_http_responses_total HTTP responses by status code.\n"
         "# TYPE packd_http_responses_total counter\n");
@@ -161,16 +176,28 @@ enum MHD_Result route_healthz(pk_req *r)
         json_is_true(json_object_get(st, "ok")) && pk_queue_writable(svc->q, why, sizeof why);
     json_decref(st);
     int draining = __atomic_load_n(&svc->draining, __ATOMIC_RELAXED);
-    int unrecorded = pk_supervisor_unrecorded(svc->sup); /* job ends waiting for the database */
+    int unrecorded = pk_executor_unrecorded(svc->exec); /* job ends waiting for the database */
     int ready = db_ok && !draining && unrecorded == 0;
     json_t *doc =
         json_pack("{s:s,s:b,s:b,s:s,s:{s:i,s:i},s:f}", "status", ready ? "ok" : "unavailable",
                   "live", 1, "ready", ready, "database", db_ok ? "ok" : "error", "workers", "busy",
-                  pk_supervisor_busy(svc->sup), "max", pk_supervisor_capacity(svc->sup), "uptime_s",
+                  pk_executor_busy(svc->exec), "max", pk_executor_capacity(svc->exec), "uptime_s",
                   pk_queue_now() - svc->started);
     if (why[0])
         json_object_set_new(doc, "database_error", json_string(why));
     if (unrecorded)
         json_object_set_new(doc, "unrecorded_job_ends", json_integer(unrecorded));
+    /* a degraded executor (Slurm controller away) keeps the service ready:
+     * jobs are accepted and wait; the status and the reason say so */
+    char exec_why[300];
+    int exec_ok = pk_executor_healthy(svc->exec, exec_why, sizeof exec_why);
+    json_object_set_new(doc, "executor",
+                        json_pack("{s:s,s:s}", "name", pk_executor_name(svc->exec), "state",
+                                  exec_ok ? "ok" : "degraded"));
+    if (!exec_ok) {
+        json_object_set_new(json_object_get(doc, "executor"), "reason", json_string(exec_why));
+        if (ready)
+            json_object_set_new(doc, "status", json_string("degraded"));
+    }
     return pk_send_json(r, ready ? 200 : 503, doc, NULL);
 }

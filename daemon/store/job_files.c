@@ -14,6 +14,10 @@ const char *pk_job_file_name(pk_job_file f)
     case PK_JOB_LOCK: return "worker.lock";
     case PK_JOB_CHECKPOINT: return "checkpoint.h5";
     case PK_JOB_EXEC_OPTS: return "execute.json";
+    case PK_JOB_SLURM_SCRIPT: return "slurm.sh";
+    case PK_JOB_SLURM_OUT: return "slurm.out";
+    case PK_JOB_PROGRESS: return "progress.jsonl";
+    case PK_JOB_EXIT: return "exit_status";
     }
     return "";
 }

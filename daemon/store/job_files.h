@@ -16,6 +16,10 @@ typedef enum pk_job_file {
     PK_JOB_LOCK,       /* worker.lock: flock'd by the worker while it lives */
     PK_JOB_CHECKPOINT, /* checkpoint.h5: kept across attempts, a re-queued job resumes from it */
     PK_JOB_EXEC_OPTS, /* execute.json: the request's response/outputs, only when not the defaults */
+    PK_JOB_SLURM_SCRIPT, /* slurm.sh: the batch script submitted to Slurm */
+    PK_JOB_SLURM_OUT,    /* slurm.out: the batch script's own output */
+    PK_JOB_PROGRESS, /* progress.jsonl: a Slurm job's progress lines (packd run --progress-file) */
+    PK_JOB_EXIT, /* exit_status: "<status> <attempt> <node>" the batch script writes at its end */
 } pk_job_file;
 
 /* The file's name inside the job directory, e.g. "result.h5". */

@@ -71,6 +71,10 @@ static const char *const steps[] = {
     "  SELECT process, (SELECT min(le) FROM duration_buckets WHERE le >= finished - started) AS b,"
     "  count(*), sum(finished - started) FROM jobs"
     "  WHERE started IS NOT NULL AND finished IS NOT NULL GROUP BY process, b;",
+    /* 3 -> 4: the back end that holds a job outside this process
+     * (daemon/executor.h): 'slurm:<job id>' while Slurm has it,
+     * 'slurm:<job id>:ended' once its end is recorded; NULL for local jobs. */
+    "ALTER TABLE jobs ADD COLUMN executor_ref TEXT;",
 };
 
 int pk_schema_version(void) { return (int)(sizeof steps / sizeof *steps); }

@@ -38,6 +38,7 @@ struct pk_queue {
      * commit succeeds again: /healthz is not ready meanwhile. */
     double write_failed_at, probed_at;
     char write_error[160];
+    long long commits; /* transactions the writer committed (atomic) */
 };
 
 double pk_queue_now(void)
@@ -234,6 +235,19 @@ static int commit(pk_queue *q)
 }
 static void rollback(pk_queue *q) { sqlite3_exec(q->db, "ROLLBACK", NULL, NULL, NULL); }
 
+/* Every commit of the writer, explicit or autocommit: /metrics shows what
+ * a poll cycle or a progress line costs the database. */
+static int count_commit(void *arg)
+{
+    __atomic_add_fetch(&((pk_queue *)arg)->commits, 1, __ATOMIC_RELAXED);
+    return 0;
+}
+
+long long pk_queue_transactions(pk_queue *q)
+{
+    return __atomic_load_n(&q->commits, __ATOMIC_RELAXED);
+}
+
 pk_queue *pk_queue_open(const char *path, char *err, size_t errlen)
 {
     pk_queue *q = calloc(1, sizeof *q);
@@ -246,6 +260,7 @@ pk_queue *pk_queue_open(const char *path, char *err, size_t errlen)
         free(q);
         return NULL;
     }
+    sqlite3_commit_hook(q->db, count_commit, q);
     pthread_mutex_init(&q->mu, NULL);
     pthread_mutex_init(&q->ev_mu, NULL);
     pthread_cond_init(&q->ev_cond, NULL);
@@ -355,7 +370,7 @@ out:
 #define JOB_COLUMNS                                                                                \
     "id, process, inputs, owner, status, progress, message, created, started, "                    \
     "finished, updated, attempts, cancel_requested, worker_pid, rev, summary, "                    \
-    "result_sha256, result_size"
+    "result_sha256, result_size, executor_ref"
 
 json_t *pk_queue_get(pk_queue *q, const char *id)
 {
@@ -398,14 +413,21 @@ json_t *pk_queue_list(pk_queue *q, const pk_job_filter *f, int limit, int offset
     return r;
 }
 
-json_t *pk_queue_claim(pk_queue *q)
+json_t *pk_queue_claim(pk_queue *q) { return pk_queue_claim_by_wall(q, PK_CLAIM_ANY, 0); }
+
+json_t *pk_queue_claim_by_wall(pk_queue *q, pk_claim which, double bound_s)
 {
     json_t *r = NULL;
     pthread_mutex_lock(&q->mu);
     if (begin(q) != SQLITE_OK)
         goto out;
-    json_t *next =
-        one_row(prep(q, "SELECT id FROM jobs WHERE status='accepted' ORDER BY seq LIMIT 1", NULL));
+    /* a job a back end holds (executor_ref) is not claimable, even while accepted */
+    json_t *next = one_row(
+        prep(q,
+             "SELECT id FROM jobs WHERE status='accepted' AND executor_ref IS NULL AND"
+             " (?1=0 OR (coalesce(json_extract(inputs, '$.limits.wall_time_s') <= ?2, 0) = (?1=1)))"
+             " ORDER BY seq LIMIT 1",
+             "id", (int)which, bound_s));
     if (!next) {
         rollback(q);
         goto out;
@@ -456,16 +478,34 @@ void pk_queue_progress(pk_queue *q, const char *id, int percent, json_t *data)
     notify(q);
 }
 
+static const char *finish_tx(pk_queue *q, const char *id, const char *status, const char *message,
+                             const char *summary_json, const char *sha256, long long size);
+
 const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, const char *message,
                             const char *summary_json, const char *sha256, long long size)
 {
     const char *ended = NULL; /* not recorded, unless the commit below succeeds */
-    double now = pk_queue_now();
     pthread_mutex_lock(&q->mu);
     if (begin(q) != SQLITE_OK) {
         note_write(q, 0);
-        goto out;
+    } else if (!(ended = finish_tx(q, id, status, message, summary_json, sha256, size))) {
+        note_write(q, 0); /* the database took no write (full, I/O error) */
+        rollback(q);
+    } else if (commit(q) != 0) {
+        ended = NULL;
     }
+    pthread_mutex_unlock(&q->mu);
+    notify(q);
+    return ended;
+}
+
+/* pk_queue_finish inside an open transaction: the end recorded, "unchanged"
+ * when the job is not ours to end, NULL when the database took no write. */
+static const char *finish_tx(pk_queue *q, const char *id, const char *status, const char *message,
+                             const char *summary_json, const char *sha256, long long size)
+{
+    const char *ended;
+    double now = pk_queue_now();
     int n =
         run(q,
             prep(q,
@@ -474,10 +514,9 @@ const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, con
                  " result_sha256=?, result_size=?, worker_pid=NULL, rev=rev+1"
                  " WHERE id=? AND status='running'",
                  "sssddssIs", status, message, status, now, now, summary_json, sha256, size, id));
-    const char *end = "dismissed";
     if (n == 1) {
-        end = !strcmp(status, "successful") ? "successful" : "failed";
-        pk_metrics_job_ended(q->db, id, end);
+        ended = !strcmp(status, "successful") ? "successful" : "failed";
+        pk_metrics_job_ended(q->db, id, ended);
     } else if (n == 0) {
         n = run(q,
                 prep(q,
@@ -485,17 +524,14 @@ const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, con
                      " message='dismissed; worker stopped' WHERE id=? AND"
                      " status='dismissed' AND finished IS NULL",
                      "dds", now, now, id));
-        if (n == 0) { /* not ours to end */
-            ended = commit(q) == 0 ? "unchanged" : NULL;
-            goto out;
-        }
-        if (n == 1)
-            pk_metrics_job_ended(q->db, id, "dismissed"); /* its worker stopped */
-    }
-    if (n != 1) { /* the database took no write (full, I/O error) */
-        note_write(q, 0);
-        rollback(q);
-        goto out;
+        if (n == 0)
+            return "unchanged"; /* not ours to end */
+        if (n != 1)
+            return NULL;
+        ended = "dismissed";
+        pk_metrics_job_ended(q->db, id, "dismissed"); /* its worker stopped */
+    } else {
+        return NULL;
     }
     add_status_event(q, id);
     /* History stays small: of the progress events only the last is kept. */
@@ -504,11 +540,6 @@ const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, con
              "DELETE FROM events WHERE job_id=?1 AND kind='progress' AND id <"
              " (SELECT max(id) FROM events WHERE job_id=?1 AND kind='progress')",
              "s", id));
-    if (commit(q) == 0)
-        ended = end;
-out:
-    pthread_mutex_unlock(&q->mu);
-    notify(q);
     return ended;
 }
 
@@ -568,8 +599,9 @@ int pk_queue_recover(pk_queue *q, int max_attempts, int *failed)
     pthread_mutex_lock(&q->mu);
     if (begin(q) == SQLITE_OK) {
         json_t *left = rows(prep(q,
-                                 "SELECT id, attempts, status FROM jobs WHERE (status='running') OR"
-                                 " (cancel_requested=1 AND finished IS NULL)",
+                                 "SELECT id, attempts, status FROM jobs WHERE executor_ref IS NULL"
+                                 " AND (status='running' OR (cancel_requested=1 AND"
+                                 " finished IS NULL))",
                                  NULL));
         double now = pk_queue_now();
         size_t i;
@@ -757,4 +789,106 @@ json_t *pk_queue_get_file(pk_queue *q, const char *id, const char *owner)
                               "ss", id, owner));
     reader_give(rd);
     return r;
+}
+
+json_t *pk_queue_held_jobs(pk_queue *q, const char *backend)
+{
+    pthread_mutex_lock(&q->mu);
+    json_t *r = rows(prep(q,
+                          "SELECT id, status, attempts, progress, message, owner, inputs,"
+                          " executor_ref FROM jobs WHERE executor_ref LIKE ?1 || ':%' AND"
+                          " executor_ref NOT LIKE '%:ended' ORDER BY seq",
+                          "s", backend));
+    pthread_mutex_unlock(&q->mu);
+    return r;
+}
+
+/* One change of pk_queue_sync inside its transaction; 1 when a status or
+ * progress event was added. */
+static int sync_one(pk_queue *q, json_t *c, double now)
+{
+    const char *id = json_string_value(json_object_get(c, "id"));
+    const char *op = json_string_value(json_object_get(c, "op"));
+    const char *msg = json_string_value(json_object_get(c, "message"));
+    const char *ref = json_string_value(json_object_get(c, "ref"));
+    int attempts = (int)json_integer_value(json_object_get(c, "attempts"));
+    if (!id || !op)
+        return 0;
+    if (ref)
+        run(q, prep(q, "UPDATE jobs SET executor_ref=? WHERE id=?", "ss", ref, id));
+    if (!strcmp(op, "queued") || !strcmp(op, "running")) {
+        int queued = op[0] == 'q';
+        /* attempts 0: keep; a change of status or message is a status event */
+        int n =
+            run(q,
+                prep(q,
+                     "UPDATE jobs SET status=?1, message=?2,"
+                     " attempts=CASE WHEN ?3>0 THEN ?3 ELSE attempts END,"
+                     " started=CASE WHEN ?1='running' THEN coalesce(started, ?4) ELSE"
+                     " started END, updated=?4, rev=rev+1 WHERE id=?5 AND status IN"
+                     " ('accepted','running') AND (status<>?1 OR message<>?2 OR"
+                     " (?3>0 AND attempts<>?3))",
+                     "ssids", queued ? "accepted" : "running", msg ? msg : "", attempts, now, id));
+        if (n == 1)
+            add_status_event(q, id);
+        json_t *data = json_object_get(c, "progress");
+        if (!queued && json_is_object(data)) {
+            json_int_t pct = json_integer_value(json_object_get(data, "progress"));
+            if (run(q,
+                    prep(q,
+                         "UPDATE jobs SET progress=?, updated=?, rev=rev+1 WHERE id=? AND"
+                         " status='running' AND progress<>?",
+                         "idsi", (int)pct, now, id, (int)pct)) == 1) {
+                add_event(q, id, "progress", data);
+                n = 1;
+            }
+        }
+        return n == 1;
+    }
+    if (!strcmp(op, "finish")) {
+        run(q,
+            prep(q,
+                 "UPDATE jobs SET status='running', started=coalesce(started, ?) WHERE id=?"
+                 " AND status='accepted'",
+                 "ds", now, id));
+        const char *sum = json_string_value(json_object_get(c, "summary"));
+        const char *sha = json_string_value(json_object_get(c, "sha256"));
+        const char *status = json_string_value(json_object_get(c, "status"));
+        /* NULL: not written; the job stays running and the next cycle ends it again */
+        const char *e = finish_tx(q, id, status ? status : "failed", msg ? msg : "", sum, sha,
+                                  json_integer_value(json_object_get(c, "size")));
+        return e && strcmp(e, "unchanged") != 0;
+    }
+    if (!strcmp(op, "requeue")) {
+        if (run(q,
+                prep(q,
+                     "UPDATE jobs SET status='accepted', attempts=max(attempts-1, 0),"
+                     " progress=0, message=?, updated=?, rev=rev+1 WHERE id=? AND"
+                     " status='running' AND executor_ref IS NULL",
+                     "sds", msg ? msg : "re-queued", now, id)) == 1) {
+            add_status_event(q, id);
+            return 1;
+        }
+    }
+    return 0;
+}
+
+int pk_queue_sync(pk_queue *q, json_t *changes)
+{
+    if (!json_array_size(changes))
+        return 0;
+    int events = 0, rc = -1;
+    double now = pk_queue_now();
+    pthread_mutex_lock(&q->mu);
+    if (begin(q) == SQLITE_OK) {
+        size_t i;
+        json_t *c;
+        json_array_foreach (changes, i, c)
+            events += sync_one(q, c, now);
+        rc = commit(q);
+    }
+    pthread_mutex_unlock(&q->mu);
+    if (events)
+        notify(q);
+    return rc;
 }

@@ -59,8 +59,13 @@ typedef struct pk_job_filter {
 json_t *pk_queue_list(pk_queue *q, const pk_job_filter *f, int limit, int offset, int *total);
 
 /* Move the oldest accepted job to running (attempts + 1).  Returns the job
- * row (new ref) or NULL when none waits. */
+ * row (new ref) or NULL when none waits.  A job a back end holds
+ * (executor_ref set, e.g. queued on Slurm) is never claimed. */
 json_t *pk_queue_claim(pk_queue *q);
+/* The same among jobs whose inputs' limits.wall_time_s is at most bound_s
+ * (SHORT) or is not (LONG: larger or absent); ANY ignores bound_s. */
+typedef enum { PK_CLAIM_ANY, PK_CLAIM_SHORT, PK_CLAIM_LONG } pk_claim;
+json_t *pk_queue_claim_by_wall(pk_queue *q, pk_claim which, double bound_s);
 void pk_queue_set_worker(pk_queue *q, const char *id, int pid);
 
 /* A running job's progress (0..100) and the worker's progress object. */
@@ -108,10 +113,33 @@ void pk_queue_wake_all(pk_queue *q);
  * pk_metrics_read (job_metrics.h)}. */
 json_t *pk_queue_stats(pk_queue *q);
 
+/* Transactions the writer committed since the queue was opened. */
+long long pk_queue_transactions(pk_queue *q);
+
 /* 1 when the last write committed; 0 while writes fail (why: the error and
  * how long).  Meanwhile a probe as large as a job's end is written at most
  * once a second, so the state clears by itself once space returns. */
 int pk_queue_writable(pk_queue *q, char *why, size_t n);
+
+/* For a back end that runs jobs outside this process (daemon/executor.h):
+ * the jobs it holds, executor_ref 'backend:<ref>' not yet ended, oldest
+ * first: [{id, status, attempts, progress, message, owner, inputs,
+ * executor_ref}]. */
+json_t *pk_queue_held_jobs(pk_queue *q, const char *backend);
+
+/* Apply a poll cycle's changes in ONE transaction, events only for what
+ * changed.  Each change is {"id", "op", ...}, and any op may carry "ref"
+ * (the new executor_ref):
+ *   "hold"     only set the ref
+ *   "queued"   accepted/running -> accepted, "message"; "attempts" if > 0
+ *   "running"  accepted/running -> running, "message", "attempts" if > 0,
+ *              "progress": a worker progress object with "progress" 0..99
+ *   "finish"   as pk_queue_finish: "status", "message", "summary" (JSON
+ *              text), "sha256", "size" (an accepted job passes by running)
+ *   "requeue"  a claimed job not yet held goes back to accepted, its start
+ *              given back, "message" says why
+ * Returns 0 when committed. */
+int pk_queue_sync(pk_queue *q, json_t *changes);
 
 /* Uploaded files: one row per (id, owner) — the bytes are stored once, each
  * owner who sent them owns the upload.  get_file with owner NULL: any owner's. */

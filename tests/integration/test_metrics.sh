@@ -53,9 +53,9 @@ stop_daemon
 python3 - "$T/m1/queue.db" <<'PY'
 import sqlite3, sys
 db = sqlite3.connect(sys.argv[1])
-v = db.execute("PRAGMA user_version").fetchone()[0]
+# version 2: the schema before the counters (daemon/store/migrations.c, step 2 -> 3)
 db.executescript("DROP TABLE job_counts; DROP TABLE job_durations; DROP TABLE duration_buckets;"
-                 "PRAGMA user_version = %d;" % (v - 1))
+                 "ALTER TABLE jobs DROP COLUMN executor_ref; PRAGMA user_version = 2;")
 PY
 start_daemon m1 --workers 1 || { fail upgrade_start; exit 1; }
 c "$B/metrics" >"$T/m4.txt"

@@ -6,18 +6,9 @@
 # it was resumed (summary and file), and the packing is valid.
 . "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
 
-# 3000 equal spheres grown from RSA at φ = 0.30 until jammed by Meier's Δφ
-# test at one rate (~9e6 events; the default 10^12 stop spends most of its
-# events near jamming, where a resumed trajectory's length varies by more
-# than the part saved)
+# 3000 equal spheres until jammed (jam_body)
 N=3000 L=14
-body_of "$SRC/examples/meier-quartz-2d.json" "
-i.clear()
-i.update({'dim': 3, 'domain': {'box': {'size': [$L, $L, $L], 'periodic': True}},
-          'grading': {'type': 'classes', 'classes': [{'d': 1.0, 'volume_percent': 100}]},
-          'sampling': 'discrete', 'count': $N, 'algorithm': 'edmd',
-          'edmd': {'until': 'jammed', 'growth_rate': 0.01, 'collision_rule': 'lift',
-                   'jamming': {'delta_phi': 1e-9, 'rate_factor': 1}}, 'seed': 3})" >"$T/jam.json"
+jam_body $N $L >"$T/jam.json"
 python3 -c "import json,sys; print(json.dumps({'process': 'pack', **json.load(open(sys.argv[1]))}))" \
     "$T/jam.json" >"$T/jam-job.json"
 

@@ -1,7 +1,21 @@
-/* supervisor.c — the worker processes: claim a job, fork and exec `packd run`
- * in its directory, relay progress, enforce wall time and cancels, record the
- * end; contract in supervisor.h. */
-#include "supervisor.h"
+/* executor_local.c — the local back end: claim a job, fork and exec
+ * `packd run` in its directory, relay progress, enforce wall time and
+ * cancels, record the end.
+ *
+ * One thread claims accepted jobs from the queue while fewer than `workers`
+ * run, and starts each as a child process: fork/exec of this same binary,
+ *   packd run DATA/jobs/<id>/job.json -o DATA/jobs/<id>/result.h5 --progress-fd 3 --threads T
+ * with stdout -> summary.json, stderr -> worker.log.  The child
+ *   - dies with the daemon (PR_SET_PDEATHSIG = SIGKILL, checked against a race),
+ *   - holds an exclusive flock on DATA/jobs/<id>/worker.lock for its whole life,
+ *     so a second worker of the same job (e.g. after a daemon restart while the
+ *     old child is still being killed) waits until the first is gone.
+ * The thread relays progress lines to the queue (-> SSE), reaps children
+ * (a crash fails only that job, with the signal in `message`), hashes the
+ * result (SHA-256) and sends SIGTERM to workers of dismissed jobs — which
+ * the worker turns into the core's cancel flag — within 0.2 s of the request.
+ * Contract: executor.h. */
+#include "executor.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -21,7 +35,7 @@
 #include "data_paths.h"
 #include "job_end.h"
 #include "log.h"
-#include "api/digest.h"
+#include "worker_files.h"
 #include "daemon/store/job_files.h"
 
 #define MAX_SLOTS 1024
@@ -43,8 +57,11 @@ typedef struct slot {
     pk_job_end end; /* pending: the slot holds an end the queue has not recorded */
 } slot;
 
-struct pk_supervisor {
+typedef struct local_exec {
+    pk_executor base;
     pk_queue *q;
+    int short_only; /* beside slurm: only jobs with limits.wall_time_s <= local_below_s */
+    double local_below_s;
     char exe[1024], data[1024];
     pthread_t thread;
     pthread_mutex_t mu;
@@ -58,76 +75,7 @@ struct pk_supervisor {
     int busy;       /* slots with a worker or a pending end */
     int unrecorded; /* slots with a pending end */
     slot slots[MAX_SLOTS];
-};
-
-static int mkdirs(const char *path)
-{
-    char tmp[1200];
-    snprintf(tmp, sizeof tmp, "%s", path);
-    for (char *p = tmp + 1; *p; p++)
-        if (*p == '/') {
-            *p = 0;
-            if (mkdir(tmp, 0750) != 0 && errno != EEXIST)
-                return -1;
-            *p = '/';
-        }
-    return mkdir(tmp, 0750) != 0 && errno != EEXIST ? -1 : 0;
-}
-
-/* Leftover temporary result files of an interrupted run. */
-static void remove_tmp_files(const char *dir)
-{
-    DIR *d = opendir(dir);
-    if (!d)
-        return;
-    struct dirent *e;
-    while ((e = readdir(d)))
-        if (strstr(e->d_name, ".tmp")) {
-            char p[1400];
-            if (snprintf(p, sizeof p, "%s/%s", dir, e->d_name) < (int)sizeof p)
-                unlink(p);
-        }
-    closedir(d);
-}
-
-/* job.json by temp file and rename: 0, or -1 with errno (no temp file left). */
-static int write_job_file(const char *path, json_t *job)
-{
-    char tmp[1300];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp) {
-        errno = ENAMETOOLONG;
-        return -1;
-    }
-    char *text = json_dumps(job, JSON_INDENT(2) | JSON_SORT_KEYS);
-    if (!text) {
-        errno = ENOMEM;
-        return -1;
-    }
-    size_t n = strlen(text), off = 0;
-    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640), rc = fd < 0 ? -1 : 0;
-    while (rc == 0 && off < n) {
-        ssize_t w = write(fd, text + off, n - off);
-        if (w > 0)
-            off += (size_t)w;
-        else if (!(w < 0 && errno == EINTR))
-            rc = -1;
-    }
-    int saved = errno;
-    if (fd >= 0 && close(fd) != 0 && rc == 0) {
-        rc = -1;
-        saved = errno;
-    }
-    free(text);
-    if (rc == 0 && rename(tmp, path) != 0) {
-        rc = -1;
-        saved = errno;
-    }
-    if (rc != 0) {
-        unlink(tmp);
-        errno = saved;
-    }
-    return rc;
-}
+} local_exec;
 
 /* pipe2(O_CLOEXEC) without _GNU_SOURCE. */
 static int cloexec_pipe(int p[2], int nonblock)
@@ -146,12 +94,12 @@ static void set_nonblock(int fd) { fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NON
 
 /* A slot's end recorded: the worker's files of a dismissed job go, the slot
  * is free. */
-static void end_recorded(pk_supervisor *s, slot *sl, const char *ended)
+static void end_recorded(local_exec *s, slot *sl, const char *ended)
 {
     if (!strcmp(ended, "dismissed")) { /* nobody will download it */
         char dir[1200], path[1300];
         pk_job_dir(s->data, sl->id, dir, sizeof dir);
-        remove_tmp_files(dir);
+        pk_worker_remove_tmp(dir);
         pk_job_file_path(dir, PK_JOB_RESULT, path, sizeof path);
         unlink(path);
     }
@@ -160,7 +108,7 @@ static void end_recorded(pk_supervisor *s, slot *sl, const char *ended)
 
 /* Record a slot's end (the slot counts as busy); kept pending while the
  * queue cannot write it.  Returns what the job ended with, or NULL. */
-static const char *end_slot(pk_supervisor *s, slot *sl, const char *status, const char *msg,
+static const char *end_slot(local_exec *s, slot *sl, const char *status, const char *msg,
                             const char *summary, const char *sha256, long long size)
 {
     /* what clients read (status, SSE, problems) names no path of the data directory */
@@ -177,7 +125,7 @@ static const char *end_slot(pk_supervisor *s, slot *sl, const char *status, cons
 }
 
 /* A claimed job that could not start fails (its end pending if need be). */
-static void launch_failed(pk_supervisor *s, slot *sl, const char *id, const char *why)
+static void launch_failed(local_exec *s, slot *sl, const char *id, const char *why)
 {
     memset(sl, 0, sizeof *sl);
     snprintf(sl->id, sizeof sl->id, "%s", id);
@@ -185,7 +133,7 @@ static void launch_failed(pk_supervisor *s, slot *sl, const char *id, const char
     end_slot(s, sl, "failed", why, NULL, NULL, 0);
 }
 
-static int launch(pk_supervisor *s, slot *sl, json_t *job)
+static int launch(local_exec *s, slot *sl, json_t *job)
 {
     const char *id = json_string_value(json_object_get(job, "id"));
     char dir[1200], job_path[1300], out_path[1300], sum_path[1300], log_path[1300], lock_path[1300],
@@ -198,18 +146,10 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
     pk_job_file_path(dir, PK_JOB_LOCK, lock_path, sizeof lock_path);
     pk_job_file_path(dir, PK_JOB_CHECKPOINT, ckpt_path, sizeof ckpt_path);
     char why[1400];
-    if (mkdirs(dir) != 0) {
-        snprintf(why, sizeof why, "cannot create the job directory: %s", strerror(errno));
+    if (pk_worker_prepare(dir, job, why, sizeof why) != 0) {
         launch_failed(s, sl, id, why);
         return -1;
     }
-    remove_tmp_files(dir);
-    unlink(out_path);
-    json_t *file = json_pack("{s:O,s:O}", "process", json_object_get(job, "process"), "inputs",
-                             json_object_get(job, "inputs"));
-    int wrote = write_job_file(job_path, file);
-    int wrote_errno = errno;
-    json_decref(file);
     char threads[16], interval[32], owner[128];
     /* the job's owner is its result's /h5md/author */
     const char *own = json_string_value(json_object_get(job, "owner"));
@@ -220,9 +160,8 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
              s->checkpoint_interval_s > 0 ? s->checkpoint_interval_s : 30);
     pthread_mutex_unlock(&s->mu);
     int p[2];
-    if (wrote != 0 || cloexec_pipe(p, 0) != 0) {
-        snprintf(why, sizeof why, "cannot write the job file: %s",
-                 strerror(wrote != 0 ? wrote_errno : errno));
+    if (cloexec_pipe(p, 0) != 0) {
+        snprintf(why, sizeof why, "cannot make a pipe: %s", strerror(errno));
         launch_failed(s, sl, id, why);
         return -1;
     }
@@ -273,22 +212,19 @@ static int launch(pk_supervisor *s, slot *sl, json_t *job)
     return 0;
 }
 
-static void relay_line(pk_supervisor *s, slot *sl, const char *line)
+static void relay_line(local_exec *s, slot *sl, const char *line)
 {
     json_t *p = json_loads(line, 0, NULL);
     if (!json_is_object(p)) {
         json_decref(p);
         return;
     }
-    double f = json_number_value(json_object_get(p, "fraction"));
-    int percent = f >= 0 ? (int)(f * 100.0) : 0;
-    percent = percent < 0 ? 0 : percent > 99 ? 99 : percent; /* 100 = successful */
-    json_object_set_new(p, "progress", json_integer(percent));
+    int percent = pk_worker_percent(p);
     pk_queue_progress(s->q, sl->id, percent, p);
     json_decref(p);
 }
 
-static void drain(pk_supervisor *s, slot *sl)
+static void drain(local_exec *s, slot *sl)
 {
     for (;;) {
         ssize_t n = read(sl->fd, sl->line + sl->nline, sizeof sl->line - 1 - sl->nline);
@@ -309,23 +245,7 @@ static void drain(pk_supervisor *s, slot *sl)
     }
 }
 
-/* Last non-empty line of the worker's stderr, for `message`. */
-static void last_log_line(const char *path, char *out, size_t n)
-{
-    out[0] = 0;
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return;
-    char line[1024];
-    while (fgets(line, sizeof line, f)) {
-        line[strcspn(line, "\n")] = 0;
-        if (line[0])
-            snprintf(out, n, "%s", line);
-    }
-    fclose(f);
-}
-
-static void finished(pk_supervisor *s, slot *sl, int wstatus)
+static void finished(local_exec *s, slot *sl, int wstatus)
 {
     drain(s, sl);
     close(sl->fd);
@@ -336,33 +256,14 @@ static void finished(pk_supervisor *s, slot *sl, int wstatus)
      * summary says why (docs/job-format.md, "Status") */
     int code = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1;
     if (code == 0 || code == 3) {
-        pk_job_file_path(dir, PK_JOB_SUMMARY, path, sizeof path);
-        json_t *sum = json_load_file(path, 0, NULL);
-        char *text = sum ? json_dumps(sum, JSON_COMPACT | JSON_REAL_PRECISION(10)) : NULL;
-        const char *status = code == 0 ? "successful" : "failed";
-        json_t *w = json_object_get(sum, "warnings");
-        if (code == 3)
-            snprintf(msg, sizeof msg, "failed: %s",
-                     json_is_string(json_object_get(sum, "failure"))
-                         ? json_string_value(json_object_get(sum, "failure"))
-                         : "the job's own checks failed");
-        else if (json_array_size(w))
-            snprintf(msg, sizeof msg, "finished with %zu warning%s: %s", json_array_size(w),
-                     json_array_size(w) > 1 ? "s" : "", json_string_value(json_array_get(w, 0)));
-        else
-            snprintf(msg, sizeof msg, "finished");
-        json_decref(sum);
-        char hex[65];
-        struct stat st;
-        pk_job_file_path(dir, PK_JOB_RESULT, path, sizeof path);
-        if (pk_sha256_file_hex(path, hex) == 0 && stat(path, &st) == 0)
-            ended = end_slot(s, sl, status, msg, text, hex, (long long)st.st_size);
-        else
-            ended = end_slot(s, sl, "failed", "the worker wrote no result file", text, NULL, 0);
-        free(text);
+        pk_worker_outcome o;
+        pk_worker_outcome_read(dir, code, &o);
+        ended =
+            end_slot(s, sl, o.status, o.message, o.summary, o.sha256[0] ? o.sha256 : NULL, o.size);
+        free(o.summary);
     } else {
         pk_job_file_path(dir, PK_JOB_LOG, path, sizeof path);
-        last_log_line(path, tail, sizeof tail);
+        pk_worker_last_line(path, tail, sizeof tail);
         if (sl->killed_for_time)
             snprintf(msg, sizeof msg, "worker killed: wall time exceeded");
         else if (WIFSIGNALED(wstatus))
@@ -381,7 +282,7 @@ static void finished(pk_supervisor *s, slot *sl, int wstatus)
 }
 
 /* Pending ends whose second has come are written again. */
-static void retry_ends(pk_supervisor *s)
+static void retry_ends(local_exec *s)
 {
     double now = pk_queue_now();
     for (int k = 0; k < MAX_SLOTS && __atomic_load_n(&s->unrecorded, __ATOMIC_RELAXED); k++) {
@@ -394,7 +295,7 @@ static void retry_ends(pk_supervisor *s)
     }
 }
 
-static void send_cancels(pk_supervisor *s)
+static void send_cancels(local_exec *s)
 {
     json_t *req = pk_queue_cancel_requests(s->q);
     size_t i;
@@ -419,7 +320,7 @@ static void send_cancels(pk_supervisor *s)
     json_decref(req);
 }
 
-static void enforce_wall_time(pk_supervisor *s, double max_wall)
+static void enforce_wall_time(local_exec *s, double max_wall)
 {
     double now = pk_queue_now();
     for (int k = 0; k < MAX_SLOTS; k++) {
@@ -433,7 +334,7 @@ static void enforce_wall_time(pk_supervisor *s, double max_wall)
 
 static void *loop(void *arg)
 {
-    pk_supervisor *s = arg;
+    local_exec *s = arg;
     struct pollfd pfd[MAX_SLOTS + 1];
     int map[MAX_SLOTS + 1];
     for (;;) {
@@ -472,7 +373,8 @@ static void *loop(void *arg)
         for (int k = 0; !stopping && busy < workers && k < MAX_SLOTS; k++) {
             if (s->slots[k].pid || s->slots[k].end.pending)
                 continue;
-            json_t *job = pk_queue_claim(s->q);
+            json_t *job = pk_queue_claim_by_wall(
+                s->q, s->short_only ? PK_CLAIM_SHORT : PK_CLAIM_ANY, s->local_below_s);
             if (!job)
                 break;
             if (launch(s, &s->slots[k], job) == 0)
@@ -511,88 +413,93 @@ static void *loop(void *arg)
     return NULL;
 }
 
-pk_supervisor *pk_supervisor_start(pk_queue *q, const char *exe, const char *data, int workers,
-                                   double max_wall_time_s, int job_threads)
+static void configure(pk_executor *e, const pk_config *c)
 {
-    pk_supervisor *s = calloc(1, sizeof *s);
-    if (!s)
-        return NULL;
-    s->q = q;
-    snprintf(s->exe, sizeof s->exe, "%s", exe);
-    snprintf(s->data, sizeof s->data, "%s", data);
-    s->workers = workers > MAX_SLOTS ? MAX_SLOTS : workers;
-    s->max_wall_time_s = max_wall_time_s;
-    s->job_threads = job_threads;
-    pthread_mutex_init(&s->mu, NULL);
-    if (cloexec_pipe(s->wake, 1) != 0 || pthread_create(&s->thread, NULL, loop, s) != 0) {
-        free(s);
-        return NULL;
-    }
-    return s;
-}
-
-void pk_supervisor_configure(pk_supervisor *s, int workers, double max_wall_time_s, int job_threads)
-{
+    local_exec *s = (local_exec *)e;
     pthread_mutex_lock(&s->mu);
-    s->workers = workers > MAX_SLOTS ? MAX_SLOTS : workers;
-    s->max_wall_time_s = max_wall_time_s;
-    s->job_threads = job_threads;
+    s->workers = c->workers > MAX_SLOTS ? MAX_SLOTS : c->workers;
+    s->max_wall_time_s = c->max_wall_time_s;
+    s->job_threads = c->job_threads;
+    s->checkpoint_interval_s = c->checkpoint_interval_s;
+    s->local_below_s = c->slurm_local_below_s;
     pthread_mutex_unlock(&s->mu);
-    pk_supervisor_wake(s);
+    e->ops->wake(e);
 }
 
-void pk_supervisor_set_checkpoint_interval(pk_supervisor *s, double seconds)
+static void wake(pk_executor *e)
 {
+    ssize_t r = write(((local_exec *)e)->wake[1], "w", 1);
+    (void)r;
+}
+
+static int busy(pk_executor *e)
+{
+    return __atomic_load_n(&((local_exec *)e)->busy, __ATOMIC_RELAXED);
+}
+
+static int capacity(pk_executor *e)
+{
+    local_exec *s = (local_exec *)e;
     pthread_mutex_lock(&s->mu);
-    s->checkpoint_interval_s = seconds;
+    int w = s->workers;
     pthread_mutex_unlock(&s->mu);
-}
-
-void pk_supervisor_wake(pk_supervisor *s)
-{
-    if (s) {
-        ssize_t r = write(s->wake[1], "w", 1);
-        (void)r;
-    }
-}
-
-int pk_supervisor_busy(const pk_supervisor *s)
-{
-    return __atomic_load_n(&s->busy, __ATOMIC_RELAXED);
-}
-
-int pk_supervisor_unrecorded(const pk_supervisor *s)
-{
-    return __atomic_load_n(&s->unrecorded, __ATOMIC_RELAXED);
-}
-
-int pk_supervisor_capacity(const pk_supervisor *s)
-{
-    pk_supervisor *m = (pk_supervisor *)s;
-    pthread_mutex_lock(&m->mu);
-    int w = m->workers;
-    pthread_mutex_unlock(&m->mu);
     return w;
 }
 
-void pk_supervisor_stop(pk_supervisor *s, double grace_s)
+static int healthy(pk_executor *e, char *why, size_t n) { return 1; }
+
+static int unrecorded(pk_executor *e)
 {
-    if (!s)
-        return;
+    return __atomic_load_n(&((local_exec *)e)->unrecorded, __ATOMIC_RELAXED);
+}
+
+static void stop(pk_executor *e, double grace_s)
+{
+    local_exec *s = (local_exec *)e;
     pthread_mutex_lock(&s->mu);
+    if (s->stopping) {
+        pthread_mutex_unlock(&s->mu);
+        return;
+    }
     s->stopping = 1;
     s->grace_deadline = pk_queue_now() + grace_s;
     pthread_mutex_unlock(&s->mu);
-    pk_supervisor_wake(s);
+    wake(e);
     pthread_join(s->thread, NULL);
 }
 
-void pk_supervisor_free(pk_supervisor *s)
+static void destroy(pk_executor *e)
 {
-    if (!s)
-        return;
+    local_exec *s = (local_exec *)e;
     close(s->wake[0]);
     close(s->wake[1]);
     pthread_mutex_destroy(&s->mu);
     free(s);
+}
+
+static const pk_executor_ops local_ops = {"local", configure, wake,    busy, capacity,
+                                          healthy, stop,      destroy, NULL, unrecorded};
+
+pk_executor *pk_executor_local_start(pk_queue *q, const char *exe, const pk_config *c,
+                                     int short_only)
+{
+    local_exec *s = calloc(1, sizeof *s);
+    if (!s)
+        return NULL;
+    s->base.ops = &local_ops;
+    s->q = q;
+    s->short_only = short_only;
+    snprintf(s->exe, sizeof s->exe, "%s", exe);
+    snprintf(s->data, sizeof s->data, "%s", c->data);
+    pthread_mutex_init(&s->mu, NULL);
+    if (cloexec_pipe(s->wake, 1) != 0) {
+        free(s);
+        return NULL;
+    }
+    configure(&s->base, c);
+    if (pthread_create(&s->thread, NULL, loop, s) != 0) {
+        destroy(&s->base);
+        return NULL;
+    }
+    return &s->base;
 }
