@@ -17,6 +17,9 @@
  * Δd 1 mm needs 26 per grain, Titscher's 150 mm specimen 37. */
 #define VOXELS_PER_GRAIN 64
 #define VOXELS_FREE 65536
+/* and at most this many in all: 12 bytes a voxel, 1.6 GB (A16 with Δd 1 mm:
+ * ~5·10⁶ grains); beyond, plain draws */
+#define VOXELS_MAX ((uint64_t)1 << 27)
 
 /* Marking covered sub-voxels costs more than it saves while most draws
  * succeed: it starts once a window of WINDOW placements took more than
@@ -57,7 +60,7 @@ static void begin_segment(segment *sg, const pk_box *b, const double *diameters,
     sg->tried = 1;
     double r_valid = 0.5 * diameters[n - 1];
     uint64_t nv = pk_rsa_vox_count(b, r_valid, 0.5 * diameters[i], gap, wall);
-    if (nv == 0 || nv > (uint64_t)VOXELS_PER_GRAIN * (n - i) + VOXELS_FREE)
+    if (nv == 0 || nv > VOXELS_MAX || nv > (uint64_t)VOXELS_PER_GRAIN * (n - i) + VOXELS_FREE)
         return;
     if (pk_rsa_vox_init(&sg->vox, b, r_valid, 0.5 * diameters[i], gap, wall) != 0)
         return; /* out of memory for the set: plain draws still work */

@@ -87,18 +87,15 @@ int pk_rsa_vox_init(pk_rsa_vox *v, const pk_box *b, double r_valid, double r_top
      * coordinates, far below any length that matters to the statistics. */
     v->margin = 1e-9 * (2 * r_top + gap) + 1e-12 * lmax;
     v->nvox = nv;
-    v->sub = b->dim == 3 ? 4 : 8; /* 4³ or 8² sub-voxels: one 64-bit mask */
+    v->sub = b->dim == 3 ? 4 : 8; /* 4³ or 8² sub-voxels: one 64-bit word */
     for (int k = 0; k < PK_MAXDIM; k++)
         v->se[k] = v->e[k] / (double)v->sub;
-    v->mask = malloc(nv * sizeof *v->mask);
-    v->list = malloc(nv * sizeof *v->list);
-    if (!v->mask || !v->list) {
+    /* zeroed pages are mapped on first touch: no pass over the voxels here,
+     * and the list is the identity until its first compaction */
+    v->covered = calloc(nv, sizeof *v->covered);
+    if (!v->covered) {
         pk_rsa_vox_free(v);
         return -1;
-    }
-    for (uint64_t i = 0; i < nv; i++) {
-        v->mask[i] = ~(uint64_t)0;
-        v->list[i] = (uint32_t)i;
     }
     v->nlist = nv;
     return 0;
@@ -106,7 +103,7 @@ int pk_rsa_vox_init(pk_rsa_vox *v, const pk_box *b, double r_valid, double r_top
 
 void pk_rsa_vox_free(pk_rsa_vox *v)
 {
-    free(v->mask);
+    free(v->covered);
     free(v->list);
     memset(v, 0, sizeof *v);
 }
@@ -127,13 +124,23 @@ static inline void axis_range(const pk_rsa_vox *v, int k, double a, double c, in
 }
 
 /* Drop the voxels left without an open sub-voxel from the list (in place, in
- * list order, so the masks are read as a stream). */
+ * list order, so the bits are read as a stream); the first compaction
+ * makes the list. */
 static void compact(pk_rsa_vox *v)
 {
     uint64_t k = 0;
-    for (uint64_t i = 0; i < v->nlist; i++)
-        if (v->mask[v->list[i]])
-            v->list[k++] = v->list[i];
+    if (!v->list) {
+        v->list = malloc((v->nlist - v->nstale + 1) * sizeof *v->list);
+        if (!v->list)
+            return; /* draws stay on the identity list */
+        for (uint64_t i = 0; i < v->nlist; i++)
+            if (~v->covered[i])
+                v->list[k++] = (uint32_t)i;
+    } else {
+        for (uint64_t i = 0; i < v->nlist; i++)
+            if (~v->covered[v->list[i]])
+                v->list[k++] = v->list[i];
+    }
     v->nlist = k;
     v->nstale = 0;
 }
@@ -210,11 +217,11 @@ void pk_rsa_vox_cover(pk_rsa_vox *v, const double x[PK_MAXDIM], double r)
                 if (nzy + near2(v, 0, ix, x[0]) >= R2)
                     continue;
                 uint64_t vid = base + (uint64_t)wrap_index(v, 0, ix);
-                uint64_t m = v->mask[vid];
+                uint64_t m = ~v->covered[vid]; /* open sub-voxels */
                 if (!m)
                     continue;
                 if (fzy + far2(v, 0, ix, x[0]) <= R2) { /* the whole voxel is inside */
-                    v->mask[vid] = 0;
+                    v->covered[vid] = ~(uint64_t)0;
                     v->nstale++;
                     continue;
                 }
@@ -228,8 +235,8 @@ void pk_rsa_vox_cover(pk_rsa_vox *v, const double x[PK_MAXDIM], double r)
                             covered |= (uint64_t)(fx[lx] <= rem) << bit;
                     }
                 if (m & covered) {
-                    v->mask[vid] = m & ~covered;
-                    v->nstale += !v->mask[vid];
+                    v->covered[vid] |= covered;
+                    v->nstale += !~v->covered[vid];
                 }
             }
         }
@@ -254,23 +261,25 @@ static inline uint64_t uniform_below(pk_rng *g, uint32_t n)
 }
 
 /* Draws are picked DRAW_AHEAD calls before their use and their voxel is
- * looked up halfway, so the two cache misses of a draw (list entry, mask)
+ * looked up halfway, so the two cache misses of a draw (list entry, bits)
  * overlap with other draws' work.  Still exact: a pick is uniform over the
  * list when made; if it lies beyond the list's end at the look-up (a
  * compaction since) it is a rejected draw, otherwise its voxel is uniform
  * over the list of that moment, whose open space contains all space still
- * open at the use, where the mask and the exact test are applied.  8: TODO */
+ * open at the use, where the bits and the exact test are applied.  8: TODO */
 static inline void pick(pk_rsa_vox *v, pk_rng *g, int s)
 {
     v->pick[s] = (uint32_t)uniform_below(g, (uint32_t)v->nlist);
-    __builtin_prefetch(&v->list[v->pick[s]]);
+    if (v->list)
+        __builtin_prefetch(&v->list[v->pick[s]]);
 }
 
 static inline void look_up(pk_rsa_vox *v, int s)
 {
-    v->id[s] = v->pick[s] < v->nlist ? v->list[v->pick[s]] : UINT32_MAX;
+    uint32_t k = v->pick[s];
+    v->id[s] = k >= v->nlist ? UINT32_MAX : (v->list ? v->list[k] : k);
     if (v->id[s] != UINT32_MAX)
-        __builtin_prefetch(&v->mask[v->id[s]]);
+        __builtin_prefetch(&v->covered[v->id[s]]);
 }
 
 int pk_rsa_vox_draw(pk_rsa_vox *v, pk_rng *g, double x[PK_MAXDIM])
@@ -292,7 +301,7 @@ int pk_rsa_vox_draw(pk_rsa_vox *v, pk_rng *g, double x[PK_MAXDIM])
     if (id == UINT32_MAX)
         return 1; /* past the list's end: a compaction dropped its voxel */
     unsigned bit = (unsigned)(pk_rng_next(g) >> 58); /* uniform sub-voxel of 64 */
-    if (!(v->mask[id] >> bit & 1))
+    if (v->covered[id] >> bit & 1)
         return 1; /* covered sub-voxel: the exact test would reject any point in it */
     uint64_t t = id;
     x[2] = 0;

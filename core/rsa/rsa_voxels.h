@@ -2,7 +2,7 @@
  *
  * Late in an RSA run most uniform draws land in the exclusion zone of a placed
  * grain and are wasted.  This structure tiles the draw range with voxels, each
- * split into 64 sub-voxels (4³ or 8²) with one bit "not yet known to be
+ * split into 64 sub-voxels (4³ or 8²) with one bit "known to be
  * covered"; voxels with no bit left leave the list of active voxels at its
  * next compaction.  A draw
  * picks an active voxel uniformly and a point uniformly inside it; if the
@@ -49,8 +49,9 @@ typedef struct pk_rsa_vox {
     double margin;        /* absolute safety margin of the cover test */
     int sub;              /* sub-voxels per axis and voxel (sub^dim = 64) */
     double se[PK_MAXDIM]; /* sub-voxel edge per axis */
-    uint64_t *mask;       /* [nvox] sub-voxels not yet known covered, bit (z·sub+y)·sub+x */
-    uint32_t *list;       /* voxels with an open sub-voxel at the last compaction */
+    uint64_t *covered;    /* [nvox] sub-voxels known covered, bit (z·sub+y)·sub+x */
+    uint32_t *list;       /* voxels with an open sub-voxel at the last compaction
+                             (NULL before the first: all voxels, in order) */
     uint64_t nlist;
     uint64_t nstale; /* listed voxels full since */
     /* draws picked ahead (rsa_voxels.c, pk_rsa_vox_draw) */

@@ -252,7 +252,7 @@ static void test_cover_is_exact(void)
                         vid = vid * (uint64_t)v.n[k] + (uint64_t)(j[k] / v.sub);
                         bit = bit * (unsigned)v.sub + (unsigned)(j[k] % v.sub);
                     }
-                    int cleared = !(v.mask[vid] >> bit & 1);
+                    int cleared = (int)(v.covered[vid] >> bit & 1);
                     int inside = 0, deep = 0;
                     for (int q = 0; q < nb; q++) {
                         double f2 = sub_far2_brute(&v, j, c[q]);
