@@ -6,8 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define MAX_VOXELS ((uint64_t)1 << 31)
-/* The list is compacted once 1/STALE_PER_LIST of its voxels are full: draws
+/* list entries voxel·8 + group fit 32 bits */
+#define MAX_VOXELS ((uint64_t)1 << 29)
+/* The list is compacted once 1/STALE_PER_LIST of its groups are full: draws
  * into those are certain rejections, a compaction is one pass over the list.
  * 2: TODO */
 #define STALE_PER_LIST 2
@@ -61,6 +62,31 @@ uint64_t pk_rsa_vox_count(const pk_box *b, double r_valid, double r_top, double 
     return total;
 }
 
+/* Groups of 2×2×2 (3D) or 4×2 (2D) sub-voxels, one byte each: a pocket of
+ * open space a few sub-voxels wide keeps only its groups listed. */
+static void set_bit_layout(pk_rsa_vox *v)
+{
+    for (int l = 0; l < v->sub; l++) {
+        if (v->box.dim == 3) {
+            v->boff[0][l] = (uint8_t)((l >> 1) * 8 + (l & 1));
+            v->boff[1][l] = (uint8_t)((l >> 1) * 16 + (l & 1) * 2);
+            v->boff[2][l] = (uint8_t)((l >> 1) * 32 + (l & 1) * 4);
+        } else {
+            v->boff[0][l] = (uint8_t)((l >> 2) * 8 + (l & 3));
+            v->boff[1][l] = (uint8_t)((l >> 1) * 16 + (l & 1) * 4);
+        }
+    }
+    int S = v->sub, Sz = v->box.dim == 3 ? S : 1;
+    for (int lz = 0; lz < Sz; lz++)
+        for (int ly = 0; ly < S; ly++)
+            for (int lx = 0; lx < S; lx++) {
+                unsigned bit = v->boff[0][lx] + v->boff[1][ly] + v->boff[2][lz];
+                v->lsub[bit][0] = (uint8_t)lx;
+                v->lsub[bit][1] = (uint8_t)ly;
+                v->lsub[bit][2] = (uint8_t)lz;
+            }
+}
+
 int pk_rsa_vox_init(pk_rsa_vox *v, const pk_box *b, double r_valid, double r_top, double gap,
                     double wall)
 {
@@ -90,6 +116,7 @@ int pk_rsa_vox_init(pk_rsa_vox *v, const pk_box *b, double r_valid, double r_top
     v->sub = b->dim == 3 ? 4 : 8; /* 4³ or 8² sub-voxels: one 64-bit word */
     for (int k = 0; k < PK_MAXDIM; k++)
         v->se[k] = v->e[k] / (double)v->sub;
+    set_bit_layout(v);
     /* zeroed pages are mapped on first touch: no pass over the voxels here,
      * and the list is the identity until its first compaction */
     v->covered = calloc(nv, sizeof *v->covered);
@@ -97,7 +124,7 @@ int pk_rsa_vox_init(pk_rsa_vox *v, const pk_box *b, double r_valid, double r_top
         pk_rsa_vox_free(v);
         return -1;
     }
-    v->nlist = nv;
+    v->nlist = nv * PK_RSA_VOX_GROUPS;
     return 0;
 }
 
@@ -105,6 +132,7 @@ void pk_rsa_vox_free(pk_rsa_vox *v)
 {
     free(v->covered);
     free(v->list);
+
     memset(v, 0, sizeof *v);
 }
 
@@ -123,22 +151,39 @@ static inline void axis_range(const pk_rsa_vox *v, int k, double a, double c, in
     }
 }
 
-/* Drop the voxels left without an open sub-voxel from the list (in place, in
+static inline int group_open(const pk_rsa_vox *v, uint32_t e)
+{
+    return (uint8_t)(v->covered[e >> 3] >> (8 * (e & 7))) != 0xff;
+}
+
+/* Bytes of w with all 8 bits set (exact: no carry crosses a byte). */
+static inline int full_bytes(uint64_t w)
+{
+    const uint64_t lo7 = 0x7f7f7f7f7f7f7f7full;
+    uint64_t t = ~w;
+    uint64_t y = ~(((t & lo7) + lo7) | t | lo7) >> 7; /* 1 in each full byte */
+    return (int)((y * 0x0101010101010101ull) >> 56);
+}
+
+/* Drop the groups left without an open sub-voxel from the list (in place, in
  * list order, so the bits are read as a stream); the first compaction
- * makes the list. */
+ * makes the list, of the exact size. */
 static void compact(pk_rsa_vox *v)
 {
     uint64_t k = 0;
     if (!v->list) {
-        v->list = malloc((v->nlist - v->nstale + 1) * sizeof *v->list);
+        uint64_t open = 0;
+        for (uint64_t i = 0; i < v->nvox; i++)
+            open += (uint64_t)(PK_RSA_VOX_GROUPS - full_bytes(v->covered[i]));
+        v->list = malloc((open + 1) * sizeof *v->list);
         if (!v->list)
             return; /* draws stay on the identity list */
-        for (uint64_t i = 0; i < v->nlist; i++)
-            if (~v->covered[i])
-                v->list[k++] = (uint32_t)i;
+        for (uint32_t i = 0; i < v->nlist; i++)
+            if (group_open(v, i))
+                v->list[k++] = i;
     } else {
         for (uint64_t i = 0; i < v->nlist; i++)
-            if (~v->covered[v->list[i]])
+            if (group_open(v, v->list[i]))
                 v->list[k++] = v->list[i];
     }
     v->nlist = k;
@@ -197,6 +242,17 @@ void pk_rsa_vox_cover(pk_rsa_vox *v, const double x[PK_MAXDIM], double r)
         axis_range(v, 2, x[2] - R, x[2] + R, &zlo, &zhi);
     axis_range(v, 1, x[1] - R, x[1] + R, &ylo, &yhi);
     axis_range(v, 0, x[0] - R, x[0] + R, &xlo, &xhi);
+    /* the rows' words are far apart: fetch them all before the work (the
+     * loads were most of this function's time) */
+    for (int64_t iz = zlo; iz <= zhi; iz++) {
+        uint64_t zbase = (uint64_t)wrap_index(v, 2, iz) * (uint64_t)v->n[1];
+        for (int64_t iy = ylo; iy <= yhi; iy++) {
+            const uint64_t *row =
+                &v->covered[(zbase + (uint64_t)wrap_index(v, 1, iy)) * (uint64_t)v->n[0]];
+            __builtin_prefetch(&row[wrap_index(v, 0, xlo)]);
+            __builtin_prefetch(&row[wrap_index(v, 0, xhi)]);
+        }
+    }
     double fz[8] = {0}, fy[8], fx[8];
     for (int64_t iz = zlo; iz <= zhi; iz++) {
         double nz = dim == 3 ? near2(v, 2, iz, x[2]) : 0;
@@ -217,26 +273,26 @@ void pk_rsa_vox_cover(pk_rsa_vox *v, const double x[PK_MAXDIM], double r)
                 if (nzy + near2(v, 0, ix, x[0]) >= R2)
                     continue;
                 uint64_t vid = base + (uint64_t)wrap_index(v, 0, ix);
-                uint64_t m = ~v->covered[vid]; /* open sub-voxels */
-                if (!m)
+                uint64_t was = v->covered[vid];
+                if (!~was)
                     continue;
                 if (fzy + far2(v, 0, ix, x[0]) <= R2) { /* the whole voxel is inside */
                     v->covered[vid] = ~(uint64_t)0;
-                    v->nstale++;
+                    v->nstale += (uint64_t)(PK_RSA_VOX_GROUPS - full_bytes(was));
                     continue;
                 }
                 sub_far2(v, 0, ix, x[0], fx);
                 uint64_t covered = 0;
-                unsigned bit = 0; /* (lz·S + ly)·S + lx, as in pk_rsa_vox_draw */
                 for (int lz = 0; lz < Sz; lz++)
                     for (int ly = 0; ly < S; ly++) {
                         double rem = R2 - fz[lz] - fy[ly];
-                        for (int lx = 0; lx < S; lx++, bit++)
-                            covered |= (uint64_t)(fx[lx] <= rem) << bit;
+                        unsigned row = (unsigned)v->boff[2][lz] + v->boff[1][ly];
+                        for (int lx = 0; lx < S; lx++)
+                            covered |= (uint64_t)(fx[lx] <= rem) << (row + v->boff[0][lx]);
                     }
-                if (m & covered) {
-                    v->covered[vid] |= covered;
-                    v->nstale += !~v->covered[vid];
+                if (covered & ~was) {
+                    v->covered[vid] = was | covered;
+                    v->nstale += (uint64_t)(full_bytes(was | covered) - full_bytes(was));
                 }
             }
         }
@@ -260,7 +316,7 @@ static inline uint64_t uniform_below(pk_rng *g, uint32_t n)
     return m >> 32;
 }
 
-/* Draws are picked DRAW_AHEAD calls before their use and their voxel is
+/* Draws are picked DRAW_AHEAD calls before their use and their group is
  * looked up halfway, so the two cache misses of a draw (list entry, bits)
  * overlap with other draws' work.  Still exact: a pick is uniform over the
  * list when made; if it lies beyond the list's end at the look-up (a
@@ -279,7 +335,7 @@ static inline void look_up(pk_rsa_vox *v, int s)
     uint32_t k = v->pick[s];
     v->id[s] = k >= v->nlist ? UINT32_MAX : (v->list ? v->list[k] : k);
     if (v->id[s] != UINT32_MAX)
-        __builtin_prefetch(&v->covered[v->id[s]]);
+        __builtin_prefetch(&v->covered[v->id[s] >> 3]);
 }
 
 int pk_rsa_vox_draw(pk_rsa_vox *v, pk_rng *g, double x[PK_MAXDIM])
@@ -299,17 +355,17 @@ int pk_rsa_vox_draw(pk_rsa_vox *v, pk_rng *g, double x[PK_MAXDIM])
     pick(v, g, h);
     look_up(v, (h + PK_RSA_DRAW_AHEAD / 2) % PK_RSA_DRAW_AHEAD);
     if (id == UINT32_MAX)
-        return 1; /* past the list's end: a compaction dropped its voxel */
-    unsigned bit = (unsigned)(pk_rng_next(g) >> 58); /* uniform sub-voxel of 64 */
-    if (v->covered[id] >> bit & 1)
+        return 1; /* past the list's end: a compaction dropped its group */
+    /* a uniform sub-voxel of the group's 8 */
+    unsigned bit = (unsigned)(id & 7) * 8 + (unsigned)(pk_rng_next(g) >> 61);
+    uint64_t t = id >> 3;
+    if (v->covered[t] >> bit & 1)
         return 1; /* covered sub-voxel: the exact test would reject any point in it */
-    uint64_t t = id;
     x[2] = 0;
     for (int k = 0; k < v->box.dim; k++) {
         int64_t i = (int64_t)(t % (uint64_t)v->n[k]);
         t /= (uint64_t)v->n[k];
-        int64_t j = i * v->sub + (int64_t)(bit % (unsigned)v->sub);
-        bit /= (unsigned)v->sub;
+        int64_t j = i * v->sub + v->lsub[bit][k];
         x[k] = v->org[k] + v->se[k] * ((double)j + pk_rng_uniform(g));
     }
     return 0;

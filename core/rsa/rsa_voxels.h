@@ -3,14 +3,14 @@
  * Late in an RSA run most uniform draws land in the exclusion zone of a placed
  * grain and are wasted.  This structure tiles the draw range with voxels, each
  * split into 64 sub-voxels (4³ or 8²) with one bit "known to be
- * covered"; voxels with no bit left leave the list of active voxels at its
- * next compaction.  A draw
- * picks an active voxel uniformly and a point uniformly inside it; if the
+ * covered", in 8 groups of 8; groups with every bit set leave the list of
+ * active groups at its next compaction.  A draw
+ * picks an active group uniformly and a point uniformly inside it; if the
  * point's sub-voxel is marked covered the draw is rejected at once, otherwise
- * it is tested exactly as before.  Why this is still true RSA: all voxels have
- * the same volume, so the point is uniform over the union of active voxels;
+ * it is tested exactly as before.  Why this is still true RSA: all groups have
+ * the same volume, so the point is uniform over the union of active groups;
  * that union contains all the space still available to the grain (a bit is
- * cleared only when its sub-voxel lies inside the exclusion ball of one
+ * set only when its sub-voxel lies inside the exclusion ball of one
  * placed grain, see pk_rsa_vox_cover), and the marked sub-voxels hold no
  * available point; rejection then leaves the accepted point uniform over the
  * available space — the law of a plain draw-until-accepted loop, with fewer
@@ -24,7 +24,8 @@
  * the lattice tiles the draw range of r_valid, the largest one; a larger grain
  * rejects draws outside its own range.
  *
- * The set holds only the bits (8 bytes a voxel, 12 with the list): the
+ * The set holds only the bits (8 bytes a voxel, at most 8·4 more for the
+ * list of groups, typically ~8 after its first compaction): the
  * exact test is the caller's (pk_grid), so the voxel edge
  * (2 r_valid + Δd)/√dim only sets the resolution of the marks. */
 #ifndef PK_RSA_VOXELS_H
@@ -36,6 +37,11 @@
 #include "core/base/rng.h"
 
 #define PK_RSA_DRAW_AHEAD 8
+
+/* A voxel's 64 bits come in 8 groups of 8 sub-voxels (2×2×2 in 3D, 4×2 in
+ * 2D), one byte each; the list holds groups, entry = voxel·8 + group, so a
+ * group whose 8 sub-voxels are covered leaves the list on its own. */
+#define PK_RSA_VOX_GROUPS 8
 
 typedef struct pk_rsa_vox {
     pk_box box;
@@ -49,11 +55,15 @@ typedef struct pk_rsa_vox {
     double margin;        /* absolute safety margin of the cover test */
     int sub;              /* sub-voxels per axis and voxel (sub^dim = 64) */
     double se[PK_MAXDIM]; /* sub-voxel edge per axis */
-    uint64_t *covered;    /* [nvox] sub-voxels known covered, bit (z·sub+y)·sub+x */
-    uint32_t *list;       /* voxels with an open sub-voxel at the last compaction
-                             (NULL before the first: all voxels, in order) */
+    /* bit of sub-voxel (lx, ly, lz): boff[0][lx] + boff[1][ly] + boff[2][lz]
+     * (group·8 + place in the group) */
+    uint8_t boff[PK_MAXDIM][8];
+    uint8_t lsub[64][PK_MAXDIM]; /* the inverse: sub-voxel coordinates of a bit */
+    uint64_t *covered;           /* [nvox] sub-voxels known covered */
+    uint32_t *list;              /* groups with an open sub-voxel at the last compaction
+                                    (NULL before the first: all groups, in order) */
     uint64_t nlist;
-    uint64_t nstale; /* listed voxels full since */
+    uint64_t nstale; /* listed groups full since */
     /* draws picked ahead (rsa_voxels.c, pk_rsa_vox_draw) */
     uint32_t pick[PK_RSA_DRAW_AHEAD], id[PK_RSA_DRAW_AHEAD];
     int head, primed;
@@ -79,5 +89,14 @@ void pk_rsa_vox_cover(pk_rsa_vox *v, const double x[PK_MAXDIM], double r);
  * certain rejection: x is not computed), or -1 if no voxel is left: no room
  * for any grain with r >= r_valid (saturation). */
 int pk_rsa_vox_draw(pk_rsa_vox *v, pk_rng *g, double x[PK_MAXDIM]);
+
+/* The bit of sub-voxel l (coordinates 0..sub-1 per axis) in its voxel's word. */
+static inline unsigned pk_rsa_vox_bit(const pk_rsa_vox *v, const int l[PK_MAXDIM])
+{
+    unsigned b = 0;
+    for (int k = 0; k < v->box.dim; k++)
+        b += v->boff[k][l[k]];
+    return b;
+}
 
 #endif
