@@ -3,12 +3,14 @@
  * Late in an RSA run most uniform draws land in the exclusion zone of a placed
  * grain and are wasted.  This structure tiles the draw range with voxels, each
  * split into 64 sub-voxels (4³ or 8²) with one bit "known to be
- * covered", in 8 groups of 8; groups with every bit set leave the list of
- * active groups at its next compaction.  A draw
- * picks an active group uniformly and a point uniformly inside it; if the
+ * covered", in 8 groups of 8.  The list holds the voxels with an open
+ * sub-voxel, and once the open groups are fewer than half of those, the open
+ * groups instead; the full ones leave it at its next compaction.  A draw
+ * picks a listed voxel (group) uniformly and a point uniformly inside it; if the
  * point's sub-voxel is marked covered the draw is rejected at once, otherwise
- * it is tested exactly as before.  Why this is still true RSA: all groups have
- * the same volume, so the point is uniform over the union of active groups;
+ * it is tested exactly as before.  Why this is still true RSA: all voxels
+ * (groups) have the same volume, so the point is uniform over the union of
+ * the listed ones;
  * that union contains all the space still available to the grain (a bit is
  * set only when its sub-voxel lies inside the exclusion ball of one
  * placed grain, see pk_rsa_vox_cover), and the marked sub-voxels hold no
@@ -24,8 +26,8 @@
  * the lattice tiles the draw range of r_valid, the largest one; a larger grain
  * rejects draws outside its own range.
  *
- * The set holds only the bits (8 bytes a voxel, at most 8·4 more for the
- * list of groups, typically ~8 after its first compaction): the
+ * The set holds only the bits (8 bytes a voxel, at most 4 more for the
+ * list): the
  * exact test is the caller's (pk_grid), so the voxel edge
  * (2 r_valid + Δd)/√dim only sets the resolution of the marks. */
 #ifndef PK_RSA_VOXELS_H
@@ -39,8 +41,8 @@
 #define PK_RSA_DRAW_AHEAD 8
 
 /* A voxel's 64 bits come in 8 groups of 8 sub-voxels (2×2×2 in 3D, 4×2 in
- * 2D), one byte each; the list holds groups, entry = voxel·8 + group, so a
- * group whose 8 sub-voxels are covered leaves the list on its own. */
+ * 2D), one byte each; a list of groups (entry voxel·8 + group) keeps only
+ * the groups of a pocket of open space. */
 #define PK_RSA_VOX_GROUPS 8
 
 typedef struct pk_rsa_vox {
@@ -60,10 +62,12 @@ typedef struct pk_rsa_vox {
     uint8_t boff[PK_MAXDIM][8];
     uint8_t lsub[64][PK_MAXDIM]; /* the inverse: sub-voxel coordinates of a bit */
     uint64_t *covered;           /* [nvox] sub-voxels known covered */
-    uint32_t *list;              /* groups with an open sub-voxel at the last compaction
-                                    (NULL before the first: all groups, in order) */
+    uint32_t *list;              /* voxels (grouped: groups) with an open sub-voxel at the
+                                    last compaction (NULL before the first: all voxels) */
     uint64_t nlist;
-    uint64_t nstale; /* listed groups full since */
+    uint64_t nstale;      /* listed voxels (groups) full since */
+    int grouped;          /* list entries are groups, voxel·8 + group */
+    uint64_t open_groups; /* groups with an open sub-voxel, all voxels */
     /* draws picked ahead (rsa_voxels.c, pk_rsa_vox_draw) */
     uint32_t pick[PK_RSA_DRAW_AHEAD], id[PK_RSA_DRAW_AHEAD];
     int head, primed;
