@@ -50,10 +50,10 @@ const char *pk_verdict_status(const json_t *summary)
 int pk_verdict_write_h5(pk_h5 *h, const json_t *summary)
 {
     int rc = pk_h5_obs_string(h, "verdict/status", pk_verdict_status(summary));
-    rc |= pk_h5_obs_int(h, "verdict/complete", json_is_true(json_object_get(summary, "complete")));
+    pk_h5_obs_int(h, "verdict/complete", json_is_true(json_object_get(summary, "complete")));
     if (pk_verdict_failed(summary))
-        rc |= pk_h5_obs_string(h, "verdict/failure",
-                               json_string_value(json_object_get(summary, "failure")));
+        pk_h5_obs_string(h, "verdict/failure",
+                         json_string_value(json_object_get(summary, "failure")));
     json_t *w = json_object_get(summary, "warnings");
     size_t n = json_array_size(w), len = 1, i;
     json_t *e;
@@ -68,8 +68,8 @@ int pk_verdict_write_h5(pk_h5 *h, const json_t *summary)
         if (i + 1 < n)
             strcat(text, "\n");
     }
-    rc |= pk_h5_obs_string(h, "verdict/warnings", text);
-    rc |= pk_h5_obs_int(h, "verdict/warning_count", (int64_t)n);
+    pk_h5_obs_string(h, "verdict/warnings", text);
+    pk_h5_obs_int(h, "verdict/warning_count", (int64_t)n);
     free(text);
     return rc ? -1 : 0;
 }
@@ -77,7 +77,7 @@ int pk_verdict_write_h5(pk_h5 *h, const json_t *summary)
 int pk_verdict_close_h5(pk_h5 *h, int failed, const json_t *summary, const char *out_path,
                         char *err, size_t errlen)
 {
-    if (failed || pk_verdict_write_h5(h, summary) != 0) {
+    if (failed || pk_verdict_write_h5(h, summary) != 0 || pk_h5_failed(h)) {
         pk_h5_abort(h); /* a half-written file never takes the result's name */
         snprintf(err, errlen, "writing %s failed", out_path);
         return -1;

@@ -12,17 +12,21 @@
 #include "job_verdict.h"
 #include "api/pack/pack_job.h"
 
+static const char *const pack_pictures[] = {"packing", "grading", "history", NULL};
 static const pk_process pack_process = {
     .id = "pack",
     .title = "Pack grains from a grading curve",
     .description = "Draw grain sizes from a grading (sieve) curve and place them in a 2D or 3D "
                    "box (periodic or walled) with a minimum gap; writes an H5MD result file.",
     .inputs_schema = "pack.inputs.schema.json",
+    .pictures = pack_pictures,
     .parse = pk_pack_parse,
     .free_job = pk_pack_free,
+    .plan = pk_pack_plan_json,
     .run = pk_pack_run,
 };
 
+static const char *const homogenize_pictures[] = {"packing", "stress", "residual", NULL};
 static const pk_process homogenize_process = {
     .id = "homogenize",
     .title = "Homogenize a packing (DEM RVE)",
@@ -31,11 +35,13 @@ static const pk_process homogenize_process = {
                    "conditions; per step the Piola and Cauchy stress, energies, relaxation "
                    "figures and optionally the tangent (Meier 2009); writes an H5MD result file.",
     .inputs_schema = "homogenize.inputs.schema.json",
+    .pictures = homogenize_pictures,
     .parse = pk_homog_parse,
     .free_job = pk_homog_free,
     .run = pk_homog_run,
 };
 
+static const char *const fe2_pictures[] = {"packing", "response", NULL};
 static const pk_process fe2_process = {
     .id = "fe2",
     .title = "FE²: a plane-strain boundary value problem with a DEM RVE at every Gauss point",
@@ -47,6 +53,7 @@ static const pk_process fe2_process = {
                    "cutting; writes an H5MD result file with the mesh, the fields per converged "
                    "load step and the Newton histories.",
     .inputs_schema = "fe2.inputs.schema.json",
+    .pictures = fe2_pictures,
     .parse = pk_fe2_parse,
     .free_job = pk_fe2_free,
     .run = pk_fe2_run,
@@ -86,19 +93,6 @@ size_t pk_process_validate_inputs(const pk_process *p, json_t *inputs, const pk_
 }
 
 /* Prefix the pointers of errors [from, n) with "/inputs". */
-static void prefix_inputs(pk_schema_errors *errs, size_t from)
-{
-    for (size_t i = from; i < errs->n; i++) {
-        char *ptr = errs->items[i].pointer;
-        size_t len = strlen(ptr), cap = sizeof errs->items[i].pointer;
-        if (len + 8 > cap) /* keep the tail of very deep pointers */
-            len = cap - 8;
-        memmove(ptr + 7, ptr, len);
-        memcpy(ptr, "/inputs", 7);
-        ptr[len + 7] = 0;
-    }
-}
-
 size_t pk_job_parse(json_t *job, const pk_check_ctx *ctx, const pk_process **proc, void **parsed,
                     pk_schema_errors *errs)
 {
@@ -116,16 +110,10 @@ size_t pk_job_parse(json_t *job, const pk_check_ctx *ctx, const pk_process **pro
     size_t mark = errs->n;
     if (pk_input_links_refuse(json_object_get(job, "inputs"), errs) == 0)
         pk_process_parse_inputs(p, json_object_get(job, "inputs"), ctx, parsed, errs);
-    prefix_inputs(errs, mark);
+    pk_schema_errors_prefix(errs, mark, "/inputs");
     if (errs->n == before)
         *proc = p;
     return errs->n - before;
-}
-
-size_t pk_job_validate(json_t *job, const pk_check_ctx *ctx, const pk_process **proc,
-                       pk_schema_errors *errs)
-{
-    return pk_job_parse(job, ctx, proc, NULL, errs);
 }
 
 int pk_job_run(json_t *job, const pk_run_ctx *run, const char *out_path, json_t **summary,

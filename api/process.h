@@ -16,12 +16,18 @@ typedef struct pk_process {
     const char *title;
     const char *description;
     const char *inputs_schema; /* file name in schemas/ */
+    /* The picture kinds (api/picture/picture.h) its results may hold,
+     * NULL-terminated: the pictures its description declares as outputs. */
+    const char *const *pictures;
     /* Schema-valid inputs → the parsed job (the process's option table
      * filled, semantic checks beyond the schema: cross-field rules,
      * feasibility), released by free_job; NULL with errors appended (JSON
      * pointers relative to the inputs object).  Borrows from inputs. */
     void *(*parse)(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
     void (*free_job)(void *job);
+    /* What a parsed job implies, for `packd validate` to show before a run
+     * (a new object, e.g. pack's expected grains); NULL: nothing to show. */
+    json_t *(*plan)(const void *job);
     /* Run a parsed job in the run context run (run_ctx.h: threads, monitor,
      * checkpoint, author), write the result file, return a summary object
      * (new reference) in *summary carrying the verdict (job_verdict.h).  0
@@ -51,8 +57,6 @@ size_t pk_process_validate_inputs(const pk_process *p, json_t *inputs, const pk_
  * errors are relative to the job file root. */
 size_t pk_job_parse(json_t *job, const pk_check_ctx *ctx, const pk_process **proc, void **parsed,
                     pk_schema_errors *errs);
-size_t pk_job_validate(json_t *job, const pk_check_ctx *ctx, const pk_process **proc,
-                       pk_schema_errors *errs);
 
 /* Validate, parse once and run a job (the one code path of `packd run` and
  * the daemon's workers) in the run context run (NULL: PK_RUN_CTX_DEFAULT;

@@ -179,7 +179,7 @@ static void job_case(const char *name, const char *json)
     double cpu = cpu_s() - c0;
     if (rc == 0) {
         json_t *o = json_object_get(sum, "edmd");
-        double s = json_real_value(json_object_get(sum, "seconds_place"));
+        double s = bench_num(sum, "timing/place_s");
         double coll = (double)json_integer_value(json_object_get(o, "events_pair"));
         double ev = (double)json_integer_value(json_object_get(o, "events"));
         printf("bench=edmd case=%s n=%lld phi=%.5f phi_mix=%.5f reason=%s criterion=%s events=%.0f "
@@ -250,7 +250,7 @@ static double file_case(const char *name, const char *job, const char *patch)
            name, job, bench_num(r.sum, "count_placed"), bench_num(r.sum, "phi_resolved"),
            bench_num(r.sum, "phi_mix"),
            json_string_value(json_object_get(r.sum, "termination_reason")), ev, coll,
-           bench_num(r.sum, "seconds_place"), r.cpu_s, coll / r.cpu_s, ev / r.cpu_s, r.maxrss_kb);
+           bench_num(r.sum, "timing/place_s"), r.cpu_s, coll / r.cpu_s, ev / r.cpu_s, r.maxrss_kb);
     fflush(stdout);
     json_decref(r.sum);
     return coll / r.cpu_s;

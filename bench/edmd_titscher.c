@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <sys/resource.h>
 
+#include "api/results/h5_observables.h"
 #include "api/process.h"
 
 static double cpu_s(void)
@@ -21,7 +22,7 @@ static double cpu_s(void)
         (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
 }
 
-static double num(json_t *o, const char *key) { return json_number_value(json_object_get(o, key)); }
+static double num(json_t *o, const char *key) { return json_number_value(pk_obs_value(o, key)); }
 
 /* maximize: grow the shell until jammed (job delta_d 0.5 as the floor). */
 static void a16(const char *name, double phi_mix, int seed, const char *wall_gap, int maximize)
@@ -54,7 +55,7 @@ static void a16(const char *name, double phi_mix, int seed, const char *wall_gap
             (long long)json_integer_value(json_object_get(sum, "count_placed")),
             dd >= 1 - 1e-12 ? "yes" : "no", dd, num(sum, "phi_mix"), num(o, "phi_shell"),
             json_string_value(json_object_get(o, "termination_criterion")),
-            (double)json_integer_value(json_object_get(o, "events")), num(sum, "seconds_place"),
+            (double)json_integer_value(json_object_get(o, "events")), num(sum, "timing/place_s"),
             cpu);
     } else {
         printf("reached=no error=\"%s\" cpu_s=%.2f\n", err, cpu);

@@ -255,7 +255,7 @@ static double job_case(const char *name, const char *job, const char *patch, int
         }
     const bench_job *m = &run[order[reps / 2]];
     json_t *sum = m->sum, *rsa = json_object_get(sum, "rsa");
-    double placed = bench_num(sum, "count_placed"), wall = bench_num(sum, "seconds_place");
+    double placed = bench_num(sum, "count_placed"), wall = bench_num(sum, "timing/place_s");
     printf("bench=rsa case=%s job=%s n=%.0f placed=%.0f reason=%s phi_mix=%.4f seconds=%.3f "
            "cpu_s=%.3f rate=%.0f rate_wall=%.0f draws_per_grain=%.2f maxrss_kb=%ld "
            "smallest_gap=%.6g smallest_wall_gap=%.6g reps=%d rate_min=%.0f rate_max=%.0f\n",

@@ -85,11 +85,6 @@ const char *pk_log_level_name(pk_log_level l)
     return l >= PK_LOG_DEBUG && l <= PK_LOG_ERROR ? level_names[l] : "info";
 }
 
-const char *pk_auth_mode_name(pk_auth_mode m)
-{
-    return m >= PK_AUTH_AUTO && m <= PK_AUTH_OFF ? auth_names[m] : "auto";
-}
-
 void pk_config_defaults(pk_config *c)
 {
     memset(c, 0, sizeof *c);

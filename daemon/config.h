@@ -64,7 +64,6 @@ int pk_config_load_env(pk_config *c, char *err, size_t errlen);
 int pk_config_from_args(pk_config *c, int argc, char **argv, char *err, size_t errlen);
 
 const char *pk_log_level_name(pk_log_level l);
-const char *pk_auth_mode_name(pk_auth_mode m);
 
 /* Print the keys with their defaults (for --help). */
 void pk_config_print_keys(void *file);

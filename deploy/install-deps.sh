@@ -4,6 +4,7 @@
 #   run    build packd and run the daemon: `make`, `make run` (the default)
 #   test   run + what `make test`'s tests drive (HDF5 tools, python, clang's fuzzer,
 #          chromium and node for the dashboard, Slurm and munge)
+#   mpi    run + OpenMPI: fe2 runs over MPI ranks (mpirun, srun), after a make
 #   bench  run + what bench/service.sh drives (wrk, sqlite3)
 # `install-deps.sh --list PURPOSE` prints that purpose's packages, one per line
 # (tests/integration/test_deps_list.sh holds the lists equal to what the build and the
@@ -11,12 +12,14 @@
 # installed; otherwise, or when sudo refuses, it prints the one command to run as root.
 set -eu
 # build + run: the compiler, the libraries packd links, a font for its pictures, and the
-# curl and h5dump (hdf5-tools) the README's commands use; OpenMPI, which the default build
-# links when present (Makefile MPI=auto: `mpirun`/`srun` spread an fe2 run over ranks)
-RUN_PKGS="build-essential pkg-config hdf5-tools libmicrohttpd-dev libcurl4-openssl-dev libssl-dev libjansson-dev libsqlite3-dev libhdf5-dev libsuitesparse-dev libopenblas0-serial libcairo2-dev fonts-dejavu-core curl openmpi-bin libopenmpi-dev"
+# curl and h5dump (hdf5-tools) the README's commands use
+RUN_PKGS="build-essential pkg-config hdf5-tools libmicrohttpd-dev libcurl4-openssl-dev libssl-dev libjansson-dev libsqlite3-dev libhdf5-dev libsuitesparse-dev libopenblas0-serial libcairo2-dev fonts-dejavu-core curl"
+# OpenMPI, which the build links when present (Makefile MPI=auto: `mpirun`/`srun` spread an
+# fe2 run over ranks); 48 packages, 141 MB, so not in `run`: `install-deps.sh mpi`, then make
+MPI_PKGS="openmpi-bin libopenmpi-dev"
 # libomp-14-dev: clang's <omp.h> for the fuzz build; libopenblas0-pthread: the digest
 # guard runs the solver against the threaded OpenBLAS too; clang-format: the format check
-TEST_PKGS="python3 python3-jsonschema python3-matplotlib python3-owslib procps clang libclang-rt-14-dev libomp-14-dev clang-format chromium nodejs libopenblas0-pthread slurm-wlm munge"
+TEST_PKGS="$MPI_PKGS python3 python3-jsonschema python3-matplotlib python3-owslib procps clang libclang-rt-14-dev libomp-14-dev clang-format chromium nodejs libopenblas0-pthread slurm-wlm munge"
 BENCH_PKGS="wrk sqlite3"
 # The dashboard's browser test drives chromium with playwright-core from npm; a node
 # from elsewhere (NodeSource) brings its own npm, which Debian's npm would conflict with.
@@ -26,9 +29,10 @@ pkgs_of() {
     case $1 in
     run) echo "$RUN_PKGS" ;;
     test) echo "$RUN_PKGS $TEST_PKGS" ;;
+    mpi) echo "$RUN_PKGS $MPI_PKGS" ;;
     bench) echo "$RUN_PKGS $BENCH_PKGS" ;;
     *)
-        echo "install-deps: unknown purpose '$1' (run, test or bench)" >&2
+        echo "install-deps: unknown purpose '$1' (run, mpi, test or bench)" >&2
         exit 2
         ;;
     esac

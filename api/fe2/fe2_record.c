@@ -42,6 +42,32 @@ static double mesh_area(const pk_fe2_mesh *m, const double *x)
     return a;
 }
 
+/* fe2's observables with a unit (h5_units.h), per unit thickness. */
+static const pk_unit_row fe2_units[] = {
+    {"fe2/mesh/nodes", PK_U_LENGTH},
+    {"fe2/mesh/gauss_position", PK_U_LENGTH},
+    {"fe2/mesh/gauss_weight", PK_U_AREA},
+    {"fe2/displacement", PK_U_LENGTH},
+    {"fe2/position", PK_U_LENGTH},
+    {"fe2/piola_stress", PK_U_PLANE_STRESS},
+    {"fe2/cauchy_stress", PK_U_PLANE_STRESS},
+    {"fe2/von_mises", PK_U_PLANE_STRESS},
+    {"fe2/von_mises_element", PK_U_PLANE_STRESS},
+    {"fe2/rve/energy_density", PK_U_PLANE_STRESS},
+    {"fe2/reaction", PK_U_FORCE_PER_THICKNESS},
+    {"fe2/area", PK_U_AREA},
+    {"fe2/reference_area", PK_U_AREA},
+    {"fe2/micro", PK_U_LENGTH}, /* the RVE centres micro/gauss_point_<g> */
+    {"fe2/newton/solves/abs_residual_0", PK_U_FORCE_PER_THICKNESS},
+    {"fe2/E_n", PK_U_STIFFNESS},
+    {NULL},
+};
+
+const char *pk_fe2_unit_of(const char *name, const pk_units *u)
+{
+    return pk_unit_in(fe2_units, name, u);
+}
+
 int pk_fe2_record_init(pk_fe2_record *r, const pk_fe2_setup *s, const size_t *micro_gp,
                        size_t nmicro, size_t ngrain)
 {
@@ -207,7 +233,7 @@ static int series(pk_h5 *h, const pk_fe2_record *r, char *clock, const char *nam
     static const double none[1] = {0};
     int rc =
         pk_h5_time_element(h, p, *clock ? clock : NULL, step, r->nstep ? r->time.v : none, NULL,
-                           PK_H5_F64, rank + 1, all, d->n ? d->v : none, pk_units_of(un, u));
+                           PK_H5_F64, rank + 1, all, d->n ? d->v : none, pk_fe2_unit_of(un, u));
     free(step);
     if (!*clock)
         snprintf(clock, 200, "%s", p);
@@ -235,7 +261,7 @@ int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r, const pk_units *u)
     int rc = 0;
     /* the mesh and its Gauss points */
     size_t d2[2] = {m->nnode, 2}, d4[2] = {m->nelem, 4};
-    rc |= arr(h, "/observables/fe2/mesh/nodes", 2, d2, m->xy, pk_units_of("fe2/mesh/nodes", u));
+    rc |= arr(h, "/observables/fe2/mesh/nodes", 2, d2, m->xy, pk_fe2_unit_of("fe2/mesh/nodes", u));
     rc |= pk_h5_write_array(h, "/observables/fe2/mesh/elements", PK_H5_I32, 2, d4, m->conn, NULL);
     /* the XDMF topology: one array per element kind, or Mixed (4 triangle, 5 quadrilateral) */
     size_t ntri = 0, nflat = 0;
@@ -266,9 +292,9 @@ int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r, const pk_units *u)
     }
     size_t dg[2] = {r->ngp, 2};
     rc |= arr(h, "/observables/fe2/mesh/gauss_position", 2, dg, gx,
-              pk_units_of("fe2/mesh/gauss_position", u));
+              pk_fe2_unit_of("fe2/mesh/gauss_position", u));
     rc |= arr(h, "/observables/fe2/mesh/gauss_weight", 1, &r->ngp, gw,
-              pk_units_of("fe2/mesh/gauss_weight", u));
+              pk_fe2_unit_of("fe2/mesh/gauss_weight", u));
     rc |= iarr(h, "/observables/fe2/mesh/gauss_element", ge, r->ngp);
     free(flat), free(gx), free(gw), free(ge);
     /* the load steps */
@@ -293,7 +319,8 @@ int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r, const pk_units *u)
     rc |= series(h, r, clock, "reaction", NULL, &r->reaction, 2, b2, u);
     rc |= series(h, r, clock, "area", NULL, &r->area, 0, NULL, u);
     rc |= series(h, r, clock, "dilatancy_percent", NULL, &r->dilatancy, 0, NULL, u);
-    rc |= pk_h5_obs_double(h, "fe2/reference_area", r->area0, pk_units_of("fe2/reference_area", u));
+    rc |= pk_h5_obs_double(h, "fe2/reference_area", r->area0,
+                           pk_fe2_unit_of("fe2/reference_area", u));
     /* the names of the conditions (rows of reaction) */
     char names[4096] = "";
     for (size_t k = 0; k < s->nbc; k++)
@@ -323,7 +350,7 @@ int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r, const pk_units *u)
     rc |= arr(h, "/observables/fe2/newton/solves/t1", 1, &np, r->part_t1.v, NULL);
     rc |= iarr(h, "/observables/fe2/newton/solves/iterations", r->part_n.v, np);
     rc |= arr(h, "/observables/fe2/newton/solves/abs_residual_0", 1, &np, r->part_abs0.v,
-              pk_units_of("fe2/newton/solves/abs_residual_0", u));
+              pk_fe2_unit_of("fe2/newton/solves/abs_residual_0", u));
     rc |= iarr(h, "/observables/fe2/newton/solves/converged", r->part_conv.v, np);
     rc |= iarr(h, "/observables/fe2/newton/iterations/solve", r->it_part.v, ni);
     rc |= arr(h, "/observables/fe2/newton/iterations/relative_residual", 1, &ni, r->it_res.v, NULL);

@@ -14,6 +14,9 @@
 #include "core/fe2/fe2_solver.h"
 #include "fe2_job.h"
 
+/* The unit of an fe2 observable ("fe2/piola_stress") in u, or NULL. */
+const char *pk_fe2_unit_of(const char *name, const pk_units *u);
+
 typedef struct pk_fe2_dbuf {
     double *v;
     size_t n, cap;

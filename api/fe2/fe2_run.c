@@ -352,7 +352,7 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
     w |= pk_h5_obs_string(h, "fe2/termination_reason", reason);
     w |= pk_h5_obs_string(h, "fe2/boundary_condition", pk_homog_bc_name(job->micro.bc));
     w |= pk_h5_obs_int(h, "fe2/rve_particles", (int64_t)rve.n);
-    w |= pk_h5_obs_double(h, "fe2/E_n", job->micro.E_n, pk_units_of("fe2/E_n", &units));
+    w |= pk_h5_obs_double(h, "fe2/E_n", job->micro.E_n, pk_fe2_unit_of("fe2/E_n", &units));
     if (pk_verdict_close_h5(h, w, sum, out_path, err, errlen) != 0)
         goto out;
     *summary = sum;

@@ -48,20 +48,20 @@ int pk_homog_ckpt_save(const char *path, const char *digest, const pk_homog_ckpt
                                   (int64_t)com->ncontact,
                                   (int64_t)com->hist.n};
     int rc = pk_h5_obs_string(h, G "digest", digest);
-    rc |= pk_h5_obs_ints(h, G "counters", cnt, C_COUNT);
-    rc |= pk_h5_obs_doubles(h, G "F", com->F, 9, NULL);
-    rc |= pk_h5_obs_doubles(h, G "A", c->A, 81, NULL);
+    pk_h5_obs_ints(h, G "counters", cnt, C_COUNT);
+    pk_h5_obs_doubles(h, G "F", com->F, 9, NULL);
+    pk_h5_obs_doubles(h, G "A", c->A, 81, NULL);
     /* the step report as it is in memory: the digest names the packd version */
-    rc |= pk_h5_obs_doubles(h, G "last_step", (const double *)&c->last,
-                            sizeof c->last / sizeof(double), NULL);
-    rc |= pk_h5_obs_doubles(h, G "x", com->x, 3 * com->n, NULL);
-    rc |= pk_h5_obs_ints(h, G "keys", (const int64_t *)com->keys, com->ncontact);
-    rc |= pk_h5_obs_doubles(h, G "u", u, com->n, NULL);
-    rc |= pk_h5_obs_ints(h, G "hist_key", (const int64_t *)com->hist.key, com->hist.n);
-    rc |= pk_h5_obs_doubles(h, G "hist_gamma", com->hist.gamma, com->hist.n, NULL);
-    rc |= pk_h5_obs_doubles(h, G "hist_gamma_pl", com->hist.gamma_pl, com->hist.n, NULL);
-    rc |= pk_h5_obs_doubles(h, G "hist_alpha", com->hist.alpha, com->hist.n, NULL);
-    rc |= pk_h5_obs_string(h, G "record", text);
+    pk_h5_obs_doubles(h, G "last_step", (const double *)&c->last, sizeof c->last / sizeof(double),
+                      NULL);
+    pk_h5_obs_doubles(h, G "x", com->x, 3 * com->n, NULL);
+    pk_h5_obs_ints(h, G "keys", (const int64_t *)com->keys, com->ncontact);
+    pk_h5_obs_doubles(h, G "u", u, com->n, NULL);
+    pk_h5_obs_ints(h, G "hist_key", (const int64_t *)com->hist.key, com->hist.n);
+    pk_h5_obs_doubles(h, G "hist_gamma", com->hist.gamma, com->hist.n, NULL);
+    pk_h5_obs_doubles(h, G "hist_gamma_pl", com->hist.gamma_pl, com->hist.n, NULL);
+    pk_h5_obs_doubles(h, G "hist_alpha", com->hist.alpha, com->hist.n, NULL);
+    pk_h5_obs_string(h, G "record", text);
     free(text);
     free(u);
     if (rc) {

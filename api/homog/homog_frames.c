@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/base/grow.h"
+
 #include "core/dem/dem_contact.h"
 
 void pk_homog_frames_init(pk_homog_frames *fr, const pk_homog_rve *rve, size_t nstep)
@@ -49,20 +51,10 @@ int pk_homog_frames_add(pk_homog_frames *fr, const pk_homog_rve *rve, const pk_h
         return 0;
     const size_t n = fr->n, dim = (size_t)fr->dim;
     if (fr->count == fr->cap) {
-        size_t cap = fr->cap ? 2 * fr->cap : 8;
-        int64_t *st = realloc(fr->step, cap * sizeof *st);
-        if (st)
-            fr->step = st;
-        double *t = realloc(fr->time, cap * sizeof *t);
-        if (t)
-            fr->time = t;
-        double *x = realloc(fr->x, cap * n * dim * sizeof *x);
-        if (x)
-            fr->x = x;
-        double *f = realloc(fr->force, cap * n * sizeof *f);
-        if (f)
-            fr->force = f;
-        if (!st || !t || !x || !f)
+        const size_t cap = pk_grow_cap(fr->cap, fr->count + 1, 8);
+        const pk_grow_item arrays[] = {PK_GROW_ITEM(fr->step, 1), PK_GROW_ITEM(fr->time, 1),
+                                       PK_GROW_ITEM(fr->x, n * dim), PK_GROW_ITEM(fr->force, n)};
+        if (pk_grow(arrays, 4, cap) != 0)
             return -1;
         fr->cap = cap;
     }
@@ -84,24 +76,24 @@ int pk_homog_frames_write(pk_h5 *h, const pk_homog_frames *fr, const pk_homog_rv
     const char *unit = u->length[0] ? u->length : NULL;
     const size_t n = rve->n, c = fr->count;
     int rc = pk_h5_link(h, "/particles/grains/box", "/particles/rve/box");
-    rc |= pk_h5_write_array(h, "/particles/rve/radius", PK_H5_F64, 1, &n, rve->r, unit);
-    rc |= pk_h5_write_array(h, "/particles/rve/grain", PK_H5_I32, 1, &n, rve->grain, NULL);
+    pk_h5_write_array(h, "/particles/rve/radius", PK_H5_F64, 1, &n, rve->r, unit);
+    pk_h5_write_array(h, "/particles/rve/grain", PK_H5_I32, 1, &n, rve->grain, NULL);
     int64_t *id = malloc((n ? n : 1) * sizeof *id);
     if (!id)
         return -1;
     for (size_t i = 0; i < n; i++)
         id[i] = (int64_t)i;
-    rc |= pk_h5_write_array(h, "/particles/rve/id", PK_H5_I64, 1, &n, id, NULL);
+    pk_h5_write_array(h, "/particles/rve/id", PK_H5_I64, 1, &n, id, NULL);
     free(id);
     if (!c)
         return rc ? -1 : 0;
     /* H5MD time-dependent elements: step, time (shared), value */
     const char *el[2] = {"position", "contact_force"};
     size_t dx[3] = {c, n, (size_t)fr->dim}, df[2] = {c, n};
-    rc |= pk_h5_time_element(h, "/particles/rve/position", NULL, fr->step, fr->time, NULL,
-                             PK_H5_F64, 3, dx, fr->x, unit);
-    rc |= pk_h5_time_element(h, "/particles/rve/contact_force", "/particles/rve/position", NULL,
-                             NULL, NULL, PK_H5_F64, 2, df, fr->force, "N");
+    pk_h5_time_element(h, "/particles/rve/position", NULL, fr->step, fr->time, NULL, PK_H5_F64, 3,
+                       dx, fr->x, unit);
+    pk_h5_time_element(h, "/particles/rve/contact_force", "/particles/rve/position", NULL, NULL,
+                       NULL, PK_H5_F64, 2, df, fr->force, "N");
     /* per step views position/<k> [n][dim] and contact_force/<k> [n] for the
      * XDMF sidecar: ParaView's Xdmf3 reader reads no HyperSlab */
     for (size_t k = 0; k < c; k++)
@@ -109,7 +101,7 @@ int pk_homog_frames_write(pk_h5 *h, const pk_homog_frames *fr, const pk_homog_rv
             char src[64], p[64];
             snprintf(src, sizeof src, "/particles/rve/%s/value", el[e]);
             snprintf(p, sizeof p, "/particles/rve/views/%s/%zu", el[e], k);
-            rc |= pk_h5_slice_view(h, src, k, p);
+            pk_h5_slice_view(h, src, k, p);
         }
     return rc ? -1 : 0;
 }

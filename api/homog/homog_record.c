@@ -245,6 +245,34 @@ int pk_homog_record_audit(json_t *aud, const pk_homog_audit *a)
 
 #define OBS "/observables/"
 
+/* The homogenization's observables with a unit (h5_units.h); every other
+ * one is a count, a ratio or dimensionless (J, strains, iterations). */
+static const pk_unit_row homog_units[] = {
+    {"homogenize/rve_volume", PK_U_VOLUME},
+    {"homogenize/E_n", PK_U_STIFFNESS},
+    {"homogenize/friction/E_t", PK_U_STIFFNESS},
+    {"homogenize/P", PK_U_STRESS},
+    {"homogenize/sigma", PK_U_STRESS},
+    {"homogenize/sigma_skew", PK_U_STRESS},
+    {"homogenize/energy", PK_U_ENERGY},
+    {"homogenize/energy_density", PK_U_STRESS},
+    {"homogenize/energy_tangential", PK_U_ENERGY},
+    {"homogenize/dissipation", PK_U_ENERGY},
+    {"homogenize/sum_force", PK_U_FORCE},
+    {"homogenize/dr/residual", PK_U_FORCE},
+    {"homogenize/dr/residual_initial", PK_U_FORCE},
+    {"homogenize/tangent/A", PK_U_STRESS},
+    {"homogenize/tangent/seconds", PK_U_SECONDS},
+    {"homogenize/final_state/position", PK_U_LENGTH},
+    {"homogenize/final_state/fluctuation", PK_U_LENGTH},
+    {NULL},
+};
+
+const char *pk_homog_unit_of(const char *name, const void *units)
+{
+    return pk_unit_in(homog_units, name, units);
+}
+
 typedef struct {
     pk_h5 *h;
     const pk_units *u;
@@ -275,7 +303,7 @@ static int series(const writer *w, const char *path, const char *clock, json_t *
     int all_int = 1;
     json_array_foreach (arr, i, e)
         all_int &= json_is_integer(e);
-    const char *unit = pk_units_of(path + strlen(OBS), w->u);
+    const char *unit = pk_homog_unit_of(path + strlen(OBS), w->u);
     void *v = malloc((S ? S : 1) * 8);
     if (!v)
         return -1;
@@ -312,7 +340,7 @@ static int tensor(const writer *w, const char *path, const char *clock, json_t *
         }
     size_t dims[3] = {S, (size_t)dim, (size_t)dim};
     int rc = pk_h5_time_element(w->h, path, clock, step, time, NULL, PK_H5_F64, 3, dims, v,
-                                pk_units_of(path + strlen(OBS), w->u));
+                                pk_homog_unit_of(path + strlen(OBS), w->u));
     free(v);
     return rc;
 }
@@ -397,8 +425,8 @@ static int final_state(const writer *w, json_t *fs, int dim)
                 ((int64_t *)a)[i] = (int64_t)json_integer_value(e);
         }
         size_t dims[2] = {vec ? n / (size_t)dim : n, (size_t)dim};
-        rc |= pk_h5_write_array(w->h, path, vec ? PK_H5_F64 : PK_H5_I64, vec ? 2 : 1, dims, a,
-                                pk_units_of(path + strlen(OBS), w->u));
+        pk_h5_write_array(w->h, path, vec ? PK_H5_F64 : PK_H5_I64, vec ? 2 : 1, dims, a,
+                          pk_homog_unit_of(path + strlen(OBS), w->u));
         free(a);
     }
     return rc;
@@ -427,12 +455,11 @@ static int final_contacts(const writer *w, json_t *fc, int dim)
         }
         size_t d2[2] = {n, (size_t)dim};
         rc = pk_h5_connectivity(w->h, "/connectivity/contacts", pairs, n, "/particles/rve");
-        rc |= pk_h5_write_array(w->h, "/connectivity/contact_overlap", PK_H5_F64, 1, d2, ov,
-                                w->u->length[0] ? w->u->length : NULL);
-        rc |= pk_h5_write_array(w->h, "/connectivity/contact_normal_force", PK_H5_F64, 1, d2, fn,
-                                "N");
-        rc |= pk_h5_write_array(w->h, "/connectivity/contact_branch", PK_H5_F64, 2, d2, br,
-                                w->u->length[0] ? w->u->length : NULL);
+        pk_h5_write_array(w->h, "/connectivity/contact_overlap", PK_H5_F64, 1, d2, ov,
+                          w->u->length[0] ? w->u->length : NULL);
+        pk_h5_write_array(w->h, "/connectivity/contact_normal_force", PK_H5_F64, 1, d2, fn, "N");
+        pk_h5_write_array(w->h, "/connectivity/contact_branch", PK_H5_F64, 2, d2, br,
+                          w->u->length[0] ? w->u->length : NULL);
     }
     free(pairs);
     free(br);
@@ -497,12 +524,12 @@ int pk_homog_record_write(pk_h5 *h, json_t *rec, json_t *aud, int dim, size_t au
         rc |= final_contacts(&w, fc, dim);
     json_object_del(r, "final_state");
     json_object_del(r, "final_contacts");
-    rc |= pk_h5_obs_json_units(h, "homogenize", r, pk_units_of, u);
+    pk_h5_obs_json_units(h, "homogenize", r, pk_homog_unit_of, u);
     /* the audit: one entry per audited step (from audit_first on) */
     const char *aclock = NULL;
     char abuf[256];
     rc |= series_of(&w, OBS "audit", a, &aclock, abuf, astep, atime);
-    rc |= pk_h5_obs_json(h, "audit", a);
+    pk_h5_obs_json(h, "audit", a);
 out:
     json_decref(r);
     json_decref(a);

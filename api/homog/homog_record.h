@@ -37,4 +37,8 @@ int pk_homog_record_audit(json_t *aud, const pk_homog_audit *a);
 int pk_homog_record_write(pk_h5 *h, json_t *rec, json_t *aud, int dim, size_t audit_first,
                           size_t nstep, const pk_units *u);
 
+/* The unit of a homogenization observable ("homogenize/P") in units (a
+ * pk_units), or NULL: a pk_h5_unit_fn. */
+const char *pk_homog_unit_of(const char *name, const void *units);
+
 #endif

@@ -2,52 +2,85 @@
  * options (contract in http_outputs.h). */
 #include "http_outputs.h"
 
+#include <pthread.h>
 #include <stdio.h>
 #include <string.h>
 
+#include "api/picture/picture.h"
 #include "http_status_info.h"
 
-const pk_output pk_outputs[] = {
+/* The outputs every result has, then two per picture kind (picture.h). */
+static const pk_output fixed[] = {
     {"summary", "application/json", "summary",
-     "the worker's summary: counts, achieved density, grading, verdict, timings, result_digest", 0},
+     "the worker's summary: counts, achieved density, grading, verdict, timings, result_digest", 0,
+     NULL},
     {"result", PK_RESULT_MEDIA_TYPE, "result file",
-     "HDF5 (H5MD 1.1) result file, see docs/result-format.md", 0},
+     "HDF5 (H5MD 1.1) result file, see docs/result-format.md", 0, NULL},
     {"xdmf", "application/xml", "XDMF 3 description",
      "the grains as points with radius and species, for ParaView; refers to the result as "
      "<jobID>.h5",
-     0},
-    {"picture.png", "image/png", "the packing", "PNG picture of the packing", 1},
-    {"picture.svg", "image/svg+xml", "the packing",
-     "SVG picture of the packing (up to 20 000 grains)", 1},
-    {"grading.png", "image/png", "the grading curve",
-     "target and achieved grading curves (pack jobs)", 1},
-    {"grading.svg", "image/svg+xml", "the grading curve",
-     "target and achieved grading curves (pack jobs)", 1},
-    {"history.png", "image/png", "the EDMD history",
-     "phi and reduced pressure over the events (EDMD)", 1},
-    {"history.svg", "image/svg+xml", "the EDMD history",
-     "phi and reduced pressure over the events (EDMD)", 1},
-    {"stress.png", "image/png", "the stress-strain curve", "P components over F (homogenize jobs)",
-     1},
-    {"stress.svg", "image/svg+xml", "the stress-strain curve",
-     "P components over F (homogenize jobs)", 1},
-    {"residual.png", "image/png", "the residual history",
-     "relaxation residual of every load step (homogenize jobs)", 1},
-    {"residual.svg", "image/svg+xml", "the residual history",
-     "relaxation residual of every load step (homogenize jobs)", 1},
-    {"response.png", "image/png", "the fe2 response",
-     "reactions of the supports and dilatancy per load step (fe2 jobs)", 1},
-    {"response.svg", "image/svg+xml", "the fe2 response",
-     "reactions of the supports and dilatancy per load step (fe2 jobs)", 1},
-    {NULL, NULL, NULL, NULL, 0},
+     0, NULL},
 };
+#define NFIXED (sizeof fixed / sizeof *fixed)
+#define MAX_OUTPUTS (NFIXED + 2 * 16)
+
+static pk_output table[MAX_OUTPUTS + 1];
+static char ids[MAX_OUTPUTS][40], svg_packing[200];
+static pthread_once_t table_once = PTHREAD_ONCE_INIT;
+
+static void table_init(void)
+{
+    size_t n = 0;
+    for (; n < NFIXED; n++)
+        table[n] = fixed[n];
+    const char *name, *file, *title, *help;
+    for (int k = 0; (name = pk_picture_kind_name(k, &file, &title, &help)) && n + 2 <= MAX_OUTPUTS;
+         k++)
+        for (int svg = 0; svg < 2; svg++, n++) {
+            snprintf(ids[n], sizeof ids[n], "%s.%s", file, svg ? "svg" : "png");
+            table[n] =
+                (pk_output){ids[n], svg ? "image/svg+xml" : "image/png", title, help, 1, name};
+            if (svg && !strcmp(file, "picture")) { /* one element per grain image */
+                snprintf(svg_packing, sizeof svg_packing, "%s (up to %d grains)", help,
+                         PK_PICTURE_SVG_MAX_GRAINS);
+                table[n].description = svg_packing;
+            }
+        }
+}
+
+const pk_output *pk_output_at(size_t i)
+{
+    pthread_once(&table_once, table_init);
+    return i < MAX_OUTPUTS && table[i].id ? &table[i] : NULL;
+}
 
 const pk_output *pk_output_find(const char *id)
 {
-    for (const pk_output *o = pk_outputs; id && o->id; o++)
+    const pk_output *o;
+    for (size_t i = 0; id && (o = pk_output_at(i)); i++)
         if (!strcmp(o->id, id))
             return o;
     return NULL;
+}
+
+int pk_output_offered(const pk_process *p, const pk_output *o)
+{
+    if (!o->picture)
+        return 1;
+    for (size_t i = 0; p->pictures && p->pictures[i]; i++)
+        if (!strcmp(p->pictures[i], o->picture))
+            return 1;
+    return 0;
+}
+
+size_t pk_outputs_list(char *buf, size_t n)
+{
+    size_t k = 0;
+    const pk_output *o;
+    buf[0] = 0;
+    for (size_t i = 0; (o = pk_output_at(i)) && k < n; i++)
+        k += (size_t)snprintf(buf + k, n - k, "%s%s", i ? ", " : "", o->id);
+    return k < n ? k : n - 1;
 }
 
 int pk_exec_opts_parse(json_t *body, pk_exec_opts *o, char *detail, size_t n)
@@ -69,10 +102,9 @@ int pk_exec_opts_parse(json_t *body, pk_exec_opts *o, char *detail, size_t n)
     size_t values = 0;
     json_object_foreach (outs, key, v) {
         if (!pk_output_find(key)) {
-            snprintf(detail, n,
-                     "/outputs/%.60s: no such output (summary, result, xdmf, "
-                     "picture, grading, history, stress, residual, response .png/.svg)",
-                     key);
+            char all[600];
+            pk_outputs_list(all, sizeof all);
+            snprintf(detail, n, "/outputs/%.60s: no such output (%s)", key, all);
             return -1;
         }
         json_t *tm = json_object_get(v, "transmissionMode");

@@ -7,18 +7,29 @@
 
 #include <jansson.h>
 
+#include "api/process.h"
+
 typedef struct pk_output {
     const char *id;   /* key in the results document, last segment of /results/{id} */
     const char *type; /* media type */
     const char *title, *description;
-    int optional; /* present only for some jobs (pictures) */
+    int optional;        /* present only for some jobs (pictures) */
+    const char *picture; /* the picture kind (picture.h) it shows, or NULL */
 } pk_output;
 
-/* Every output, terminated by {NULL}. */
-extern const pk_output pk_outputs[];
+/* The i-th output (i from 0; NULL past the last): summary, result, xdmf,
+ * then <file>.png and <file>.svg of every picture kind (picture.h). */
+const pk_output *pk_output_at(size_t i);
 
 /* The output called id, or NULL. */
 const pk_output *pk_output_find(const char *id);
+
+/* 1 when process p declares output o: the fixed ones always, a picture when
+ * p lists its kind (pk_process.pictures). */
+int pk_output_offered(const pk_process *p, const pk_output *o);
+
+/* Every output id, comma-separated, into buf; returns the length. */
+size_t pk_outputs_list(char *buf, size_t n);
 
 /* What an execute request asks of its results (OGC Part 1 "response" and
  * "outputs"): serve names the one output answered as raw bytes ("" for the

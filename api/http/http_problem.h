@@ -19,6 +19,31 @@
 #define PK_PROBLEM_PACKD "urn:packd:problem:"
 #define PK_PROBLEM_GENERIC "about:blank" /* the HTTP status says it all */
 
+/* The problems the service answers with, each one row of a table
+ * (http_problem.c) that decides its status, type and title: a route names
+ * the code and the detail only (the pattern of TALER_MHD_reply_with_ec). */
+typedef enum pk_problem_code {
+    PK_P_BAD_REQUEST,
+    PK_P_NOT_FOUND,
+    PK_P_NO_SUCH_JOB,
+    PK_P_NO_SUCH_PROCESS,
+    PK_P_NO_SUCH_OUTPUT,
+    PK_P_NO_SUCH_FILE,
+    PK_P_RESULT_NOT_READY,
+    PK_P_CONTENT_TOO_LARGE,
+    PK_P_UNSUPPORTED_MEDIA_TYPE,
+    PK_P_INTERNAL,
+    PK_P_UNAVAILABLE,
+    PK_P_COUNT
+} pk_problem_code;
+
+/* The HTTP status of code. */
+unsigned pk_problem_status(pk_problem_code code);
+
+/* The document of code: {"type","title","status","detail"} (detail omitted
+ * when NULL). */
+json_t *pk_problem_of(pk_problem_code code, const char *detail);
+
 /* {"type","title","status","detail"} (detail omitted when NULL). */
 json_t *pk_problem(int status, const char *type, const char *title, const char *detail);
 

@@ -107,7 +107,10 @@ json_t *pk_process_description(const pk_process *p)
     }
     json_object_set_new(d, "inputs", inputs);
     json_t *outputs = json_object();
-    for (const pk_output *o = pk_outputs; o->id; o++) {
+    const pk_output *o;
+    for (size_t i = 0; (o = pk_output_at(i)); i++) {
+        if (!pk_output_offered(p, o))
+            continue;
         json_t *os = !strcmp(o->type, "application/json")
             ? json_pack("{s:s,s:s}", "type", "object", "contentMediaType", o->type)
             : json_pack("{s:s,s:s,s:s}", "type", "string", "contentEncoding",

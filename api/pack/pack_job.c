@@ -181,7 +181,10 @@ static void auto_without_plan(json_t *in, pk_pack_job *job, int box)
         : until && !strcmp(until, "jammed")
         ? "edmd.until is jammed: only EDMD grows a packing until it jams"
         : NULL;
-    snprintf(job->algorithm, sizeof job->algorithm, "%s", !box ? "tetfill" : why ? "edmd" : "rsa");
+    snprintf(job->algorithm, sizeof job->algorithm, "%s",
+             !box      ? pk_placer_filling_mesh()->name
+                 : why ? "edmd"
+                       : "rsa");
     snprintf(job->choice.reason, sizeof job->choice.reason, "%s", why ? why : "");
 }
 
@@ -239,56 +242,16 @@ size_t pk_pack_job_from_json(json_t *in, pk_pack_job *job, pk_schema_errors *err
     const pk_placer *placer = pk_placer_find(job->algorithm);
     if (!placer)
         pk_schema_errors_add(errs, "/algorithm", "enum", "no placer named \"%s\"", job->algorithm);
-    else if (!box && !placer->own_sizes)
+    else if (!box && !placer->fills_mesh)
         pk_schema_errors_add(errs, "/domain", "boxDomain",
-                             "algorithm \"%s\" needs a box domain (a mesh needs \"tetfill\")",
-                             job->algorithm);
+                             "algorithm \"%s\" needs a box domain (a mesh needs \"%s\")",
+                             job->algorithm, pk_placer_filling_mesh()->name);
     if (placer && placer->options)
         pk_options_fill(placer->options, in, &job->opt, errs);
     return errs->n - before;
 }
 
 static double class_rep_measure(int dim, double d) { return pk_ball_measure(dim, 0.5 * d); }
-
-/* EDMD growing every diameter until jammed (relative growth) bounds the sizes
- * only by φ <= 1 (core/edmd/edmd.c, spec §3.3d): the largest grain, shell included,
- * may reach (d_max + Δd)·φ_s^(-1/dim), φ_s the shells' fraction at the target
- * sizes.  On a periodic axis that must stay below L/2, or a pair could meet
- * two images of each other (minimum image).  φ_s is bounded below by
- * φ (1 + Δd/d_max)^dim, so the check errs on the refusing side. */
-/* EDMD growing the grains themselves until jammed: the given sizes are
- * ratios, the final sizes are set by jamming. */
-static int grows_until_jammed(const pk_pack_job *job)
-{
-    const pk_edmd_options *o = &job->opt.edmd;
-    return !strcmp(job->algorithm, "edmd") && o->prm.until == PK_EDMD_UNTIL_JAMMED &&
-        o->prm.growth == PK_EDMD_GROW_RELATIVE && !o->maximize_delta_d;
-}
-
-static void check_periodic_jamming(const pk_pack_job *job, const pk_pack_plan *plan,
-                                   pk_schema_errors *errs)
-{
-    if (!grows_until_jammed(job))
-        return;
-    const int dim = job->dim;
-    double phi_s = plan->phi_resolved * pow(1 + job->delta_d / plan->d_max, dim);
-    double reach = (plan->d_max + job->delta_d) * pow(fmax(phi_s, 1e-300), -1.0 / dim);
-    for (int k = 0; k < dim; k++) {
-        if (!job->box.periodic[k] || reach < 0.5 * job->box.L[k])
-            continue;
-        char ptr[64];
-        snprintf(ptr, sizeof ptr, "/domain/box/size/%d", k);
-        double need = pow((plan->d_max + job->delta_d) / (0.5 * job->box.L[k]), dim);
-        pk_schema_errors_add(
-            errs, ptr, "periodicJamming",
-            "until jammed the grains may grow to fill the box: the largest could "
-            "reach d = %.4g, over half the periodic edge %g (minimum image); needs "
-            "φ at the target sizes > %.3g (got %.3g): more grains, a walled axis "
-            "or until: target",
-            reach, job->box.L[k], need, phi_s);
-        return;
-    }
-}
 
 size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_errors *errs)
 {
@@ -412,7 +375,9 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
         for (int k = 0; k < dim; k++)
             widened *= job->box.L[k] / (job->box.L[k] + (job->box.periodic[k] ? 0 : job->delta_d));
         double phi_shell = plan->phi_resolved * widened * pow(1 + job->delta_d / plan->d_max, dim);
-        if (!(phi_shell < 1) && !grows_until_jammed(job)) {
+        const pk_placer *p = pk_placer_find(job->algorithm);
+        const int jams = p && p->grows_until_jammed && p->grows_until_jammed(job);
+        if (!(phi_shell < 1) && !jams) {
             const char *ptr = plan->phi_resolved < 1 && job->delta_d > 0 ? "/delta_d"
                 : job->count && !job->has_phi                            ? "/count"
                                                                          : "/phi/value";
@@ -422,8 +387,6 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
                                  plan->phi_resolved, phi_shell);
         }
     }
-    if (errs->n == before)
-        check_periodic_jamming(job, plan, errs);
     const pk_placer *placer = pk_placer_find(job->algorithm);
     if (placer && placer->check && errs->n == before)
         placer->check(job, plan, job->prepare ? &plan->prepared : NULL, errs);
@@ -448,6 +411,15 @@ void *pk_pack_parse(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *e
     }
     free(t);
     return NULL;
+}
+
+json_t *pk_pack_plan_json(const void *task)
+{
+    const pk_pack_plan *plan = &((const pk_pack_task *)task)->plan;
+    return json_pack("{s:f,s:f,s:f,s:f,s:f,s:i}", "expected_grains", plan->expected_n,
+                     "phi_target_mix", plan->phi_mix, "phi_target_resolved", plan->phi_resolved,
+                     "mass_cut_fraction", plan->mass_cut, "d_max", plan->d_max, "size_classes",
+                     plan->resolved.nclass);
 }
 
 void pk_pack_free(void *task)

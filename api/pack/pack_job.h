@@ -82,6 +82,14 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
 /* process table hooks (see process.h): parse returns a pk_pack_task */
 void *pk_pack_parse(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
 void pk_pack_free(void *task);
+/* What the parsed task implies (pk_process.plan): expected grains, target
+ * fractions, mass cut, d_max, size classes. */
+json_t *pk_pack_plan_json(const void *task);
+/* The pack process's scalar observables (h5_observables.h): each a member
+ * of the summary and a dataset /observables/<name>, with its unit kind. */
+#include "api/results/h5_units.h"
+const pk_unit_row *pk_pack_observables(void);
+
 int pk_pack_run(const void *task, const pk_run_ctx *run, const char *job_json, const char *out_path,
                 json_t **summary, char *err, size_t errlen);
 

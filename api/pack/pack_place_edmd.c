@@ -78,10 +78,54 @@ static void read_params(const pk_pack_job *job, const pk_pack_plan *plan, pk_edm
         prm->phi_target = plan->phi_resolved;
 }
 
+/* EDMD growing every diameter until jammed (relative growth) bounds the sizes
+ * only by φ <= 1 (core/edmd/edmd.c, spec §3.3d): the largest grain, shell included,
+ * may reach (d_max + Δd)·φ_s^(-1/dim), φ_s the shells' fraction at the target
+ * sizes.  On a periodic axis that must stay below L/2, or a pair could meet
+ * two images of each other (minimum image).  φ_s is bounded below by
+ * φ (1 + Δd/d_max)^dim, so the check errs on the refusing side. */
+/* EDMD growing the grains themselves until jammed: the given sizes are
+ * ratios, the final sizes are set by jamming. */
+static int grows_until_jammed(const pk_pack_job *job)
+{
+    const pk_edmd_options *o = &job->opt.edmd;
+    return o->prm.until == PK_EDMD_UNTIL_JAMMED && o->prm.growth == PK_EDMD_GROW_RELATIVE &&
+        !o->maximize_delta_d;
+}
+
+static void check_periodic_jamming(const pk_pack_job *job, const pk_pack_plan *plan,
+                                   pk_schema_errors *errs)
+{
+    if (!grows_until_jammed(job))
+        return;
+    const int dim = job->dim;
+    double phi_s = plan->phi_resolved * pow(1 + job->delta_d / plan->d_max, dim);
+    double reach = (plan->d_max + job->delta_d) * pow(fmax(phi_s, 1e-300), -1.0 / dim);
+    for (int k = 0; k < dim; k++) {
+        if (!job->box.periodic[k] || reach < 0.5 * job->box.L[k])
+            continue;
+        char ptr[64];
+        snprintf(ptr, sizeof ptr, "/domain/box/size/%d", k);
+        double need = pow((plan->d_max + job->delta_d) / (0.5 * job->box.L[k]), dim);
+        pk_schema_errors_add(
+            errs, ptr, "periodicJamming",
+            "until jammed the grains may grow to fill the box: the largest could "
+            "reach d = %.4g, over half the periodic edge %g (minimum image); needs "
+            "φ at the target sizes > %.3g (got %.3g): more grains, a walled axis "
+            "or until: target",
+            reach, job->box.L[k], need, phi_s);
+        return;
+    }
+}
+
 static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, void **prepared,
                        pk_schema_errors *errs)
 {
     (void)prepared;
+    size_t before = errs->n;
+    check_periodic_jamming(job, plan, errs);
+    if (errs->n != before)
+        return;
     pk_edmd_params prm;
     read_params(job, plan, &prm);
     if (prm.growth == PK_EDMD_GROW_SHELL && prm.start_zero)
@@ -336,5 +380,20 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     return 0;
 }
 
-const pk_placer pk_placer_edmd = {
-    .name = "edmd", .options = &edmd_options, .check = check_edmd, .place = place_edmd};
+/* Its observables with a unit; the rest are counts, fractions or in reduced
+ * units (time, d̄/u). */
+static const pk_unit_row edmd_units[] = {
+    {"delta_d_reached", PK_U_LENGTH},
+    {"wall_gap_guaranteed", PK_U_LENGTH},
+    {"start_seconds", PK_U_SECONDS},
+    {"collisions_per_second", PK_U_HERTZ},
+    {NULL},
+};
+
+const pk_placer pk_placer_edmd = {.name = "edmd",
+                                  .has_history = 1,
+                                  .grows_until_jammed = grows_until_jammed,
+                                  .options = &edmd_options,
+                                  .units = edmd_units,
+                                  .check = check_edmd,
+                                  .place = place_edmd};

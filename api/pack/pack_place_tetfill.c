@@ -242,15 +242,15 @@ static int write_mesh(pk_h5 *h, const char *prefix, void *extra)
     int rc = 0;
     size_t dn[2] = {m->nnode, 3}, dt[2] = {m->ntet, 4};
     snprintf(name, sizeof name, "/observables/%s/mesh_nodes", prefix);
-    rc |= pk_h5_write_array(h, name, PK_H5_F64, 2, dn, m->x, ((tetfill_setup *)extra)->unit);
+    pk_h5_write_array(h, name, PK_H5_F64, 2, dn, m->x, ((tetfill_setup *)extra)->unit);
     for (size_t i = 0; i < 4 * m->ntet; i++)
         t[i] = m->t[i];
     snprintf(name, sizeof name, "/observables/%s/mesh_tets", prefix);
-    rc |= pk_h5_write_array(h, name, PK_H5_I64, 2, dt, t, NULL);
+    pk_h5_write_array(h, name, PK_H5_I64, 2, dt, t, NULL);
     for (size_t i = 0; i < m->ntet; i++)
         t[i] = m->region[i];
     snprintf(name, sizeof name, "%s/mesh_regions", prefix);
-    rc |= pk_h5_obs_ints(h, name, t, m->ntet);
+    pk_h5_obs_ints(h, name, t, m->ntet);
     free(t);
     return rc;
 }
@@ -335,7 +335,21 @@ static int place_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, const
     return 0;
 }
 
+/* Its observables with a unit. */
+static const pk_unit_row tetfill_units[] = {
+    {"r_min", PK_U_LENGTH},
+    {"r_max", PK_U_LENGTH},
+    {"overlap_bound", PK_U_LENGTH},
+    {"mesh_volume", PK_U_VOLUME},
+    {"mesh_edge_mean", PK_U_LENGTH},
+    {"mesh_origin", PK_U_LENGTH},
+    {"seconds_geometric", PK_U_SECONDS},
+    {NULL},
+};
+
 const pk_placer pk_placer_tetfill = {.name = "tetfill",
+                                     .fills_mesh = 1,
+                                     .units = tetfill_units,
                                      .own_sizes = 1,
                                      .options = &tetfill_options,
                                      .check = check_tetfill,

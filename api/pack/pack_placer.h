@@ -1,8 +1,8 @@
 /* pack_placer.h — the placement algorithms of the 'pack' process.
  *
  * The pack process draws sizes (core/psd/psd), hands them to one placer, audits
- * the result and writes the file.  A placer is one row in pk_placers[]
- * (api/pack/pack_placers.c) plus one file api/pack/pack_place_<name>.c: its
+ * the result and writes the file.  A placer is one row of the table
+ * (api/pack/pack_placers.c, or pk_placer_register) plus one file api/pack/pack_place_<name>.c: its
  * option table fills its options struct (pack_options.h) from its parameter
  * object of the inputs (e.g. "edmd": {...}) once per job, and the placer reads
  * them from job->opt; it runs its core/ algorithm and reports common statistics plus any algorithm-specific
@@ -13,6 +13,7 @@
 
 #include <jansson.h>
 
+#include "api/results/h5_units.h"
 #include "core/space/gap_audit.h"
 #include "pack_job.h"
 #include "core/space/particles.h"
@@ -52,11 +53,25 @@ typedef struct pk_place_stats {
 
 typedef struct pk_placer {
     const char *name; /* the "algorithm" value */
-    int own_sizes;    /* 1 = the placer makes its own sizes: no grading, no size draw */
+    /* Capabilities, read by the pack process instead of the placer's name: */
+    int own_sizes;   /* 1 = the placer makes its own sizes: no grading, no size draw */
+    int fills_mesh;  /* 1 = it places into "domain": {"mesh"} (else a box only);
+                       * "algorithm": "auto" takes it for a mesh */
+    int has_history; /* 1 = its observables hold "history": {events, time, phi,
+                       * reduced_pressure} (the "history" picture; the model's
+                       * history_stored) */
+    /* 1 when the job grows the grains until jammed: the given sizes are
+     * ratios, so the plan's shell-fill bound (φ with the Δd shells < 1) does
+     * not apply (the placer's check bounds it instead).  NULL = never. */
+    int (*grows_until_jammed)(const pk_pack_job *job);
     const pk_option_table *options; /* fills job->opt (pack_options.h), or NULL */
-    /* Semantic checks of the placer's own inputs (schema already passed);
-     * may be NULL.  With job->prepare it may leave in *prepared what it built
-     * for the run (plan->prepared), freed by release. */
+    /* The units of its observables (names relative to /observables/<name>/,
+     * h5_units.h); an observable not listed is written without one. */
+    const pk_unit_row *units;
+    /* Semantic checks of the placer's own inputs (schema already passed),
+     * after the plan's (the plan is made); may be NULL.  With job->prepare
+     * it may leave in *prepared what it built for the run (plan->prepared),
+     * freed by release. */
     void (*check)(const pk_pack_job *job, const pk_pack_plan *plan, void **prepared,
                   pk_schema_errors *errs);
     void (*release)(void *prepared);
@@ -76,8 +91,16 @@ void pk_pack_verdict(const pk_pack_job *job, const pk_pack_plan *plan, const pk_
                      const pk_particles *p, const pk_gap_report *gap, double phi, double delta_d,
                      json_t *summary);
 
-/* NULL-terminated table. */
-extern const pk_placer *const pk_placers[];
+/* The i-th placer of the table (from 0; NULL past the last): the built-in
+ * ones (pack_placers.c), then the registered ones. */
+const pk_placer *pk_placer_at(size_t i);
 const pk_placer *pk_placer_find(const char *name);
+/* Add a placer to the table and its name to the "algorithm" enum of the pack
+ * inputs schema (so validation and the process description offer it).  At
+ * start-up only, before any thread reads the table or the schema.  0, or -1
+ * when p lacks a name or place, its name is taken or the table is full. */
+int pk_placer_register(const pk_placer *p);
+/* The first placer of the table that fills a mesh (there is one). */
+const pk_placer *pk_placer_filling_mesh(void);
 
 #endif

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "core/space/gap_audit.h"
+#include "api/results/h5_observables.h"
 #include "api/results/h5_result.h"
 #include "api/results/h5_units.h"
 #include "api/job_verdict.h"
@@ -70,21 +71,65 @@ static size_t grains_outside_walls(const pk_box *b, const pk_particles *p, doubl
     return n;
 }
 
+/* The pack process's scalar observables: the summary's members and
+ * /observables/<name> both come from this list (h5_observables.h). */
+static const pk_unit_row pack_observables[] = {
+    {"algorithm", PK_U_NONE},
+    {"termination_reason", PK_U_NONE},
+    {"count_requested", PK_U_NONE},
+    {"count_placed", PK_U_NONE},
+    {"count_expected", PK_U_NONE},
+    {"phi_resolved", PK_U_NONE},
+    {"phi_mix", PK_U_NONE},
+    {"phi_target_resolved", PK_U_NONE},
+    {"phi_target_mix", PK_U_NONE},
+    {"mass_cut_fraction", PK_U_NONE},
+    {"d_min", PK_U_LENGTH},
+    {"delta_d", PK_U_LENGTH},
+    {"size_scale", PK_U_NONE},
+    {"smallest_gap", PK_U_LENGTH},
+    {"smallest_wall_gap", PK_U_LENGTH}, /* -1 when every axis is periodic */
+    {"pairs_below_delta_d", PK_U_NONE},
+    {"grains_below_wall_gap", PK_U_NONE},
+    {"timing/sizes_s", PK_U_SECONDS},
+    {"timing/place_s", PK_U_SECONDS},
+    {"timing/audit_s", PK_U_SECONDS},
+    {NULL},
+};
+
+const pk_unit_row *pk_pack_observables(void) { return pack_observables; }
+
 /* What was modelled and, for "auto", the choice: /observables/modelled,
  * /observables/auto (the summary's "model" and "auto"). */
 static int write_scene(pk_h5 *h, json_t *summary)
 {
     int rc = pk_h5_obs_json(h, "modelled", json_object_get(summary, "model"));
     if (json_object_get(summary, "auto"))
-        rc |= pk_h5_obs_json(h, "auto", json_object_get(summary, "auto"));
+        pk_h5_obs_json(h, "auto", json_object_get(summary, "auto"));
     return rc;
+}
+
+/* The unit of a placer observable: "<algorithm>/<name>" looked up in the
+ * placer's table (a pk_h5_unit_fn). */
+typedef struct placer_units {
+    const pk_placer *placer;
+    pk_units units;
+} placer_units;
+
+static const char *placer_unit_of(const char *name, const void *ctx)
+{
+    const placer_units *pu = ctx;
+    size_t n = strlen(pu->placer->name);
+    if (strncmp(name, pu->placer->name, n) != 0 || name[n] != '/')
+        return NULL;
+    return pk_unit_in(pu->placer->units, name + n + 1, &pu->units);
 }
 
 static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const char *job_json,
                         const pk_box *box, double V, const pk_particles *p, const pk_sizes *sz,
-                        double scale, const pk_place_stats *st, const pk_gap_report *gap,
-                        double t_sizes, double t_audit, const char *out_path, const char *author,
-                        json_t *summary, char *err, size_t errlen)
+                        double scale, const pk_place_stats *st, json_t *obs_values,
+                        const char *out_path, const char *author, json_t *summary, char *err,
+                        size_t errlen)
 {
     pk_h5 *h = pk_h5_create(out_path, author, err, errlen);
     if (!h)
@@ -92,46 +137,26 @@ static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const 
     const char *u = job->unit;
     const int dim = job->dim;
     double solid = pk_particles_solid_measure(p);
-    double phi = solid / V;
     int rc = 0;
-    rc |= pk_h5_write_particles(h, box, p, u);
-    rc |= pk_h5_write_parameters(h, "pack", job_json, job->seed);
-    rc |= pk_h5_obs_double(h, "phi_resolved", phi, NULL);
-    rc |= pk_h5_obs_double(h, "phi_mix", phi / (1 - plan->mass_cut), NULL);
-    rc |= pk_h5_obs_double(h, "phi_target_resolved", plan->phi_resolved, NULL);
-    rc |= pk_h5_obs_double(h, "phi_target_mix", plan->phi_mix, NULL);
-    rc |= pk_h5_obs_double(h, "mass_cut_fraction", plan->mass_cut, NULL);
-    rc |= pk_h5_obs_double(h, "d_min", job->d_min, u);
-    rc |= pk_h5_obs_double(h, "delta_d", job->delta_d, u);
-    rc |= pk_h5_obs_double(h, "size_scale", scale, NULL);
-    rc |= pk_h5_obs_int(h, "count_requested", (int64_t)st->requested);
-    rc |= pk_h5_obs_int(h, "count_placed", (int64_t)st->placed);
-    rc |= pk_h5_obs_double(h, "count_expected", plan->expected_n, NULL);
-    rc |= pk_h5_obs_string(h, "termination_reason", pk_stop_reason_name(st->reason));
-    rc |= pk_h5_obs_string(h, "algorithm", job->algorithm);
+    pk_h5_write_particles(h, box, p, u);
+    pk_h5_write_parameters(h, "pack", job_json, job->seed);
+    pk_units units;
+    pk_units_init(&units, u, dim);
+    pk_h5_obs_rows(h, pack_observables, obs_values, &units);
     if (st->obs) {
         /* a history {events, time, ...} as H5MD time-dependent elements */
-        pk_units units;
-        pk_units_init(&units, u, dim);
+        placer_units pu = {.placer = pk_placer_find(job->algorithm)};
+        pk_units_init(&pu.units, u, dim);
         json_t *obs = json_copy(st->obs), *hist = json_object_get(st->obs, "history");
         char hp[64];
         snprintf(hp, sizeof hp, "%s/history", job->algorithm);
         if (hist && json_object_del(obs, "history") == 0)
-            rc |= pk_h5_obs_history(h, hp, hist, "events", "time");
-        rc |= obs ? pk_h5_obs_json_units(h, job->algorithm, obs, pk_units_of, &units) : -1;
+            pk_h5_obs_history(h, hp, hist, "events", "time");
+        rc |= obs ? pk_h5_obs_json_units(h, job->algorithm, obs, placer_unit_of, &pu) : -1;
         json_decref(obs);
     }
     if (st->write_extra)
         rc |= st->write_extra(h, job->algorithm, st->extra);
-    rc |= pk_h5_obs_double(h, "smallest_gap", gap->min_gap, u);
-    rc |= pk_h5_obs_double(h, "smallest_wall_gap",
-                           isinf(gap->min_wall_gap) ? -1 : gap->min_wall_gap, u);
-    rc |= pk_h5_obs_int(h, "pairs_below_delta_d", (int64_t)gap->pairs_below);
-    rc |= pk_h5_obs_int(h, "grains_below_wall_gap", (int64_t)gap->walls_below);
-    rc |= pk_h5_obs_double(h, "timing/sizes_s", t_sizes, "s");
-    rc |= pk_h5_obs_double(h, "timing/place_s", st->seconds, "s");
-    rc |= pk_h5_obs_double(h, "timing/audit_s", t_audit, "s");
-
     /* Per class: bounds, target and achieved shares of the resolved measure. */
     const pk_grading *g = &plan->resolved;
     int nc = g->nclass;
@@ -181,16 +206,16 @@ static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const 
                 below += pk_ball_measure(dim, p->r[i]);
         pass_a[s] = solid > 0 ? 100 * below / solid : 0;
     }
-    rc |= pk_h5_obs_doubles(h, "grading/class_d_lo", lo, (size_t)nc, u);
-    rc |= pk_h5_obs_doubles(h, "grading/class_d_hi", hi, (size_t)nc, u);
-    rc |= pk_h5_obs_doubles(h, "grading/class_target_fraction", tgt, (size_t)nc, NULL);
-    rc |= pk_h5_obs_doubles(h, "grading/class_achieved_fraction", ach, (size_t)nc, NULL);
-    rc |= pk_h5_obs_doubles(h, "grading/class_count_expected", exp_n, (size_t)nc, NULL);
-    rc |= pk_h5_obs_ints(h, "grading/class_count_drawn", n_drawn, (size_t)nc);
-    rc |= pk_h5_obs_ints(h, "grading/class_count_placed", n_placed, (size_t)nc);
-    rc |= pk_h5_obs_doubles(h, "grading/sieve_size", sieve, (size_t)ns, u);
-    rc |= pk_h5_obs_doubles(h, "grading/target_passing_percent", pass_t, (size_t)ns, NULL);
-    rc |= pk_h5_obs_doubles(h, "grading/achieved_passing_percent", pass_a, (size_t)ns, NULL);
+    pk_h5_obs_doubles(h, "grading/class_d_lo", lo, (size_t)nc, u);
+    pk_h5_obs_doubles(h, "grading/class_d_hi", hi, (size_t)nc, u);
+    pk_h5_obs_doubles(h, "grading/class_target_fraction", tgt, (size_t)nc, NULL);
+    pk_h5_obs_doubles(h, "grading/class_achieved_fraction", ach, (size_t)nc, NULL);
+    pk_h5_obs_doubles(h, "grading/class_count_expected", exp_n, (size_t)nc, NULL);
+    pk_h5_obs_ints(h, "grading/class_count_drawn", n_drawn, (size_t)nc);
+    pk_h5_obs_ints(h, "grading/class_count_placed", n_placed, (size_t)nc);
+    pk_h5_obs_doubles(h, "grading/sieve_size", sieve, (size_t)ns, u);
+    pk_h5_obs_doubles(h, "grading/target_passing_percent", pass_t, (size_t)ns, NULL);
+    pk_h5_obs_doubles(h, "grading/achieved_passing_percent", pass_a, (size_t)ns, NULL);
 
     json_t *cls = json_array();
     for (int c = 0; c < nc; c++)
@@ -211,8 +236,6 @@ done:
     free(pass_t);
     free(pass_a);
     rc |= write_scene(h, summary);
-    json_object_set_new(summary, "phi_resolved", json_real(phi));
-    json_object_set_new(summary, "phi_mix", json_real(phi / (1 - plan->mass_cut)));
     return pk_verdict_close_h5(h, rc, summary, out_path, err, errlen);
 }
 
@@ -284,34 +307,42 @@ int pk_pack_run(const void *task, const pk_run_ctx *run, const char *job_json, c
         gap.walls_below = grains_outside_walls(&box, &p, tol);
     double t_audit = pk_wall_seconds() - t1;
 
+    const double phi = pk_particles_solid_measure(&p) / V;
+    json_t *o = json_object();
+    pk_obs_set(o, "algorithm", json_string(job.algorithm));
+    pk_obs_set(o, "termination_reason", json_string(pk_stop_reason_name(st.reason)));
+    pk_obs_set(o, "count_requested", json_integer((json_int_t)st.requested));
+    pk_obs_set(o, "count_placed", json_integer((json_int_t)st.placed));
+    pk_obs_set(o, "count_expected", json_real(plan.expected_n));
+    pk_obs_set(o, "phi_resolved", json_real(phi));
+    pk_obs_set(o, "phi_mix", json_real(phi / (1 - plan.mass_cut)));
+    pk_obs_set(o, "phi_target_resolved", json_real(plan.phi_resolved));
+    pk_obs_set(o, "phi_target_mix", json_real(plan.phi_mix));
+    pk_obs_set(o, "mass_cut_fraction", json_real(plan.mass_cut));
+    pk_obs_set(o, "d_min", json_real(job.d_min));
+    pk_obs_set(o, "delta_d", json_real(job.delta_d));
+    pk_obs_set(o, "size_scale", json_real(scale));
+    pk_obs_set(o, "smallest_gap", json_real(gap.min_gap));
+    pk_obs_set(o, "smallest_wall_gap", json_real(isinf(gap.min_wall_gap) ? -1 : gap.min_wall_gap));
+    pk_obs_set(o, "pairs_below_delta_d", json_integer((json_int_t)gap.pairs_below));
+    pk_obs_set(o, "grains_below_wall_gap", json_integer((json_int_t)gap.walls_below));
+    pk_obs_set(o, "timing/sizes_s", json_real(t_sizes));
+    pk_obs_set(o, "timing/place_s", json_real(st.seconds));
+    pk_obs_set(o, "timing/audit_s", json_real(t_audit));
+
     json_t *sum = json_object();
     json_object_set_new(sum, "process", json_string("pack"));
-    json_object_set_new(sum, "algorithm", json_string(job.algorithm));
-    json_object_set_new(sum, "termination_reason", json_string(pk_stop_reason_name(st.reason)));
     json_t *choice = pk_pack_auto_json(&job);
     if (choice)
         json_object_set_new(sum, "auto", choice);
     json_object_set_new(sum, "model", pk_pack_model_json(&job, &plan));
     json_object_set_new(sum, "complete",
                         json_false()); /* here in the listing; pk_pack_verdict sets it */
-    json_object_set_new(sum, "count_placed", json_integer((json_int_t)st.placed));
-    json_object_set_new(sum, "count_requested", json_integer((json_int_t)st.requested));
-    json_object_set_new(sum, "count_expected", json_real(plan.expected_n));
-    json_object_set_new(sum, "phi_target_resolved", json_real(plan.phi_resolved));
-    json_object_set_new(sum, "phi_target_mix", json_real(plan.phi_mix));
-    json_object_set_new(sum, "mass_cut_fraction", json_real(plan.mass_cut));
-    json_object_set_new(sum, "smallest_gap", json_real(gap.min_gap));
-    if (!isinf(gap.min_wall_gap))
-        json_object_set_new(sum, "smallest_wall_gap", json_real(gap.min_wall_gap));
-    json_object_set_new(sum, "pairs_below_delta_d", json_integer((json_int_t)gap.pairs_below));
-    json_object_set_new(sum, "size_scale", json_real(scale));
-    json_object_set_new(sum, "seconds_place", json_real(st.seconds));
-
-    if (st.overlap_tol > 0)
-        json_object_set_new(sum, "overlap_tolerance", json_real(st.overlap_tol));
-    pk_pack_verdict(&job, &plan, &st, &p, &gap, pk_particles_solid_measure(&p) / V, audit_dd, sum);
-    int rc = write_result(&job, &plan, job_json, &box, V, &p, &sz, scale, &st, &gap, t_sizes,
-                          t_audit, out_path, rx.author, sum, err, errlen);
+    json_object_update(sum, o);
+    pk_pack_verdict(&job, &plan, &st, &p, &gap, phi, audit_dd, sum);
+    int rc = write_result(&job, &plan, job_json, &box, V, &p, &sz, scale, &st, o, out_path,
+                          rx.author, sum, err, errlen);
+    json_decref(o);
     pk_sizes_free(&sz);
     pk_particles_free(&p);
     if (st.free_extra)

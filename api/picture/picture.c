@@ -10,23 +10,28 @@
 #include "picture_internal.h"
 
 static const struct {
-    const char *name, *file, *help;
+    const char *name, *file, *title, *help;
     pk_picture_kind kind;
     int (*draw)(const char *h5_path, const char *out_path, char *err, size_t errlen);
 } kinds[] = {
-    {"packing", "picture",
+    {"packing", "picture", "the packing",
      "the grains by size class (3D: mid-plane section and depth-shaded view along -z)",
      PK_PICTURE_PACKING, pk_picture_packing},
-    {"grading", "grading", "the grading curve, target against achieved (pack results)",
-     PK_PICTURE_GRADING, pk_picture_grading},
-    {"history", "history", "phi and reduced pressure over the events (pack results made by EDMD)",
+    {"grading", "grading", "the grading curve",
+     "the grading curve, target against achieved (pack results)", PK_PICTURE_GRADING,
+     pk_picture_grading},
+    {"history", "history", "the placer's history",
+     "phi and reduced pressure over the events (pack results of a placer with a history: EDMD)",
      PK_PICTURE_HISTORY, pk_picture_history},
-    {"stress", "stress", "stress-strain curve, P components over F (homogenize results)",
-     PK_PICTURE_STRESS, pk_picture_stress},
-    {"residual", "residual", "relaxation residual of every load step (homogenize results)",
-     PK_PICTURE_RESIDUAL, pk_picture_residual},
-    {"response", "response", "reactions of the supports and dilatancy per load step (fe2 results)",
-     PK_PICTURE_RESPONSE, pk_picture_response},
+    {"stress", "stress", "the stress-strain curve",
+     "stress-strain curve, P components over F (homogenize results)", PK_PICTURE_STRESS,
+     pk_picture_stress},
+    {"residual", "residual", "the residual history",
+     "relaxation residual of every load step (homogenize results)", PK_PICTURE_RESIDUAL,
+     pk_picture_residual},
+    {"response", "response", "the fe2 response",
+     "reactions of the supports and dilatancy per load step (fe2 results)", PK_PICTURE_RESPONSE,
+     pk_picture_response},
 };
 #define KINDS (sizeof kinds / sizeof *kinds)
 
@@ -40,12 +45,14 @@ int pk_picture_kind_parse(const char *name, pk_picture_kind *kind)
     return -1;
 }
 
-const char *pk_picture_kind_name(int i, const char **file, const char **help)
+const char *pk_picture_kind_name(int i, const char **file, const char **title, const char **help)
 {
     if (i < 0 || (size_t)i >= KINDS)
         return NULL;
     if (file)
         *file = kinds[i].file;
+    if (title)
+        *title = kinds[i].title;
     if (help)
         *help = kinds[i].help;
     return kinds[i].name;

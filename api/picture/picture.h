@@ -37,9 +37,11 @@ typedef enum {
 int pk_picture_kind_parse(const char *name, pk_picture_kind *kind);
 
 /* The i-th kind (i from 0): its name, its file name in a job's folder
- * without extension ("picture" for packing, else the name) and a one-line
- * description; NULL past the last. */
-const char *pk_picture_kind_name(int i, const char **file, const char **help);
+ * without extension ("picture" for packing, else the name), a title and a
+ * one-line description (each pointer may be NULL); NULL past the last.  The
+ * one list of the kinds: `packd picture` and the service's outputs
+ * (api/http/http_outputs.h) read it. */
+const char *pk_picture_kind_name(int i, const char **file, const char **title, const char **help);
 
 /* Draw the picture of h5_path into out_path (written under a temporary name,
  * then renamed).  0 on success, -1 with err. */

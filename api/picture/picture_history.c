@@ -1,5 +1,7 @@
-/* picture_history.c — an EDMD run over its events: φ on the left axis,
- * the reduced pressure PV/NkT on a logarithmic right axis (picture.h). */
+/* picture_history.c — a placer's run over its events (a placer with a
+ * history, pack_placer.h: EDMD): φ on the left axis, the reduced pressure
+ * PV/NkT on a logarithmic right axis (picture.h).  The data sit under
+ * /observables/<algorithm>/, the algorithm named by /observables/algorithm. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -11,7 +13,6 @@
 
 #define W 760.0
 #define H 480.0
-#define HISTORY "/observables/edmd/history/"
 
 int pk_picture_history(const char *h5_path, const char *out_path, char *err, size_t errlen)
 {
@@ -21,26 +22,30 @@ int pk_picture_history(const char *h5_path, const char *out_path, char *err, siz
         return -1;
     }
     size_t n, np, nz;
+    char alg[32] = "", at[128];
+    pk_plot_string(f, "/observables/algorithm", alg, sizeof alg);
+#define AT(name) (snprintf(at, sizeof at, "/observables/%s/%s", alg, name), at)
     /* the events: the H5MD step of the history (a flat `events` series in
      * files before the H5MD 1.1 layout) */
-    double *ev = pk_plot_series(f, HISTORY "phi/step", &n);
+    double *ev = pk_plot_series(f, AT("history/phi/step"), &n);
     if (!ev)
-        ev = pk_plot_series(f, HISTORY "events", &n);
-    double *phi = pk_plot_series(f, HISTORY "phi", &np);
-    double *z = pk_plot_series(f, HISTORY "reduced_pressure", &nz);
-    double phi_final = pk_plot_scalar(f, "/observables/edmd/phi_final");
-    double z_final = pk_plot_scalar(f, "/observables/edmd/reduced_pressure");
-    double events = pk_plot_scalar(f, "/observables/edmd/events");
+        ev = pk_plot_series(f, AT("history/events"), &n);
+    double *phi = pk_plot_series(f, AT("history/phi"), &np);
+    double *z = pk_plot_series(f, AT("history/reduced_pressure"), &nz);
+    double phi_final = pk_plot_scalar(f, AT("phi_final"));
+    double z_final = pk_plot_scalar(f, AT("reduced_pressure"));
+    double events = pk_plot_scalar(f, AT("events"));
     char criterion[64];
-    pk_plot_string(f, "/observables/edmd/termination_criterion", criterion, sizeof criterion);
+    pk_plot_string(f, AT("termination_criterion"), criterion, sizeof criterion);
+#undef AT
     pk_plot_file_close(f);
     int rc = -1;
     double lo, hi;
     pk_canvas c;
     if (!ev || !phi || !z || n < 2 || np != n || nz != n) {
         snprintf(err, errlen,
-                 "%s has no EDMD history (only pack results made by EDMD have "
-                 "/observables/edmd/history)",
+                 "%s has no placer history (only pack results of a placer with one, "
+                 "EDMD, have /observables/<algorithm>/history)",
                  h5_path);
     } else if (pk_canvas_open(&c, out_path, W, H, err, errlen) == 0) {
         pk_plot p = {.left = 80, .top = 50, .right = W - 90, .bottom = H - 60};

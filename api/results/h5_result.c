@@ -24,7 +24,17 @@ struct pk_h5 {
     hid_t lcpl; /* link creation: intermediate groups */
     int fd;     /* the temporary file, written at commit */
     char *path, *tmp;
+    int failed; /* sticky: a writer failed since pk_h5_create (pk_h5_commit refuses) */
 };
+
+/* A writer's status, remembered in h: the callers write on without summing
+ * return codes, pk_h5_commit reports the first failure's consequence. */
+static int sticky(pk_h5 *h, int rc)
+{
+    if (rc != 0)
+        h->failed = 1;
+    return rc;
+}
 
 static void quiet_hdf5(void)
 {
@@ -224,7 +234,7 @@ int pk_h5_write_particles(pk_h5 *h, const pk_box *b, const pk_particles *p, cons
     const int dim = b->dim;
     hid_t grains = make_group(h->file, "particles/grains", h->lcpl);
     if (grains < 0)
-        return -1;
+        return sticky(h, -1);
     int rc = 0;
     hid_t box = make_group(grains, "box", H5P_DEFAULT);
     rc |= attr_ints(box, "dimension", &dim, 1, 1);
@@ -251,7 +261,7 @@ int pk_h5_write_particles(pk_h5 *h, const pk_box *b, const pk_particles *p, cons
     double *pos = malloc((n ? n : 1) * (size_t)dim * sizeof *pos);
     if (!pos) {
         H5Gclose(grains);
-        return -1;
+        return sticky(h, -1);
     }
     for (size_t i = 0; i < n; i++)
         for (int k = 0; k < dim; k++)
@@ -266,21 +276,21 @@ int pk_h5_write_particles(pk_h5 *h, const pk_box *b, const pk_particles *p, cons
     int64_t *id = malloc((n ? n : 1) * sizeof *id);
     if (!id) {
         H5Gclose(grains);
-        return -1;
+        return sticky(h, -1);
     }
     for (size_t i = 0; i < n; i++)
         id[i] = (int64_t)i;
     rc |= write_dataset(grains, H5P_DEFAULT, "id", H5T_NATIVE_INT64, 1, &d1, id, NULL);
     free(id);
     H5Gclose(grains);
-    return rc ? -1 : 0;
+    return sticky(h, rc ? -1 : 0);
 }
 
 int pk_h5_write_parameters(pk_h5 *h, const char *process, const char *job_json, uint64_t seed)
 {
     hid_t g = make_group(h->file, "parameters", H5P_DEFAULT);
     if (g < 0)
-        return -1;
+        return sticky(h, -1);
     int rc = attr_string(g, "process", process);
     rc |= attr_string(g, "packd_version", PACKD_VERSION);
     rc |= attr_u64(g, "seed", seed);
@@ -290,17 +300,17 @@ int pk_h5_write_parameters(pk_h5 *h, const char *process, const char *job_json, 
     rc |= write_dataset(g, H5P_DEFAULT, "job", t, 0, NULL, job_json, NULL);
     H5Tclose(t);
     H5Gclose(g);
-    return rc ? -1 : 0;
+    return sticky(h, rc ? -1 : 0);
 }
 
 int pk_h5_obs_double(pk_h5 *h, const char *name, double v, const char *unit)
 {
-    return write_dataset(h->obs, h->lcpl, name, H5T_NATIVE_DOUBLE, 0, NULL, &v, unit);
+    return sticky(h, write_dataset(h->obs, h->lcpl, name, H5T_NATIVE_DOUBLE, 0, NULL, &v, unit));
 }
 
 int pk_h5_obs_int(pk_h5 *h, const char *name, int64_t v)
 {
-    return write_dataset(h->obs, h->lcpl, name, H5T_NATIVE_INT64, 0, NULL, &v, NULL);
+    return sticky(h, write_dataset(h->obs, h->lcpl, name, H5T_NATIVE_INT64, 0, NULL, &v, NULL));
 }
 
 int pk_h5_obs_string(pk_h5 *h, const char *name, const char *v)
@@ -308,19 +318,19 @@ int pk_h5_obs_string(pk_h5 *h, const char *name, const char *v)
     hid_t t = string_type(strlen(v) + 1);
     int rc = write_dataset(h->obs, h->lcpl, name, t, 0, NULL, v, NULL);
     H5Tclose(t);
-    return rc;
+    return sticky(h, rc);
 }
 
 int pk_h5_obs_doubles(pk_h5 *h, const char *name, const double *v, size_t n, const char *unit)
 {
     hsize_t d = (hsize_t)n;
-    return write_dataset(h->obs, h->lcpl, name, H5T_NATIVE_DOUBLE, 1, &d, v, unit);
+    return sticky(h, write_dataset(h->obs, h->lcpl, name, H5T_NATIVE_DOUBLE, 1, &d, v, unit));
 }
 
 int pk_h5_obs_ints(pk_h5 *h, const char *name, const int64_t *v, size_t n)
 {
     hsize_t d = (hsize_t)n;
-    return write_dataset(h->obs, h->lcpl, name, H5T_NATIVE_INT64, 1, &d, v, NULL);
+    return sticky(h, write_dataset(h->obs, h->lcpl, name, H5T_NATIVE_INT64, 1, &d, v, NULL));
 }
 
 int pk_h5_write_array(pk_h5 *h, const char *path, pk_h5_type type, int rank, const size_t *dims,
@@ -328,25 +338,26 @@ int pk_h5_write_array(pk_h5 *h, const char *path, pk_h5_type type, int rank, con
 {
     hsize_t d[5];
     if (rank < 0 || rank > 5)
-        return -1;
+        return sticky(h, -1);
     for (int k = 0; k < rank; k++)
         d[k] = (hsize_t)dims[k];
     hid_t t = type == PK_H5_F64 ? H5T_NATIVE_DOUBLE
         : type == PK_H5_I64     ? H5T_NATIVE_INT64
                                 : H5T_NATIVE_INT32;
-    return write_dataset(h->file, h->lcpl, path, t, rank, d, data, unit);
+    return sticky(h, write_dataset(h->file, h->lcpl, path, t, rank, d, data, unit));
 }
 
 int pk_h5_link(pk_h5 *h, const char *existing, const char *path)
 {
-    return H5Lcreate_hard(h->file, existing, h->file, path, h->lcpl, H5P_DEFAULT) < 0 ? -1 : 0;
+    return sticky(
+        h, H5Lcreate_hard(h->file, existing, h->file, path, h->lcpl, H5P_DEFAULT) < 0 ? -1 : 0);
 }
 
 int pk_h5_slice_view(pk_h5 *h, const char *src, size_t k, const char *path)
 {
     hid_t ds = H5Dopen2(h->file, src, H5P_DEFAULT);
     if (ds < 0)
-        return -1;
+        return sticky(h, -1);
     hid_t ss = H5Dget_space(ds), t = H5Dget_type(ds);
     hsize_t d[3], start[3] = {(hsize_t)k, 0, 0}, count[3];
     int rank = H5Sget_simple_extent_ndims(ss), rc = -1;
@@ -371,7 +382,7 @@ int pk_h5_slice_view(pk_h5 *h, const char *src, size_t k, const char *path)
     H5Tclose(t);
     H5Sclose(ss);
     H5Dclose(ds);
-    return rc;
+    return sticky(h, rc);
 }
 
 int pk_h5_obs_json_units(pk_h5 *h, const char *prefix, json_t *obj, pk_h5_unit_fn unit_of,
@@ -408,7 +419,7 @@ int pk_h5_obs_json_units(pk_h5 *h, const char *prefix, json_t *obj, pk_h5_unit_f
             if (all_int) {
                 int64_t *a = malloc((n ? n : 1) * sizeof *a);
                 if (!a)
-                    return -1;
+                    return sticky(h, -1);
                 json_array_foreach (v, i, e)
                     a[i] = (int64_t)json_integer_value(e);
                 rc |= pk_h5_obs_ints(h, name, a, n);
@@ -416,7 +427,7 @@ int pk_h5_obs_json_units(pk_h5 *h, const char *prefix, json_t *obj, pk_h5_unit_f
             } else {
                 double *a = malloc((n ? n : 1) * sizeof *a);
                 if (!a)
-                    return -1;
+                    return sticky(h, -1);
                 json_array_foreach (v, i, e)
                     a[i] = json_number_value(e);
                 rc |= pk_h5_obs_doubles(h, name, a, n, unit);
@@ -424,7 +435,7 @@ int pk_h5_obs_json_units(pk_h5 *h, const char *prefix, json_t *obj, pk_h5_unit_f
             }
         }
     }
-    return rc ? -1 : 0;
+    return sticky(h, rc ? -1 : 0);
 }
 
 int pk_h5_obs_json(pk_h5 *h, const char *prefix, json_t *obj)
@@ -452,7 +463,7 @@ int pk_h5_time_element(pk_h5 *h, const char *path, const char *clock, const int6
     }
     snprintf(p, sizeof p, "%s/value", path);
     rc |= pk_h5_write_array(h, p, type, rank, dims, value, unit);
-    return rc ? -1 : 0;
+    return sticky(h, rc ? -1 : 0);
 }
 
 int pk_h5_obs_history(pk_h5 *h, const char *prefix, json_t *hist, const char *step_key,
@@ -461,7 +472,7 @@ int pk_h5_obs_history(pk_h5 *h, const char *prefix, json_t *hist, const char *st
     json_t *st = json_object_get(hist, step_key), *tm = json_object_get(hist, time_key);
     size_t S = json_array_size(st);
     if (json_array_size(tm) != S)
-        return -1;
+        return sticky(h, -1);
     int64_t *step = malloc((S ? S : 1) * sizeof *step);
     double *time = malloc((S ? S : 1) * sizeof *time), *v = malloc((S ? S : 1) * sizeof *v);
     int rc = step && time && v ? 0 : -1;
@@ -488,7 +499,7 @@ int pk_h5_obs_history(pk_h5 *h, const char *prefix, json_t *hist, const char *st
     free(step);
     free(time);
     free(v);
-    return rc;
+    return sticky(h, rc);
 }
 
 int pk_h5_connectivity(pk_h5 *h, const char *path, const int64_t *pairs, size_t n,
@@ -496,7 +507,7 @@ int pk_h5_connectivity(pk_h5 *h, const char *path, const int64_t *pairs, size_t 
 {
     size_t d[2] = {n, 2};
     if (pk_h5_write_array(h, path, PK_H5_I64, 2, d, pairs, NULL) != 0)
-        return -1;
+        return sticky(h, -1);
     /* H5MD 1.1 connectivity: the particles group the indices refer to */
     hobj_ref_t ref;
     hid_t ds = H5Dopen2(h->file, path, H5P_DEFAULT), s = H5Screate(H5S_SCALAR);
@@ -511,7 +522,7 @@ int pk_h5_connectivity(pk_h5 *h, const char *path, const int64_t *pairs, size_t 
     H5Sclose(s);
     if (ds >= 0)
         H5Dclose(ds);
-    return rc;
+    return sticky(h, rc);
 }
 
 static void h5_free(pk_h5 *h)
@@ -572,8 +583,15 @@ static void write_result_digest(pk_h5 *h)
     H5Gclose(g);
 }
 
+int pk_h5_failed(const pk_h5 *h) { return h->failed; }
+
 int pk_h5_commit(pk_h5 *h, char *err, size_t errlen)
 {
+    if (h->failed) { /* a half-written file never takes the result's name */
+        snprintf(err, errlen, "writing %s failed", h->path);
+        pk_h5_abort(h);
+        return -1;
+    }
     write_result_digest(h);
     unsigned char *img = NULL;
     ssize_t n = H5Fflush(h->file, H5F_SCOPE_GLOBAL) < 0 ? -1 : H5Fget_file_image(h->file, NULL, 0);

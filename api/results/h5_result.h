@@ -35,6 +35,12 @@ pk_h5 *pk_h5_create(const char *path, const char *author, char *err, size_t errl
 int pk_h5_write_particles(pk_h5 *h, const pk_box *b, const pk_particles *p, const char *unit);
 int pk_h5_write_parameters(pk_h5 *h, const char *process, const char *job_json, uint64_t seed);
 
+/* Every writer below returns 0 or -1 and also remembers a failure in h (a
+ * sticky error): a caller may write on without summing return codes, and
+ * pk_h5_commit refuses a file one of whose writes failed ("writing <path>
+ * failed", the temporary file removed).  pk_h5_failed tells so early. */
+int pk_h5_failed(const pk_h5 *h);
+
 /* Observables under /observables (name may contain '/' for sub-groups,
  * e.g. "grading/target_passing"); unit may be NULL (dimensionless). */
 int pk_h5_obs_double(pk_h5 *h, const char *name, double v, const char *unit);

@@ -25,10 +25,36 @@ typedef struct pk_units {
  * dimensional figure then goes without one) in dim dimensions. */
 void pk_units_init(pk_units *u, const char *length, int dim);
 
-/* The unit of an observable written from a JSON record (its name under
- * /observables, "edmd/delta_d_reached", "homogenize/P"), or NULL when it is
- * dimensionless or a count.  ctx: a pk_units.  A pk_h5_unit_fn.  fe2's
- * datasets are named so too ("fe2/piola_stress", "fe2/mesh/nodes"). */
-const char *pk_units_of(const char *name, const void *ctx);
+/* What an observable measures; PK_U_NONE: a count, a ratio, a flag or in
+ * reduced units (EDMD's time, d̄/u). */
+typedef enum {
+    PK_U_NONE,
+    PK_U_LENGTH,
+    PK_U_AREA,
+    PK_U_VOLUME,
+    PK_U_STIFFNESS,
+    PK_U_STRESS,
+    PK_U_ENERGY,
+    PK_U_FORCE,
+    PK_U_SECONDS,
+    PK_U_HERTZ,
+    PK_U_PLANE_STRESS,
+    PK_U_FORCE_PER_THICKNESS
+} pk_unit_kind;
+
+/* The unit string of kind in u, or NULL (PK_U_NONE, or a length-based kind
+ * without a length unit). */
+const char *pk_unit_string(const pk_units *u, pk_unit_kind kind);
+
+/* One row of an owner's unit table: an observable's name (relative to the
+ * owner's group under /observables) and its kind.  Tables end with {NULL}. */
+typedef struct pk_unit_row {
+    const char *name;
+    pk_unit_kind kind;
+} pk_unit_row;
+
+/* The unit of name in rows (NULL-terminated) with u, or NULL when the table
+ * does not list it. */
+const char *pk_unit_in(const pk_unit_row *rows, const char *name, const pk_units *u);
 
 #endif

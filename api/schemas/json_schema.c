@@ -1468,6 +1468,22 @@ static void embedded_init(void)
     embedded_count = n;
 }
 
+void pk_schema_errors_prefix(pk_schema_errors *e, size_t from, const char *prefix)
+{
+    const size_t np = strlen(prefix);
+    for (size_t i = from; i < e->n; i++) {
+        char *ptr = e->items[i].pointer;
+        size_t len = strlen(ptr), cap = sizeof e->items[i].pointer;
+        if (np >= cap)
+            return;
+        if (len + np + 1 > cap) /* a very deep pointer is cut at its end */
+            len = cap - np - 1;
+        memmove(ptr + np, ptr, len);
+        memcpy(ptr, prefix, np);
+        ptr[len + np] = 0;
+    }
+}
+
 json_t *pk_schema_get(const char *schema_file)
 {
     if (!schema_file)

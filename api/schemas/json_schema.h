@@ -37,6 +37,10 @@ typedef struct pk_schema_errors {
 
 void pk_schema_errors_free(pk_schema_errors *e);
 /* Append an error (printf-style message); used by the semantic checks in api/ too. */
+/* Prefix the pointers of errors from..n with prefix ("/inputs": pointers of
+ * the inputs made relative to the job file or the request body).  A pointer
+ * that would overflow is cut at its end. */
+void pk_schema_errors_prefix(pk_schema_errors *e, size_t from, const char *prefix);
 void pk_schema_errors_add(pk_schema_errors *e, const char *pointer, const char *rule,
                           const char *fmt, ...) __attribute__((format(printf, 4, 5)));
 

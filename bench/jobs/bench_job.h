@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "api/process.h"
+#include "api/results/h5_observables.h"
 
 typedef struct bench_job {
     json_t *sum;    /* the job's summary (new reference), NULL on failure */
@@ -121,9 +122,10 @@ static inline int bench_job_run(const char *name, const char *patch, bench_job *
     return rc;
 }
 
+/* key may name a member of a sub-object ("timing/place_s"). */
 static inline double bench_num(json_t *o, const char *key)
 {
-    return json_number_value(json_object_get(o, key));
+    return json_number_value(pk_obs_value(o, key));
 }
 
 #endif

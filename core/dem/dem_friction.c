@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/base/grow.h"
+
 int pk_fric_law_active(const pk_fric_law *law) { return law && (law->tan_rho > 0 || law->h > 0); }
 
 int pk_fric_return_map(const pk_fric_law *law, double fn, double gamma, double gamma_pl_n,
@@ -45,19 +47,9 @@ static int hist_reserve(pk_fric_hist *h, size_t n)
     if (n <= h->cap && h->key)
         return 0;
     size_t cap = n ? n : 1;
-    uint64_t *k = realloc(h->key, cap * sizeof *k);
-    if (k)
-        h->key = k;
-    double *a = realloc(h->gamma, cap * sizeof *a);
-    if (a)
-        h->gamma = a;
-    double *b = realloc(h->gamma_pl, cap * sizeof *b);
-    if (b)
-        h->gamma_pl = b;
-    double *d = realloc(h->alpha, cap * sizeof *d);
-    if (d)
-        h->alpha = d;
-    if (!k || !a || !b || !d)
+    const pk_grow_item arrays[] = {PK_GROW_ITEM(h->key, 1), PK_GROW_ITEM(h->gamma, 1),
+                                   PK_GROW_ITEM(h->gamma_pl, 1), PK_GROW_ITEM(h->alpha, 1)};
+    if (pk_grow(arrays, 4, cap) != 0)
         return -1;
     h->cap = cap;
     return 0;
@@ -103,13 +95,12 @@ static int pairs_reserve(pk_fric_pairs *w, size_t n)
     if (n <= w->cap && w->gamma)
         return 0;
     size_t cap = n ? n : 1;
-    double **arr[] = {&w->gamma, &w->gamma_pl, &w->alpha, &w->ft, &w->dlambda, &w->keff, &w->ct};
-    for (size_t k = 0; k < sizeof arr / sizeof *arr; k++) {
-        double *a = realloc(*arr[k], cap * sizeof *a);
-        if (!a)
-            return -1;
-        *arr[k] = a;
-    }
+    const pk_grow_item arrays[] = {PK_GROW_ITEM(w->gamma, 1),   PK_GROW_ITEM(w->gamma_pl, 1),
+                                   PK_GROW_ITEM(w->alpha, 1),   PK_GROW_ITEM(w->ft, 1),
+                                   PK_GROW_ITEM(w->dlambda, 1), PK_GROW_ITEM(w->keff, 1),
+                                   PK_GROW_ITEM(w->ct, 1)};
+    if (pk_grow(arrays, sizeof arrays / sizeof *arrays, cap) != 0)
+        return -1;
     w->cap = cap;
     return 0;
 }

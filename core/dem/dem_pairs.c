@@ -2,9 +2,12 @@
  * from the shared pk_grid) and each candidate's periodic image; contract: dem_contact.h. */
 #include "dem_contact.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "core/base/grow.h"
 
 #include "core/space/mat3.h"
 #include "core/space/grid.h"
@@ -51,30 +54,19 @@ void pk_dem_pairs_stiffness(pk_dem_pairs *c, const int32_t *kclass, const double
 
 static int pairs_push(pk_dem_pairs *c, int32_t i, int32_t j)
 {
+    assert(0 <= i && i < j && (size_t)j < c->np); /* each pair once, i < j */
     if (c->n == c->cap) {
-        size_t cap = c->cap ? 2 * c->cap : 1024;
-        int32_t *ni = realloc(c->i, cap * sizeof *ni);
-        if (ni)
-            c->i = ni;
-        int32_t *nj = realloc(c->j, cap * sizeof *nj);
-        if (nj)
-            c->j = nj;
-        double *nl = realloc(c->l, 3 * cap * sizeof *nl);
-        if (nl)
-            c->l = nl;
-        double *nn = realloc(c->len, cap * sizeof *nn);
-        if (nn)
-            c->len = nn;
-        double *ne = realloc(c->eps, cap * sizeof *ne);
-        if (ne)
-            c->eps = ne;
-        double *nk = c->kclass ? realloc(c->kf, cap * sizeof *nk) : c->kf;
-        if (nk)
-            c->kf = nk;
-        double *ns = realloc(c->sh, 3 * cap * sizeof *ns);
-        if (ns)
-            c->sh = ns;
-        if (!ni || !nj || !nl || !nn || !ne || (c->kclass && !nk) || !ns)
+        const size_t cap = pk_grow_cap(c->cap, c->n + 1, 1024);
+        const pk_grow_item arrays[] = {
+            PK_GROW_ITEM(c->i, 1),
+            PK_GROW_ITEM(c->j, 1),
+            PK_GROW_ITEM(c->l, 3),
+            PK_GROW_ITEM(c->len, 1),
+            PK_GROW_ITEM(c->eps, 1),
+            PK_GROW_ITEM(c->sh, 3),
+            {c->kclass ? (void *)&c->kf : NULL, sizeof *c->kf},
+        };
+        if (pk_grow(arrays, sizeof arrays / sizeof *arrays, cap) != 0)
             return -1;
         c->cap = cap;
     }

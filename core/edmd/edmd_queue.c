@@ -16,6 +16,7 @@
  * and a chain of compares (a quarter of the CPU time of mono 3D N = 10^4 to
  * jamming); here an event costs a small heap's pop and a list insert
  * (docs/perf/edmd.md). */
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -177,6 +178,8 @@ static inline void list_push(edmd_queue *q, uint32_t b, size_t i)
 static inline void list_unlink(edmd_queue *q, uint32_t b, size_t i)
 {
     const int32_t nx = q->nxt[i], pv = q->prv[i];
+    assert(pv < 0 ? q->head[b] == (int32_t)i : q->nxt[pv] == (int32_t)i);
+    assert(nx < 0 || q->prv[nx] == (int32_t)i);
     if (pv >= 0)
         q->nxt[pv] = nx;
     else

@@ -665,14 +665,3 @@ int pk_hybrid_step(pk_hybrid *h, double *x, pk_dr_stats *st, pk_newton_stats *ns
         rc = pk_dem_pairs_build(c, sy->s.g, x, sy->s.r, np, sy->prm->skin);
     return rc;
 }
-
-int pk_homog_newton(const pk_dem_system *s, double *x, const pk_dr_params *prm,
-                    const pk_newton_opts *no, pk_monitor *mon, pk_dr_stats *st, pk_newton_stats *ns)
-{
-    pk_hybrid h;
-    int rc = pk_hybrid_begin(&h, s, x, prm, no, mon, st, ns);
-    if (rc == 0)
-        rc = pk_hybrid_step(&h, x, st, ns);
-    pk_hybrid_end(&h);
-    return rc;
-}

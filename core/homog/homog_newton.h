@@ -25,9 +25,10 @@
  * where the block it factorised last was positive definite: the end point is
  * a local minimum.  Which one, when the step crosses a plastic event, is
  * path dependent (docs/homogenization.md).
- * pk_homog_newton is the serial hybrid; pk_homog_newton_speculative
- * (homog_speculative.h) wraps its step and, with a pool of two threads or
- * more, makes the attempts on a second thread: the same result, bit for bit. */
+ * The hybrid's steps are pk_hybrid_begin/step/end (homog_hybrid.h);
+ * pk_homog_newton_speculative (homog_speculative.h) wraps its step and, with
+ * a pool of two threads or more, makes the attempts on a second thread: the
+ * same result, bit for bit, as the serial step. */
 #ifndef PK_HOMOG_NEWTON_H
 #define PK_HOMOG_NEWTON_H
 
@@ -63,12 +64,5 @@ typedef struct pk_newton_opts {
     pk_sparse_ctx *sctx;
     size_t max_iter; /* factorisations over all Newton phases */
 } pk_newton_opts;
-
-/* The serial hybrid.  Same contract as pk_homog_relax (st describes the DR
- * part, if any, with st->f0 the initial and st->f the final residual of the
- * whole solve). */
-int pk_homog_newton(const pk_dem_system *s, double *x, const pk_dr_params *prm,
-                    const pk_newton_opts *no, pk_monitor *mon, pk_dr_stats *st,
-                    pk_newton_stats *ns);
 
 #endif

@@ -7,7 +7,9 @@
 
 #include "homog_newton.h"
 
-/* pk_homog_newton's contract. */
+/* The hybrid solve (homog_newton.h).  Same contract as pk_homog_relax (st
+ * describes the DR part, if any, with st->f0 the initial and st->f the final
+ * residual of the whole solve); with fewer than two threads the serial step. */
 int pk_homog_newton_speculative(const pk_dem_system *s, double *x, const pk_dr_params *prm,
                                 const pk_newton_opts *no, pk_monitor *mon, pk_dr_stats *st,
                                 pk_newton_stats *ns);

@@ -2,6 +2,7 @@
  * size ratio, memory O(N).  Contract: core/space/grid.h. */
 #include "grid.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -109,6 +110,7 @@ static inline int64_t cell_coord(const pk_grid *g, const pk_grid_level *lv, int 
     } else if (c >= n) {
         c = n - 1;
     }
+    assert(c >= 0 && c < n);
     return c;
 }
 
@@ -169,6 +171,8 @@ int pk_grid_insert(pk_grid *g, const pk_particles *p, size_t i)
     g->cell[i] = cell_of(g, lv, &p->x[3 * i]);
     link_grain(lv, g, i);
     lv->count++;
+    /* queries reach a level's grains through its bound; buckets >= grains */
+    assert(p->r[i] <= lv->r_hi && lv->count <= lv->mask + 1);
     return 0;
 }
 
@@ -180,6 +184,7 @@ void pk_grid_remove(pk_grid *g, size_t i)
     int32_t *pp = &lv->head[bucket_of(lv, g->cell[i])];
     while (*pp >= 0 && *pp != (int32_t)i)
         pp = &g->next[*pp];
+    assert(*pp == (int32_t)i); /* a filed grain is in its bucket's chain */
     if (*pp == (int32_t)i) {
         *pp = g->next[i];
         lv->count--;

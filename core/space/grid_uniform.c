@@ -2,6 +2,7 @@
  * searches (EDMD's lists).  Contract: core/space/grid_uniform.h. */
 #include "grid_uniform.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -108,6 +109,9 @@ void pk_ugrid_free(pk_ugrid *g)
 static void unlink_grain(pk_ugrid *g, size_t i)
 {
     int32_t nx = g->next[i], pv = g->prev[i];
+    /* the chain is doubly linked: i's neighbours point back at i */
+    assert(pv < 0 ? g->lv[g->level[i]].head[g->cell[i]] == (int32_t)i : g->next[pv] == (int32_t)i);
+    assert(nx < 0 || g->prev[nx] == (int32_t)i);
     if (pv >= 0)
         g->next[pv] = nx;
     else
@@ -144,6 +148,7 @@ int pk_ugrid_insert(pk_ugrid *g, const pk_particles *p, size_t i)
     g->level[i] = (int8_t)l;
     if (p->r[i] > lv->r_max)
         lv->r_max = p->r[i];
+    assert(c >= 0 && p->r[i] <= lv->r_max); /* a query reaches it through r_max */
     if (g->covered[l] &&
         (move ? pk_ugrid_cover_move(g, i, x, p->r[i]) : pk_ugrid_cover_add(g, i, x, p->r[i])) != 0)
         return -1;

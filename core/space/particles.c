@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/base/grow.h"
+
 #include "box.h"
 
 int pk_particles_init(pk_particles *p, int dim, size_t cap)
@@ -26,18 +28,10 @@ int pk_particles_reserve(pk_particles *p, size_t cap)
 {
     if (cap <= p->cap)
         return 0;
-    double *x = realloc(p->x, cap * 3 * sizeof *x);
-    if (!x)
+    const pk_grow_item arrays[] = {PK_GROW_ITEM(p->x, 3), PK_GROW_ITEM(p->r, 1),
+                                   PK_GROW_ITEM(p->species, 1)};
+    if (pk_grow(arrays, 3, cap) != 0)
         return -1;
-    p->x = x;
-    double *r = realloc(p->r, cap * sizeof *r);
-    if (!r)
-        return -1;
-    p->r = r;
-    int32_t *s = realloc(p->species, cap * sizeof *s);
-    if (!s)
-        return -1;
-    p->species = s;
     p->cap = cap;
     return 0;
 }

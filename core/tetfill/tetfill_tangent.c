@@ -1,6 +1,7 @@
 /* tetfill_tangent.c — the fifth sphere tangent to four (Jerier §2.1,
  * Eqs. 1–9).  Contract: core/tetfill/tetfill_tangent.h. */
 #include "tetfill_tangent.h"
+#include "tetfill_tangent_internal.h"
 
 #include <math.h>
 #include <string.h>

@@ -29,9 +29,6 @@ pk_tangent_status pk_tangent_sphere(const double c[4][3], const double r[4], dou
  * "last resort" when the four-sphere root exceeds r_max (see tetfill.h). */
 int pk_tangent_sphere3(const double c[3][3], const double r[3], double rho, double x[2][3]);
 
-/* det A of Eq. 6 (for tests). */
-double pk_tangent_det(const double c[4][3]);
-
 /* 1 if x lies inside the tetrahedron c[0..3] (either orientation). */
 int pk_point_in_tet(const double c[4][3], const double x[3]);
 

@@ -12,7 +12,7 @@ static int usage(FILE *f)
             "usage: packd picture RESULT.h5 -o FILE.svg|FILE.png [--kind KIND]\n"
             "kinds (default packing; a kind needs its data in the file):\n");
     const char *name, *help;
-    for (int i = 0; (name = pk_picture_kind_name(i, NULL, &help)); i++)
+    for (int i = 0; (name = pk_picture_kind_name(i, NULL, NULL, &help)); i++)
         fprintf(f, "  %-9s %s\n", name, help);
     return f == stderr ? 64 : 0;
 }

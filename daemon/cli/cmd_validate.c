@@ -5,7 +5,6 @@
 
 #include "cli.h"
 #include "input_hint.h"
-#include "api/pack/pack_job.h"
 #include "api/process.h"
 
 int cmd_validate(int argc, char **argv)
@@ -28,16 +27,8 @@ int cmd_validate(int argc, char **argv)
         rc = 1;
     } else {
         json_t *out = json_pack("{s:b,s:s,s:s}", "valid", 1, "file", argv[1], "process", proc->id);
-        if (strcmp(proc->id, "pack") == 0) {
-            /* what the job implies, so a user sees the cost before running it */
-            const pk_pack_plan plan = ((const pk_pack_task *)parsed)->plan;
-            json_object_set_new(out, "plan",
-                                json_pack("{s:f,s:f,s:f,s:f,s:f,s:i}", "expected_grains",
-                                          plan.expected_n, "phi_target_mix", plan.phi_mix,
-                                          "phi_target_resolved", plan.phi_resolved,
-                                          "mass_cut_fraction", plan.mass_cut, "d_max", plan.d_max,
-                                          "size_classes", plan.resolved.nclass));
-        }
+        if (proc->plan) /* what the job implies, so a user sees the cost before running it */
+            json_object_set_new(out, "plan", proc->plan(parsed));
         json_dumpf(out, stdout, JSON_INDENT(2));
         putchar('\n');
         json_decref(out);

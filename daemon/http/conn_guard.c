@@ -121,8 +121,8 @@ void pk_conn_guard_notify(void *cls, struct MHD_Connection *c, void **socket_con
     slot *s = G.free_list;
     if (s && ci) {
         G.free_list = s->next_free;
-        *s = (slot){.fd = ci->connect_fd, .used = 1, .phase = HEAD, .since = t,
-                    .deadline = t + head};
+        *s = (slot){
+            .fd = ci->connect_fd, .used = 1, .phase = HEAD, .since = t, .deadline = t + head};
         G.open++;
         *socket_context = s;
         if (G.open - G.closing > G.threshold) {

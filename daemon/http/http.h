@@ -82,6 +82,9 @@ enum MHD_Result pk_send_text(pk_req *r, unsigned status, const char *ctype, cons
  * retry_after > 0 adds Retry-After. */
 enum MHD_Result pk_send_problem(pk_req *r, unsigned status, const char *type, const char *title,
                                 const char *detail, json_t *extra, int retry_after);
+/* The problem of code (api/http/http_problem.h: the code decides status,
+ * type and title) with detail (may be NULL). */
+enum MHD_Result pk_reply_problem(pk_req *r, pk_problem_code code, const char *detail);
 /* A problem document already built (stolen). */
 enum MHD_Result pk_send_problem_doc(pk_req *r, unsigned status, json_t *doc, int retry_after);
 

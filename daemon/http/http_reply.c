@@ -178,6 +178,11 @@ enum MHD_Result pk_send_problem(pk_req *r, unsigned status, const char *type, co
     return pk_send_problem_doc(r, status, doc, retry_after);
 }
 
+enum MHD_Result pk_reply_problem(pk_req *r, pk_problem_code code, const char *detail)
+{
+    return pk_send_problem_doc(r, pk_problem_status(code), pk_problem_of(code, detail), 0);
+}
+
 const char *pk_header(pk_req *r, const char *name)
 {
     return MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, name);

@@ -208,12 +208,7 @@ enum MHD_Result route_execute(pk_req *r)
     if (pk_input_files_confine(inputs, cfg.input_dir, cfg.input_max_bytes, &errs) > 0 ||
         pk_resolve_input_refs(inputs, data, svc->q, pk_scope(r), &errs) > 0 ||
         pk_process_validate_inputs(p, inputs, &request, &errs) > 0) {
-        for (size_t i = 0; i < errs.n; i++) { /* pointers relative to the body */
-            char ptr[sizeof errs.items[i].pointer + 8];
-            snprintf(ptr, sizeof ptr, "/inputs%s", errs.items[i].pointer);
-            ptr[sizeof errs.items[i].pointer - 1] = 0;
-            memcpy(errs.items[i].pointer, ptr, sizeof errs.items[i].pointer);
-        }
+        pk_schema_errors_prefix(&errs, 0, "/inputs"); /* pointers relative to the body */
         char d[80];
         snprintf(d, sizeof d, "%zu invalid input%s", errs.n, errs.n == 1 ? "" : "s");
         json_decref(body);

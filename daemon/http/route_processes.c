@@ -17,7 +17,6 @@ enum MHD_Result route_process(pk_req *r)
 {
     const pk_process *p = pk_process_find(r->seg[1]);
     if (!p)
-        return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_PROCESS, "No such process", r->seg[1],
-                               NULL, 0);
+        return pk_reply_problem(r, PK_P_NO_SUCH_PROCESS, r->seg[1]);
     return pk_send_json(r, 200, pk_process_description(p), NULL);
 }

@@ -95,7 +95,8 @@ static json_t *results_document(pk_req *r, json_t *row, const pk_exec_opts *o)
 {
     const char *id = json_string_value(json_object_get(row, "id"));
     json_t *doc = pk_results_document(row);
-    for (const pk_output *out = pk_outputs; out->id; out++) {
+    const pk_output *out;
+    for (size_t i = 0; (out = pk_output_at(i)); i++) {
         char path[1300], href[200];
         job_file(r, id, out->id, path, sizeof path);
         if (out->optional && access(path, R_OK) == 0) {
@@ -128,8 +129,7 @@ static enum MHD_Result send_output(pk_req *r, json_t *row, const pk_output *out)
                      "this job has no such picture (SVG packings are drawn up to %d "
                      "grains, each plot when the result has its data)",
                      PK_PICTURE_SVG_MAX_GRAINS);
-            rc = pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output", d,
-                                 NULL, 0);
+            rc = pk_reply_problem(r, PK_P_NO_SUCH_OUTPUT, d);
         } else {
             rc = pk_send_file(r, path, out->type, hex, NULL); /* shown inline */
         }
@@ -140,10 +140,9 @@ static enum MHD_Result send_output(pk_req *r, json_t *row, const pk_output *out)
         snprintf(name, sizeof name, "%s.h5", id);
         snprintf(xname, sizeof xname, "%s.xdmf", id);
         if (access(xpath, R_OK) != 0 && pk_xdmf_write(path, name, xpath, err, sizeof err) != 0)
-            rc = pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error", err, NULL, 0);
+            rc = pk_reply_problem(r, PK_P_INTERNAL, err);
         else if (pk_sha256_file_hex(xpath, hex) != 0)
-            rc = pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error",
-                                 "cannot read the XDMF file", NULL, 0);
+            rc = pk_reply_problem(r, PK_P_INTERNAL, "cannot read the XDMF file");
         else
             rc = pk_send_file(r, xpath, out->type, hex, xname);
     } else {
@@ -172,7 +171,7 @@ enum MHD_Result route_results(pk_req *r)
 {
     json_t *row = pk_job_visible(r, r->seg[1]);
     if (!row)
-        return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
+        return pk_reply_problem(r, PK_P_NO_SUCH_JOB, r->seg[1]);
     pk_exec_opts o;
     pk_results_opts_load(r, r->seg[1], &o);
     /* a client that takes only JSON (packd fetch) gets the document of a raw job */
@@ -188,14 +187,14 @@ enum MHD_Result route_results(pk_req *r)
 enum MHD_Result route_result_file(pk_req *r)
 {
     const pk_output *out = pk_output_find(r->seg[3]);
-    if (!out)
-        return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-output", "No such output",
-                               "outputs: summary, result, xdmf, picture, grading, history, "
-                               "stress, residual, response .png/.svg",
-                               NULL, 0);
+    if (!out) {
+        char all[600];
+        pk_outputs_list(all, sizeof all);
+        return pk_reply_problem(r, PK_P_NO_SUCH_OUTPUT, all);
+    }
     json_t *row = pk_job_visible(r, r->seg[1]);
     if (!row)
-        return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
+        return pk_reply_problem(r, PK_P_NO_SUCH_JOB, r->seg[1]);
     enum MHD_Result rc;
     /* a failed job's partial result file stays downloadable */
     if (!(row = finished_job(r, row, !strcmp(out->id, "result") || !strcmp(out->id, "xdmf"), &rc)))

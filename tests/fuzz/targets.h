@@ -101,10 +101,10 @@ static inline void fuzz_request(const uint8_t *data, size_t size)
                 json_decref(copy);
             }
         }
-        /* the same object as a job file (pk_job_validate), still unread */
+        /* the same object as a job file (pk_job_parse, not kept), still unread */
         const pk_process *proc;
         pk_schema_errors errs = {0};
-        pk_job_validate(body, &request, &proc, &errs);
+        pk_job_parse(body, &request, &proc, NULL, &errs);
         pk_schema_errors_free(&errs);
     }
     json_decref(body);

@@ -74,7 +74,7 @@ plot_ok picture_residual "$T/h.h5" residual 728
 # errors
 # a plot asked of a result without its data names what is missing
 "$PACKD" picture "$T/q.h5" --kind history -o "$T/x.png" 2>"$T/e2"
-check picture_history_needs_edmd test $? -eq 2 -a -n "$(grep 'has no EDMD history' "$T/e2")"
+check picture_history_needs_edmd test $? -eq 2 -a -n "$(grep 'has no placer history' "$T/e2")"
 "$PACKD" picture "$T/e.h5" --kind stress -o "$T/x.svg" 2>"$T/e3"
 check picture_stress_needs_homogenize test $? -eq 2 -a -n "$(grep 'has no stress-strain data' "$T/e3")"
 "$PACKD" picture "$T/q.h5" --kind residual -o "$T/x.png" 2>"$T/e4"

@@ -641,6 +641,28 @@ static void test_integer_fields(void)
     }
 }
 
+/* One rewrite of error pointers (the job file's and the request body's
+ * /inputs): from the mark on, a deep pointer cut at its end, never overflowing. */
+static void test_errors_prefix(void)
+{
+    pk_schema_errors e = {0};
+    pk_schema_errors_add(&e, "/dim", "type", "x");
+    pk_schema_errors_add(&e, "/phi/value", "minimum", "x");
+    pk_schema_errors_add(&e, "", "required", "x");
+    char deep[300];
+    memset(deep, 'a', sizeof deep - 1);
+    deep[0] = '/';
+    deep[sizeof deep - 1] = 0;
+    pk_schema_errors_add(&e, deep, "type", "x");
+    pk_schema_errors_prefix(&e, 1, "/inputs");
+    CHECK(!strcmp(e.items[0].pointer, "/dim")); /* before the mark: untouched */
+    CHECK(!strcmp(e.items[1].pointer, "/inputs/phi/value"));
+    CHECK(!strcmp(e.items[2].pointer, "/inputs"));
+    size_t n = strlen(e.items[3].pointer);
+    CHECK(n == sizeof e.items[3].pointer - 1 && !strncmp(e.items[3].pointer, "/inputs/aaa", 11));
+    pk_schema_errors_free(&e);
+}
+
 int main(void)
 {
     RUN(test_type);
@@ -671,6 +693,7 @@ int main(void)
     RUN(test_malformed_schema);
     RUN(test_max_errors);
     RUN(test_errors_json);
+    RUN(test_errors_prefix);
     RUN(test_embedded);
     RUN(test_integer_fields);
     return check_summary();

@@ -146,9 +146,9 @@ static void collect_tables(void)
     tables[ntables++] = &pk_pack_options;
     tables[ntables++] = &pk_homog_options;
     tables[ntables++] = &pk_fe2_options;
-    for (size_t i = 0; pk_placers[i]; i++)
-        if (pk_placers[i]->options)
-            tables[ntables++] = pk_placers[i]->options;
+    for (size_t i = 0; pk_placer_at(i); i++)
+        if (pk_placer_at(i)->options)
+            tables[ntables++] = pk_placer_at(i)->options;
 }
 
 static int table_has(const char *schema, const char *pointer)

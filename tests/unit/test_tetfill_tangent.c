@@ -8,6 +8,7 @@
 #include "check.h"
 #include "core/base/rng.h"
 #include "core/tetfill/tetfill_tangent.h"
+#include "core/tetfill/tetfill_tangent_internal.h"
 
 static double residual(const double c[4][3], const double r[4], const double x[3], double rr, int n)
 {

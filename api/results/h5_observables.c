@@ -1,0 +1,63 @@
+/* h5_observables.c — one observable list to the summary and the file; the
+ * contract is in h5_observables.h. */
+#include "h5_observables.h"
+
+#include <stdio.h>
+#include <string.h>
+
+json_t *pk_obs_value(json_t *values, const char *name)
+{
+    char key[128];
+    const char *slash;
+    while (values && (slash = strchr(name, '/'))) {
+        snprintf(key, sizeof key, "%.*s", (int)(slash - name), name);
+        values = json_object_get(values, key);
+        name = slash + 1;
+    }
+    return json_object_get(values, name);
+}
+
+int pk_obs_set(json_t *values, const char *name, json_t *v)
+{
+    char key[128];
+    const char *slash;
+    while ((slash = strchr(name, '/'))) {
+        snprintf(key, sizeof key, "%.*s", (int)(slash - name), name);
+        json_t *sub = json_object_get(values, key);
+        if (!sub && json_object_set_new(values, key, sub = json_object()) != 0)
+            sub = NULL;
+        if (!json_is_object(sub)) {
+            json_decref(v);
+            return -1;
+        }
+        values = sub;
+        name = slash + 1;
+    }
+    return v ? json_object_set_new(values, name, v) : -1;
+}
+
+const pk_unit_row *pk_obs_row(const pk_unit_row *rows, const char *name)
+{
+    for (; rows && rows->name; rows++)
+        if (!strcmp(rows->name, name))
+            return rows;
+    return NULL;
+}
+
+int pk_h5_obs_rows(pk_h5 *h, const pk_unit_row *rows, json_t *values, const pk_units *u)
+{
+    int rc = 0;
+    for (; rows->name; rows++) {
+        json_t *v = pk_obs_value(values, rows->name);
+        const char *unit = pk_unit_string(u, rows->kind);
+        if (json_is_integer(v) && !unit)
+            pk_h5_obs_int(h, rows->name, (int64_t)json_integer_value(v));
+        else if (json_is_number(v))
+            pk_h5_obs_double(h, rows->name, json_number_value(v), unit);
+        else if (json_is_string(v))
+            pk_h5_obs_string(h, rows->name, json_string_value(v));
+        else
+            rc = -1;
+    }
+    return rc ? -1 : 0;
+}
