@@ -97,9 +97,11 @@ static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const 
     rc |= pk_h5_write_particles(h, box, p, u);
     rc |= pk_h5_write_parameters(h, "pack", job_json, job->seed);
     rc |= pk_h5_obs_double(h, "phi_resolved", phi, NULL);
-    rc |= pk_h5_obs_double(h, "phi_mix", phi / (1 - plan->mass_cut), NULL);
-    rc |= pk_h5_obs_double(h, "phi_target_resolved", plan->phi_resolved, NULL);
-    rc |= pk_h5_obs_double(h, "phi_target_mix", plan->phi_mix, NULL);
+    if (!st->phi_own) {
+        rc |= pk_h5_obs_double(h, "phi_mix", phi / (1 - plan->mass_cut), NULL);
+        rc |= pk_h5_obs_double(h, "phi_target_resolved", plan->phi_resolved, NULL);
+        rc |= pk_h5_obs_double(h, "phi_target_mix", plan->phi_mix, NULL);
+    }
     rc |= pk_h5_obs_double(h, "mass_cut_fraction", plan->mass_cut, NULL);
     rc |= pk_h5_obs_double(h, "d_min", job->d_min, u);
     rc |= pk_h5_obs_double(h, "delta_d", job->delta_d, u);
@@ -107,7 +109,7 @@ static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const 
     rc |= pk_h5_obs_int(h, "count_requested", (int64_t)st->requested);
     rc |= pk_h5_obs_int(h, "count_placed", (int64_t)st->placed);
     rc |= pk_h5_obs_double(h, "count_expected", plan->expected_n, NULL);
-    rc |= pk_h5_obs_string(h, "termination_reason", pk_stop_reason_name(st->reason));
+    rc |= pk_h5_obs_string(h, "termination_reason", pk_place_termination(st));
     rc |= pk_h5_obs_string(h, "algorithm", job->algorithm);
     if (st->obs) {
         /* a history {events, time, ...} as H5MD time-dependent elements */
@@ -212,7 +214,8 @@ done:
     free(pass_a);
     rc |= write_scene(h, summary);
     json_object_set_new(summary, "phi_resolved", json_real(phi));
-    json_object_set_new(summary, "phi_mix", json_real(phi / (1 - plan->mass_cut)));
+    if (!st->phi_own)
+        json_object_set_new(summary, "phi_mix", json_real(phi / (1 - plan->mass_cut)));
     return pk_verdict_close_h5(h, rc, summary, out_path, err, errlen);
 }
 
@@ -285,7 +288,7 @@ int pk_pack_run(const void *task, int threads, const char *job_json, const char 
     json_t *sum = json_object();
     json_object_set_new(sum, "process", json_string("pack"));
     json_object_set_new(sum, "algorithm", json_string(job.algorithm));
-    json_object_set_new(sum, "termination_reason", json_string(pk_stop_reason_name(st.reason)));
+    json_object_set_new(sum, "termination_reason", json_string(pk_place_termination(&st)));
     json_t *choice = pk_pack_auto_json(&job);
     if (choice)
         json_object_set_new(sum, "auto", choice);
@@ -295,8 +298,10 @@ int pk_pack_run(const void *task, int threads, const char *job_json, const char 
     json_object_set_new(sum, "count_placed", json_integer((json_int_t)st.placed));
     json_object_set_new(sum, "count_requested", json_integer((json_int_t)st.requested));
     json_object_set_new(sum, "count_expected", json_real(plan.expected_n));
-    json_object_set_new(sum, "phi_target_resolved", json_real(plan.phi_resolved));
-    json_object_set_new(sum, "phi_target_mix", json_real(plan.phi_mix));
+    if (!st.phi_own) {
+        json_object_set_new(sum, "phi_target_resolved", json_real(plan.phi_resolved));
+        json_object_set_new(sum, "phi_target_mix", json_real(plan.phi_mix));
+    }
     json_object_set_new(sum, "mass_cut_fraction", json_real(plan.mass_cut));
     json_object_set_new(sum, "smallest_gap", json_real(gap.min_gap));
     if (!isinf(gap.min_wall_gap))
