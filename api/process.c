@@ -128,26 +128,12 @@ size_t pk_job_validate(json_t *job, const pk_check_ctx *ctx, const pk_process **
     return pk_job_parse(job, ctx, proc, NULL, errs);
 }
 
-static const char *ckpt_path, *ckpt_digest;
-static double ckpt_interval_s = 30;
-
-void pk_job_set_checkpoint(const char *path, const char *digest, double interval_s)
-{
-    ckpt_path = path;
-    ckpt_digest = digest;
-    ckpt_interval_s = interval_s;
-}
-
-const char *pk_job_checkpoint(const char **digest, double *interval_s)
-{
-    *digest = ckpt_digest ? ckpt_digest : "";
-    *interval_s = ckpt_interval_s;
-    return ckpt_path;
-}
-
-int pk_job_run(json_t *job, int threads, const char *out_path, pk_monitor *mon, json_t **summary,
+int pk_job_run(json_t *job, const pk_run_ctx *run, const char *out_path, json_t **summary,
                pk_schema_errors *errs, char *err, size_t errlen)
 {
+    pk_run_ctx rx = run ? *run : PK_RUN_CTX_DEFAULT;
+    if (rx.threads < 1)
+        rx.threads = 1;
     const pk_process *p;
     void *parsed;
     const pk_check_ctx local = {.service = 0}; /* the job runs here: its files are read */
@@ -162,7 +148,7 @@ int pk_job_run(json_t *job, int threads, const char *out_path, pk_monitor *mon, 
         snprintf(err, errlen, "out of memory");
         return -1;
     }
-    int rc = p->run(parsed, threads < 1 ? 1 : threads, text, out_path, mon, summary, err, errlen);
+    int rc = p->run(parsed, &rx, text, out_path, summary, err, errlen);
     p->free_job(parsed);
     free(text);
     if (rc == 0 && pk_verdict_failed(*summary)) {

@@ -8,8 +8,8 @@
 #include <stddef.h>
 
 #include "api/inputs/check_ctx.h"
+#include "api/run_ctx.h"
 #include "api/schemas/json_schema.h"
-#include "core/base/progress.h"
 
 typedef struct pk_process {
     const char *id; /* "pack" */
@@ -22,14 +22,13 @@ typedef struct pk_process {
      * pointers relative to the inputs object).  Borrows from inputs. */
     void *(*parse)(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
     void (*free_job)(void *job);
-    /* Run a parsed job on threads threads (core/base/par.h: the results are
-     * the same bits for any number), write the result file, return a
-     * summary object (new reference) in *summary carrying the verdict
-     * (job_verdict.h).  0 whenever a result file and a summary were written,
-     * failed verdict included; -1 with err when there is no result file at
-     * all. */
-    int (*run)(const void *job, int threads, const char *job_json, const char *out_path,
-               pk_monitor *mon, json_t **summary, char *err, size_t errlen);
+    /* Run a parsed job in the run context run (run_ctx.h: threads, monitor,
+     * checkpoint, author), write the result file, return a summary object
+     * (new reference) in *summary carrying the verdict (job_verdict.h).  0
+     * whenever a result file and a summary were written, failed verdict
+     * included; -1 with err when there is no result file at all. */
+    int (*run)(const void *job, const pk_run_ctx *run, const char *job_json, const char *out_path,
+               json_t **summary, char *err, size_t errlen);
 } pk_process;
 
 /* NULL-terminated table. */
@@ -55,21 +54,14 @@ size_t pk_job_parse(json_t *job, const pk_check_ctx *ctx, const pk_process **pro
 size_t pk_job_validate(json_t *job, const pk_check_ctx *ctx, const pk_process **proc,
                        pk_schema_errors *errs);
 
-/* Checkpoints of long runs (EDMD): the file, the job's digest stored in it
- * (a checkpoint of another job is never resumed) and the wall seconds
- * between two saves; path NULL = none (default).  A run resumes from the
- * file when it exists and its digest matches. */
-void pk_job_set_checkpoint(const char *path, const char *digest, double interval_s);
-const char *pk_job_checkpoint(const char **digest, double *interval_s);
-
 /* Validate, parse once and run a job (the one code path of `packd run` and
- * the daemon's workers) on threads threads (a deployment setting, not a job
- * input: the results are the same bits for any number).  Returns 0 when the
+ * the daemon's workers) in the run context run (NULL: PK_RUN_CTX_DEFAULT;
+ * threads < 1 count as 1).  Returns 0 when the
  * job is successful (complete or not); 2 when it failed but wrote its partial
  * result file and a summary whose "failure" says why (err holds the same
  * text); 1 on invalid input with errs filled; -1 on a runtime failure
  * without a result file, with err. */
-int pk_job_run(json_t *job, int threads, const char *out_path, pk_monitor *mon, json_t **summary,
+int pk_job_run(json_t *job, const pk_run_ctx *run, const char *out_path, json_t **summary,
                pk_schema_errors *errs, char *err, size_t errlen);
 
 #endif

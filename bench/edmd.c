@@ -175,7 +175,7 @@ static void job_case(const char *name, const char *json)
     char err[512];
     const char *out = "/tmp/packd-bench-edmd.h5";
     double c0 = cpu_s();
-    int rc = pk_job_run(job, 1, out, NULL, &sum, &errs, err, sizeof err);
+    int rc = pk_job_run(job, NULL, out, &sum, &errs, err, sizeof err);
     double cpu = cpu_s() - c0;
     if (rc == 0) {
         json_t *o = json_object_get(sum, "edmd");

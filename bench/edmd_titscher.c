@@ -41,7 +41,7 @@ static void a16(const char *name, double phi_mix, int seed, const char *wall_gap
     char err[512] = "";
     const char *out = "/tmp/packd-bench-edmd-titscher.h5";
     double c0 = cpu_s();
-    int rc = job ? pk_job_run(job, 1, out, NULL, &sum, &errs, err, sizeof err) : -1;
+    int rc = job ? pk_job_run(job, NULL, out, &sum, &errs, err, sizeof err) : -1;
     double cpu = cpu_s() - c0;
     printf("bench=edmd_titscher case=%s phi_M=%g seed=%d wall_gap=%s ", name, phi_mix, seed,
            wall_gap);

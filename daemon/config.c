@@ -63,13 +63,18 @@ static const struct key {
      "close a connection silent this long (restart to change)"},
     {"sync_wait_s", K_DOUBLE, F(sync_wait_s), 0, 300,
      "Prefer: respond-sync: seconds an execute request waits for its job (then 201 async)"},
+    {"head_timeout_s", K_DOUBLE, F(head_timeout_s), 0.5, 3600,
+     "seconds a request head may take, from the connection or the previous response (beyond: "
+     "closed)"},
     {"body_timeout_s", K_DOUBLE, F(body_timeout_s), 1, 86400,
-     "seconds a request body may take after its headers (beyond: connection closed)"},
+     "most seconds a request body may take after its head (beyond: connection closed)"},
+    {"body_min_rate", K_DOUBLE, F(body_min_rate), 1, 1e12,
+     "bytes/s: a body of n bytes must arrive within head_timeout_s + n / body_min_rate"},
     {"log_level", K_LEVEL, F(log_level), 0, 0, "debug | info | warn | error"},
     {"public_url", K_STR, F(public_url), 0, 0,
      "base URL of absolute links (reverse proxy); unset: http://<Host header>"},
     {"auth", K_AUTH, F(auth), 0, 0,
-     "bearer tokens required: auto (unless bind is loopback) | on | off"},
+     "bearer tokens required: auto (on unless bind is loopback without trusted_proxy) | on | off"},
     {"trusted_proxy", K_ADDR, F(trusted_proxy), 0, 0,
      "address of the reverse proxy whose X-Packd-Owner is honoured"},
 #undef F
@@ -106,7 +111,9 @@ void pk_config_defaults(pk_config *c)
     c->max_connections = 4096;
     c->max_connections_per_ip = 128;
     c->idle_timeout_s = 20;
+    c->head_timeout_s = 10;
     c->body_timeout_s = 120;
+    c->body_min_rate = 65536;
     c->sync_wait_s = 10;
     c->checkpoint_interval_s = 30;
     c->log_level = PK_LOG_INFO;

@@ -9,7 +9,7 @@
 #include <stddef.h>
 
 typedef enum { PK_LOG_DEBUG, PK_LOG_INFO, PK_LOG_WARN, PK_LOG_ERROR } pk_log_level;
-/* auto: on unless bind is a loopback address */
+/* auto: on unless bind is a loopback address and no trusted proxy is configured */
 typedef enum { PK_AUTH_AUTO, PK_AUTH_ON, PK_AUTH_OFF } pk_auth_mode;
 
 typedef struct pk_config {
@@ -34,8 +34,11 @@ typedef struct pk_config {
     int max_connections;        /* open HTTP connections in total */
     int max_connections_per_ip; /* open HTTP connections of one client address (0: no limit) */
     int idle_timeout_s;    /* a connection silent this long is closed (headers, body, keep-alive) */
+    double head_timeout_s; /* a request head must arrive within this time (new or kept-alive) */
     double body_timeout_s; /* a request body must arrive within this time after its headers */
-    double sync_wait_s;    /* Prefer: respond-sync waits this long for the job, then 201 */
+    double
+        body_min_rate; /* bytes/s: a body of n bytes gets head_timeout_s + n / this (≤ body_timeout_s) */
+    double sync_wait_s; /* Prefer: respond-sync waits this long for the job, then 201 */
     double
         checkpoint_interval_s; /* between two checkpoints of a long job (job dir checkpoint.h5) */
     pk_log_level log_level;

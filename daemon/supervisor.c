@@ -293,8 +293,6 @@ static void finished(pk_supervisor *s, slot *sl, int wstatus)
     if (code == 0 || code == 3) {
         pk_job_file_path(dir, PK_JOB_SUMMARY, path, sizeof path);
         json_t *sum = json_load_file(path, 0, NULL);
-        json_object_del(sum, "output"); /* a path inside the data directory */
-        json_object_del(sum, "xdmf");
         char *text = sum ? json_dumps(sum, JSON_COMPACT | JSON_REAL_PRECISION(10)) : NULL;
         const char *status = code == 0 ? "successful" : "failed";
         json_t *w = json_object_get(sum, "warnings");

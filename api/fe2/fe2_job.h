@@ -10,6 +10,7 @@
 
 #include "api/homog/homog_job.h"
 #include "api/inputs/check_ctx.h"
+#include "api/run_ctx.h"
 #include "api/mesh/mesh_io.h"
 #include "api/schemas/json_schema.h"
 #include "api/schemas/option_table.h"
@@ -85,7 +86,7 @@ void pk_fe2_setup_targets(const pk_fe2_setup *s, size_t k, double t, double *uD,
 /* process table hooks (see process.h): parse returns a pk_fe2_job */
 void *pk_fe2_parse(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
 void pk_fe2_free(void *job);
-int pk_fe2_run(const void *job, int threads, const char *job_json, const char *out_path,
-               pk_monitor *mon, json_t **summary, char *err, size_t errlen);
+int pk_fe2_run(const void *job, const pk_run_ctx *run, const char *job_json, const char *out_path,
+               json_t **summary, char *err, size_t errlen);
 
 #endif

@@ -50,8 +50,8 @@ static int fe2_progress(const pk_progress *p, void *vctx)
 
 /* The RVE's grains: the file, or the nested pack job run into a temporary
  * file beside the result (removed once read). */
-static int load_rve(const pk_fe2_job *job, int threads, const char *out_path, pk_monitor *mon,
-                    pk_box *box, pk_particles *p, char *err, size_t errlen)
+static int load_rve(const pk_fe2_job *job, const pk_run_ctx *run, const char *out_path, pk_box *box,
+                    pk_particles *p, char *err, size_t errlen)
 {
     if (!job->pack_job) {
         /* the file's lengths are in the job's unit: a file with another
@@ -75,10 +75,10 @@ static int load_rve(const pk_fe2_job *job, int threads, const char *out_path, pk
     char e2[400] = "";
     /* its own copy of the monitor: the pack run restarts the clock with its
      * own wall limit, the job's limit keeps counting from the job's start */
-    pk_monitor pm = mon ? *mon : (pk_monitor){0};
-    int rc = text
-        ? pack->run(job->pack_job, threads, text, tmp, mon ? &pm : NULL, &sum, e2, sizeof e2)
-        : -1;
+    pk_monitor pm = run->mon ? *run->mon : (pk_monitor){0};
+    pk_run_ctx sub = *run;
+    sub.mon = run->mon ? &pm : NULL;
+    int rc = text ? pack->run(job->pack_job, &sub, text, tmp, &sum, e2, sizeof e2) : -1;
     free(text);
     if (rc == 0 && pk_verdict_failed(sum)) {
         snprintf(err, errlen, "the nested pack job (micro.rve.pack) failed: %s",
@@ -101,9 +101,11 @@ static json_t *series_json(const double *v, size_t n, size_t stride, size_t off)
     return a;
 }
 
-int pk_fe2_run(const void *parsed, int threads, const char *job_json, const char *out_path,
-               pk_monitor *mon, json_t **summary, char *err, size_t errlen)
+int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
+               const char *out_path, json_t **summary, char *err, size_t errlen)
 {
+    const int threads = run->threads;
+    pk_monitor *mon = run->mon;
     *summary = NULL;
     const pk_fe2_job *job = parsed;
     pk_monitor_start(mon, job->wall_time_s);
@@ -131,7 +133,7 @@ int pk_fe2_run(const void *parsed, int threads, const char *job_json, const char
                      job->micro_gp[i], ngp);
             goto out;
         }
-    if (load_rve(job, threads, out_path, mon, &box, &p, err, errlen) != 0)
+    if (load_rve(job, run, out_path, &box, &p, err, errlen) != 0)
         goto out;
     if (box.dim != 2) {
         snprintf(err, errlen, "the RVE is %dD: fe2 is plane strain and needs a 2D packing",
@@ -273,7 +275,7 @@ int pk_fe2_run(const void *parsed, int threads, const char *job_json, const char
         pk_verdict_fail(sum, "%s (the result file holds the %zu converged load steps before it)",
                         failure, done);
 
-    pk_h5 *h = pk_h5_create(out_path, err, errlen);
+    pk_h5 *h = pk_h5_create(out_path, run->author, err, errlen);
     if (!h)
         goto out;
     pk_units units; /* lengths in the job's unit, forces in N, per unit thickness */

@@ -29,7 +29,7 @@ int pk_homog_ckpt_save(const char *path, const char *digest, const pk_homog_ckpt
 {
     char *text = json_dumps(rec, JSON_COMPACT | JSON_REAL_PRECISION(17));
     double *u = calloc(com->n ? com->n : 1, sizeof *u);
-    pk_h5 *h = text && u ? pk_h5_create(path, err, errlen) : NULL;
+    pk_h5 *h = text && u ? pk_h5_create(path, NULL, err, errlen) : NULL;
     if (!h) {
         if (!text || !u)
             snprintf(err, errlen, "out of memory for the checkpoint");

@@ -7,6 +7,7 @@
 #include <stddef.h>
 
 #include "api/inputs/check_ctx.h"
+#include "api/run_ctx.h"
 #include "core/homog/homog_bc.h"
 #include "core/homog/homog_rve.h"
 #include "api/schemas/json_schema.h"
@@ -80,7 +81,7 @@ void pk_homog_opts_of(const pk_homog_job *job, const pk_homog_rve *rve, pk_homog
 /* process table hooks (see process.h): parse returns a pk_homog_job */
 void *pk_homog_parse(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
 void pk_homog_free(void *job);
-int pk_homog_run(const void *job, int threads, const char *job_json, const char *out_path,
-                 pk_monitor *mon, json_t **summary, char *err, size_t errlen);
+int pk_homog_run(const void *job, const pk_run_ctx *run, const char *job_json, const char *out_path,
+                 json_t **summary, char *err, size_t errlen);
 
 #endif

@@ -50,6 +50,24 @@ static const char *eval_error(int rc)
                     : "out of memory";
 }
 
+/* The rule a periodic RVE breaks when its pair search cannot tell a grain's
+ * neighbours from their periodic images (core/dem/dem_pairs.c): every edge
+ * longer than twice the largest contact reach at F̄ = I. */
+static void periodic_box_rule(const pk_homog_rve *rve, double skin, char *err, size_t errlen)
+{
+    double rmax = 0;
+    for (size_t i = 0; i < rve->n; i++)
+        rmax = fmax(rmax, rve->r[i]);
+    double need = 2 * (2 * rmax + skin), shortest = INFINITY;
+    for (int k = 0; k < rve->dim; k++)
+        shortest = fmin(shortest, rve->L[k]);
+    snprintf(err, errlen,
+             "/rve: the periodic box is too small for its grains: every edge must exceed 2 x "
+             "(largest diameter %.6g + pair-list skin %.6g) = %.6g, the shortest edge is %.6g "
+             "(rule periodic_box: a contact and its periodic image must not both be in reach)",
+             2 * rmax, skin, need, shortest);
+}
+
 /* An object of the n named values (taking their references). */
 static json_t *object_of(const char *const *names, json_t *const *vals, size_t n)
 {
@@ -131,9 +149,11 @@ static json_t *tensor_json(const double T[9], int dim)
     return a;
 }
 
-int pk_homog_run(const void *parsed, int threads, const char *job_json, const char *out_path,
-                 pk_monitor *mon, json_t **summary, char *err, size_t errlen)
+int pk_homog_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
+                 const char *out_path, json_t **summary, char *err, size_t errlen)
 {
+    const int threads = run->threads;
+    pk_monitor *mon = run->mon;
     *summary = NULL;
     const pk_homog_job job = *(const pk_homog_job *)parsed; /* its arrays stay the caller's */
     pk_monitor_start(mon, job.wall_time_s);
@@ -173,7 +193,11 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
     if (o.newton && o.newton->ctx_new)
         o.newton_ctx = nctx = o.newton->ctx_new();
     o.par = pool = pk_par_new(threads);
-    if (pk_homog_state_init(&rve, &o, &com) != 0) {
+    int irc = pk_homog_state_init(&rve, &o, &com);
+    if (irc == -2) {
+        periodic_box_rule(&rve, o.dr.skin, err, errlen);
+        goto out;
+    } else if (irc != 0) {
         snprintf(err, errlen, "out of memory");
         goto out;
     }
@@ -191,9 +215,9 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
     /* a re-queued job continues after its last saved step (checkpoint file
      * of `packd run --checkpoint`: committed state, record, counters) */
     pk_homog_ckpt ck = {0};
-    const char *ck_digest;
-    double ck_every, ck_last = pk_wall_seconds();
-    const char *ck_path = pk_job_checkpoint(&ck_digest, &ck_every);
+    const char *ck_digest = run->checkpoint.digest ? run->checkpoint.digest : "";
+    double ck_every = run->checkpoint.interval_s, ck_last = pk_wall_seconds();
+    const char *ck_path = run->checkpoint.path;
     char ck_err[300] = "";
     int ck_loaded = ck_path
         ? pk_homog_ckpt_load(ck_path, ck_digest, &ck, &com, &rec, ck_err, sizeof ck_err)
@@ -399,7 +423,7 @@ int pk_homog_run(const void *parsed, int threads, const char *job_json, const ch
         }
     }
 
-    pk_h5 *h = pk_h5_create(out_path, err, errlen);
+    pk_h5 *h = pk_h5_create(out_path, run->author, err, errlen);
     if (!h)
         goto out;
     /* lengths in the RVE file's unit, forces in N (E_n per length unit) */

@@ -24,7 +24,4 @@ static int within(const json_t *v, int left)
     return 1;
 }
 
-int pk_json_depth_within(const json_t *v, int max)
-{
-    return within(v, max);
-}
+int pk_json_depth_within(const json_t *v, int max) { return within(v, max); }

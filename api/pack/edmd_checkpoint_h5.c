@@ -15,7 +15,7 @@ static const char *hist_names[4] = {"events", "time", "phi", "reduced_pressure"}
 int pk_edmd_ckpt_save(const char *path, const char *digest, const pk_edmd_snapshot *s, char *err,
                       size_t errlen)
 {
-    pk_h5 *h = pk_h5_create(path, err, errlen);
+    pk_h5 *h = pk_h5_create(path, NULL, err, errlen);
     if (!h)
         return -1;
     int rc = pk_h5_obs_string(h, G "digest", digest);

@@ -8,6 +8,7 @@
 
 #include "core/space/box.h"
 #include "api/inputs/check_ctx.h"
+#include "api/run_ctx.h"
 #include "api/schemas/json_schema.h"
 #include "api/schemas/option_table.h"
 #include "pack_options.h"
@@ -81,7 +82,7 @@ size_t pk_pack_plan_make(const pk_pack_job *job, pk_pack_plan *plan, pk_schema_e
 /* process table hooks (see process.h): parse returns a pk_pack_task */
 void *pk_pack_parse(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs);
 void pk_pack_free(void *task);
-int pk_pack_run(const void *task, int threads, const char *job_json, const char *out_path,
-                pk_monitor *mon, json_t **summary, char *err, size_t errlen);
+int pk_pack_run(const void *task, const pk_run_ctx *run, const char *job_json, const char *out_path,
+                json_t **summary, char *err, size_t errlen);
 
 #endif

@@ -12,7 +12,6 @@
 #include "core/edmd/edmd_rigidity.h"
 #include "core/edmd/edmd_walls.h"
 #include "pack_placer.h"
-#include "api/process.h"
 #include "api/solver/sparse_cholmod.h"
 
 static void preset(void *dst) { pk_edmd_params_default(&((pk_edmd_options *)dst)->prm); }
@@ -104,7 +103,7 @@ static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, void **
     /* the periodic edge > 2 (d_max + Δd) rule is the plan's (pack_job.c) */
 }
 
-/* The job's checkpoint file (pk_job_checkpoint): saved by the run, loaded
+/* The job's checkpoint file (the run context's): saved by the run, loaded
  * to resume. */
 typedef struct ckpt_file {
     const char *path, *digest;
@@ -166,9 +165,10 @@ static json_t *doubles(const double *a, size_t n)
 }
 
 static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk_sizes *sz,
-                      pk_monitor *mon, pk_particles *p, pk_place_stats *st, char *err,
+                      const pk_run_ctx *run, pk_particles *p, pk_place_stats *st, char *err,
                       size_t errlen)
 {
+    pk_monitor *mon = run->mon;
     pk_edmd_params prm;
     read_params(job, plan, &prm);
     /* the default δ: RSA at φ = PK_EDMD_START_PHI (core/edmd/edmd.h); should RSA
@@ -226,7 +226,9 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     ckpt_file cf = {0};
     pk_edmd_checkpoint ck = {0};
     pk_edmd_snapshot snap = {0};
-    cf.path = pk_job_checkpoint(&cf.digest, &ck.interval_s);
+    cf.path = run->checkpoint.path;
+    cf.digest = run->checkpoint.digest ? run->checkpoint.digest : "";
+    ck.interval_s = run->checkpoint.interval_s;
     int loaded = 1;
     if (cf.path) {
         ck.save = save_ckpt;

@@ -5,8 +5,10 @@
 #include "pack_placer.h"
 
 static int place_rsa(const pk_pack_job *job, const pk_pack_plan *plan, const pk_sizes *sz,
-                     pk_monitor *mon, pk_particles *p, pk_place_stats *st, char *err, size_t errlen)
+                     const pk_run_ctx *run, pk_particles *p, pk_place_stats *st, char *err,
+                     size_t errlen)
 {
+    pk_monitor *mon = run->mon;
     (void)plan;
     pk_rsa_params prm = {.delta_d = job->delta_d,
                          .max_failed_draws = job->opt.rsa.max_failed_draws,

@@ -287,9 +287,10 @@ static void check_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, void
 }
 
 static int place_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, const pk_sizes *sz,
-                         pk_monitor *mon, pk_particles *p, pk_place_stats *st, char *err,
+                         const pk_run_ctx *run, pk_particles *p, pk_place_stats *st, char *err,
                          size_t errlen)
 {
+    pk_monitor *mon = run->mon;
     (void)sz;
     tetfill_setup *S = plan->prepared; /* the check's, or built here */
     const int own = !S;

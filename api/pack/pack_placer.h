@@ -66,10 +66,12 @@ typedef struct pk_placer {
                   pk_schema_errors *errs);
     void (*release)(void *prepared);
     /* Place the grains (diameters sz->d, descending) into job->box, appending
-     * to p (initialised, dim = job->dim).  0 when the run ended cleanly for
-     * whatever reason (st->reason), -1 on failure with err. */
+     * to p (initialised, dim = job->dim), in the run context run (its
+     * monitor, started; its checkpoint file).  0 when the run ended cleanly
+     * for whatever reason (st->reason), -1 on failure with err. */
     int (*place)(const pk_pack_job *job, const pk_pack_plan *plan, const pk_sizes *sz,
-                 pk_monitor *mon, pk_particles *p, pk_place_stats *st, char *err, size_t errlen);
+                 const pk_run_ctx *run, pk_particles *p, pk_place_stats *st, char *err,
+                 size_t errlen);
 } pk_placer;
 
 /* The verdict of a placed, audited packing (api/job_verdict.h): sets

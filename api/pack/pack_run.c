@@ -83,10 +83,10 @@ static int write_scene(pk_h5 *h, json_t *summary)
 static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const char *job_json,
                         const pk_box *box, double V, const pk_particles *p, const pk_sizes *sz,
                         double scale, const pk_place_stats *st, const pk_gap_report *gap,
-                        double t_sizes, double t_audit, const char *out_path, json_t *summary,
-                        char *err, size_t errlen)
+                        double t_sizes, double t_audit, const char *out_path, const char *author,
+                        json_t *summary, char *err, size_t errlen)
 {
-    pk_h5 *h = pk_h5_create(out_path, err, errlen);
+    pk_h5 *h = pk_h5_create(out_path, author, err, errlen);
     if (!h)
         return -1;
     const char *u = job->unit;
@@ -219,16 +219,18 @@ done:
     return pk_verdict_close_h5(h, rc, summary, out_path, err, errlen);
 }
 
-int pk_pack_run(const void *task, int threads, const char *job_json, const char *out_path,
-                pk_monitor *mon, json_t **summary, char *err, size_t errlen)
+int pk_pack_run(const void *task, const pk_run_ctx *run, const char *job_json, const char *out_path,
+                json_t **summary, char *err, size_t errlen)
 {
-    (void)threads; /* the placers run serially */
+    /* the placers run serially (run->threads unused) */
+    pk_run_ctx rx = *run;
+    pk_monitor *mon = rx.mon;
     const pk_pack_job job = ((const pk_pack_task *)task)->job;
     const pk_pack_plan plan = ((const pk_pack_task *)task)->plan;
     *summary = NULL;
     pk_monitor own = {0}; /* the job's wall time holds without a caller's monitor too */
     if (!mon && job.wall_time_s > 0)
-        mon = &own;
+        rx.mon = mon = &own;
     pk_monitor_start(mon, job.wall_time_s); /* across all stages, from now */
 
     double t0 = pk_wall_seconds();
@@ -248,7 +250,7 @@ int pk_pack_run(const void *task, int threads, const char *job_json, const char 
         return -1;
     }
     pk_place_stats st = {0};
-    if (!placer || placer->place(&job, &plan, &sz, mon, &p, &st, err, errlen) != 0) {
+    if (!placer || placer->place(&job, &plan, &sz, &rx, &p, &st, err, errlen) != 0) {
         if (!placer)
             snprintf(err, errlen, "no placer named %s", job.algorithm);
         pk_sizes_free(&sz);
@@ -314,7 +316,7 @@ int pk_pack_run(const void *task, int threads, const char *job_json, const char 
         json_object_set_new(sum, "overlap_tolerance", json_real(st.overlap_tol));
     pk_pack_verdict(&job, &plan, &st, &p, &gap, pk_particles_solid_measure(&p) / V, audit_dd, sum);
     int rc = write_result(&job, &plan, job_json, &box, V, &p, &sz, scale, &st, &gap, t_sizes,
-                          t_audit, out_path, sum, err, errlen);
+                          t_audit, out_path, rx.author, sum, err, errlen);
     pk_sizes_free(&sz);
     pk_particles_free(&p);
     if (st.free_extra)

@@ -130,14 +130,7 @@ static int write_dataset(hid_t parent, hid_t lcpl, const char *name, hid_t type,
     return rc < 0 ? -1 : 0;
 }
 
-static char author_name[128] = "packd";
-
-void pk_h5_set_author(const char *name)
-{
-    snprintf(author_name, sizeof author_name, "%s", name && *name ? name : "packd");
-}
-
-pk_h5 *pk_h5_create(const char *path, char *err, size_t errlen)
+pk_h5 *pk_h5_create(const char *path, const char *author, char *err, size_t errlen)
 {
     quiet_hdf5();
     pk_h5 *h = calloc(1, sizeof *h);
@@ -193,7 +186,7 @@ pk_h5 *pk_h5_create(const char *path, char *err, size_t errlen)
     int ver[2] = {1, 1};
     attr_ints(md, "version", ver, 2, 0);
     hid_t au = make_group(md, "author", H5P_DEFAULT);
-    attr_string(au, "name", author_name);
+    attr_string(au, "name", author && *author ? author : "packd");
     H5Gclose(au);
     /* the units module: every dimensional dataset carries a `unit` string of
      * SI symbols ("mm", "N mm-2"); H5MD units module 1.0 */

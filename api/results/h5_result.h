@@ -1,6 +1,6 @@
 /* h5_result.h — packd result files, layout after H5MD 1.1 (docs/result-format.md).
  *
- *   /h5md                       version = [1,1]; /h5md/author (name: pk_h5_set_author),
+ *   /h5md                       version = [1,1]; /h5md/author (name: pk_h5_create),
  *                               /h5md/creator (name, version), /h5md/modules/units (system SI)
  *   /particles/grains/box       attrs dimension, boundary[dim] ("periodic"|"none"); dataset edges[dim]
  *   /particles/grains/position  [N][dim] float64, attr unit
@@ -27,12 +27,10 @@
 
 typedef struct pk_h5 pk_h5;
 
-/* The /h5md/author name of the files this process writes (the job's owner
- * for a service job, the user for `packd run`); "packd" until set. */
-void pk_h5_set_author(const char *name);
-
-/* Creates "<path>.tmp.<pid>".  NULL on failure with a message in err. */
-pk_h5 *pk_h5_create(const char *path, char *err, size_t errlen);
+/* Creates "<path>.tmp.<pid>" with /h5md/author name author (the job's owner
+ * for a service job, the user for `packd run`; NULL or "" = "packd").  NULL
+ * on failure with a message in err. */
+pk_h5 *pk_h5_create(const char *path, const char *author, char *err, size_t errlen);
 
 int pk_h5_write_particles(pk_h5 *h, const pk_box *b, const pk_particles *p, const char *unit);
 int pk_h5_write_parameters(pk_h5 *h, const char *process, const char *job_json, uint64_t seed);

@@ -69,7 +69,7 @@ static inline int bench_job_run(const char *name, const char *patch, bench_job *
         pk_schema_errors errs = {0};
         json_t *sum = NULL;
         double c0 = bench_cpu_now();
-        int rc = pk_job_run(job, 1, out, NULL, &sum, &errs, err, sizeof err);
+        int rc = pk_job_run(job, NULL, out, &sum, &errs, err, sizeof err);
         double cpu = bench_cpu_now() - c0;
         remove(out);
         struct rusage ru;

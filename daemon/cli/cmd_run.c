@@ -13,7 +13,6 @@
 #include "api/picture/picture.h"
 #include "api/process.h"
 #include "api/digest.h"
-#include "api/results/h5_result.h"
 #include "api/results/result_digest.h"
 #include "api/results/xdmf.h"
 
@@ -160,6 +159,9 @@ int cmd_run(int argc, char **argv)
     pk_schema_errors errs = {0};
     json_t *summary = NULL;
     char err[1024] = "";
+    /* the file's author: the service's job owner, else who runs packd */
+    pk_run_ctx run = {
+        .threads = threads, .mon = &mon, .author = author && *author ? author : "packd run"};
     /* a checkpoint resumes only the job (and packd version) that wrote it */
     char digest[65];
     if (ckpt_path) {
@@ -178,11 +180,9 @@ int cmd_run(int argc, char **argv)
         pk_sha256_hex(src, n + sizeof PACKD_VERSION, digest);
         free(src);
         free(text);
-        pk_job_set_checkpoint(ckpt_path, digest, ckpt_interval);
+        run.checkpoint = (pk_run_checkpoint){ckpt_path, digest, ckpt_interval};
     }
-    /* the file's author: the service's job owner, else who runs packd */
-    pk_h5_set_author(author && *author ? author : "packd run");
-    int rc = pk_job_run(job, threads, out_path, &mon, &summary, &errs, err, sizeof err);
+    int rc = pk_job_run(job, &run, out_path, &summary, &errs, err, sizeof err);
     pk_run_line_clear(&sink.line);
     int status;
     if (rc == 1) {
@@ -194,16 +194,13 @@ int cmd_run(int argc, char **argv)
     } else {
         if (rc == 2) /* failed, with its partial file and summary */
             fprintf(stderr, "packd run: failed: %s (partial result in %s)\n", err, out_path);
-        json_object_set_new(summary, "output", json_string(out_path));
         char digest_hex[65];
         if (pk_result_digest_stored(out_path, digest_hex) == 0)
             json_object_set_new(summary, "result_digest", json_string(digest_hex));
-        if (xdmf_path) {
-            /* the XML names the HDF5 file by its path relative to the XML */
-            if (pk_xdmf_write(out_path, NULL, xdmf_path, err, sizeof err) != 0)
-                fprintf(stderr, "packd run: %s\n", err);
-            else
-                json_object_set_new(summary, "xdmf", json_string(xdmf_path));
+        /* the XML names the HDF5 file by its path relative to the XML */
+        if (xdmf_path && pk_xdmf_write(out_path, NULL, xdmf_path, err, sizeof err) != 0) {
+            fprintf(stderr, "packd run: %s\n", err);
+            xdmf_path = NULL;
         }
         if (pictures_dir) {
             if (pk_picture_write_set(out_path, pictures_dir, err, sizeof err) == 0)
@@ -212,7 +209,8 @@ int cmd_run(int argc, char **argv)
         }
         pk_run_summary_drop_series(summary);
         if (!json_summary && isatty(STDOUT_FILENO))
-            pk_run_summary_print(stdout, summary, pk_wall_seconds() - sink.line.t0, sink.line.utf8);
+            pk_run_summary_print(stdout, summary, out_path, xdmf_path,
+                                 pk_wall_seconds() - sink.line.t0, sink.line.utf8);
         else {
             json_dumpf(summary, stdout, JSON_INDENT(2) | JSON_REAL_PRECISION(10));
             putchar('\n');

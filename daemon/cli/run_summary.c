@@ -80,7 +80,8 @@ static void fe2_lines(FILE *f, const json_t *s)
     fputc('\n', f);
 }
 
-void pk_run_summary_print(FILE *f, const json_t *s, double seconds, int utf8)
+void pk_run_summary_print(FILE *f, const json_t *s, const char *output, const char *xdmf,
+                          double seconds, int utf8)
 {
     const char *process = str(s, "process"), *algo = str(s, "algorithm");
     const char *reason = str(s, "termination_reason");
@@ -112,7 +113,7 @@ void pk_run_summary_print(FILE *f, const json_t *s, double seconds, int utf8)
         fprintf(f, "  %-9s %s\n", i ? "" : "warnings", json_string_value(v));
     if (failed)
         fprintf(f, "  failure   %s\n", str(s, "failure"));
-    fprintf(f, "  output    %s%s\n", str(s, "output"), failed ? " (partial)" : "");
-    if (json_is_string(json_object_get(s, "xdmf")))
-        fprintf(f, "  xdmf      %s\n", str(s, "xdmf"));
+    fprintf(f, "  output    %s%s\n", output, failed ? " (partial)" : "");
+    if (xdmf)
+        fprintf(f, "  xdmf      %s\n", xdmf);
 }

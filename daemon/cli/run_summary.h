@@ -13,7 +13,9 @@
 void pk_run_summary_drop_series(json_t *summary);
 
 /* A short human summary: process, status, grains, φ achieved vs target (or
- * the homogenization's steps), wall time, warnings, failure, output files. */
-void pk_run_summary_print(FILE *f, const json_t *summary, double seconds, int utf8);
+ * the homogenization's steps), wall time, warnings, failure, the output
+ * files (xdmf NULL = none written). */
+void pk_run_summary_print(FILE *f, const json_t *summary, const char *output, const char *xdmf,
+                          double seconds, int utf8);
 
 #endif

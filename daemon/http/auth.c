@@ -28,10 +28,20 @@ int pk_auth_required(const pk_config *c, const char **why)
         w = "auth = on: every route but /, /conformance, /api and /healthz needs a bearer token";
     } else if (c->auth == PK_AUTH_OFF) {
         on = 0,
-        w = "auth = off: every client that reaches the port may read, submit and dismiss every job";
+        w = c->trusted_proxy[0]
+            ? "auth = off behind a trusted proxy: everyone who reaches the proxy may read, submit "
+              "and dismiss every job, as any owner"
+            : "auth = off: every client that reaches the port may read, submit and dismiss every "
+              "job";
+    } else if (c->trusted_proxy[0]) {
+        /* a proxy on this host forwards whoever reaches it: loopback says nothing of who */
+        on = 1,
+        w = "auth = auto and a trusted proxy is configured: the proxy forwards clients from "
+            "elsewhere, so every route but /, /conformance, /api and /healthz needs a bearer token";
     } else if (is_loopback(c->bind)) {
         on = 0,
-        w = "auth = auto and bind is a loopback address: only this host can connect, and every "
+        w = "auth = auto, bind is a loopback address and no trusted proxy is configured: only "
+            "processes on this host can connect (any local forwarder opens it further), and every "
             "local user may read, submit and dismiss every job (auth = on to require tokens)";
     } else {
         on = 1,

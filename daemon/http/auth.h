@@ -9,7 +9,7 @@
 #include "http.h"
 
 /* 1 when bearer tokens are required: auth = on, or auto with a bind address
- * that is not loopback.  why (may be NULL) gets a sentence for the log. */
+ * that is not loopback or with a trusted proxy (which forwards anyone).  why (may be NULL) gets a sentence for the log. */
 int pk_auth_required(const pk_config *c, const char **why);
 
 /* Set r->owner and r->admin for a route of the given access.  Returns 1 to

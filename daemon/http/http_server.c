@@ -18,6 +18,7 @@
 #include <sys/resource.h>
 
 #include "auth.h"
+#include "conn_guard.h"
 #include "http.h"
 #include "http_park.h"
 #include "daemon/log.h"
@@ -71,20 +72,25 @@ static int match(const pk_req *r, const char *pattern)
     return i == r->nseg;
 }
 
-static enum MHD_Result dispatch(pk_req *r)
+/* The route of this method and path (HEAD is GET); NULL if none.  An
+ * unknown path is 404; a known path with another method 405 with Allow. */
+static const pk_route *find_route(pk_req *r)
 {
     if (split_path(r, r->url) != 0)
-        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such resource", NULL,
-                               0);
+        return NULL;
+    for (const pk_route *rt = pk_routes; rt->method; rt++)
+        if (!strcmp(rt->method, r->method) && match(r, rt->pattern))
+            return rt;
+    return NULL;
+}
+
+static enum MHD_Result no_route(pk_req *r)
+{
     char allow[128] = "";
-    for (const pk_route *rt = pk_routes; rt->method; rt++) {
-        if (!match(r, rt->pattern))
-            continue;
-        if (!strcmp(rt->method, r->method)) {
-            enum MHD_Result refused;
-            return pk_authorize(r, rt->access, &refused) ? rt->handler(r) : refused;
-        }
-        if (!strstr(allow, rt->method)) {
+    if (split_path(r, r->url) == 0)
+        for (const pk_route *rt = pk_routes; rt->method; rt++) {
+            if (!match(r, rt->pattern) || strstr(allow, rt->method))
+                continue;
             size_t l = strlen(allow);
             snprintf(allow + l, sizeof allow - l, "%s%s", l ? ", " : "", rt->method);
             if (!strcmp(rt->method, "GET") && !strstr(allow, "HEAD")) {
@@ -92,7 +98,6 @@ static enum MHD_Result dispatch(pk_req *r)
                 snprintf(allow + l, sizeof allow - l, ", HEAD");
             }
         }
-    }
     if (!allow[0])
         return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such resource", NULL,
                                0);
@@ -112,12 +117,18 @@ static const char *const json_body_routes[] = {"/processes/*/execution", NULL};
 
 static int wants_json_body(pk_req *r)
 {
-    if (strcmp(r->method, "POST") != 0 || split_path(r, r->url) != 0)
-        return 0;
     for (const char *const *p = json_body_routes; *p; p++)
         if (match(r, *p))
             return 1;
     return 0;
+}
+
+/* Whether the request announces a body: a Content-Length above 0 or a
+ * Transfer-Encoding (chunked). */
+static int has_body(pk_req *r)
+{
+    const char *cl = pk_header(r, "Content-Length");
+    return (cl && strtoll(cl, NULL, 10) != 0) || pk_header(r, "Transfer-Encoding");
 }
 
 /* "application/json", any case, optionally followed by parameters
@@ -135,41 +146,41 @@ static int is_json_media_type(const char *ct)
     return *ct == 0 || *ct == ';';
 }
 
-/* The route of a request with a body (POST), or NULL. */
-static const pk_route *body_route(pk_req *r)
-{
-    if (strcmp(r->method, "POST") != 0 || split_path(r, r->url) != 0)
-        return NULL;
-    for (const pk_route *rt = pk_routes; rt->method; rt++)
-        if (!strcmp(rt->method, r->method) && match(r, rt->pattern))
-            return rt;
-    return NULL;
-}
-
-/* First call of a request (headers complete): answers that need no body —
- * a request that may not call its route is refused before its body is read. */
+/* First call of a request (headers complete): the route is found and the
+ * client authorised before a byte of the body is read; a request refused,
+ * one for no route (404, 405) and one with a body for a route that takes
+ * none (413) are answered from the headers and their body is never kept. */
 static enum MHD_Result on_headers(pk_req *r)
 {
     pk_config cfg = pk_service_config(r->svc);
-    const pk_route *rt = body_route(r);
+    const pk_route *rt = find_route(r);
     enum MHD_Result refused;
-    if (rt && !pk_authorize(r, rt->access, &refused)) {
-        r->answered = 1;
+    r->answered = 1;
+    if (!rt)
+        return no_route(r);
+    if (!pk_authorize(r, rt->access, &refused))
         return refused;
-    }
-    if (wants_json_body(r) && !is_json_media_type(pk_header(r, "Content-Type"))) {
-        r->answered = 1;
+    if (strcmp(rt->method, "POST") != 0 && has_body(r))
+        return pk_send_problem(r, 413, PK_PROBLEM_GENERIC, "Content Too Large",
+                               "this route takes no request body", NULL, 0);
+    if (wants_json_body(r) && !is_json_media_type(pk_header(r, "Content-Type")))
         return pk_send_problem(r, 415, PK_PROBLEM_GENERIC, "Unsupported Media Type",
                                "this route takes a JSON body: Content-Type must be application/json"
                                " (a charset parameter is allowed)",
                                NULL, 0);
-    }
     const char *cl = pk_header(r, "Content-Length");
     if (cl && strtoll(cl, NULL, 10) > cfg.max_body_bytes) {
-        r->answered = 1;
         char d[128];
         snprintf(d, sizeof d, "the body exceeds max_body_bytes = %ld", cfg.max_body_bytes);
         return pk_send_problem(r, 413, PK_PROBLEM_GENERIC, "Content Too Large", d, NULL, 0);
+    }
+    r->answered = 0;
+    r->route = rt;
+    if (strcmp(rt->method, "POST") == 0) { /* the body's deadline grows with its size */
+        double allow = cfg.body_timeout_s;
+        if (cl && cfg.head_timeout_s + (double)strtoll(cl, NULL, 10) / cfg.body_min_rate < allow)
+            allow = cfg.head_timeout_s + (double)strtoll(cl, NULL, 10) / cfg.body_min_rate;
+        pk_conn_guard_body(r->conn, allow);
     }
     return MHD_YES;
 }
@@ -224,7 +235,10 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
         r->method = !strcmp(method, "HEAD") ? "GET" : method;
         r->started = pk_queue_now();
         *con_cls = r;
-        return on_headers(r);
+        enum MHD_Result rc = on_headers(r);
+        if (!r->route || strcmp(r->route->method, "POST") != 0)
+            pk_conn_guard_response(conn);
+        return rc;
     }
     if (*upload_size) {
         enum MHD_Result rc = on_body(r, upload, *upload_size);
@@ -235,19 +249,21 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
         return MHD_YES;
     if (r->resume)
         return r->resume(r);
+    pk_conn_guard_response(conn);
     if (r->too_large) {
         pk_config cfg = pk_service_config(svc);
         char d[128];
         snprintf(d, sizeof d, "the body exceeds max_body_bytes = %ld", cfg.max_body_bytes);
         return pk_send_problem(r, 413, PK_PROBLEM_GENERIC, "Content Too Large", d, NULL, 0);
     }
-    return dispatch(r);
+    return r->route->handler(r);
 }
 
 static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
                          enum MHD_RequestTerminationCode toe)
 {
     pk_req *r = *con_cls;
+    pk_conn_guard_head(conn); /* kept alive: the next head has head_timeout_s */
     if (r) {
         if (r->wait_free)
             r->wait_free(r->wait);
@@ -307,14 +323,21 @@ struct MHD_Daemon *pk_http_start(pk_service *svc, int *port, char *err, size_t e
         return NULL;
     }
     unsigned limit = connection_limit(&cfg);
+    if (pk_conn_guard_start(svc, limit) != 0) {
+        pk_park_stop();
+        snprintf(err, errlen, "cannot start the connection deadline thread");
+        return NULL;
+    }
     struct MHD_Daemon *d = MHD_start_daemon(
         MHD_USE_EPOLL_INTERNAL_THREAD | MHD_ALLOW_SUSPEND_RESUME | MHD_USE_ERROR_LOG,
         (uint16_t)cfg.port, NULL, NULL, on_request, svc, MHD_OPTION_EXTERNAL_LOGGER, mhd_log, NULL,
         MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr, MHD_OPTION_NOTIFY_COMPLETED, on_completed,
         NULL, MHD_OPTION_THREAD_POOL_SIZE, (unsigned)cfg.http_threads, MHD_OPTION_CONNECTION_LIMIT,
         limit, MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)cfg.max_connections_per_ip,
-        MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg.idle_timeout_s, MHD_OPTION_END);
+        MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg.idle_timeout_s, MHD_OPTION_NOTIFY_CONNECTION,
+        pk_conn_guard_notify, NULL, MHD_OPTION_END);
     if (!d) {
+        pk_conn_guard_stop();
         pk_park_stop();
         snprintf(err, errlen, "cannot listen on %s:%d (in use or not permitted)", cfg.bind,
                  cfg.port);
@@ -322,14 +345,17 @@ struct MHD_Daemon *pk_http_start(pk_service *svc, int *port, char *err, size_t e
     }
     const union MHD_DaemonInfo *info = MHD_get_daemon_info(d, MHD_DAEMON_INFO_BIND_PORT);
     *port = info ? info->port : cfg.port;
-    pk_log(PK_LOG_INFO, "http", "{s:i,s:i,s:i,s:i}", "threads", cfg.http_threads, "max_connections",
-           (int)limit, "max_connections_per_ip", cfg.max_connections_per_ip, "idle_timeout_s",
-           cfg.idle_timeout_s);
+    pk_log(PK_LOG_INFO, "http", "{s:i,s:i,s:i,s:i,s:i,s:f}", "threads", cfg.http_threads,
+           "max_connections", (int)limit, "evict_slowest_above",
+           (int)pk_conn_guard_threshold(limit), "max_connections_per_ip",
+           cfg.max_connections_per_ip, "idle_timeout_s", cfg.idle_timeout_s, "head_timeout_s",
+           cfg.head_timeout_s);
     return d;
 }
 
 void pk_http_stop(struct MHD_Daemon *d)
 {
     pk_park_stop(); /* resumes every parked stream: MHD must not stop with suspended ones */
+    pk_conn_guard_stop();
     MHD_stop_daemon(d);
 }

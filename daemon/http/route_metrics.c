@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "conn_guard.h"
 #include "http.h"
 #include "api/process.h"
 
@@ -131,6 +132,15 @@ enum MHD_Result route_metrics(pk_req *r)
         if (n)
             put(&b, "packd_http_responses_total{code=\"%d\"} %llu\n", c, n);
     }
+    long long by_deadline, evicted;
+    pk_conn_guard_counts(&by_deadline, &evicted);
+    put(&b,
+        "# HELP packd_http_connections_closed_total Connections closed by the server: a head or "
+        "body past its deadline, or evicted as the slowest near max_connections.\n"
+        "# TYPE packd_http_connections_closed_total counter\n"
+        "packd_http_connections_closed_total{reason=\"deadline\"} %lld\n"
+        "packd_http_connections_closed_total{reason=\"evicted\"} %lld\n",
+        by_deadline, evicted);
     put(&b,
         "# HELP packd_uptime_seconds Seconds since the daemon started.\n"
         "# TYPE packd_uptime_seconds gauge\npackd_uptime_seconds %.1f\n",

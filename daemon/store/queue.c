@@ -16,9 +16,21 @@
 #include "migrations.h"
 #include "uuid.h"
 
-struct pk_queue {
+/* Connections that only read (query_only), one per HTTP event-loop thread
+ * at most: in WAL mode a read never waits on the writer's fsync, so status
+ * polls stay fast while workers report progress. */
+#define READERS 8
+
+typedef struct reader {
     sqlite3 *db;
     pthread_mutex_t mu;
+} reader;
+
+struct pk_queue {
+    sqlite3 *db; /* the one writer */
+    pthread_mutex_t mu;
+    reader rd[READERS];
+    unsigned rd_next;
     pthread_mutex_t ev_mu;
     pthread_cond_t ev_cond;
     long long ev_seq; /* bumped on every inserted event / state change */
@@ -35,16 +47,15 @@ double pk_queue_now(void)
     return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
-/* Prepare and bind: types "s" text (NULL ok), "i" int, "I" long long, "d" double. */
-static sqlite3_stmt *prep(pk_queue *q, const char *sql, const char *types, ...)
+/* Prepare on db and bind: types "s" text (NULL ok), "i" int, "I" long long,
+ * "d" double. */
+static sqlite3_stmt *vprep(sqlite3 *db, const char *sql, const char *types, va_list ap)
 {
     sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(q->db, sql, -1, &st, NULL) != SQLITE_OK) {
-        fprintf(stderr, "packd: sql error: %s in %s\n", sqlite3_errmsg(q->db), sql);
+    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK) {
+        fprintf(stderr, "packd: sql error: %s in %s\n", sqlite3_errmsg(db), sql);
         return NULL;
     }
-    va_list ap;
-    va_start(ap, types);
     for (int i = 0; types && types[i]; i++) {
         switch (types[i]) {
         case 's': {
@@ -60,9 +71,44 @@ static sqlite3_stmt *prep(pk_queue *q, const char *sql, const char *types, ...)
         case 'd': sqlite3_bind_double(st, i + 1, va_arg(ap, double)); break;
         }
     }
+    return st;
+}
+
+/* A statement on the writer connection (under q->mu). */
+static sqlite3_stmt *prep(pk_queue *q, const char *sql, const char *types, ...)
+{
+    va_list ap;
+    va_start(ap, types);
+    sqlite3_stmt *st = vprep(q->db, sql, types, ap);
     va_end(ap);
     return st;
 }
+
+/* A statement on a reader connection (held by the caller). */
+static sqlite3_stmt *rprep(reader *rd, const char *sql, const char *types, ...)
+{
+    va_list ap;
+    va_start(ap, types);
+    sqlite3_stmt *st = vprep(rd->db, sql, types, ap);
+    va_end(ap);
+    return st;
+}
+
+/* A free reader, or the next one in turn when all are busy. */
+static reader *reader_take(pk_queue *q)
+{
+    unsigned start = __atomic_fetch_add(&q->rd_next, 1, __ATOMIC_RELAXED);
+    for (unsigned i = 0; i < READERS; i++) {
+        reader *rd = &q->rd[(start + i) % READERS];
+        if (pthread_mutex_trylock(&rd->mu) == 0)
+            return rd;
+    }
+    reader *rd = &q->rd[start % READERS];
+    pthread_mutex_lock(&rd->mu);
+    return rd;
+}
+
+static void reader_give(reader *rd) { pthread_mutex_unlock(&rd->mu); }
 
 static void note_write(pk_queue *q, int ok);
 
@@ -203,6 +249,20 @@ pk_queue *pk_queue_open(const char *path, char *err, size_t errlen)
     pthread_mutex_init(&q->mu, NULL);
     pthread_mutex_init(&q->ev_mu, NULL);
     pthread_cond_init(&q->ev_cond, NULL);
+    for (int i = 0; i < READERS; i++)
+        pthread_mutex_init(&q->rd[i].mu, NULL);
+    for (int i = 0; i < READERS; i++) {
+        /* after the writer: the file exists, is in WAL mode and migrated */
+        if (sqlite3_open_v2(path, &q->rd[i].db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX,
+                            NULL) != SQLITE_OK ||
+            sqlite3_exec(q->rd[i].db, "PRAGMA query_only=1", NULL, NULL, NULL) != SQLITE_OK) {
+            snprintf(err, errlen, "%s: reader: %s", path,
+                     q->rd[i].db ? sqlite3_errmsg(q->rd[i].db) : "cannot open");
+            pk_queue_close(q);
+            return NULL;
+        }
+        sqlite3_busy_timeout(q->rd[i].db, 5000);
+    }
     return q;
 }
 
@@ -210,6 +270,10 @@ void pk_queue_close(pk_queue *q)
 {
     if (!q)
         return;
+    for (int i = 0; i < READERS; i++) {
+        sqlite3_close(q->rd[i].db); /* NULL: a no-op */
+        pthread_mutex_destroy(&q->rd[i].mu);
+    }
     sqlite3_close(q->db);
     pthread_mutex_destroy(&q->mu);
     pthread_mutex_destroy(&q->ev_mu);
@@ -295,9 +359,9 @@ out:
 
 json_t *pk_queue_get(pk_queue *q, const char *id)
 {
-    pthread_mutex_lock(&q->mu);
-    json_t *r = one_row(prep(q, "SELECT " JOB_COLUMNS " FROM jobs WHERE id=?", "s", id));
-    pthread_mutex_unlock(&q->mu);
+    reader *rd = reader_take(q);
+    json_t *r = one_row(rprep(rd, "SELECT " JOB_COLUMNS " FROM jobs WHERE id=?", "s", id));
+    reader_give(rd);
     return r;
 }
 
@@ -315,22 +379,22 @@ json_t *pk_queue_list(pk_queue *q, const pk_job_filter *f, int limit, int offset
                         "coalesce(?9, 1e300)))";
     char sql[1024];
     double now = pk_queue_now();
-    pthread_mutex_lock(&q->mu);
+    reader *rd = reader_take(q);
     snprintf(sql, sizeof sql, "SELECT count(*) FROM jobs%s", where);
     if (total)
         *total = (int)scalar(q,
-                             prep(q, sql, "ssiisddddd", f->status_json, f->process_json, 0, 0,
-                                  f->owner, f->created_from, f->created_before, f->min_duration,
-                                  f->max_duration, now));
+                             rprep(rd, sql, "ssiisddddd", f->status_json, f->process_json, 0, 0,
+                                   f->owner, f->created_from, f->created_before, f->min_duration,
+                                   f->max_duration, now));
     snprintf(
         sql, sizeof sql,
         "SELECT id, process, status, progress, message, created, started, finished, updated, rev"
         " FROM jobs%s ORDER BY seq DESC LIMIT ?3 OFFSET ?4",
         where);
     json_t *r =
-        rows(prep(q, sql, "ssiisddddd", f->status_json, f->process_json, limit, offset, f->owner,
-                  f->created_from, f->created_before, f->min_duration, f->max_duration, now));
-    pthread_mutex_unlock(&q->mu);
+        rows(rprep(rd, sql, "ssiisddddd", f->status_json, f->process_json, limit, offset, f->owner,
+                   f->created_from, f->created_before, f->min_duration, f->max_duration, now));
+    reader_give(rd);
     return r;
 }
 
@@ -556,12 +620,12 @@ void pk_queue_requeue(pk_queue *q, const char *id, const char *why)
 
 json_t *pk_queue_events(pk_queue *q, const char *id, long long after, int limit)
 {
-    pthread_mutex_lock(&q->mu);
-    json_t *r = rows(prep(q,
-                          "SELECT id, kind, data FROM events WHERE job_id=? AND id>? ORDER BY id"
-                          " LIMIT ?",
-                          "sIi", id, after, limit));
-    pthread_mutex_unlock(&q->mu);
+    reader *rd = reader_take(q);
+    json_t *r = rows(rprep(rd,
+                           "SELECT id, kind, data FROM events WHERE job_id=? AND id>? ORDER BY id"
+                           " LIMIT ?",
+                           "sIi", id, after, limit));
+    reader_give(rd);
     return r;
 }
 
@@ -596,11 +660,11 @@ void pk_queue_wake_all(pk_queue *q) { notify(q); }
 
 json_t *pk_queue_stats(pk_queue *q)
 {
-    pthread_mutex_lock(&q->mu);
-    json_t *by = rows(prep(q, "SELECT status, count(*) AS n FROM jobs GROUP BY status", NULL));
-    int ok = scalar(q, prep(q, "SELECT count(*) FROM jobs", NULL)) >= 0; /* the database answers */
-    json_t *metrics = pk_metrics_read(q->db);
-    pthread_mutex_unlock(&q->mu);
+    reader *rd = reader_take(q);
+    json_t *by = rows(rprep(rd, "SELECT status, count(*) AS n FROM jobs GROUP BY status", NULL));
+    int ok = scalar(q, rprep(rd, "SELECT count(*) FROM jobs", NULL)) >= 0; /* it answers */
+    json_t *metrics = pk_metrics_read(rd->db);
+    reader_give(rd);
     json_t *jobs = json_object();
     const char *all[] = {"accepted", "running", "successful", "failed", "dismissed"};
     for (size_t i = 0; i < 5; i++)
@@ -655,11 +719,11 @@ int pk_queue_add_file(pk_queue *q, const char *id, const char *sha256, long long
 
 json_t *pk_queue_get_file(pk_queue *q, const char *id, const char *owner)
 {
-    pthread_mutex_lock(&q->mu);
-    json_t *r = one_row(prep(q,
-                             "SELECT id, sha256, size, media_type, created FROM files WHERE id=?1"
-                             " AND (?2 IS NULL OR owner=?2) LIMIT 1",
-                             "ss", id, owner));
-    pthread_mutex_unlock(&q->mu);
+    reader *rd = reader_take(q);
+    json_t *r = one_row(rprep(rd,
+                              "SELECT id, sha256, size, media_type, created FROM files WHERE id=?1"
+                              " AND (?2 IS NULL OR owner=?2) LIMIT 1",
+                              "ss", id, owner));
+    reader_give(rd);
     return r;
 }

@@ -2,7 +2,9 @@
  * migrations.c) is the source of truth for jobs, inputs, states, progress,
  * idempotency keys, uploads and the events SSE listeners resume from.
  *
- * One connection per pk_queue, serialised by a mutex: every function is one
+ * One writer connection per pk_queue, serialised by a mutex, and a few
+ * query-only reader connections for the lookups (get, list, events, files,
+ * stats), so a read never waits on a commit's fsync: every function is one
  * short transaction and safe to call from any thread.  Job rows come back as
  * JSON objects with the column names as keys (inputs/summary parsed). */
 #ifndef PK_QUEUE_H

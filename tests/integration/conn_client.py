@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
 """conn_client.py — loopback clients for test_serve_conn.sh and bench/service.sh.
 
-  hold  PORT --slow N --idle M [--per-src K] [--src-from I] --ready FILE --seconds S
+  hold  PORT --slow N --idle M [--per-src K] [--src-from I] [--reconnect 1] --ready FILE --seconds S
         N slow-loris connections (a request whose header grows by one byte per
         second per connection, never finished) and M idle ones (connected, silent),
         spread over source addresses 127.0.0.I, 127.0.0.I+1, ... with K connections
         each.  Writes FILE (slow=, idle=, closed=, failed=) once all are open, keeps
-        them S seconds (or until SIGTERM), prints the final counts.
+        them S seconds (or until SIGTERM), prints the final counts.  --reconnect 1:
+        a slow connection the server closes is opened again from its address at
+        once (reopened= counts them), so the flood never lets up.
   sse   PORT PATH --n N [--per-src K] [--src-from I] --ready FILE --seconds S
         N Server-Sent Events listeners of PATH; FILE is written once every stream
         has sent its first line (or S seconds passed).  Then waits until every
@@ -85,24 +87,34 @@ def hold(args):
     nslow, nidle = opt(args, "--slow", 0), opt(args, "--idle", 0)
     per_src, first = opt(args, "--per-src", 50), opt(args, "--src-from", 2)
     ready, seconds = opt(args, "--ready", ""), opt(args, "--seconds", 30.0)
+    reconnect = opt(args, "--reconnect", 0)
     src = sources(first, per_src)
     sel = selectors.DefaultSelector()
-    slow, closed, failed = [], 0, 0
+    slow, closed, failed, reopened = {}, 0, 0, 0  # slow: an ordered set
+    origin = {}
+
+    def open_slow(a):
+        s = connect(port, a)
+        s.send(b"GET /healthz HTTP/1.1\r\nHost: x\r\nX-Slow: ")
+        slow[s] = None
+        origin[s] = a
+        sel.register(s, selectors.EVENT_READ)
+
     for k in range(nslow + nidle):
         try:
+            if k < nslow:
+                open_slow(next(src))
+                continue
             s = connect(port, next(src))
         except OSError:
             failed += 1
             continue
-        if k < nslow:
-            s.send(b"GET /healthz HTTP/1.1\r\nHost: x\r\nX-Slow: ")
-            slow.append(s)
         sel.register(s, selectors.EVENT_READ)
     stop = [False]
     signal.signal(signal.SIGTERM, lambda *a: stop.__setitem__(0, True))
 
     def pump(until):
-        nonlocal closed
+        nonlocal closed, reopened
         while time.time() < until and not stop[0]:
             for key, _ in sel.select(timeout=0.05):
                 try:
@@ -116,12 +128,21 @@ def hold(args):
                     sel.unregister(key.fileobj)
                     key.fileobj.close()
                     if key.fileobj in slow:
-                        slow.remove(key.fileobj)
+                        del slow[key.fileobj]
+                        a = origin.pop(key.fileobj)
+                        if reconnect and ready_written[0]:
+                            try:
+                                open_slow(a)
+                                reopened += 1
+                            except OSError:
+                                failed += 1
 
+    ready_written = [False]
     pump(time.time() + 0.5)  # connections the server refuses are closed at once
     doc = {"slow": len(slow), "idle": len(sel.get_map()) - len(slow), "closed": closed, "failed": failed}
     if ready:
         write_ready(ready, doc)
+    ready_written[0] = True
     end = time.time() + seconds
     # One header byte per connection per second, spread over the second.
     while time.time() < end and not stop[0]:
@@ -134,7 +155,7 @@ def hold(args):
             if i % 100 == 99:
                 pump(min(t0 + 1.0 * (i + 1) / max(len(slow), 1), end))
         pump(min(t0 + 1.0, end))
-    doc["closed"] = closed
+    doc.update(closed=closed, reopened=reopened, failed=failed, open_slow=len(slow))
     print(kv(doc))
 
 

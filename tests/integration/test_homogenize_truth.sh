@@ -171,3 +171,23 @@ for b, path, v in cases:
 sys.exit(1 if bad else 0)
 PY
 if [ $? -eq 0 ]; then pass every_numeric_field_at_its_extremes; else fail every_numeric_field_at_its_extremes "$(grep BAD fields.out | head -5)"; fi
+
+# A periodic RVE whose box cannot hold its contact reach (2 disks of d 4.37
+# in a 10 mm box, +30 % radii) fails naming the rule and the figures, never
+# "out of memory".
+cat >small-pack.json <<'J'
+{"process": "pack", "inputs": {"dim": 2, "unit": "mm",
+ "domain": {"box": {"size": [10.0, 10.0], "periodic": true}},
+ "grading": {"type": "classes", "classes": [{"d": 4.37, "volume_percent": 100}]},
+ "sampling": "discrete", "count": 2, "phi": {"value": 0.3, "refers_to": "resolved"},
+ "algorithm": "rsa", "seed": 1}}
+J
+"$PACKD" run small-pack.json -o small.h5 >/dev/null 2>&1
+python3 -c "import json; j = json.load(open('wall.json')); j['inputs'].pop('limits'); j['inputs']['rve']['file'] = 'small.h5'; json.dump(j, open('small.json', 'w'))"
+run small
+if rc_is small 2 && grep -q 'rule periodic_box' small.err && grep -q 'shortest edge is 10' small.err &&
+    ! grep -q 'out of memory' small.err; then
+    pass small_periodic_box_names_the_rule
+else
+    fail small_periodic_box_names_the_rule "exit $(cat small.rc): $(cat small.err)"
+fi

@@ -51,6 +51,28 @@ s.sendall(b'POST /files HTTP/1.1\\r\\nHost: x\\r\\nContent-Type: application/oct
 head = s.recv(200).decode('latin-1')
 assert head.startswith('HTTP/1.1 401'), head
 "
+# every route, not only POST: the answer comes from the headers while 9 MB of
+# the announced body are still unsent (before, a GET, DELETE, unknown or 405
+# route buffered up to max_body_bytes first, without a token)
+early() { # EXPECTED-STATUS METHOD PATH [CHUNKED]
+    python3 - "$B" "$@" <<'PY'
+import socket, sys
+base, want, method, path = sys.argv[1:5]
+chunked = len(sys.argv) > 5
+host, port = base.split('//')[1].split(':')
+s = socket.create_connection((host, int(port)), timeout=5)
+framing = b'Transfer-Encoding: chunked\r\n\r\n3e8\r\n' if chunked else b'Content-Length: 10000000\r\n\r\n'
+s.sendall(('%s %s HTTP/1.1\r\nHost: x\r\nContent-Type: application/octet-stream\r\n' % (method, path)).encode()
+          + framing + b'x' * 1000)
+head = s.recv(200).decode('latin-1')
+assert head.startswith('HTTP/1.1 ' + want), head
+PY
+}
+check get_body_refused_before_auth_reads_it early 401 GET /jobs
+check delete_body_refused_before_body early 401 DELETE /jobs/00000000-0000-4000-8000-000000000000
+check unknown_route_body_404_from_headers early 404 POST /nothing/here
+check method_405_from_headers early 405 PUT /jobs
+check chunked_get_body_refused early 401 GET /jobs/x/results chunked
 check submit_without_token_401 test "$(as nobody -H 'Content-Type: application/json' --data-binary "@$T/fast.json" \
     "$B/processes/pack/execution")" = 401
 check metrics_user_403 test "$(as alice "$B/metrics")" = 403
@@ -130,8 +152,20 @@ as alice "$B/jobs" >/dev/null
 check proxy_owner_scopes sh -c "! grep -q '$CAROL' '$T/as.out'"
 check proxy_still_needs_token test "$(as nobody -H 'X-Packd-Owner: carol' "$B/jobs")" = 401
 
+# auth = auto with a trusted proxy on loopback (the reverse-proxy layout of
+# docs/service.md without "auth = on") is on: the proxy forwards anyone
+printf 'workers = 0\ntrusted_proxy = 127.0.0.1\n' >"$T/proxy.conf"
+start_daemon proxy --config "$T/proxy.conf" || { fail proxy_starts; exit 1; }
+check auto_with_proxy_log_on wait_for 5 grep -q 'trusted proxy is configured.*"msg":"auth is on"' "$LOG"
+check auto_with_proxy_owner_401 test "$(as nobody -H 'X-Packd-Owner: mallory' "$B/jobs")" = 401
+check auto_with_proxy_metrics_401 test "$(as nobody -H 'X-Packd-Owner: mallory' "$B/metrics")" = 401
+
 # the loopback default stays open and says so
 start_daemon open || { fail open_starts; exit 1; }
 check startup_log_says_auth_off grep -q '"msg":"auth is off"' "$LOG"
 check open_no_token_200 test "$(as nobody "$B/jobs")" = 200
+check open_log_names_this_host wait_for 5 grep -q 'only processes on this host.*"msg":"auth is off"' "$LOG"
+# a route that takes no body refuses one (413) from its headers, auth or not
+check open_get_body_413 early 413 GET /healthz
+check open_get_chunked_body_413 early 413 GET /jobs chunked
 exit 0

@@ -100,3 +100,57 @@ code=$(c -o /dev/null -w '%{http_code}' -H 'Content-Type: application/json; char
 check execute_json_charset_201 test "$code" = 201
 code=$(c -o /dev/null -w '%{http_code}' -H 'Content-Type: text/plain' --data-binary "@$T/fast.json" "$B/files")
 check files_take_any_bytes test "$code" = 201
+
+# 5. a head that trickles (one byte a second: never idle) is closed at
+# head_timeout_s; a body slower than its size allows at head_timeout_s +
+# size / body_min_rate (here 2 + 1000/1000 = 3 s)
+start_daemon deadline --workers 0 --idle-timeout-s 60 --head-timeout-s 2 --body-min-rate 1000 || exit 1
+PORT=${B##*:}
+timeout 20 $CL hold "$PORT" --slow 5 --src-from 700 --ready "$T/dl.ready" --seconds 5 >"$T/dl.out"
+echo "# trickled heads after 5 s: $(cat "$T/dl.out")"
+check head_deadline_closes_tricklers test "$(kv "$T/dl.out" closed)" = 5
+check body_deadline_by_size python3 - "$PORT" <<'PY'
+import socket, sys, time
+s = socket.create_connection(("127.0.0.1", int(sys.argv[1])), timeout=10)
+s.sendall(b"POST /files HTTP/1.1\r\nHost: x\r\nContent-Type: application/octet-stream\r\n"
+          b"Content-Length: 1000\r\n\r\n")
+t0 = time.time()
+s.setblocking(False)
+while time.time() - t0 < 10:   # 10 bytes a second: 1000 bytes would take 100 s
+    try:
+        s.send(b"x" * 5)
+        if s.recv(1, socket.MSG_PEEK) == b"":
+            break
+    except BlockingIOError:
+        pass
+    except OSError:
+        break
+    time.sleep(0.5)
+took = time.time() - t0
+assert 2.5 < took < 5, took   # deadline 2 + 1000/1000 = 3 s, swept every 0.25 s
+PY
+
+# 6. 33 addresses × 128 trickling connections (4 224 > max_connections 4 096,
+# every address at max_connections_per_ip), reopened as soon as closed: a
+# 34th address is served at once, because near the limit each new connection
+# evicts the one waiting longest for its head.
+if [ "$hard" -lt 9000 ]; then
+    skip flood_33x128 "open-files limit $hard < 9000"
+    exit 0
+fi
+start_daemon table --workers 0 --idle-timeout-s 60 || exit 1
+PORT=${B##*:}
+timeout 90 $CL hold "$PORT" --slow 4224 --per-src 128 --src-from 1000 --reconnect 1 --ready "$T/tab.ready" \
+    --seconds 30 >"$T/tab.out" &
+HOLD=$!
+wait_file "$T/tab.ready" 60
+echo "# 33 x 128 tricklers: $(cat "$T/tab.ready")"
+timeout 60 $CL probe "$PORT" --n 200 --src 127.0.250.250 --interval 0.02 >"$T/probe3"
+echo "# healthz of a 34th address under it: $(cat "$T/probe3")"
+check flood_33x128_healthz_p99 probe_ok "$T/probe3"
+kill "$HOLD" 2>/dev/null
+wait "$HOLD"
+echo "# tricklers at the end: $(cat "$T/tab.out")"
+ev=$(c "$B/metrics" | sed -n 's/^packd_http_connections_closed_total{reason="evicted"} //p')
+echo "# evicted as the slowest near the limit: $ev"
+check flood_33x128_slowest_evicted test "${ev:-0}" -ge 384

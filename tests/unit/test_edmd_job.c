@@ -33,7 +33,7 @@ static json_t *run_job(const char *extra)
     char err[512] = "";
     char out[64];
     snprintf(out, sizeof out, "/tmp/packd-test-edmd-job-%d.h5", (int)getpid());
-    CHECK_MSG(pk_job_run(job, 1, out, NULL, &sum, &errs, err, sizeof err) == 0, "%s", err);
+    CHECK_MSG(pk_job_run(job, NULL, out, &sum, &errs, err, sizeof err) == 0, "%s", err);
     remove(out);
     pk_schema_errors_free(&errs);
     json_decref(job);

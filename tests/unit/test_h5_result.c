@@ -31,7 +31,7 @@ static void test_round_trip_and_layout(void)
     pk_particles p;
     fill(&p, 3, 100);
     char err[256];
-    pk_h5 *h = pk_h5_create(path, err, sizeof err);
+    pk_h5 *h = pk_h5_create(path, NULL, err, sizeof err);
     CHECK(h != NULL);
     CHECK(!exists(path)); /* nothing at the final name before commit */
     CHECK(pk_h5_write_particles(h, &b, &p, "mm") == 0);
@@ -101,7 +101,7 @@ static void test_2d_positions_have_two_columns(void)
     pk_particles p;
     fill(&p, 2, 10);
     char err[256];
-    pk_h5 *h = pk_h5_create(path, err, sizeof err);
+    pk_h5 *h = pk_h5_create(path, NULL, err, sizeof err);
     pk_h5_write_particles(h, &b, &p, "mm");
     CHECK(pk_h5_commit(h, err, sizeof err) == 0);
     pk_box b2;
@@ -123,7 +123,7 @@ static void test_abort_and_atomic_replace(void)
     fputs("old content", old);
     fclose(old);
     char err[256];
-    pk_h5 *h = pk_h5_create(path, err, sizeof err);
+    pk_h5 *h = pk_h5_create(path, NULL, err, sizeof err);
     CHECK(h != NULL);
     snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
     CHECK(exists(tmp));
@@ -135,7 +135,7 @@ static void test_abort_and_atomic_replace(void)
     if (f)
         fclose(f);
     /* a failing create reports an error instead of crashing */
-    CHECK(pk_h5_create("/nonexistent-dir/x.h5", err, sizeof err) == NULL);
+    CHECK(pk_h5_create("/nonexistent-dir/x.h5", NULL, err, sizeof err) == NULL);
     CHECK(strlen(err) > 0);
     unlink(path);
 }
@@ -152,7 +152,7 @@ static void test_slice_view_and_link(void)
     double v[3 * 4 * 2];
     for (size_t i = 0; i < 24; i++)
         v[i] = (double)i;
-    pk_h5 *h = pk_h5_create(path, err, sizeof err);
+    pk_h5 *h = pk_h5_create(path, NULL, err, sizeof err);
     CHECK(h != NULL);
     CHECK(pk_h5_write_particles(h, &b, &p, "mm") == 0);
     size_t d[3] = {3, 4, 2};
@@ -221,9 +221,7 @@ static void test_h5md_elements_units_author(void)
     pk_box b = {.dim = 2, .L = {1, 1}, .periodic = {true, true}};
     pk_particles p;
     fill(&p, 2, 3);
-    pk_h5_set_author("dora");
-    pk_h5 *h = pk_h5_create(path, err, sizeof err);
-    pk_h5_set_author(NULL);
+    pk_h5 *h = pk_h5_create(path, "dora", err, sizeof err);
     CHECK(h != NULL);
     CHECK(pk_h5_write_particles(h, &b, &p, "mm") == 0);
     int64_t step[2] = {0, 1};

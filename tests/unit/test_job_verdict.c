@@ -75,7 +75,7 @@ static void test_file_group(void)
     pk_verdict_warn(s, "one");
     pk_verdict_warn(s, "two");
     pk_verdict_fail(s, "diverged at step 3");
-    pk_h5 *h = pk_h5_create(path, err, sizeof err);
+    pk_h5 *h = pk_h5_create(path, NULL, err, sizeof err);
     CHECK(h != NULL);
     CHECK(pk_verdict_write_h5(h, s) == 0);
     CHECK(pk_h5_commit(h, err, sizeof err) == 0);

@@ -171,7 +171,7 @@ static int run_job(json_t *inputs, json_t **sum)
     pk_schema_errors errs = {0};
     char err[512] = "";
     *sum = NULL;
-    int rc = pk_job_run(job, 1, out, NULL, sum, &errs, err, sizeof err);
+    int rc = pk_job_run(job, NULL, out, sum, &errs, err, sizeof err);
     if (rc != 0 && rc != 2)
         fprintf(stderr, "  run: rc %d: %s\n", rc, err);
     unlink(out);

@@ -68,7 +68,7 @@ static int run_inputs(const char *inputs_json, json_t **sum, int *file_written)
     pk_schema_errors errs = {0};
     char err[512] = "";
     *sum = NULL;
-    int rc = pk_job_run(job, 1, out, NULL, sum, &errs, err, sizeof err);
+    int rc = pk_job_run(job, NULL, out, sum, &errs, err, sizeof err);
     if (rc != 0 && rc != 2) /* 2: a failed verdict, its file written */
         fprintf(stderr, "  run: rc %d: %s %s\n", rc, err, errs.n ? errs.items[0].message : "");
     *file_written = access(out, F_OK) == 0;
@@ -140,7 +140,7 @@ static void test_run_count_matches_plan(void)
     pk_schema_errors errs = {0};
     json_t *sum = NULL;
     char err[256];
-    CHECK(pk_job_run(job, 1, out, NULL, &sum, &errs, err, sizeof err) == 0);
+    CHECK(pk_job_run(job, NULL, out, &sum, &errs, err, sizeof err) == 0);
     if (sum) {
         double expected = json_real_value(json_object_get(sum, "count_expected"));
         double placed = (double)json_integer_value(json_object_get(sum, "count_placed"));
@@ -300,10 +300,12 @@ static void test_stop_in_rsa_start(void)
         int fd = mkstemp(out);
         close(fd);
         pk_monitor mon = {.fn = cancel_in_rsa, .interval_s = 1e-9};
+        pk_run_ctx run = PK_RUN_CTX_DEFAULT;
+        run.mon = &mon;
         pk_schema_errors errs = {0};
         json_t *sum = NULL;
         char err[512];
-        CHECK(pk_job_run(job, 1, out, &mon, &sum, &errs, err, sizeof err) == 2);
+        CHECK(pk_job_run(job, &run, out, &sum, &errs, err, sizeof err) == 2);
         const char *why = json_string_value(json_object_get(sum, "failure"));
         CHECK_MSG(why && strstr(why, "cancelled"), "%s: failure %s", shapes[k],
                   why ? why : "(none)");

@@ -35,7 +35,7 @@ static json_t *run_job(const char *extra, pk_schema_errors *errs)
     json_t *job = json_loads(text, 0, NULL);
     json_t *sum = NULL;
     char err[512] = "";
-    int rc = pk_job_run(job, 1, out, NULL, &sum, errs, err, sizeof err);
+    int rc = pk_job_run(job, NULL, out, &sum, errs, err, sizeof err);
     json_decref(job);
     unlink(out);
     if (rc != 0) {
