@@ -116,20 +116,6 @@ static int save_ckpt(const pk_edmd_snapshot *snap, void *ctx)
     return pk_edmd_ckpt_save(f->path, f->digest, snap, f->err, sizeof f->err);
 }
 
-/* The contact network of the stop (contacts within ctol, walls at the gap
- * they keep) and the rigidity of its backbone. */
-static int certify(const pk_pack_job *job, const pk_particles *p, const pk_edmd_stats *es,
-                   double w, double ctol, pk_contact_stats *cs, pk_rigidity *rg)
-{
-    pk_contact_network net;
-    if (pk_contact_network_compute(&job->box, p, es->delta_d, fmax(0.5 * es->delta_d - w, 0),
-                                   ctol, &net, cs) != 0)
-        return -1;
-    int rc = pk_rigidity_test(&job->box, p, &net, cs, &pk_sparse_cholmod, rg);
-    pk_contact_network_free(&net);
-    return rc;
-}
-
 /* Why a packing that met its stop criterion is not certified jammed. */
 static void not_rigid_warning(const pk_rigidity *rg, const pk_edmd_stats *es, double ctol,
                               char *buf, size_t len)
@@ -154,6 +140,10 @@ static void not_rigid_warning(const pk_rigidity *rg, const pk_edmd_stats *es, do
                  "is not jammed",
                  pk_edmd_criterion_name(es->criterion), es->pressure, rg->backbone, rg->contacts,
                  rg->maxwell_min, rg->floppy, es->phi);
+    const size_t used = strlen(buf);
+    if (used < len)
+        snprintf(buf + used, len - used, " (nor rigid at any contact tolerance up to %g)",
+                 PK_JAM_TOL_MAX);
 }
 
 static json_t *doubles(const double *a, size_t n)
@@ -278,7 +268,9 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     pk_contact_stats cs = {0};
     pk_rigidity rg = {0};
     double ctol = pk_contact_tolerance(job->box.dim, es.pressure);
-    if (prm.until == PK_EDMD_UNTIL_JAMMED && certify(job, p, &es, w, ctol, &cs, &rg) != 0) {
+    if (prm.until == PK_EDMD_UNTIL_JAMMED &&
+        pk_jam_certify(&job->box, p, es.delta_d, fmax(0.5 * es.delta_d - w, 0), ctol,
+                       &pk_sparse_cholmod, &cs, &rg, &ctol) != 0) {
         snprintf(err, errlen, "out of memory in the contact analysis");
         return -1;
     }

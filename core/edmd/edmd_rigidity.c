@@ -83,3 +83,37 @@ out:
     free(id);
     return rc;
 }
+
+/* One tolerance: the network, then its test. */
+static int certify_at(const pk_box *b, const pk_particles *p, double delta_d, double wall_gap,
+                      double tol, const pk_sparse_solver *solver, pk_contact_stats *cs,
+                      pk_rigidity *rg)
+{
+    pk_contact_network net;
+    if (pk_contact_network_compute(b, p, delta_d, wall_gap, tol, &net, cs) != 0)
+        return -1;
+    int rc = pk_rigidity_test(b, p, &net, cs, solver, rg);
+    pk_contact_network_free(&net);
+    return rc;
+}
+
+int pk_jam_certify(const pk_box *b, const pk_particles *p, double delta_d, double wall_gap,
+                   double tol0, const pk_sparse_solver *solver, pk_contact_stats *cs,
+                   pk_rigidity *rg, double *tol_used)
+{
+    *tol_used = tol0;
+    if (certify_at(b, p, delta_d, wall_gap, tol0, solver, cs, rg) != 0)
+        return -1;
+    for (double tol = 10 * tol0; !rg->rigid && tol <= PK_JAM_TOL_MAX * (1 + 1e-9); tol *= 10) {
+        pk_contact_stats c2;
+        pk_rigidity r2;
+        if (certify_at(b, p, delta_d, wall_gap, tol, solver, &c2, &r2) != 0)
+            return -1;
+        if (r2.rigid) {
+            *cs = c2;
+            *rg = r2;
+            *tol_used = tol;
+        }
+    }
+    return 0;
+}
