@@ -50,6 +50,10 @@ static void set_mode(pk_edmd_params *prm, const char *mode)
 {
     if (strcmp(mode, "default") == 0)
         return;
+    if (strncmp(mode, "rf", 2) == 0) { /* rf<factor>: the default with another rate factor */
+        prm->jam_rate_factor = atof(mode + 2);
+        return;
+    }
     if (strcmp(mode, "grow060") == 0) { /* the yardstick: grow to φ = 0.60 */
         prm->until = PK_EDMD_UNTIL_TARGET;
         prm->phi_target = 0.60;

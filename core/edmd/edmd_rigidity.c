@@ -2,6 +2,7 @@
  * Contract: core/edmd/edmd_rigidity.h. */
 #include "edmd_rigidity.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 
@@ -104,7 +105,8 @@ int pk_jam_certify(const pk_box *b, const pk_particles *p, double delta_d, doubl
     *tol_used = tol0;
     if (certify_at(b, p, delta_d, wall_gap, tol0, solver, cs, rg) != 0)
         return -1;
-    for (double tol = 10 * tol0; !rg->rigid && tol <= PK_JAM_TOL_MAX * (1 + 1e-9); tol *= 10) {
+    for (double tol = tol0; !rg->rigid && tol < PK_JAM_TOL_MAX;) {
+        tol = fmin(10 * tol, PK_JAM_TOL_MAX);
         pk_contact_stats c2;
         pk_rigidity r2;
         if (certify_at(b, p, delta_d, wall_gap, tol, solver, &c2, &r2) != 0)
