@@ -148,6 +148,8 @@ static result run(const char *name, const char *mode, int dim, const double *r, 
 static void ratio(const char *name, const char *mode, const double *r, size_t n, double rate,
                   int reps)
 {
+    if (!wanted(name, mode))
+        return;
     double jam[8] = {0}, grow[8] = {0};
     result last = {0};
     reps = reps > 8 ? 8 : reps < 1 ? 1 : reps;
