@@ -141,7 +141,7 @@ static void not_rigid_warning(const pk_rigidity *rg, const pk_edmd_stats *es, do
                  pk_edmd_criterion_name(es->criterion), es->pressure, rg->backbone, rg->contacts,
                  rg->maxwell_min, rg->floppy, es->phi);
     const size_t used = strlen(buf);
-    if (used < len)
+    if (used < len && ctol < PK_JAM_TOL_MAX)
         snprintf(buf + used, len - used, " (nor rigid at any contact tolerance up to %g)",
                  PK_JAM_TOL_MAX);
 }

@@ -6,6 +6,7 @@
 #     jammed — complete false, the backbone's count below Maxwell's named;
 #  2. equal spheres, 3D periodic, `until: jammed`: a rigid backbone at the
 #     Maxwell count within a gap of 10⁻⁴ (r_i + r_j): complete, jammed;
+#     its φ printed without a target or a share "of the mix" (count given);
 #  3. Meier's Δφ stop without the thermostat: termination_reason delta_phi,
 #     and "jammed" only if the certificate holds.
 . "${PACKD_SRC:-.}/tests/integration/check.inc"
@@ -13,7 +14,8 @@ PACKD=${PACKD:-build/packd}
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 
-field() { # FILE KEY: the first value of "KEY" in a packd run     grep -o "\"$2\": [^,]*" "$1" | head -1 | sed 's/^[^:]*: //'
+field() { # FILE KEY: the first value of "KEY" in a packd run summary
+    grep -o "\"$2\": [^,]*" "$1" | head -1 | sed 's/^[^:]*: //'
 }
 
 cat >"$T/fines.json" <<'JOB'
@@ -43,6 +45,9 @@ check mono_3d_certified_jammed sh -c "[ $rc -eq 0 ] &&
     grep -q '\"complete\": true' '$T/mono.out' && grep -q '\"jammed\": true' '$T/mono.out' &&
     grep -q '\"backbone_rigid\": true' '$T/mono.out' && [ '$bb' -ge '$mx' ] &&
     awk 'BEGIN { exit !($tol <= 1e-4) }'"
+# its φ is its own: no target and no "of the mix" for grains grown to jamming
+check mono_3d_no_target_phi sh -c "grep -q '\"phi_resolved\"' '$T/mono.out' &&
+    ! grep -q 'phi_target_resolved\|phi_mix' '$T/mono.out'"
 
 cat >"$T/quartz.json" <<'JOB'
 {"process": "pack", "inputs": {"dim": 2, "unit": "mm", "domain": {"box": {"size": [1.6, 1.6], "periodic": true}},
