@@ -1,12 +1,14 @@
 /* bench/edmd_jam — "until jammed" criteria side by side.  One
  * machine-readable line per case:
  *   bench=edmd_jam case=NAME mode=M n=N phi=F p=P criterion=C events=E
- *         cpu_s=T z=Z rattlers=R tol=TOL kinetic_ratio=K growth_changes=G
+ *         cpu_s=T z=Z rattlers=R tol=TOL certified=yes|no kinetic_ratio=K
+ *         growth_changes=G
  * Modes: default (pressure stop at 10^12, rate × 0.1 past p = 10^3), const
  * (pressure stop, one rate), dphi (Meier's Δφ < 10^-9 over N events, one
  * rate), stall (Titscher's stall, 10^-12 over max(1000, N) events, one rate),
  * lift_dphi (the former default: the lift rule and the Δφ stop), meier (Eq. 9,
- * no rescaling, Δφ stop: Meier's protocol).  z: mean contact number of the
+ * no rescaling, Δφ stop: Meier's protocol), rf<f> (the default with
+ * jamming.rate_factor f), grow060 (to φ = 0.60, the yardstick).  z: mean contact number of the
  * non-rattlers at pk_contact_tolerance(dim, p).  Cases: 3D monodisperse
  * N = 10^4 (γ = 0.02) and Fuller-like diameters 1–16 (counts ∝ d^-2.5,
  * γ = 0.03), both from the jobs' RSA start at φ = 0.30; 2D Meier A32 and
@@ -17,7 +19,9 @@
  * the two 10^4 cases jammed in MODE and grown to φ = 0.60 (mode grow060),
  * alternating, PACKD_BENCH_REPS times, one line each:
  *   bench=edmd_jam_ratio case=NAME mode=M n=N jam_cpu_s=T grow060_cpu_s=G
- *         ratio=T/G phi=F z=Z rattlers=R certified=yes|no */
+ *         ratio=T/G phi=F z=Z rattlers=R certified=yes|no
+ * PACKD_BENCH_N=n (PACKD_BENCH_MODE=m, PACKD_BENCH_RATE=γ, default 0.02): one
+ * run of n ≤ 10^4 equal spheres, for protocol trials (docs/perf/edmd.md). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -142,6 +146,18 @@ static result run(const char *name, const char *mode, int dim, const double *r, 
     return res;
 }
 
+/* The median of x[0..n) (sorted in place). */
+static double median(double *x, int n)
+{
+    for (int a = 1; a < n; a++)
+        for (int c = a; c > 0 && x[c] < x[c - 1]; c--) {
+            const double t = x[c];
+            x[c] = x[c - 1];
+            x[c - 1] = t;
+        }
+    return x[n / 2];
+}
+
 /* Issue 37's grading without the anchor: the jam's CPU time over the time
  * of growing the same grains to φ = 0.60, alternating the two (a loaded
  * machine), each `reps` times; one line with the medians' ratio. */
@@ -158,19 +174,7 @@ static void ratio(const char *name, const char *mode, const double *r, size_t n,
         last = run(name, mode, 3, r, n, rate, 0.30);
         jam[k] = last.cpu;
     }
-    for (int a = 0; a < reps; a++) /* insertion sorts: the medians */
-        for (int c = a; c > 0 && jam[c] < jam[c - 1]; c--) {
-            double t = jam[c];
-            jam[c] = jam[c - 1];
-            jam[c - 1] = t;
-        }
-    for (int a = 0; a < reps; a++)
-        for (int c = a; c > 0 && grow[c] < grow[c - 1]; c--) {
-            double t = grow[c];
-            grow[c] = grow[c - 1];
-            grow[c - 1] = t;
-        }
-    const double j = jam[reps / 2], g = grow[reps / 2];
+    const double j = median(jam, reps), g = median(grow, reps);
     printf("bench=edmd_jam_ratio case=%s mode=%s n=%zu jam_cpu_s=%.2f grow060_cpu_s=%.2f "
            "ratio=%.1f phi=%.5f z=%.3f rattlers=%.4f certified=%s\n",
            name, mode, n, j, g, j / g, last.phi, last.z, last.rattlers,
@@ -204,7 +208,8 @@ int main(void)
     if (nn) {
         const size_t n = (size_t)atol(nn);
         const char *m = getenv("PACKD_BENCH_MODE");
-        run("mono3d", m ? m : "default", 3, r, n < N ? n : N, 0.02, 0.30);
+        const char *g = getenv("PACKD_BENCH_RATE");
+        run("mono3d", m ? m : "default", 3, r, n < N ? n : N, g ? atof(g) : 0.02, 0.30);
         return 0;
     }
     const char *rmode = getenv("PACKD_BENCH_RATIO"); /* issue 37's two cases only */
