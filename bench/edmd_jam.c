@@ -8,8 +8,9 @@
  * rate), stall (Titscher's stall, 10^-12 over max(1000, N) events, one rate),
  * lift_dphi (the former default: the lift rule and the Δφ stop), meier (Eq. 9,
  * no rescaling, Δφ stop: Meier's protocol), rf<f> (the default with
- * jamming.rate_factor f), grow060 (to φ = 0.60, the yardstick).  z: mean contact number of the
- * non-rattlers at pk_contact_tolerance(dim, p).  Cases: 3D monodisperse
+ * jamming.rate_factor f), grow060 (to φ = 0.60, the yardstick).  z, rattlers,
+ * tol: of the certificate (pk_jam_certify: the pressure's tolerance, or the
+ * ladder's step at which the backbone was rigid).  Cases: 3D monodisperse
  * N = 10^4 (γ = 0.02) and Fuller-like diameters 1–16 (counts ∝ d^-2.5,
  * γ = 0.03), both from the jobs' RSA start at φ = 0.30; 2D Meier A32 and
  * quartz (nop = 1000, γ = 0.02, zero start).  PACKD_BENCH_CASE=TEXT runs the
