@@ -2,11 +2,12 @@
 #   make          build build/packd and the benchmarks' binaries (installs missing
 #                 Debian packages first; a bench binary is never left older than
 #                 the code it measures)
-#   make test     build and run every unit and integration test (the benchmarks
-#                 are built too, so they cannot rot, but not run)
+#   make test     install the test tools (first time), build and run every unit
+#                 and integration test (the benchmarks are built too, so they
+#                 cannot rot, but not run)
 #   make sanitize the same tests under AddressSanitizer + UBSan (build-san/)
 #   make bench    build and run the benchmarks in bench/ (bench/service.sh wants
-#                 wrk: PACKD_BENCH_DEPS=1 sh deploy/install-deps.sh)
+#                 wrk: sh deploy/install-deps.sh bench)
 #   make run      build and start the daemon with its embedded defaults
 #   make format   apply .clang-format to every C file (clang-format 14)
 #
@@ -16,6 +17,11 @@
 # compiler records which headers each object read (-MMD -MP, build/**/*.d).
 
 BUILD   ?= build
+# Build on every core unless the caller chose (-jN): a fresh `make run` compiles
+# ~200 files.
+ifeq ($(filter -j%,$(MAKEFLAGS))$(filter j,$(firstword $(MAKEFLAGS))),)
+MAKEFLAGS += -j$(shell nproc 2>/dev/null || echo 2)
+endif
 CC      ?= cc
 OPT     ?= -O2
 # Functions start on a cache line: the hot contact loops otherwise run 1.6x
@@ -26,6 +32,7 @@ VERSION := $(shell cat VERSION 2>/dev/null || echo 0.0.0)
 
 PKGS    := hdf5 jansson libmicrohttpd sqlite3 libcrypto cairo fontconfig libcurl
 DEPS_OK := $(BUILD)/.deps-ok
+TEST_DEPS_OK := $(BUILD)/.test-deps-ok
 
 WARN    := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wno-unused-parameter
 CSTD    := -std=c17 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
@@ -35,6 +42,19 @@ BASE_CFLAGS := $(CSTD) $(OPT) $(ALIGN) -g -MMD -MP $(WARN) $(SAN) -DPACKD_VERSIO
 CORE_CFLAGS := $(BASE_CFLAGS) -I.
 EXT_CFLAGS   = $(BASE_CFLAGS) $(shell pkg-config --cflags $(PKGS) 2>/dev/null) -I/usr/include/suitesparse -I. -I$(BUILD)/gen
 EXT_LIBS     = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lcholmod -lgomp -lm -lpthread
+
+# MPI is optional: with Debian's OpenMPI (libopenmpi-dev, pkg-config ompi-c)
+# `mpirun -np R packd run fe2.json` spreads the Gauss points over the ranks
+# (api/par/mpi_world.c, docs/fe2.md); without it packd is one process and
+# refuses a launch of several ranks.  `make MPI=0` builds without it anyway.
+# Looked for when a recipe runs, so the first make of a fresh machine finds the
+# OpenMPI its dependency step installed; only mpi_world.c includes <mpi.h>.
+MPI     ?= auto
+mpi_on   = $(if $(filter auto,$(MPI)),$(shell pkg-config --exists ompi-c 2>/dev/null && echo 1),$(filter 1,$(MPI)))
+EXT_LIBS += $(if $(mpi_on),$(shell pkg-config --libs ompi-c))
+$(BUILD)/obj/api/par/mpi_world.o: EXT_CFLAGS += $(if $(mpi_on),-DPK_HAVE_MPI $(shell pkg-config --cflags ompi-c))
+# mpi_world.o is rebuilt when that changes
+MPI_STAMP := $(BUILD)/.mpi-$(or $(mpi_on),0)
 
 tree        = $(shell find $(1) -name '*.c' | sort)
 CORE_SRC   := $(call tree,core)
@@ -52,16 +72,23 @@ LIB_OBJ    := $(DAEMON_OBJ) $(API_OBJ) $(CORE_OBJ)
 UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 BENCH_BIN  := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
-.PHONY: all deps test sanitize bench bench-fe2 run clean check-schemas install format tradeoffs tradeoff-plots
+.PHONY: all deps test test-run sanitize bench bench-fe2 run clean check-schemas install format tradeoffs tradeoff-plots
 .SECONDARY:
 
 all: $(DEPS_OK) $(BUILD)/packd $(BENCH_BIN)
 
 # Install missing Debian packages once per build directory
-# (deploy/install-deps.sh checks each package and installs only what is missing).
+# (deploy/install-deps.sh checks each package and installs only what is missing):
+# what the build and the daemon need for every target, the test tools for make test.
 $(DEPS_OK): deploy/install-deps.sh
 	@mkdir -p $(@D)
-	@sh deploy/install-deps.sh || exit 1
+	@sh deploy/install-deps.sh run || exit 1
+	@touch $@
+
+$(TEST_DEPS_OK): deploy/install-deps.sh tests/tools/playwright.sh
+	@mkdir -p $(@D)
+	@sh deploy/install-deps.sh test || exit 1
+	@sh tests/tools/playwright.sh $(BUILD)/node
 	@touch $@
 
 deps: $(DEPS_OK)
@@ -69,6 +96,13 @@ deps: $(DEPS_OK)
 $(BUILD)/obj/core/%.o: core/%.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(CC) $(CORE_CFLAGS) -c $< -o $@
+
+$(MPI_STAMP):
+	@mkdir -p $(@D)
+	@rm -f $(BUILD)/.mpi-*
+	@touch $@
+
+$(BUILD)/obj/api/par/mpi_world.o: $(MPI_STAMP)
 
 $(BUILD)/obj/api/%.o: api/%.c | $(DEPS_OK)
 	@mkdir -p $(@D)
@@ -108,7 +142,12 @@ $(BUILD)/bench/%: bench/%.c $(LIB_OBJ)
 	@mkdir -p $(@D)
 	$(CC) $(EXT_CFLAGS) -o $@ $< $(LIB_OBJ) $(EXT_LIBS)
 
-test: $(DEPS_OK) $(BUILD)/packd $(UNIT_BIN) $(BENCH_BIN)
+# The test tools first, then a make of its own: the build sees what they brought
+# (OpenMPI is looked for by pkg-config).
+test: $(TEST_DEPS_OK)
+	@$(MAKE) --no-print-directory test-run
+
+test-run: $(DEPS_OK) $(BUILD)/packd $(UNIT_BIN) $(BENCH_BIN) fuzz-build
 	@sh tests/run.sh $(BUILD)
 
 sanitize:
@@ -190,12 +229,14 @@ FUZZ_OK      := $(FUZZ_BUILD)/.fuzzer-ok
 
 .PHONY: fuzz fuzz-build
 
-# Does this clang link libFuzzer?  Leaves the stamp only if it does.
+# Does this clang link libFuzzer and find the headers packd's sources include
+# (<omp.h> is clang's own, from libomp-14-dev)?  Leaves the stamp only if so.
 $(FUZZ_OK):
 	@mkdir -p $(@D)
-	@printf 'int LLVMFuzzerTestOneInput(const char *d, unsigned long n) { return 0; }\n' > $(@D)/probe.c
-	@if $(FUZZ_CC) -fsanitize=fuzzer $(@D)/probe.c -o $(@D)/probe 2>/dev/null; then touch $@; \
-	 else echo "fuzz: skipped: $(FUZZ_CC) -fsanitize=fuzzer does not link (apt-get install clang libclang-rt-14-dev)"; fi
+	@printf '#include <omp.h>\nint LLVMFuzzerTestOneInput(const char *d, unsigned long n) { return 0; }\n' > $(@D)/probe.c
+	@if $(FUZZ_CC) -fsanitize=fuzzer $(@D)/probe.c -o $(@D)/probe 2>$(@D)/probe.err; then touch $@; \
+	 else echo "fuzz: skipped: $(FUZZ_CC) -fsanitize=fuzzer does not build: $$(grep -m1 error $(@D)/probe.err)" \
+	    "(apt-get install clang libclang-rt-14-dev libomp-14-dev)"; fi
 
 $(FUZZ_BUILD)/obj/%.o: %.c | $(DEPS_OK)
 	@mkdir -p $(@D)
@@ -221,8 +262,6 @@ fuzz: fuzz-build
 	    $(FUZZ_BUILD)/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=2048 \
 	        -artifact_prefix=$(FUZZ_BUILD)/crash-$$t- $(FUZZ_BUILD)/corpus/$$t tests/fuzz/corpus/$$t || exit 1; \
 	done
-
-test: fuzz-build
 
 clean:
 	rm -rf build build-san $(FUZZ_BUILD)

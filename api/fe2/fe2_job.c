@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "api/inputs/input_open.h"
 #include "api/process.h"
 
 static const char *const initial_stress_names[] = {"free", "balanced", NULL};
@@ -25,6 +26,7 @@ static const pk_option fe2_rows[] = {
      .hi = 1000000},
     {"/limits/max_grains_total", PK_OPT_INTEGER, F(max_grains_total), .dflt = 20000000, .lo = 1,
      .hi = 1e9},
+    {"/parallel/mpi_ranks", PK_OPT_INTEGER, F(mpi_ranks), .dflt = 1, .lo = 1, .hi = 64},
 };
 #undef F
 const pk_option_table pk_fe2_options =
@@ -73,8 +75,12 @@ static void micro_parse(json_t *micro, const pk_check_ctx *ctx, pk_fe2_job *job,
     }
     if (job->pack_inputs)
         json_object_set_new(h, "rve", json_pack("{s:s}", "file", "(nested pack)"));
-    else
+    else {
         json_object_set(h, "rve", rve);
+        const char *file = json_string_value(json_object_get(rve, "file"));
+        if (file && !(ctx && ctx->service)) /* as for homogenize (pk_homog_parse) */
+            pk_input_check(file, "/micro/rve/file", "rve", errs);
+    }
     json_object_set_new(h, "load",
                         json_pack("{s:s, s:[[i,i,i,i]]}", "type", "list", "F", 1, 0, 0, 1));
     pk_schema_errors tmp = {0};

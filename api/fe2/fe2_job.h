@@ -36,6 +36,7 @@ typedef struct pk_fe2_job {
     int balanced; /* initial_stress: 0 free, 1 balanced */
     char unit[8]; /* the length unit of the mesh, the loads and the RVE */
     size_t max_gauss_points, max_grains_total;
+    int mpi_ranks; /* what an executor starts (docs/fe2.md); packd run takes its launch's */
     /* borrowed from the inputs (they outlive the job: process.h) */
     json_t *mesh, *bcs, *stages;
     /* micro: the RVE options as a 'homogenize' job (its rve_file unused

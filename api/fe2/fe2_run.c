@@ -2,7 +2,9 @@
  * (a packd result file read as 'homogenize' does, or a nested 'pack' job
  * run once), the stages' load steps solved by core/fe2's Newton step with
  * the RVE material at every Gauss point, and the result file
- * (fe2_record.c). */
+ * (fe2_record.c).  Launched as several MPI ranks, the Gauss points are
+ * spread over them (fe2_mpi.h): rank 0 runs all of this, the others hold
+ * and evaluate their blocks until it is done. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -10,12 +12,14 @@
 #include <unistd.h>
 
 #include "api/job_verdict.h"
+#include "api/par/mpi_world.h"
 #include "api/process.h"
 #include "api/results/h5_result.h"
 #include "api/solver/sparse_cholmod.h"
 #include "core/base/par.h"
 #include "core/fe2/fe2_rve.h"
 #include "fe2_job.h"
+#include "fe2_mpi.h"
 #include "fe2_record.h"
 
 /* Progress: core/fe2 ticks once per evaluation round (every Gauss point of
@@ -121,7 +125,9 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
     json_t *sum = NULL;
     double *uD = NULL, *fext = NULL, *f0 = NULL;
     const double **micro = NULL;
-    int rc = -1, have_rve = 0, have_mr = 0;
+    double *micro_x = NULL; /* [n_micro_gp][ngrain][3] the output RVEs (rank 0, MPI) */
+    pk_fe2_mpi mpi = {0};
+    int rc = -1, have_rve = 0, have_mr = 0, have_mpi = 0;
     if (pk_fe2_setup_build(job, &s, &errs) != 0) { /* a mesh file read only now (service) */
         snprintf(err, errlen, "%s: %s", errs.items[0].pointer, errs.items[0].message);
         goto out;
@@ -133,8 +139,28 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
                      job->micro_gp[i], ngp);
             goto out;
         }
-    if (load_rve(job, run, out_path, &box, &p, err, errlen) != 0)
-        goto out;
+    if (pk_mpi_size() > 1) {
+        if (pk_fe2_mpi_init(&mpi, ngp, s.ndof, mon) != 0) {
+            snprintf(err, errlen, "out of memory, or over %d MPI ranks", PK_PAR_MAX);
+            goto out;
+        }
+        have_mpi = 1;
+    }
+    if (mpi.rank > 0) { /* the RVE as rank 0 read or packed it */
+        int sr = pk_fe2_mpi_share_rve(&mpi, 0, &box, &p, err, errlen);
+        if (sr != 0) {
+            rc = sr > 0 ? 0 : -1; /* rank 0 ended the run before: it says why */
+            if (sr > 0)
+                sum = json_pack("{s:s,s:i}", "process", "fe2", "mpi_rank", mpi.rank);
+            goto out_rank;
+        }
+    } else {
+        int lr = load_rve(job, run, out_path, &box, &p, err, errlen);
+        if (have_mpi && pk_fe2_mpi_share_rve(&mpi, lr == 0, &box, &p, err, errlen) != 0)
+            lr = -1;
+        if (lr != 0)
+            goto out;
+    }
     if (box.dim != 2) {
         snprintf(err, errlen, "the RVE is %dD: fe2 is plane strain and needs a 2D packing",
                  box.dim);
@@ -152,7 +178,9 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
     pk_homog_opts o;
     pk_homog_opts_of(&job->micro, &rve, &o);
     o.par = pool = pk_par_new(threads);
-    if (pk_fe2_rve_init(&mr, &rve, 1, &o, &pk_sparse_cholmod, ngp, mon, err, errlen) != 0)
+    /* each rank holds the states of its block only (all of them alone) */
+    if (pk_fe2_rve_init_block(&mr, &rve, 1, &o, &pk_sparse_cholmod, ngp, have_mpi ? mpi.lo : 0,
+                              have_mpi ? mpi.hi : ngp, mon, err, errlen) != 0)
         goto out;
     have_mr = 1;
     pk_fe2_material mat = pk_fe2_rve_material(&mr);
@@ -161,11 +189,22 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
                                .nfix = s.nfix,
                                .fix_dof = s.fix_dof,
                                .solver = &pk_sparse_cholmod,
-                               .par = pool};
+                               .par = pool,
+                               .dist = have_mpi ? &mpi.dist : NULL};
+    if (have_mpi)
+        pk_fe2_mpi_attach(&mpi, &mr, rve.n);
+    if (mpi.rank > 0) { /* serve rank 0 until it is done */
+        if (pk_fe2_mpi_serve(&mpi, &pb, err, errlen) != 0)
+            goto out;
+        sum = json_pack("{s:s,s:i}", "process", "fe2", "mpi_rank", mpi.rank);
+        rc = 0;
+        goto out_rank;
+    }
     uD = calloc(s.nfix + 1, sizeof *uD);
     fext = calloc(s.ndof + 1, sizeof *fext);
     micro = calloc(job->n_micro_gp + 1, sizeof *micro);
-    if (!uD || !fext || !micro || pk_fe2_state_init(&st, &s.mesh) != 0 ||
+    micro_x = have_mpi ? calloc(3 * rve.n * job->n_micro_gp + 1, sizeof *micro_x) : NULL;
+    if (!uD || !fext || !micro || (have_mpi && !micro_x) || pk_fe2_state_init(&st, &s.mesh) != 0 ||
         pk_fe2_record_init(&rec, &s, job->micro_gp, job->n_micro_gp, rve.n) != 0) {
         snprintf(err, errlen, "out of memory");
         goto out;
@@ -192,6 +231,8 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
     wm.ctx = &pc;
     char failure[700] = "";
     const char *reason = "complete";
+    size_t rounds_total = 0;
+    const double solve_t0 = pk_wall_seconds();
     for (size_t k = 0; k < s.nstage && !failure[0]; k++) {
         char sname[80];
         snprintf(sname, sizeof sname, s.stage_name[k][0] ? "%zu \"%s\"" : "%zu", k,
@@ -212,12 +253,23 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
             }
             for (size_t q = 0; q < rep.nparts; q++)
                 iters_total += (size_t)(rep.parts[q].n > 0 ? rep.parts[q].n - 1 : 0);
+            rounds_total += rep.rounds;
             cuts_total += (size_t)rep.cuts;
             if (r == 0) {
                 /* the committed centres of the output Gauss points (a commit
                  * may have moved their storage) */
-                for (size_t g = 0; g < job->n_micro_gp; g++)
-                    micro[g] = mr.committed[job->micro_gp[g]].x;
+                for (size_t g = 0; g < job->n_micro_gp; g++) {
+                    micro[g] =
+                        have_mpi ? &micro_x[3 * rve.n * g] : mr.committed[job->micro_gp[g]].x;
+                    if (have_mpi &&
+                        pk_fe2_mpi_centres(&mpi, job->micro_gp[g], &micro_x[3 * rve.n * g], rep.why,
+                                           sizeof rep.why) != 0) {
+                        r = -1;
+                        break;
+                    }
+                }
+            }
+            if (r == 0) {
                 if (pk_fe2_record_step(&rec, done + 1, (double)k + t, k, rep.cuts, &st, micro) !=
                     0) {
                     snprintf(err, errlen, "out of memory");
@@ -226,7 +278,12 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
                 done++;
                 continue;
             }
-            if (r == 2) {
+            if (mpi.broken) {
+                reason = "rank_lost";
+                snprintf(failure, sizeof failure,
+                         "load step %zu of %zu (stage %s, increment %zu of %zu): %s", done + 1,
+                         nstep, sname, i, s.increments[k], rep.why);
+            } else if (r == 2) {
                 reason = mon && mon->cancel && *mon->cancel ? "cancelled" : "wall_time";
                 snprintf(failure, sizeof failure,
                          "%s in load step %zu of %zu (stage %s, increment %zu of %zu)",
@@ -259,6 +316,15 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
     json_object_set_new(sum, "newton_iterations_total", json_integer((json_int_t)iters_total));
     json_object_set_new(sum, "step_cuts_total", json_integer((json_int_t)cuts_total));
     json_object_set_new(sum, "threads", json_integer(pk_par_threads(pool)));
+    json_object_set_new(sum, "mpi_ranks", json_integer(pk_mpi_size()));
+    /* what a round costs (docs/perf/fe2-mpi.md): wall time of the load steps
+     * (rounds, macro solves, commits) and, over ranks, the bytes rank 0 moved */
+    json_object_set_new(sum, "evaluation_rounds", json_integer((json_int_t)rounds_total));
+    json_object_set_new(sum, "steps_wall_s", json_real(pk_wall_seconds() - solve_t0));
+    if (have_mpi) {
+        json_object_set_new(sum, "mpi_bytes_sent", json_integer((json_int_t)mpi.bytes_out));
+        json_object_set_new(sum, "mpi_bytes_received", json_integer((json_int_t)mpi.bytes_in));
+    }
     /* the figures per converged step: reactions of the displacement
      * conditions and the dilatancy Δ = (v/V − 1)·100 % of the specimen */
     json_t *reac = json_object();
@@ -292,10 +358,18 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
     *summary = sum;
     sum = NULL;
     rc = 0;
+out_rank: /* a rank other than 0: no file, a summary saying which rank served */
+    if (rc == 0 && mpi.rank > 0) {
+        *summary = sum;
+        sum = NULL;
+    }
 out:
+    if (have_mpi && mpi.rank == 0)
+        pk_fe2_mpi_stop(&mpi);
     pk_schema_errors_free(&errs);
     json_decref(sum);
     free(uD);
+    free(micro_x);
     free(fext);
     free(f0);
     free(micro);
@@ -308,5 +382,7 @@ out:
     pk_par_free(pool);
     pk_particles_free(&p);
     pk_fe2_setup_free(&s);
+    if (have_mpi)
+        pk_fe2_mpi_free(&mpi);
     return rc;
 }

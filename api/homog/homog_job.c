@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "api/inputs/input_open.h"
 #include "core/space/mat3.h"
 
 static const char *const bc_names[] = {"taylor", "restricted_taylor", "periodic",
@@ -320,14 +321,18 @@ size_t pk_homog_job_from_json(json_t *inputs, pk_homog_job *job, pk_schema_error
 
 void *pk_homog_parse(json_t *inputs, const pk_check_ctx *ctx, pk_schema_errors *errs)
 {
-    (void)ctx; /* the RVE file is read by the run only */
     pk_homog_job *job = malloc(sizeof *job);
     if (!job) {
         pk_schema_errors_add(errs, "", "memory", "out of memory");
         return NULL;
     }
-    if (pk_homog_job_from_json(inputs, job, errs) == 0)
-        return job;
+    if (pk_homog_job_from_json(inputs, job, errs) == 0) {
+        /* a job file on this machine names an RVE that opens (check_ctx.h);
+         * the run reads it */
+        if ((ctx && ctx->service) || pk_input_check(job->rve_file, "/rve/file", "rve", errs) == 0)
+            return job;
+        pk_homog_job_free(job);
+    }
     free(job);
     return NULL;
 }

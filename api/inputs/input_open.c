@@ -25,13 +25,13 @@ int pk_input_open(const char *path, long long max_bytes, char *err, size_t errle
     int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
     if (fd < 0) {
         int e = errno; /* callers tell a missing file from a refused one */
-        snprintf(err, errlen, "%s: cannot open (%s)", path, strerror(e));
+        snprintf(err, errlen, "cannot open %s: %s", path, strerror(e));
         errno = e;
         return -1;
     }
     struct stat st;
     if (fstat(fd, &st) != 0) {
-        snprintf(err, errlen, "%s: cannot stat (%s)", path, strerror(errno));
+        snprintf(err, errlen, "cannot stat %s: %s", path, strerror(errno));
         close(fd);
         return -1;
     }
@@ -61,8 +61,20 @@ FILE *pk_input_fopen(const char *path, long long max_bytes, char *err, size_t er
         return NULL;
     FILE *f = fdopen(fd, "r");
     if (!f) {
-        snprintf(err, errlen, "%s: cannot read (%s)", path, strerror(errno));
+        snprintf(err, errlen, "cannot read %s: %s", path, strerror(errno));
         close(fd);
     }
     return f;
+}
+
+int pk_input_check(const char *path, const char *pointer, const char *rule, pk_schema_errors *errs)
+{
+    char err[256];
+    int fd = pk_input_open(path, 0, err, sizeof err);
+    if (fd < 0) {
+        pk_schema_errors_add(errs, pointer, rule, "%s", err);
+        return -1;
+    }
+    close(fd);
+    return 0;
 }

@@ -20,4 +20,9 @@ int pk_input_open(const char *path, long long max_bytes, char *err, size_t errle
 /* The same as a stdio stream ("r"), or NULL with err. */
 FILE *pk_input_fopen(const char *path, long long max_bytes, char *err, size_t errlen);
 
+/* Check at validation that a job's input file opens: 0, or -1 with an error
+ * at pointer with rule ("cannot open rve.h5: No such file or directory"). */
+#include "api/schemas/json_schema.h"
+int pk_input_check(const char *path, const char *pointer, const char *rule, pk_schema_errors *errs);
+
 #endif

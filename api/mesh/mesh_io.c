@@ -608,7 +608,8 @@ int pk_mesh_from_json(json_t *j, size_t max_tets, pk_mesh *m, pk_mesh_report *re
             : gmsh == 1 ? pk_mesh_read_msh(file, max_tets, m, err, errlen)
                         : pk_mesh_read_tetgen(file, max_tets, m, err, errlen);
         if (rc != 0 && gmsh == 2 && !ends_with(file, ".node") && !ends_with(file, ".ele") &&
-            strstr(err, ".node: cannot open")) /* e.g. an upload that is no mesh */
+            !strncmp(err, "cannot open ", 12) &&
+            strstr(err, ".node: ")) /* e.g. an upload that is no mesh */
             snprintf(err, errlen,
                      "%s: neither a Gmsh MSH file (no $MeshFormat at the start) nor "
                      "the base name of a TetGen .node/.ele pair",

@@ -91,7 +91,7 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
         return -1;
     }
     if (mesh) {
-        *ptr = "/domain/mesh";
+        *ptr = json_object_get(mesh, "file") ? "/domain/mesh/file" : "/domain/mesh";
         *rule = "mesh";
         if (pk_mesh_from_json(mesh, max_tets, &S->mesh, &S->rep, err, errlen) != 0)
             return -1;

@@ -1,5 +1,6 @@
 /* sparse_cholmod.c — core/base/sparse.h's solver with SuiteSparse CHOLMOD:
- * supernodal LLᵀ, simplicial LDLᵀ for the inertia.  Contract: sparse_cholmod.h. */
+ * simplicial LDLᵀ (no BLAS: the same bits on every CPU), the inertia from D.
+ * Contract: sparse_cholmod.h. */
 #include "sparse_cholmod.h"
 
 #include <cholmod.h>
@@ -26,7 +27,7 @@ struct pk_sparse_factor {
     size_t n;
 };
 
-/* The last supernodal analysis (symbolic factor, pattern only) and the
+/* The last analysis (symbolic factor, pattern only) and the
  * column pattern of the matrix it was made for. */
 struct pk_sparse_ctx {
     cholmod_common c;
@@ -62,34 +63,10 @@ static void classify_pivots(const double *d, size_t ncol, size_t n, pk_sparse_in
                                : PK_SPARSE_OK;
 }
 
-/* The pivots of a supernodal LLᵀ factor: L_jj² from each supernode's dense
- * column block (column-major, nsrow rows). */
-static int supernodal_pivots(const cholmod_factor *L, double *d)
+/* Analyse S afresh (AMD) into f->L and factorise it as simplicial LDLᵀ;
+ * 0 when CHOLMOD ran (the factor may still stop early: L->minor < n). */
+static int factorize_fresh(pk_sparse_factor *f, cholmod_sparse *S)
 {
-    const int *super = L->super, *pi = L->pi, *px = L->px;
-    const double *x = L->x;
-    for (size_t s = 0; s < L->nsuper; s++) {
-        int k1 = super[s], k2 = super[s + 1];
-        int nsrow = pi[s + 1] - pi[s];
-        for (int jj = 0; jj < k2 - k1; jj++) {
-            double l = x[px[s] + jj + (size_t)jj * nsrow];
-            d[k1 + jj] = l * l;
-        }
-    }
-    return 0;
-}
-
-/* Analyse and factorise S in the given mode; 0 when CHOLMOD ran (the factor
- * may still stop early: L->minor < n).
- * factor and factor_pd analyse (AMD) afresh; factor_pd_ctx reuses its
- * context's analysis when the pattern repeats (factorize_supernodal): that
- * pays where a context spans steps whose contact set does not change
- * (elastic load steps); within one relaxation the pattern changes.  Other
- * orderings and analyses measured against AMD: docs/perf/sparse.md. */
-static int factorize_mode(pk_sparse_factor *f, cholmod_sparse *S, int mode)
-{
-    f->c.supernodal = mode;
-    f->c.final_ll = 0; /* simplicial: keep LDLᵀ, D carries the inertia */
     f->L = cholmod_analyze(S, &f->c);
     if (!f->L)
         return -1;
@@ -121,8 +98,6 @@ static int analyse_into(pk_sparse_ctx *ctx, cholmod_sparse *S)
         ctx->i = ni;
     if (!np_ || !ni)
         return -1;
-    ctx->c.supernodal = CHOLMOD_SUPERNODAL;
-    ctx->c.final_ll = 0;
     ctx->L = cholmod_analyze(S, &ctx->c);
     if (!ctx->L)
         return -1;
@@ -133,20 +108,17 @@ static int analyse_into(pk_sparse_ctx *ctx, cholmod_sparse *S)
     return 0;
 }
 
-/* The supernodal LLᵀ of S, analysed afresh (ctx NULL) or with ctx's
- * analysis — the same AMD ordering and supernodes as a fresh analysis of
- * the same pattern (cholmod_analyze reads the pattern only), hence the same
- * numbers (the analysis is ~25 % of a factorisation). */
-static int factorize_supernodal(pk_sparse_ctx *ctx, pk_sparse_factor *f, cholmod_sparse *S,
-                                pk_sparse_info *info)
+/* The LDLᵀ of S, analysed afresh (ctx NULL) or with ctx's analysis — the
+ * same AMD ordering as a fresh analysis of the same pattern (cholmod_analyze
+ * reads the pattern only), hence the same numbers. */
+static int factorize(pk_sparse_ctx *ctx, pk_sparse_factor *f, cholmod_sparse *S,
+                     pk_sparse_info *info)
 {
     if (!ctx)
-        return factorize_mode(f, S, CHOLMOD_SUPERNODAL);
+        return factorize_fresh(f, S);
     info->reused_analysis = same_pattern(ctx, S);
     if (!info->reused_analysis && analyse_into(ctx, S) != 0)
         return -1;
-    f->c.supernodal = CHOLMOD_SUPERNODAL;
-    f->c.final_ll = 0;
     f->L = cholmod_copy_factor(ctx->L, &f->c);
     if (!f->L)
         return -1;
@@ -154,12 +126,23 @@ static int factorize_supernodal(pk_sparse_ctx *ctx, pk_sparse_factor *f, cholmod
     return f->c.status < 0 ? -1 : 0;
 }
 
-/* Supernodal LLᵀ first: BLAS-3 on dense column blocks, 2.5× faster than the
- * simplicial LDLᵀ on the 2·10⁴-DOF 2D Newton blocks (bench/homog, with
- * OpenBLAS).  It stops at the first non-positive pivot, so a block that is
- * not positive definite is factorised again as simplicial LDLᵀ, whose D
- * gives the full inertia that the tangent reports — unless `pd_only`
- * (factor_pd): then the answer is NOT_PD and no second factorisation. */
+/* CHOLMOD's settings for every factor and analysis: simplicial LDLᵀ.  Its
+ * arithmetic is CHOLMOD's own loops, in an order fixed by the ordering —
+ * no BLAS call, so the numbers do not depend on which BLAS is installed or
+ * which kernel OpenBLAS picks for the CPU (the supernodal LLᵀ's dense blocks
+ * went through dgemm/dtrsm, whose rounding changes with the kernel: a
+ * homogenization's tangent differed between CPUs).  The price and the
+ * figures: docs/perf/sparse.md.  D carries the full inertia in one pass. */
+static void simplicial_ldlt(cholmod_common *c)
+{
+    c->print = 0;
+    c->error_handler = NULL;
+    c->supernodal = CHOLMOD_SIMPLICIAL;
+    c->final_ll = 0;
+}
+
+/* Factorise A as LDLᵀ; the inertia from D.  `pd_only` (factor_pd): a block
+ * that is not positive definite gives NULL with NOT_PD and no inertia. */
 static pk_sparse_factor *factor_any(pk_sparse_ctx *ctx, const pk_sparse_sym *A, int pd_only,
                                     pk_sparse_info *info)
 {
@@ -173,8 +156,7 @@ static pk_sparse_factor *factor_any(pk_sparse_ctx *ctx, const pk_sparse_sym *A, 
     if (!f)
         return NULL;
     cholmod_start(&f->c);
-    f->c.print = 0;
-    f->c.error_handler = NULL;
+    simplicial_ldlt(&f->c);
     f->n = A->n;
     cholmod_triplet *T =
         cholmod_allocate_triplet(A->n, A->n, A->nnz ? A->nnz : 1, 1, CHOLMOD_REAL, &f->c);
@@ -194,28 +176,18 @@ static pk_sparse_factor *factor_any(pk_sparse_ctx *ctx, const pk_sparse_sym *A, 
     d = malloc((A->n ? A->n : 1) * sizeof *d);
     if (!S || !d)
         goto fail;
-    if (factorize_supernodal(ctx, f, S, info) != 0)
+    if (factorize(ctx, f, S, info) != 0)
         goto fail;
-    if (f->L->minor >= A->n && f->L->is_super) {
-        supernodal_pivots(f->L, d);
-        classify_pivots(d, A->n, A->n, info);
-    }
+    const int *Lp = f->L->p;
+    const double *Lx = f->L->x;
+    size_t ncol = f->L->minor < A->n ? f->L->minor : A->n;
+    for (size_t j = 0; j < ncol; j++)
+        d[j] = Lx[Lp[j]]; /* D_jj: the first entry of column j */
+    classify_pivots(d, ncol, A->n, info);
     if (info->status != PK_SPARSE_OK && pd_only) {
         info->status = PK_SPARSE_NOT_PD;
         info->npos = info->nneg = info->nzero = 0;
         goto fail_keep_status;
-    }
-    if (info->status != PK_SPARSE_OK) { /* not positive definite: the inertia from LDLᵀ */
-        cholmod_free_factor(&f->L, &f->c);
-        info->npos = info->nneg = info->nzero = 0;
-        if (factorize_mode(f, S, CHOLMOD_SIMPLICIAL) != 0)
-            goto fail;
-        const int *Lp = f->L->p;
-        const double *Lx = f->L->x;
-        size_t ncol = f->L->minor < A->n ? f->L->minor : A->n;
-        for (size_t j = 0; j < ncol; j++)
-            d[j] = Lx[Lp[j]];
-        classify_pivots(d, ncol, A->n, info);
     }
     cholmod_free_sparse(&S, &f->c); /* sets S = NULL */
     free(d);
@@ -258,8 +230,7 @@ static pk_sparse_ctx *chol_ctx_new(void)
     if (!ctx)
         return NULL;
     cholmod_start(&ctx->c);
-    ctx->c.print = 0;
-    ctx->c.error_handler = NULL;
+    simplicial_ldlt(&ctx->c);
     return ctx;
 }
 

@@ -41,7 +41,7 @@ typedef struct pk_sparse_info {
 typedef struct pk_sparse_factor pk_sparse_factor; /* solver-owned */
 /* A solver context kept over a sequence of factorisations (a relaxation, or
  * the steps of a load path):
- * it keeps the last symbolic analysis (fill-reducing ordering, supernodes)
+ * it keeps the last symbolic analysis (fill-reducing ordering, pattern of L)
  * and reuses it when the next matrix has the same pattern — the same
  * ordering gives the same numbers, bit for bit. */
 typedef struct pk_sparse_ctx pk_sparse_ctx; /* solver-owned */
@@ -52,9 +52,7 @@ typedef struct pk_sparse_solver {
      * = FAILED.  A factor is returned for OK and INDEFINITE. */
     pk_sparse_factor *(*factor)(const pk_sparse_sym *A, pk_sparse_info *info);
     /* Factor A only if it is positive definite (Newton's question): NULL with
-     * info->status = NOT_PD otherwise, and no inertia — the pivots' signs
-     * past an LLᵀ's first non-positive pivot need a second, LDLᵀ
-     * factorisation, 15 % of a dense 10⁴ Newton step (bench/homog). */
+     * info->status = NOT_PD otherwise, and no inertia. */
     pk_sparse_factor *(*factor_pd)(const pk_sparse_sym *A, pk_sparse_info *info);
     /* factor_pd with a context (NULL: the same as factor_pd): the analysis
      * of the context is used when A has its pattern, else A is analysed and

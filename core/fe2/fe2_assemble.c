@@ -23,6 +23,7 @@ int fe2_gp_buf_init(fe2_gp_buf *b, const pk_fe2_mesh *m)
     b->info = calloc(n1, sizeof *b->info);
     b->rc = calloc(n1, sizeof *b->rc);
     b->why = calloc(n1, sizeof *b->why);
+    b->res = NULL;
     if (!b->elem || !b->dN || !b->w || !b->F || !b->P || !b->A || !b->info || !b->rc || !b->why) {
         fe2_gp_buf_free(b);
         return -1;
@@ -39,39 +40,45 @@ int fe2_gp_buf_init(fe2_gp_buf *b, const pk_fe2_mesh *m)
 void fe2_gp_buf_free(fe2_gp_buf *b)
 {
     free(b->elem), free(b->dN), free(b->w), free(b->F), free(b->P), free(b->A);
-    free(b->info), free(b->rc), free(b->why);
+    free(b->info), free(b->rc), free(b->why), free(b->res);
     memset(b, 0, sizeof *b);
 }
 
 typedef struct round_ctx {
     const pk_fe2_problem *pb;
-    const double *u;
     fe2_gp_buf *b;
+    size_t lo; /* part t is Gauss point lo + t */
     volatile sig_atomic_t *cancel;
 } round_ctx;
 
-/* Part g of a round: Gauss point g alone, into its own slots. */
-static void round_part(void *vctx, int t, int nt)
+/* F̄ = 1 + ∇₀u at Gauss point g into its slot. */
+static void deformation(const pk_fe2_mesh *m, const double *u, fe2_gp_buf *b, size_t g)
 {
-    (void)nt;
-    round_ctx *c = vctx;
-    const size_t g = (size_t)t;
-    fe2_gp_buf *b = c->b;
-    const pk_fe2_mesh *m = c->pb->mesh;
-    if (c->cancel && *c->cancel) {
-        b->rc[g] = FE2_ROUND_CANCELLED;
-        return;
-    }
     const size_t e = b->elem[g];
     const double *dN = &b->dN[8 * g];
     double *F = &b->F[4 * g];
     F[0] = 1, F[1] = 0, F[2] = 0, F[3] = 1;
     for (int a = 0; a < pk_fe2_elem_nodes(m, e); a++) {
-        const double *ua = &c->u[2 * (size_t)m->conn[4 * e + a]];
+        const double *ua = &u[2 * (size_t)m->conn[4 * e + a]];
         for (int i = 0; i < 2; i++)
             for (int J = 0; J < 2; J++)
                 F[2 * i + J] += ua[i] * dN[2 * a + J];
     }
+}
+
+/* Part t of a round: Gauss point lo + t alone, into its own slots (its F̄
+ * already there). */
+static void round_part(void *vctx, int t, int nt)
+{
+    (void)nt;
+    round_ctx *c = vctx;
+    const size_t g = c->lo + (size_t)t;
+    fe2_gp_buf *b = c->b;
+    if (c->cancel && *c->cancel) {
+        b->rc[g] = FE2_ROUND_CANCELLED;
+        return;
+    }
+    const double *F = &b->F[4 * g];
     b->why[g][0] = 0;
     memset(&b->info[g], 0, sizeof b->info[g]);
     const double t0 = pk_wall_seconds();
@@ -91,12 +98,61 @@ static void round_part(void *vctx, int t, int nt)
         b->info[g].seconds = pk_wall_seconds() - t0;
 }
 
+/* Gauss points [lo, hi) at u over pb->par: F̄ of the block, then the parts. */
+static void eval_range(const pk_fe2_problem *pb, const double *u, fe2_gp_buf *b, size_t lo,
+                       size_t hi, volatile sig_atomic_t *cancel)
+{
+    for (size_t g = lo; g < hi; g++)
+        deformation(pb->mesh, u, b, g);
+    round_ctx c = {pb, b, lo, cancel};
+    if (hi > lo)
+        pk_par_run_parts(pb->par, round_part, &c, (int)(hi - lo));
+}
+
+/* The other evaluators' results (outside [lo, hi)) into b's slots; F̄ of
+ * every point computed here too, for the state and the record. */
+static int fetch_others(const pk_fe2_problem *pb, const double *u, fe2_gp_buf *b, char *why,
+                        size_t whylen)
+{
+    const pk_fe2_distributor *d = pb->dist;
+    int rc = d->round_finish(d->ctx, b->res, why, whylen);
+    if (rc != PK_FE2_DIST_OK)
+        return rc == PK_FE2_DIST_CANCELLED ? FE2_ROUND_CANCELLED : FE2_ROUND_LOST;
+    for (size_t g = 0; g < b->ngp; g++) {
+        if (g == d->lo)
+            g = d->hi;
+        if (g >= b->ngp)
+            break;
+        const pk_fe2_gp_result *r = &b->res[g];
+        deformation(pb->mesh, u, b, g);
+        memcpy(&b->P[4 * g], r->P, sizeof r->P);
+        memcpy(&b->A[16 * g], r->A, sizeof r->A);
+        b->info[g] = r->info;
+        b->rc[g] = r->rc;
+        memcpy(b->why[g], r->why, FE2_WHY);
+        b->why[g][FE2_WHY - 1] = 0;
+    }
+    return FE2_ROUND_OK;
+}
+
 int fe2_eval_round(const pk_fe2_problem *pb, const double *u, fe2_gp_buf *b,
                    volatile sig_atomic_t *cancel, char *why, size_t whylen)
 {
-    round_ctx c = {pb, u, b, cancel};
-    if (b->ngp)
-        pk_par_run_parts(pb->par, round_part, &c, (int)b->ngp);
+    const pk_fe2_distributor *d = pb->dist;
+    if (d) {
+        if (!b->res && !(b->res = calloc(b->ngp ? b->ngp : 1, sizeof *b->res))) {
+            snprintf(why, whylen, "out of memory");
+            return FE2_ROUND_LOST;
+        }
+        if (d->round_start(d->ctx, u, 2 * pb->mesh->nnode, why, whylen) != PK_FE2_DIST_OK)
+            return FE2_ROUND_LOST;
+    }
+    eval_range(pb, u, b, d ? d->lo : 0, d ? d->hi : b->ngp, cancel);
+    if (d) {
+        int rc = fetch_others(pb, u, b, why, whylen);
+        if (rc != FE2_ROUND_OK)
+            return rc;
+    }
     int cancelled = 0;
     for (size_t g = 0; g < b->ngp; g++) {
         if (b->rc[g] == FE2_ROUND_FAILED) {
@@ -112,6 +168,33 @@ int fe2_eval_round(const pk_fe2_problem *pb, const double *u, fe2_gp_buf *b,
     if (cancelled)
         snprintf(why, whylen, "cancelled");
     return cancelled ? FE2_ROUND_CANCELLED : FE2_ROUND_OK;
+}
+
+int pk_fe2_eval_block(const pk_fe2_problem *pb, const double *u, size_t lo, size_t hi,
+                      pk_fe2_gp_result *res, volatile sig_atomic_t *cancel)
+{
+    fe2_gp_buf b;
+    if (fe2_gp_buf_init(&b, pb->mesh) != 0)
+        return -1;
+    eval_range(pb, u, &b, lo, hi, cancel);
+    for (size_t g = lo; g < hi; g++) {
+        pk_fe2_gp_result *r = &res[g - lo];
+        memcpy(r->P, &b.P[4 * g], sizeof r->P);
+        memcpy(r->A, &b.A[16 * g], sizeof r->A);
+        r->info = b.info[g];
+        r->rc = b.rc[g];
+        memcpy(r->why, b.why[g], sizeof r->why);
+    }
+    fe2_gp_buf_free(&b);
+    return 0;
+}
+
+int pk_fe2_commit_block(const pk_fe2_problem *pb, size_t lo, size_t hi)
+{
+    for (size_t g = lo; g < hi; g++)
+        if (pb->mat->commit(pb->mat->ctx, g) != 0)
+            return -1;
+    return 0;
 }
 
 void fe2_internal_force(const pk_fe2_problem *pb, const fe2_gp_buf *b, double *fint)

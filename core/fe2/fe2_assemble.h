@@ -12,27 +12,30 @@
 
 #include "fe2_solver.h"
 
-#define FE2_WHY 160
+#define FE2_WHY PK_FE2_WHY
 
 /* Per-Gauss-point geometry (constant) and the slots of the last round. */
 typedef struct fe2_gp_buf {
     size_t ngp;
-    size_t *elem;         /* [ngp] element of g */
-    double *dN, *w;       /* [ngp][8] ∂N_a/∂X_J, [ngp] weight·det J */
-    double *F, *P, *A;    /* [ngp][4], [ngp][4], [ngp][16] */
-    pk_fe2_gp_info *info; /* [ngp] */
-    int *rc;              /* [ngp] the eval's return (0 ok) */
-    char (*why)[FE2_WHY]; /* [ngp] its reason */
+    size_t *elem;          /* [ngp] element of g */
+    double *dN, *w;        /* [ngp][8] ∂N_a/∂X_J, [ngp] weight·det J */
+    double *F, *P, *A;     /* [ngp][4], [ngp][4], [ngp][16] */
+    pk_fe2_gp_info *info;  /* [ngp] */
+    int *rc;               /* [ngp] the eval's return (0 ok) */
+    char (*why)[FE2_WHY];  /* [ngp] its reason */
+    pk_fe2_gp_result *res; /* [ngp] the other evaluators' results (pb->dist only) */
 } fe2_gp_buf;
 
 int fe2_gp_buf_init(fe2_gp_buf *b, const pk_fe2_mesh *m); /* 0 / −1 */
 void fe2_gp_buf_free(fe2_gp_buf *b);
 
 /* The round's outcome. */
-enum { FE2_ROUND_OK = 0, FE2_ROUND_FAILED = 1, FE2_ROUND_CANCELLED = 2 };
+enum { FE2_ROUND_OK = 0, FE2_ROUND_FAILED = 1, FE2_ROUND_CANCELLED = 2, FE2_ROUND_LOST = 3 };
 
-/* Evaluate every Gauss point at u.  FAILED names the first failing point
- * (lowest g) and its reason in why; CANCELLED when *cancel was set. */
+/* Evaluate every Gauss point at u (pb->dist: this process's block, the
+ * others' results fetched).  FAILED names the first failing point (lowest
+ * g) and its reason in why; CANCELLED when *cancel was set; LOST when an
+ * evaluator of pb->dist was lost (why says which). */
 int fe2_eval_round(const pk_fe2_problem *pb, const double *u, fe2_gp_buf *b,
                    volatile sig_atomic_t *cancel, char *why, size_t whylen);
 

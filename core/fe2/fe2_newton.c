@@ -87,6 +87,8 @@ static int round_at(step_ws *w, const double *u)
     w->evals += w->b.ngp;
     if (rc == FE2_ROUND_CANCELLED)
         return PART_CANCELLED;
+    if (rc == FE2_ROUND_LOST)
+        return PART_FATAL;
     pk_progress pr = {.stage = "fe2", .fraction = -1, .phi = -1, .done = w->evals, .eta_s = -1};
     if (w->mon && pk_monitor_tick(w->mon, &pr, 0) != 0) {
         snprintf(w->why, sizeof w->why, "cancelled or out of time");
@@ -353,15 +355,18 @@ static void keep_round(const step_ws *w, pk_fe2_state *s)
     s->evaluated = 1;
 }
 
-/* The converged part becomes the state: commit every Gauss point. */
+/* The converged part becomes the state: commit every Gauss point (those
+ * of other evaluators through pb->dist). */
 static int accept_part(step_ws *w, pk_fe2_state *s)
 {
-    const pk_fe2_material *mat = w->pb->mat;
-    for (size_t g = 0; g < w->b.ngp; g++)
-        if (mat->commit(mat->ctx, g) != 0) {
-            snprintf(w->why, sizeof w->why, "out of memory (commit of Gauss point %zu)", g);
-            return -1;
-        }
+    const pk_fe2_distributor *d = w->pb->dist;
+    const size_t lo = d ? d->lo : 0, hi = d ? d->hi : w->b.ngp;
+    if (pk_fe2_commit_block(w->pb, lo, hi) != 0) {
+        snprintf(w->why, sizeof w->why, "out of memory (commit of the Gauss points)");
+        return -1;
+    }
+    if (d && d->commit(d->ctx, w->why, sizeof w->why) != PK_FE2_DIST_OK)
+        return -1;
     memcpy(s->u, w->u, w->ndof * sizeof *s->u);
     memcpy(s->fext, w->fext, w->ndof * sizeof *s->fext);
     keep_round(w, s);
@@ -450,6 +455,7 @@ out:
         if (d >= 0 && (size_t)d < s->ndof)
             rep->reaction[d % 2] += s->fint[d] - s->fext[d];
     }
+    rep->rounds = w.b.ngp ? w.evals / w.b.ngp : 0;
     ws_free(&w);
     free(uD0), free(fext0);
     return ret;

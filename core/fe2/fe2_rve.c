@@ -95,6 +95,10 @@ static int rve_eval(void *ctx, size_t g, const double F[4], double P[4], double 
                     pk_fe2_gp_info *info, char *why, size_t whylen)
 {
     pk_fe2_rve *m = ctx;
+    if (g < m->lo || g >= m->hi) {
+        snprintf(why, whylen, "Gauss point %zu is not held here (block %zu..%zu)", g, m->lo, m->hi);
+        return 1;
+    }
     const pk_homog_rve *rve = &m->rve[pk_fe2_rve_index(m, g)];
     const double F3[9] = {F[0], F[1], 0, F[2], F[3], 0, 0, 0, 1};
     pk_homog_step st;
@@ -148,6 +152,8 @@ static int rve_eval(void *ctx, size_t g, const double F[4], double P[4], double 
 static int rve_commit(void *ctx, size_t g)
 {
     pk_fe2_rve *m = ctx;
+    if (g < m->lo || g >= m->hi)
+        return -1;
     return pk_homog_commit(&m->committed[g], &m->trial[g]) == 0 ? 0 : -1;
 }
 
@@ -161,12 +167,23 @@ int pk_fe2_rve_init(pk_fe2_rve *m, const pk_homog_rve *rve, size_t nrve, const p
                     const pk_sparse_solver *solver, size_t ngp, pk_monitor *mon, char *err,
                     size_t errlen)
 {
+    return pk_fe2_rve_init_block(m, rve, nrve, o, solver, ngp, 0, ngp, mon, err, errlen);
+}
+
+int pk_fe2_rve_init_block(pk_fe2_rve *m, const pk_homog_rve *rve, size_t nrve,
+                          const pk_homog_opts *o, const pk_sparse_solver *solver, size_t ngp,
+                          size_t lo, size_t hi, pk_monitor *mon, char *err, size_t errlen)
+{
     memset(m, 0, sizeof *m);
-    if (nrve == 0) {
-        snprintf(err, errlen, "no RVE");
+    if (nrve == 0 || lo > hi || hi > ngp) {
+        if (nrve == 0)
+            snprintf(err, errlen, "no RVE");
+        else
+            snprintf(err, errlen, "Gauss points %zu..%zu of %zu", lo, hi, ngp);
         return -1;
     }
     m->nrve = nrve, m->ngp = ngp, m->rve = rve, m->o = *o, m->solver = solver;
+    m->lo = lo, m->hi = hi;
     m->committed = calloc(ngp ? ngp : 1, sizeof *m->committed);
     m->trial = calloc(ngp ? ngp : 1, sizeof *m->trial);
     m->start = calloc(nrve, sizeof *m->start);
@@ -201,7 +218,7 @@ int pk_fe2_rve_init(pk_fe2_rve *m, const pk_homog_rve *rve, size_t nrve, const p
         }
         for (int I = 0; I < 4; I++)
             m->P0[4 * k + I] = m->start[k].P[EMB[I]];
-        for (size_t g = k; g < ngp; g += nrve)
+        for (size_t g = lo + (k + nrve - lo % nrve) % nrve; g < hi; g += nrve)
             if (pk_homog_state_copy(&m->committed[g], &relaxed) != 0) {
                 snprintf(err, errlen, "out of memory");
                 goto fail;

@@ -31,6 +31,7 @@
 
 typedef struct pk_fe2_rve {
     size_t nrve, ngp;
+    size_t lo, hi;           /* the Gauss points whose states this process holds */
     const pk_homog_rve *rve; /* [nrve], borrowed */
     pk_homog_opts o;         /* the options of every evaluation (serial) */
     const pk_sparse_solver *solver;
@@ -47,6 +48,13 @@ typedef struct pk_fe2_rve {
 int pk_fe2_rve_init(pk_fe2_rve *m, const pk_homog_rve *rve, size_t nrve, const pk_homog_opts *o,
                     const pk_sparse_solver *solver, size_t ngp, pk_monitor *mon, char *err,
                     size_t errlen);
+
+/* The same holding the states of Gauss points [lo, hi) only (an evaluator
+ * of a distributed round, fe2_distribute.h): the others are neither
+ * allocated nor evaluated here (eval and commit refuse them). */
+int pk_fe2_rve_init_block(pk_fe2_rve *m, const pk_homog_rve *rve, size_t nrve,
+                          const pk_homog_opts *o, const pk_sparse_solver *solver, size_t ngp,
+                          size_t lo, size_t hi, pk_monitor *mon, char *err, size_t errlen);
 
 void pk_fe2_rve_free(pk_fe2_rve *m);
 

@@ -26,6 +26,7 @@
 #include "core/base/par.h"
 #include "core/base/progress.h"
 #include "core/base/sparse.h"
+#include "fe2_distribute.h"
 #include "fe2_material.h"
 #include "fe2_mesh.h"
 
@@ -44,6 +45,8 @@ typedef struct pk_fe2_problem {
     const int32_t *fix_dof;         /* [nfix] prescribed degrees of freedom, distinct */
     const pk_sparse_solver *solver; /* factorises K over the free dofs (LDLᵀ) */
     pk_par *par;                    /* Gauss points in parallel (NULL: serial) */
+    /* Gauss points shared with other evaluators (NULL: all evaluated here) */
+    const pk_fe2_distributor *dist;
 } pk_fe2_problem;
 
 typedef struct pk_fe2_newton_opts {
@@ -93,6 +96,7 @@ typedef struct pk_fe2_step_report {
     pk_fe2_iterations parts[32];
     double reaction[2]; /* Σ (f_int − f_ext) over the prescribed dofs, by component
                              (the internal forces when no load acts on them) */
+    size_t rounds;      /* evaluation rounds (every Gauss point once), line searches included */
     char why[256];      /* the reason a step failed */
 } pk_fe2_step_report;
 
@@ -120,5 +124,14 @@ int pk_fe2_step(const pk_fe2_problem *pb, const pk_fe2_newton_opts *o, pk_fe2_st
  * (R = f_int).  0, 1 when a Gauss point failed (why says which), −1 memory. */
 int pk_fe2_residual(const pk_fe2_problem *pb, const double *u, const double *fext, double *R,
                     pk_sparse_sym *K, char *why, size_t whylen);
+
+/* The evaluator's side of a distributed round (fe2_distribute.h): Gauss
+ * points [lo, hi) at u, trials from their committed states, over pb->par
+ * (pb->dist unused) into res[0 .. hi − lo).  0, −1 memory. */
+int pk_fe2_eval_block(const pk_fe2_problem *pb, const double *u, size_t lo, size_t hi,
+                      pk_fe2_gp_result *res, volatile sig_atomic_t *cancel);
+
+/* Commit the last trials of Gauss points [lo, hi).  0, −1 memory. */
+int pk_fe2_commit_block(const pk_fe2_problem *pb, size_t lo, size_t hi);
 
 #endif

@@ -1,6 +1,7 @@
 /* cli.h — the packd subcommands.  main.c only dispatches; each command lives
  * in its own file (cmd_<name>.c) and returns the process exit status:
- *   0 success, 1 invalid input (errors printed), 2 runtime failure, 64 usage. */
+ *   0 success, 1 invalid input (errors printed; also a job or input file that
+ *   cannot be opened), 2 runtime failure, 64 usage. */
 #ifndef PK_CLI_H
 #define PK_CLI_H
 
@@ -25,7 +26,9 @@ void cmd_backup_help(const char *name, FILE *f);
 /* 1 when argv[1..] asks for help (-h or --help before a "--"). */
 int cli_help_requested(int argc, char **argv);
 
-/* Load a JSON file ("-" = stdin); NULL with a message on stderr. */
+/* Load a JSON file ("-" = stdin); NULL with the errors printed (stdout:
+ * JSON, stderr: "packd: cannot open FILE: No such file or directory" or the
+ * JSON's line, column and reason). */
 #include <jansson.h>
 json_t *cli_load_json(const char *path);
 

@@ -5,6 +5,7 @@
 
 #include "cli.h"
 
+#include "api/inputs/input_open.h"
 #include "api/inputs/json_depth.h"
 
 static void print_json(json_t *out)
@@ -14,11 +15,32 @@ static void print_json(json_t *out)
     fflush(stdout);
 }
 
+static void print_errors_json(const char *path, const pk_schema_errors *errs)
+{
+    json_t *out = json_object();
+    json_object_set_new(out, "valid", json_false());
+    json_object_set_new(out, "file", json_string(path));
+    json_object_set_new(out, "errors", pk_schema_errors_json(errs));
+    print_json(out);
+    json_decref(out);
+}
+
 json_t *cli_load_json(const char *path)
 {
     json_error_t e;
-    json_t *j = strcmp(path, "-") == 0 ? json_loadf(stdin, JSON_REJECT_DUPLICATES, &e)
-                                       : json_load_file(path, JSON_REJECT_DUPLICATES, &e);
+    char err[256];
+    FILE *f = strcmp(path, "-") == 0 ? stdin : pk_input_fopen(path, 0, err, sizeof err);
+    if (!f) { /* not the JSON's fault: no line and column, no rule "json" */
+        pk_schema_errors errs = {0};
+        pk_schema_errors_add(&errs, "", "file", "%s", err);
+        print_errors_json(path, &errs);
+        pk_schema_errors_free(&errs);
+        fprintf(stderr, "packd: %s\n", err);
+        return NULL;
+    }
+    json_t *j = json_loadf(f, JSON_REJECT_DUPLICATES, &e);
+    if (f != stdin)
+        fclose(f);
     if (!j) {
         pk_schema_errors errs = {0};
         pk_schema_errors_add(&errs, "", "json", "line %d, column %d: %s", e.line, e.column, e.text);
@@ -38,12 +60,7 @@ json_t *cli_load_json(const char *path)
 
 void cli_print_errors(const char *path, const pk_schema_errors *errs)
 {
-    json_t *out = json_object();
-    json_object_set_new(out, "valid", json_false());
-    json_object_set_new(out, "file", json_string(path));
-    json_object_set_new(out, "errors", pk_schema_errors_json(errs));
-    print_json(out);
-    json_decref(out);
+    print_errors_json(path, errs);
     for (size_t i = 0; i < errs->n; i++)
         fprintf(stderr, "%s: %s: %s (rule %s)\n", path,
                 errs->items[i].pointer[0] ? errs->items[i].pointer : "/", errs->items[i].message,

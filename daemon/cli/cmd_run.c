@@ -8,11 +8,13 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "input_hint.h"
 #include "run_line.h"
 #include "run_summary.h"
 #include "api/picture/picture.h"
 #include "api/process.h"
 #include "api/digest.h"
+#include "api/par/mpi_world.h"
 #include "api/results/result_digest.h"
 #include "api/results/xdmf.h"
 
@@ -65,14 +67,44 @@ static void run_help(FILE *f)
           "  --checkpoint FILE          save/resume the run's state in FILE\n"
           "  --checkpoint-interval S    seconds between checkpoints (default 30)\n"
           "  --author NAME              the result's /h5md/author (default $USER)\n\n"
+          "Under mpirun -np R (or srun --ntasks=R --mpi=pmix) an fe2 job spreads its\n"
+          "Gauss points over the R ranks, rank 0 alone writing and printing (docs/fe2.md);\n"
+          "other processes run on rank 0 alone.\n\n"
           "On a terminal, a live progress line on stderr and a short summary on stdout;\n"
           "otherwise (or with --json) the summary as JSON on stdout, without the time\n"
           "series (they are in the result file).  Exit 0 done, 1 invalid job, 2 error,\n"
           "3 the job failed (partial result written), 64 usage.\n",
           f);
+    fprintf(f, "This packd was built %s MPI.\n", pk_mpi_built() ? "with" : "without");
 }
 
+static int run_job(int argc, char **argv);
+
+/* Launched as R MPI ranks (mpirun -np R, srun): every rank runs this;
+ * rank 0 is `packd run` as ever, the others take part only in the processes
+ * that spread their work over ranks (fe2: api/fe2/fe2_mpi.h) and write and
+ * print nothing on stdout. */
 int cmd_run(int argc, char **argv)
+{
+    char err[400];
+    if (pk_mpi_init(err, sizeof err) != 0) {
+        fprintf(stderr, "packd run: %s\n", err);
+        return 2;
+    }
+    int status = run_job(argc, argv);
+    pk_mpi_finish(status);
+    return status;
+}
+
+/* The processes whose work spreads over MPI ranks (rank 0 runs the others
+ * alone). */
+static int spreads_over_ranks(const json_t *job)
+{
+    const char *id = json_string_value(json_object_get(job, "process"));
+    return id && !strcmp(id, "fe2");
+}
+
+static int run_job(int argc, char **argv)
 {
     const char *job_path = NULL, *out_path = NULL, *xdmf_path = NULL, *pictures_dir = NULL;
     const char *ckpt_path = NULL, *author = getenv("USER");
@@ -136,6 +168,11 @@ int cmd_run(int argc, char **argv)
     json_t *job = cli_load_json(job_path);
     if (!job)
         return 1;
+    const int other_rank = pk_mpi_rank() > 0;
+    if (other_rank && !spreads_over_ranks(job)) {
+        json_decref(job);
+        return 0;
+    }
 
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
@@ -144,13 +181,15 @@ int cmd_run(int argc, char **argv)
     sigaction(SIGTERM, &sa, NULL);
 
     progress_sink sink = {NULL};
+    if (other_rank) /* rank 0 reports the progress */
+        progress_fd = -1;
     if (progress_fd >= 0) {
         sink.out = progress_fd == 2 ? stderr : fdopen(progress_fd, "w");
         if (!sink.out)
             fprintf(stderr, "packd run: --progress-fd %d: %s\n", progress_fd, strerror(errno));
     }
     /* no live line when the JSON lines go to stderr themselves */
-    pk_run_line_init(&sink.line, progress_fd == 2 ? NULL : stderr);
+    pk_run_line_init(&sink.line, progress_fd == 2 || other_rank ? NULL : stderr);
     /* JSON lines every 0.5 s as ever; the live line alone up to 10 times a second */
     pk_monitor mon = {.fn = print_progress,
                       .ctx = &sink,
@@ -164,7 +203,7 @@ int cmd_run(int argc, char **argv)
         .threads = threads, .mon = &mon, .author = author && *author ? author : "packd run"};
     /* a checkpoint resumes only the job (and packd version) that wrote it */
     char digest[65];
-    if (ckpt_path) {
+    if (ckpt_path && !other_rank) {
         char *text = json_dumps(job, JSON_SORT_KEYS | JSON_COMPACT);
         size_t n = text ? strlen(text) : 0;
         char *src = text ? malloc(n + sizeof PACKD_VERSION + 1) : NULL;
@@ -185,8 +224,13 @@ int cmd_run(int argc, char **argv)
     int rc = pk_job_run(job, &run, out_path, &summary, &errs, err, sizeof err);
     pk_run_line_clear(&sink.line);
     int status;
-    if (rc == 1) {
+    if (other_rank) { /* rank 0 reports the job; a rank's own trouble on stderr */
+        if (rc != 0 && rc != 1)
+            fprintf(stderr, "packd run: MPI rank %d: %s\n", pk_mpi_rank(), err);
+        status = rc == 0 || rc == 1 ? rc : 2;
+    } else if (rc == 1) {
         cli_print_errors(job_path, &errs);
+        cli_hint_missing_inputs(stderr, job_path, job, &errs);
         status = 1;
     } else if (rc != 0 && rc != 2) { /* 2: failed, partial file and summary (below) */
         fprintf(stderr, "packd run: %s\n", err);

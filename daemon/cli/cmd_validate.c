@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "input_hint.h"
 #include "api/pack/pack_job.h"
 #include "api/process.h"
 
@@ -23,6 +24,7 @@ int cmd_validate(int argc, char **argv)
     const pk_check_ctx local = {.service = 0}; /* the user's own machine: files are read */
     if (pk_job_parse(job, &local, &proc, &parsed, &errs) != 0) {
         cli_print_errors(argv[1], &errs);
+        cli_hint_missing_inputs(stderr, argv[1], job, &errs);
         rc = 1;
     } else {
         json_t *out = json_pack("{s:b,s:s,s:s}", "valid", 1, "file", argv[1], "process", proc->id);

@@ -1,4 +1,5 @@
 /* run_summary.c — the end of `packd run` (run_summary.h). */
+#include <stdlib.h>
 #include <string.h>
 
 #include "run_line.h"
@@ -15,6 +16,15 @@ void pk_run_summary_drop_series(json_t *summary)
         else if (json_is_object(v))
             pk_run_summary_drop_series(v);
     }
+}
+
+void pk_run_summary_gap_text(double gap, long long pairs_below, char *out, size_t n)
+{
+    snprintf(out, n, "%.9g", gap);
+    /* a violation is below Δd − tol (tol ≈ 1e-12 of the box): only its
+     * exact digits keep it from reading as the bound itself */
+    for (int digits = 10; pairs_below > 0 && digits <= 17 && strtod(out, NULL) != gap; digits++)
+        snprintf(out, n, "%.*g", digits, gap);
 }
 
 static const char *str(const json_t *o, const char *key)
@@ -40,10 +50,12 @@ static void pack_lines(FILE *f, const json_t *s, const char *phi)
                 num(s, "phi_target_mix"));
     else if (json_is_number(json_object_get(s, "phi_resolved")))
         fprintf(f, "  %s %.4f resolved\n", phi, num(s, "phi_resolved"));
-    if (json_is_number(json_object_get(s, "smallest_gap")))
-        fprintf(f, "  gap       smallest %.6g, %lld pairs below the minimum\n",
-                num(s, "smallest_gap"),
-                (long long)json_integer_value(json_object_get(s, "pairs_below_delta_d")));
+    if (json_is_number(json_object_get(s, "smallest_gap"))) {
+        long long below = json_integer_value(json_object_get(s, "pairs_below_delta_d"));
+        char gap[32];
+        pk_run_summary_gap_text(num(s, "smallest_gap"), below, gap, sizeof gap);
+        fprintf(f, "  gap       smallest %s, %lld pairs below the minimum\n", gap, below);
+    }
 }
 
 static void homogenize_lines(FILE *f, const json_t *s)

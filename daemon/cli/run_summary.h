@@ -12,6 +12,12 @@
  * under /observables/ (docs/result-format.md). */
 void pk_run_summary_drop_series(json_t *summary);
 
+/* The smallest gap as the summary prints it: 9 significant digits, and with
+ * pairs below the minimum as many as it takes to read back the exact value,
+ * so a violation never reads as the bound it misses (0.9999996 is never
+ * "1" beside "1 pairs below the minimum"). */
+void pk_run_summary_gap_text(double gap, long long pairs_below, char *out, size_t n);
+
 /* A short human summary: process, status, grains, φ achieved vs target (or
  * the homogenization's steps), wall time, warnings, failure, the output
  * files (xdmf NULL = none written). */

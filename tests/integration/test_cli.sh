@@ -170,4 +170,57 @@ import json; lines=[l for l in open('$T/progress') if l.startswith('{')]
 assert lines, 'no progress'
 for l in lines: d=json.loads(l); assert d['stage']=='rsa' and 0 <= d['fraction'] <= 1
 "
+# 9. `packd --help`: every description starts in one column (on the synopsis's
+#    line after two spaces or more, or alone on the next line under a long one)
+"$PACKD" --help >"$T/help.txt"
+check help_descriptions_aligned python3 -c "
+import re
+lines = [l.rstrip('\\n') for l in open('$T/help.txt') if l.startswith('  ')]
+cols = []
+for l in lines:
+    if l.startswith('  packd '):
+        m = re.search(r'\\S( {2,})\\S', l[2:])
+        if m: cols.append(2 + m.end(1))
+    else:
+        cols.append(len(l) - len(l.lstrip(' ')))
+assert len(cols) >= 12 and len(set(cols)) == 1, sorted(set(cols))
+"
+
+# 10. a file that cannot be opened is said so, in one form, with exit 1: the job
+#     file itself (no JSON line and column), a mesh and an RVE (with the field's
+#     pointer); the homogenize examples' RVE names the pack job that makes it
+SRC=${PACKD_SRC:-$PWD}
+for cmd in validate "run -o x.h5"; do
+    (cd "$T" && "$PACKD" $cmd none.json >"$T/nojob.out" 2>"$T/nojob.err")
+    rc=$?
+    check "missing_job_file_${cmd%% *}" sh -c "test $rc -eq 1 &&
+        test \"\$(cat '$T/nojob.err')\" = 'packd: cannot open none.json: No such file or directory' &&
+        grep -q '\"rule\": \"file\"' '$T/nojob.out' && ! grep -q 'line -1' '$T/nojob.out'"
+done
+sed 's|"file": "tests/data/meshes/cylinder41.msh"|"file": "nope.msh"|' examples/tetfill-cylinder.json >"$T/nomesh.json"
+mkdir "$T/fe2" # alone: no pack job beside it, no hint
+python3 -c "
+import json, sys
+j = json.load(open('$SRC/examples/fe2/block-taylor.json'))
+j['inputs']['micro']['rve'] = {'file': 'rve150.h5'}
+json.dump(j, open('$T/fe2/norve.json', 'w'))"
+expect_missing() { # name, job, pointer, file, hint (or "")
+    for cmd in validate "run -o x.h5"; do
+        (cd "$T" && "$PACKD" $cmd "$2" >"$T/miss.out" 2>"$T/miss.err")
+        rc=$?
+        if [ $rc -eq 1 ] && grep -qx "$2: $3: cannot open $4: No such file or directory (rule [a-z]*)" "$T/miss.err" &&
+            grep -q "\"pointer\": \"$3\"" "$T/miss.out" && { [ -z "$5" ] || grep -qxF "$5" "$T/miss.err"; } &&
+            { [ -n "$5" ] || ! grep -q 'pack job' "$T/miss.err"; }; then
+            pass "missing_${1}_${cmd%% *}"
+        else
+            fail "missing_${1}_${cmd%% *}" "rc $rc: $(cat "$T/miss.err")"
+        fi
+    done
+}
+expect_missing mesh "$T/nomesh.json" /inputs/domain/mesh/file nope.msh ""
+H=$SRC/examples/homogenize
+expect_missing rve "$H/homogenize-periodic-2d.json" /inputs/rve/file rve-2d.h5 \
+    "packd: rve-2d.h5 is the result of a pack job: run $H/rve-rsa-2d.json first: packd run $H/rve-rsa-2d.json -o rve-2d.h5"
+expect_missing fe2_rve "$T/fe2/norve.json" /inputs/micro/rve/file rve150.h5 ""
+
 exit 0

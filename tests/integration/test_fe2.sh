@@ -14,25 +14,7 @@ cd "$T" || exit 1
 python3 - "$T" "$SRC" <<'EOF'
 import json, sys, copy
 t = sys.argv[1]
-job = {"process": "fe2", "inputs": {
-  "mesh": {"rectangle": {"size": [10, 10], "elements": [2, 2]}},
-  "boundary_conditions": [
-    {"name": "left_x", "type": "displacement", "on": "left", "component": "x"},
-    {"name": "bottom_y", "type": "displacement", "on": "bottom", "component": "y"},
-    {"name": "top_y", "type": "displacement", "on": "top", "component": "y"},
-    {"name": "p", "type": "pressure", "on": "right"}],
-  "stages": [
-    {"name": "confine", "increments": 1, "targets": {"p": 0.05}},
-    {"name": "push", "increments": 2, "targets": {"top_y": -0.1}}],
-  "micro": {
-    "rve": {"pack": {"dim": 2, "domain": {"box": {"size": [10, 10], "periodic": True}},
-       "grading": {"type": "classes", "classes": [{"d": 2.0, "volume_percent": 0},
-                   {"d": 1.6, "volume_percent": 60}, {"d": 1.2, "volume_percent": 40}]},
-       "sampling": "discrete", "count": 40, "phi": {"value": 0.5, "refers_to": "resolved"},
-       "algorithm": "rsa", "seed": 7}},
-    "boundary_condition": "taylor", "contact": {"E_n": 50},
-    "initial_state": {"policy": "radius_inflation", "value": 0.3}},
-  "output": {"micro_states": [0, 5]}}}
+job = json.load(open(sys.argv[2] + "/tests/data/fe2/block-small.json"))
 json.dump(job, open(t + "/job.json", "w"))
 json.dump({"inputs": job["inputs"]}, open(t + "/body.json", "w"))
 def bad(name, edit):

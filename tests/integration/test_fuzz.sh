@@ -8,7 +8,8 @@ SRC=${PACKD_SRC:-$(pwd)}
 FB=${FUZZ_BUILD:-$SRC/build-fuzz}
 S=${FUZZ_TEST_SECONDS:-2}
 if [ ! -f "$FB/.fuzzer-ok" ]; then
-    skip fuzz "no libFuzzer build in $FB (clang -fsanitize=fuzzer missing; apt-get install clang libclang-rt-14-dev)"
+    why=$(grep -m1 error "$FB/probe.err" 2>/dev/null)
+    skip fuzz "no libFuzzer build in $FB: ${why:-clang -fsanitize=fuzzer missing} (apt-get install clang libclang-rt-14-dev libomp-14-dev)"
     exit 0
 fi
 T=$(mktemp -d)

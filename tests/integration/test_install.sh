@@ -80,12 +80,12 @@ PACKD_SERVER=$B "$P" fetch "$ID" -o "$T/two.h5" >/dev/null
 check restored_fetch_exit_0 test $? = 0
 check restored_result_same_bytes cmp -s "$T/one.h5" "$T/two.h5"
 
-# 6. install-deps.sh: root, sudo, neither (stubs; nothing is installed)
+# 6. install-deps.sh: root, sudo, sudo that refuses, neither (stubs; nothing is installed)
 stub() { # DIR NAME BODY
     printf '#!/bin/sh\n%s\n' "$3" >"$1/$2"
     chmod +x "$1/$2"
 }
-for case in root sudo neither; do
+for case in root sudo denied neither; do
     d="$T/stub-$case"
     mkdir -p "$d"
     for tool in grep env; do ln -s "$(command -v $tool)" "$d/$tool"; done
@@ -94,9 +94,11 @@ for case in root sudo neither; do
     case $case in root) uid=0 ;; *) uid=1000 ;; esac
     stub "$d" id "echo $uid"
     [ $case = sudo ] && stub "$d" sudo "echo \"sudo \$1\" >>'$T/apt-$case.log'; exec \"\$@\""
+    [ $case = denied ] && stub "$d" sudo "echo 'alice is not in the sudoers file.' >&2; exit 1"
     PATH="$d" /bin/sh "$SRC/deploy/install-deps.sh" >"$T/deps-$case.out" 2>&1
     echo $? >"$T/deps-$case.rc"
 done
 check deps_as_root sh -c "[ \$(cat '$T/deps-root.rc') = 0 ] && grep -q 'apt-get install .* curl' '$T/apt-root.log' && ! grep -q sudo '$T/apt-root.log'"
 check deps_with_sudo sh -c "[ \$(cat '$T/deps-sudo.rc') = 0 ] && grep -q '^sudo env' '$T/apt-sudo.log' && grep -q 'apt-get install .* curl' '$T/apt-sudo.log'"
+check deps_sudo_refused_says_what_to_run sh -c "[ \$(cat '$T/deps-denied.rc') != 0 ] && grep -q 'sudoers' '$T/deps-denied.out' && grep -q \"su -c 'apt-get update && apt-get install -y --no-install-recommends curl'\" '$T/deps-denied.out' && [ ! -e '$T/apt-denied.log' ]"
 check deps_neither_says_what_to_run sh -c "[ \$(cat '$T/deps-neither.rc') != 0 ] && grep -q \"su -c 'apt-get update && apt-get install -y --no-install-recommends curl'\" '$T/deps-neither.out' && ! grep -q 'not found' '$T/deps-neither.out' && [ ! -e '$T/apt-neither.log' ]"

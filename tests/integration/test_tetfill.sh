@@ -121,9 +121,9 @@ check_invalid tetfill_refuses_zero_volume "$T/flat.json" /inputs/domain/mesh mes
 job "$T/nm.json" '{"nodes": [[0,0,0],[1,0,0],[0,1,0],[0,0,1],[0,0,-1],[1,1,-1]], "tets": [[0,1,2,3],[0,1,2,4],[0,1,2,5]]}'
 check_invalid tetfill_refuses_non_manifold "$T/nm.json" /inputs/domain/mesh mesh "non-manifold mesh"
 job "$T/big.json" "{\"file\": \"$M/cube41.msh\"}" '{"ratio": 3, "max_tets": 100}'
-check_invalid tetfill_refuses_large_mesh "$T/big.json" /inputs/domain/mesh mesh "over the limit"
+check_invalid tetfill_refuses_large_mesh "$T/big.json" /inputs/domain/mesh/file mesh "over the limit"
 job "$T/miss.json" "{\"file\": \"$T/none.msh\"}"
-check_invalid tetfill_missing_file "$T/miss.json" /inputs/domain/mesh mesh "cannot open"
+check_invalid tetfill_missing_file "$T/miss.json" /inputs/domain/mesh/file mesh "cannot open $T/none.msh: No such file or directory"
 cat >"$T/rsa.json" <<JOB
 {"process": "pack", "inputs": {"dim": 3, "domain": {"mesh": {"file": "$M/cube41.msh"}},
  "grading": {"type": "fuller", "q": 0.5, "d_max": 2}, "d_min": 1, "count": 10}}

@@ -99,7 +99,7 @@ static void test_quadratic_taylor(void)
     CHECK(pk_fe2_rve_init(&fr, &rve, 1, &o, &pk_sparse_cholmod, pk_fe2_gauss_count(&b.m), NULL, err,
                           sizeof err) == 0);
     pk_fe2_material mat = pk_fe2_rve_material(&fr);
-    pk_fe2_problem pb = {&b.m, &mat, b.nfix, b.fix, &pk_sparse_cholmod, NULL};
+    pk_fe2_problem pb = {&b.m, &mat, b.nfix, b.fix, &pk_sparse_cholmod, NULL, NULL};
     pk_fe2_state s;
     pk_fe2_step_report r1, r2;
     block_run(&b, &pb, &s, 0.01, &r1, &r2);
@@ -155,7 +155,7 @@ static void test_pool_bits(void)
         CHECK(pk_fe2_rve_init(&fr, rve, 2, &o, &pk_sparse_cholmod, pk_fe2_gauss_count(&b.m), NULL,
                               err, sizeof err) == 0);
         pk_fe2_material mat = pk_fe2_rve_material(&fr);
-        pk_fe2_problem pb = {&b.m, &mat, b.nfix, b.fix, &pk_sparse_cholmod, par};
+        pk_fe2_problem pb = {&b.m, &mat, b.nfix, b.fix, &pk_sparse_cholmod, par, NULL};
         block_run(&b, &pb, &s[run], 0.005, &r1[run], &r2[run]);
         if (run)
             print_parts("push", &r2[run]);
@@ -232,7 +232,7 @@ static void test_step_cutting(void)
         picky pk;
         picky_init(&pk, run ? 0.012 : 1.0); /* run 1: fails above 1.2 % */
         pk_fe2_material mat = {"picky", &pk, picky_eval, picky_commit};
-        pk_fe2_problem pb = {&b.m, &mat, b.nfix, b.fix, &pk_sparse_cholmod, NULL};
+        pk_fe2_problem pb = {&b.m, &mat, b.nfix, b.fix, &pk_sparse_cholmod, NULL, NULL};
         CHECK(pk_fe2_state_init(&s[run], &b.m) == 0);
         pk_fe2_newton_opts o = newton_opts();
         int rc = pk_fe2_step(&pb, &o, &s[run], uD, fz, &rep[run], NULL);
@@ -256,7 +256,7 @@ static void test_step_cutting(void)
     picky pk;
     picky_init(&pk, 0.012);
     pk_fe2_material mat = {"picky", &pk, picky_eval, picky_commit};
-    pk_fe2_problem pb = {&b.m, &mat, b.nfix, b.fix, &pk_sparse_cholmod, NULL};
+    pk_fe2_problem pb = {&b.m, &mat, b.nfix, b.fix, &pk_sparse_cholmod, NULL, NULL};
     pk_fe2_state s0;
     CHECK(pk_fe2_state_init(&s0, &b.m) == 0);
     pk_fe2_newton_opts o = newton_opts();
@@ -306,7 +306,7 @@ static void test_line_search(void)
     block_make(&b, 0.05);
     double beta = 1e6;
     pk_fe2_material mat = {"hardening", &beta, hard_eval, hard_commit};
-    pk_fe2_problem pb = {&b.m, &mat, b.nfix, b.fix, &pk_sparse_cholmod, NULL};
+    pk_fe2_problem pb = {&b.m, &mat, b.nfix, b.fix, &pk_sparse_cholmod, NULL, NULL};
     pk_fe2_state s[2];
     pk_fe2_step_report rep[2];
     double uD[32] = {0};
@@ -341,7 +341,7 @@ static void test_cancel(void)
     block_make(&b, 0.01);
     pk_fe2_linear_elastic le = {.lambda = 1, .mu = 1};
     pk_fe2_material mat = pk_fe2_linear_elastic_material(&le);
-    pk_fe2_problem pb = {&b.m, &mat, b.nfix, b.fix, &pk_sparse_cholmod, NULL};
+    pk_fe2_problem pb = {&b.m, &mat, b.nfix, b.fix, &pk_sparse_cholmod, NULL, NULL};
     volatile sig_atomic_t flag = 1;
     pk_monitor mon = {.cancel = &flag, .interval_s = 0.5};
     pk_fe2_state s;

@@ -70,7 +70,7 @@ static void patch_displacement(pk_fe2_mesh *m, const char *name)
     pk_fe2_material mat = pk_fe2_linear_elastic_material(&le);
     int32_t *fix = malloc(2 * m->nnode * sizeof *fix);
     size_t nfix = fix_boundary(m, fix);
-    pk_fe2_problem pb = {m, &mat, nfix, fix, &pk_sparse_cholmod, NULL};
+    pk_fe2_problem pb = {m, &mat, nfix, fix, &pk_sparse_cholmod, NULL, NULL};
     double *uD = malloc(nfix * sizeof *uD), *fz = calloc(2 * m->nnode, sizeof *fz);
     for (size_t k = 0; k < nfix; k++) {
         const double *X = &m->xy[2 * (size_t)(fix[k] / 2)];
@@ -155,7 +155,7 @@ static void patch_traction(pk_fe2_mesh *m, const char *name)
                 if (next)
                     pk_fe2_edge_traction(m, right[i], right[j], t, f);
             }
-    pk_fe2_problem pb = {m, &mat, nfix, fix, &pk_sparse_cholmod, NULL};
+    pk_fe2_problem pb = {m, &mat, nfix, fix, &pk_sparse_cholmod, NULL, NULL};
     pk_fe2_state s;
     CHECK(pk_fe2_state_init(&s, m) == 0);
     pk_fe2_newton_opts o = newton_opts();
@@ -236,7 +236,7 @@ static void test_fields(void)
         size_t nfix = 0;
         for (size_t d = 0; d < 2 * m.nnode; d++)
             fix[nfix++] = (int32_t)d;
-        pk_fe2_problem pb = {&m, &mat, nfix, fix, &pk_sparse_cholmod, NULL};
+        pk_fe2_problem pb = {&m, &mat, nfix, fix, &pk_sparse_cholmod, NULL, NULL};
         pk_fe2_newton_opts o = newton_opts();
         pk_fe2_step_report rep;
         double fz[32] = {0};

@@ -63,7 +63,7 @@ static void test_tangent_surrogate(void)
             mesh_q1_distorted(&m);
         else
             mesh_triangles(&m, 0);
-        pk_fe2_problem pb = {&m, &mat, 0, NULL, &pk_sparse_cholmod, NULL};
+        pk_fe2_problem pb = {&m, &mat, 0, NULL, &pk_sparse_cholmod, NULL, NULL};
         double e = fd_error(&pb, 0.05, 1e-6, 3);
         CHECK_MSG(e < 1e-8, "%s: FD error %g", which ? "triangles" : "Q1", e);
         printf("  surrogate %-9s FD rel. error %.1e\n", which ? "triangles" : "Q1", e);
@@ -96,7 +96,7 @@ static void test_tangent_rve(void)
                                      NULL, err, sizeof err);
             CHECK_MSG(rc == 0, "%s", err);
             pk_fe2_material mat = pk_fe2_rve_material(&fr);
-            pk_fe2_problem pb = {&m, &mat, 0, NULL, &pk_sparse_cholmod, NULL};
+            pk_fe2_problem pb = {&m, &mat, 0, NULL, &pk_sparse_cholmod, NULL, NULL};
             double e = fd_error(&pb, 2e-3, 1e-6, 5);
             CHECK_MSG(e < 1e-6, "%s %s: FD error %g", pk_homog_bc_name((pk_homog_bc)bc),
                       which ? "triangles" : "Q1", e);
@@ -136,7 +136,7 @@ static void test_one_gauss_point(void)
         double uD[6], fz[6] = {0};
         for (int k = 0; k < 6; k++)
             uD[k] = H[2 * (k % 2)] * xy[2 * (k / 2)] + H[2 * (k % 2) + 1] * xy[2 * (k / 2) + 1];
-        pk_fe2_problem pb = {&m, &mat, 6, fix, &pk_sparse_cholmod, NULL};
+        pk_fe2_problem pb = {&m, &mat, 6, fix, &pk_sparse_cholmod, NULL, NULL};
         pk_fe2_state s;
         CHECK(pk_fe2_state_init(&s, &m) == 0);
         pk_fe2_newton_opts no = newton_opts();
