@@ -1,18 +1,28 @@
 /* bench/edmd_jam — "until jammed" criteria side by side.  One
  * machine-readable line per case:
  *   bench=edmd_jam case=NAME mode=M n=N phi=F p=P criterion=C events=E
- *         cpu_s=T z=Z rattlers=R tol=TOL kinetic_ratio=K growth_changes=G
+ *         cpu_s=T z=Z rattlers=R tol=TOL certified=yes|no kinetic_ratio=K
+ *         growth_changes=G
  * Modes: default (pressure stop at 10^12, rate × 0.1 past p = 10^3), const
  * (pressure stop, one rate), dphi (Meier's Δφ < 10^-9 over N events, one
  * rate), stall (Titscher's stall, 10^-12 over max(1000, N) events, one rate),
  * lift_dphi (the former default: the lift rule and the Δφ stop), meier (Eq. 9,
- * no rescaling, Δφ stop: Meier's protocol).  z: mean contact number of the
- * non-rattlers at pk_contact_tolerance(dim, p).  Cases: 3D monodisperse
+ * no rescaling, Δφ stop: Meier's protocol), rf<f> (the default with
+ * jamming.rate_factor f), grow060 (to φ = 0.60, the yardstick).  z, rattlers,
+ * tol: of the certificate (pk_jam_certify: the pressure's tolerance, or the
+ * ladder's step at which the backbone was rigid).  Cases: 3D monodisperse
  * N = 10^4 (γ = 0.02) and Fuller-like diameters 1–16 (counts ∝ d^-2.5,
  * γ = 0.03), both from the jobs' RSA start at φ = 0.30; 2D Meier A32 and
  * quartz (nop = 1000, γ = 0.02, zero start).  PACKD_BENCH_CASE=TEXT runs the
  * cases whose "case/mode" contains TEXT; the default modes of the 10^4
- * cases take minutes each. */
+ * cases take minutes each.  certified: pk_jam_certify's verdict.
+ * PACKD_BENCH_RATIO=MODE (empty: default) runs issue 37's grading instead:
+ * the two 10^4 cases jammed in MODE and grown to φ = 0.60 (mode grow060),
+ * alternating, PACKD_BENCH_REPS times, one line each:
+ *   bench=edmd_jam_ratio case=NAME mode=M n=N jam_cpu_s=T grow060_cpu_s=G
+ *         ratio=T/G phi=F z=Z rattlers=R certified=yes|no
+ * PACKD_BENCH_N=n (PACKD_BENCH_MODE=m, PACKD_BENCH_RATE=γ, default 0.02): one
+ * run of n ≤ 10^4 equal spheres, for protocol trials (docs/perf/edmd.md). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,6 +31,8 @@
 
 #include "core/edmd/edmd.h"
 #include "core/edmd/edmd_contacts.h"
+#include "core/edmd/edmd_rigidity.h"
+#include "api/solver/sparse_cholmod.h"
 #include "core/rsa/rsa.h"
 
 static double cpu_s(void)
@@ -43,6 +55,15 @@ static void set_mode(pk_edmd_params *prm, const char *mode)
 {
     if (strcmp(mode, "default") == 0)
         return;
+    if (strncmp(mode, "rf", 2) == 0) { /* rf<factor>: the default with another rate factor */
+        prm->jam_rate_factor = atof(mode + 2);
+        return;
+    }
+    if (strcmp(mode, "grow060") == 0) { /* the yardstick: grow to φ = 0.60 */
+        prm->until = PK_EDMD_UNTIL_TARGET;
+        prm->phi_target = 0.60;
+        return;
+    }
     prm->jam_rate_factor = 1;
     if (strcmp(mode, "dphi") == 0 || strcmp(mode, "lift_dphi") == 0 || strcmp(mode, "meier") == 0)
         prm->dphi_crit = 1e-9;
@@ -58,11 +79,17 @@ static void set_mode(pk_edmd_params *prm, const char *mode)
 
 /* radii r (n) in a periodic box filled to φ = 0.5 at those radii; from an
  * RSA start at φ = rsa_phi (> 0) or from zero radii */
-static void run(const char *name, const char *mode, int dim, const double *r, size_t n, double rate,
-                double rsa_phi)
+typedef struct result {
+    double cpu, phi, z, rattlers;
+    int certified;
+} result;
+
+static result run(const char *name, const char *mode, int dim, const double *r, size_t n,
+                  double rate, double rsa_phi)
 {
+    result res = {0};
     if (!wanted(name, mode))
-        return;
+        return res;
     double vol = 0;
     for (size_t i = 0; i < n; i++)
         vol += pk_ball_measure(dim, r[i]);
@@ -99,18 +126,61 @@ static void run(const char *name, const char *mode, int dim, const double *r, si
     }
     pk_edmd_stats st;
     pk_edmd_run(&b, &p, &prm, NULL, &st);
-    double cpu = cpu_s() - c0;
     double tol = pk_contact_tolerance(dim, st.pressure);
-    pk_contact_stats cs;
-    pk_contact_stats_compute(&b, &p, 0, tol, &cs);
+    pk_contact_stats cs = {0};
+    pk_rigidity rg = {0};
+    if (prm.until == PK_EDMD_UNTIL_JAMMED)
+        pk_jam_certify(&b, &p, 0, 0, tol, &pk_sparse_cholmod, &cs, &rg, &tol);
+    res = (result){.cpu = cpu_s() - c0, /* the certificate included */
+                   .phi = st.phi,
+                   .z = cs.mean_contacts,
+                   .rattlers = cs.rattler_fraction,
+                   .certified = rg.rigid};
     printf(
         "bench=edmd_jam case=%s mode=%s n=%zu phi=%.5f p=%.3g criterion=%s events=%llu cpu_s=%.2f "
-        "z=%.3f rattlers=%.4f tol=%.2g kinetic_ratio=%.3g growth_changes=%llu\n",
+        "z=%.3f rattlers=%.4f tol=%.2g certified=%s kinetic_ratio=%.3g growth_changes=%llu\n",
         name, mode, n, st.phi, st.pressure, pk_edmd_criterion_name(st.criterion),
-        (unsigned long long)st.events, cpu, cs.mean_contacts, cs.rattler_fraction, tol,
-        st.kinetic_ratio, (unsigned long long)st.growth_changes);
+        (unsigned long long)st.events, res.cpu, cs.mean_contacts, cs.rattler_fraction, tol,
+        res.certified ? "yes" : "no", st.kinetic_ratio, (unsigned long long)st.growth_changes);
     fflush(stdout);
     pk_particles_free(&p);
+    return res;
+}
+
+/* The median of x[0..n) (sorted in place). */
+static double median(double *x, int n)
+{
+    for (int a = 1; a < n; a++)
+        for (int c = a; c > 0 && x[c] < x[c - 1]; c--) {
+            const double t = x[c];
+            x[c] = x[c - 1];
+            x[c - 1] = t;
+        }
+    return x[n / 2];
+}
+
+/* Issue 37's grading without the anchor: the jam's CPU time over the time
+ * of growing the same grains to φ = 0.60, alternating the two (a loaded
+ * machine), each `reps` times; one line with the medians' ratio. */
+static void ratio(const char *name, const char *mode, const double *r, size_t n, double rate,
+                  int reps)
+{
+    if (!wanted(name, mode))
+        return;
+    double jam[8] = {0}, grow[8] = {0};
+    result last = {0};
+    reps = reps > 8 ? 8 : reps < 1 ? 1 : reps;
+    for (int k = 0; k < reps; k++) {
+        grow[k] = run(name, "grow060", 3, r, n, rate, 0.30).cpu;
+        last = run(name, mode, 3, r, n, rate, 0.30);
+        jam[k] = last.cpu;
+    }
+    const double j = median(jam, reps), g = median(grow, reps);
+    printf("bench=edmd_jam_ratio case=%s mode=%s n=%zu jam_cpu_s=%.2f grow060_cpu_s=%.2f "
+           "ratio=%.1f phi=%.5f z=%.3f rattlers=%.4f certified=%s\n",
+           name, mode, n, j, g, j / g, last.phi, last.z, last.rattlers,
+           last.certified ? "yes" : "no");
+    fflush(stdout);
 }
 
 /* Meier 2007 Tables I/II column IV: counts per class of nop = 1000 */
@@ -127,18 +197,34 @@ int main(void)
 {
     static const char *modes[] = {"default", "const", "dphi", "stall", "lift_dphi", "meier"};
     enum { N = 10000 };
-    static double r[N];
+    static double r[N], rf[N];
     for (size_t i = 0; i < N; i++)
         r[i] = 0.5;
-    for (int m = 0; m < 5; m++)
-        run("mono3d_1e4_rate0.02", modes[m], 3, r, N, 0.02, 0.30);
     const double a = 1.5, lo = 1, hi = pow(16, -a);
     for (size_t i = 0; i < N; i++) {
         double u = ((double)i + 0.5) / (double)N;
-        r[N - 1 - i] = 0.5 * pow(lo - u * (lo - hi), -1 / a);
+        rf[N - 1 - i] = 0.5 * pow(lo - u * (lo - hi), -1 / a);
+    }
+    const char *nn = getenv("PACKD_BENCH_N"); /* equal spheres, N given: protocol trials */
+    if (nn) {
+        const size_t n = (size_t)atol(nn);
+        const char *m = getenv("PACKD_BENCH_MODE");
+        const char *g = getenv("PACKD_BENCH_RATE");
+        run("mono3d", m ? m : "default", 3, r, n < N ? n : N, g ? atof(g) : 0.02, 0.30);
+        return 0;
+    }
+    const char *rmode = getenv("PACKD_BENCH_RATIO"); /* issue 37's two cases only */
+    if (rmode) {
+        const char *reps = getenv("PACKD_BENCH_REPS");
+        const int k = reps ? atoi(reps) : 1;
+        ratio("mono3d_1e4_rate0.02", *rmode ? rmode : "default", r, N, 0.02, k);
+        ratio("fuller3d_d1to16_1e4_rate0.03", *rmode ? rmode : "default", rf, N, 0.03, k);
+        return 0;
     }
     for (int m = 0; m < 5; m++)
-        run("fuller3d_d1to16_1e4_rate0.03", modes[m], 3, r, N, 0.03, 0.30);
+        run("mono3d_1e4_rate0.02", modes[m], 3, r, N, 0.02, 0.30);
+    for (int m = 0; m < 5; m++)
+        run("fuller3d_d1to16_1e4_rate0.03", modes[m], 3, rf, N, 0.03, 0.30);
     static const double a32_d[] = {16, 8, 4, 2, 1};
     static const int a32_n[] = {8, 21, 53, 127, 791};
     static const double qz_d[] = {0.25, 0.16, 0.125, 0.1, 0.063, 0.05};

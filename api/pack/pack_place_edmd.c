@@ -9,8 +9,10 @@
 #include "core/edmd/edmd.h"
 #include "edmd_checkpoint_h5.h"
 #include "core/edmd/edmd_contacts.h"
+#include "core/edmd/edmd_rigidity.h"
 #include "core/edmd/edmd_walls.h"
 #include "pack_placer.h"
+#include "api/solver/sparse_cholmod.h"
 
 static void preset(void *dst) { pk_edmd_params_default(&((pk_edmd_options *)dst)->prm); }
 
@@ -158,6 +160,36 @@ static int save_ckpt(const pk_edmd_snapshot *snap, void *ctx)
     return pk_edmd_ckpt_save(f->path, f->digest, snap, f->err, sizeof f->err);
 }
 
+/* Why a packing that met its stop criterion is not certified jammed. */
+static void not_rigid_warning(const pk_rigidity *rg, const pk_edmd_stats *es, double ctol,
+                              char *buf, size_t len)
+{
+    if (rg->backbone == 0)
+        snprintf(buf, len,
+                 "EDMD stopped on %s at reduced pressure %.3g, but no grain has dim + 1 contacts "
+                 "at tolerance %.3g: no rigid backbone, the packing (phi %.6f) is not jammed; "
+                 "lower growth_rate or jamming.rate_factor",
+                 pk_edmd_criterion_name(es->criterion), es->pressure, ctol, es->phi);
+    else if (!rg->tested)
+        snprintf(buf, len,
+                 "EDMD stopped on %s at reduced pressure %.3g, but the backbone of %zu grains has "
+                 "%zu contacts, below the %zu a rigid one needs (Maxwell count, tolerance %.3g): "
+                 "the packing (phi %.6f) is not jammed",
+                 pk_edmd_criterion_name(es->criterion), es->pressure, rg->backbone, rg->contacts,
+                 rg->maxwell_min, ctol, es->phi);
+    else
+        snprintf(buf, len,
+                 "EDMD stopped on %s at reduced pressure %.3g, but the backbone of %zu grains "
+                 "(%zu contacts, Maxwell count %zu) has %zu floppy modes: the packing (phi %.6f) "
+                 "is not jammed",
+                 pk_edmd_criterion_name(es->criterion), es->pressure, rg->backbone, rg->contacts,
+                 rg->maxwell_min, rg->floppy, es->phi);
+    const size_t used = strlen(buf);
+    if (used < len && ctol < PK_JAM_TOL_MAX)
+        snprintf(buf + used, len - used, " (nor rigid at any contact tolerance up to %g)",
+                 PK_JAM_TOL_MAX);
+}
+
 static json_t *doubles(const double *a, size_t n)
 {
     json_t *arr = json_array();
@@ -268,46 +300,39 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
      * packing is kept, audited at the Δd reached and says so */
     const int dd_short =
         prm.growth == PK_EDMD_GROW_SHELL && es.delta_d < job->delta_d * (1 - 1e-12);
-    pk_contact_stats cs;
-    /* contact: gap within tol·(r_i + r_j) of Δd, tol from the final
-     * reduced pressure (pk_contact_tolerance) */
-    double ctol = pk_contact_tolerance(job->box.dim, es.pressure);
-    if (pk_contact_stats_compute(&job->box, p, es.delta_d, ctol, &cs) != 0) {
-        snprintf(err, errlen, "out of memory in the contact analysis");
-        return -1;
-    }
     *st = (pk_place_stats){.reason = es.reason,
+                           .termination = pk_edmd_criterion_name(es.criterion),
+                           .phi_own = prm.until == PK_EDMD_UNTIL_JAMMED &&
+                               prm.growth == PK_EDMD_GROW_RELATIVE,
                            .placed = p->n,
                            .requested = sz->n,
                            .seconds = es.seconds,
                            .walls_touch = w > 0};
+    /* until jammed: the contact network, certified (core/edmd/edmd_rigidity.h) */
+    pk_contact_stats cs = {0};
+    pk_rigidity rg = {0};
+    double ctol = pk_contact_tolerance(job->box.dim, es.pressure);
+    if (prm.until == PK_EDMD_UNTIL_JAMMED &&
+        pk_jam_certify(&job->box, p, es.delta_d, fmax(0.5 * es.delta_d - w, 0), ctol,
+                       &pk_sparse_cholmod, &cs, &rg, &ctol) != 0) {
+        snprintf(err, errlen, "out of memory in the contact analysis");
+        return -1;
+    }
     if (prm.until == PK_EDMD_UNTIL_JAMMED) {
-        /* "jammed" when the pressure test held, or the Δφ test the job
-         * chose; a stall below the pressure target, or max_events, is said */
-        int jam_ok = es.criterion == PK_EDMD_CRIT_PRESSURE ||
+        /* a stop criterion of jamming held (the pressure, or the Δφ test the
+         * job chose), and the backbone is rigid: "jammed"; else said */
+        const int stop_ok = es.criterion == PK_EDMD_CRIT_PRESSURE ||
             es.criterion == PK_EDMD_CRIT_DELTA_PHI ||
             (es.criterion == PK_EDMD_CRIT_STALL && es.pressure >= prm.p_max);
-        if (!jam_ok &&
+        if (!stop_ok &&
             (es.criterion == PK_EDMD_CRIT_STALL || es.criterion == PK_EDMD_CRIT_MAX_EVENTS))
             snprintf(st->warning, sizeof st->warning,
                      "EDMD stopped on %s at reduced pressure %.3g, below "
                      "jamming.reduced_pressure %.3g: the packing (phi %.6f) is not proven jammed",
                      pk_edmd_criterion_name(es.criterion), es.pressure, prm.p_max, es.phi);
-        int periodic = 1; /* (contacts with walls are not counted: walled boxes are exempt) */
-        for (int k = 0; k < job->box.dim; k++)
-            periodic &= job->box.periodic[k];
-        if (jam_ok && periodic && p->n > 1 && cs.rattlers == p->n) {
-            /* caged fines can carry the pressure with no rigid backbone (3D
-             * diameters 1–16 at one rate γ = 0.03: p 10^12, every grain a
-             * rattler; with rate_factor 0.1 an isostatic backbone) */
-            jam_ok = 0;
-            snprintf(st->warning, sizeof st->warning,
-                     "EDMD reached reduced pressure %.3g but no grain has dim + 1 contacts at "
-                     "tolerance %.3g (no rigid backbone, phi %.6f): lower growth_rate or "
-                     "jamming.rate_factor",
-                     es.pressure, ctol, es.phi);
-        }
-        st->goal_reached = jam_ok && es.reason == PK_STOP_JAMMED;
+        else if (stop_ok && !rg.rigid)
+            not_rigid_warning(&rg, &es, ctol, st->warning, sizeof st->warning);
+        st->goal_reached = stop_ok && rg.rigid && es.reason == PK_STOP_JAMMED;
     }
     if (dd_short) {
         st->short_delta_d = 1;
@@ -365,11 +390,22 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     json_object_set_new(obs, "overlaps_predicted", json_integer((json_int_t)es.overlaps));
     json_object_set_new(obs, "collisions_per_second",
                         json_real(es.seconds > 0 ? (double)es.pair / es.seconds : 0));
-    json_object_set_new(obs, "contacts", json_integer((json_int_t)cs.contacts));
-    json_object_set_new(obs, "mean_contact_number", json_real(cs.mean_contacts));
-    json_object_set_new(obs, "rattlers", json_integer((json_int_t)cs.rattlers));
-    json_object_set_new(obs, "rattler_fraction", json_real(cs.rattler_fraction));
-    json_object_set_new(obs, "contact_tolerance", json_real(ctol));
+    if (prm.until == PK_EDMD_UNTIL_JAMMED) { /* a contact network only where one was tested */
+        json_object_set_new(obs, "contacts", json_integer((json_int_t)cs.contacts));
+        json_object_set_new(obs, "wall_contacts", json_integer((json_int_t)cs.wall_contacts));
+        json_object_set_new(obs, "rattlers", json_integer((json_int_t)cs.rattlers));
+        json_object_set_new(obs, "contact_tolerance", json_real(ctol));
+        json_object_set_new(obs, "backbone", json_integer((json_int_t)rg.backbone));
+        json_object_set_new(obs, "backbone_contacts", json_integer((json_int_t)rg.contacts));
+        json_object_set_new(obs, "maxwell_contacts", json_integer((json_int_t)rg.maxwell_min));
+        json_object_set_new(obs, "backbone_rigid", json_boolean(rg.rigid));
+        if (rg.tested)
+            json_object_set_new(obs, "floppy_modes", json_integer((json_int_t)rg.floppy));
+        if (rg.backbone) {
+            json_object_set_new(obs, "mean_contact_number", json_real(cs.mean_contacts));
+            json_object_set_new(obs, "rattler_fraction", json_real(cs.rattler_fraction));
+        }
+    }
     json_t *h = json_object();
     json_object_set_new(h, "events", doubles(es.hist_events, es.nhist));
     json_object_set_new(h, "time", doubles(es.hist_t, es.nhist));

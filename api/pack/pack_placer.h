@@ -24,6 +24,11 @@ struct pk_h5;
 
 typedef struct pk_place_stats {
     pk_stop_reason reason;
+    const char *termination; /* the placer's name of the criterion that stopped it (edmd:
+                              * pressure, delta_phi, stall, target, …), or NULL: the
+                              * reason's name (pk_stop_reason_name) */
+    int phi_own;             /* 1: the grains grew to a φ of their own (edmd relative growth
+                              * until jammed): no φ target and no φ of the mix exist */
     size_t placed, requested;
     double seconds;
     json_t *obs; /* algorithm-specific observables (new reference) or NULL */
@@ -90,6 +95,9 @@ typedef struct pk_placer {
 void pk_pack_verdict(const pk_pack_job *job, const pk_pack_plan *plan, const pk_place_stats *st,
                      const pk_particles *p, const pk_gap_report *gap, double phi, double delta_d,
                      json_t *summary);
+
+/* What stopped the placer: st->termination, else the reason's name. */
+const char *pk_place_termination(const pk_place_stats *st);
 
 /* The i-th placer of the table (from 0; NULL past the last): the built-in
  * ones (pack_placers.c), then the registered ones. */

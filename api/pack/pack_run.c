@@ -316,14 +316,16 @@ int pk_pack_run(const void *task, const pk_run_ctx *run, const char *job_json, c
     const double phi = pk_particles_solid_measure(&p) / V;
     json_t *o = json_object();
     pk_obs_set(o, "algorithm", json_string(job.algorithm));
-    pk_obs_set(o, "termination_reason", json_string(pk_stop_reason_name(st.reason)));
+    pk_obs_set(o, "termination_reason", json_string(pk_place_termination(&st)));
     pk_obs_set(o, "count_requested", json_integer((json_int_t)st.requested));
     pk_obs_set(o, "count_placed", json_integer((json_int_t)st.placed));
     pk_obs_set(o, "count_expected", json_real(plan.expected_n));
     pk_obs_set(o, "phi_resolved", json_real(phi));
-    pk_obs_set(o, "phi_mix", json_real(phi / (1 - plan.mass_cut)));
-    pk_obs_set(o, "phi_target_resolved", json_real(plan.phi_resolved));
-    pk_obs_set(o, "phi_target_mix", json_real(plan.phi_mix));
+    if (!st.phi_own) { /* grown until jammed: φ is the packing's own, no target or mix */
+        pk_obs_set(o, "phi_mix", json_real(phi / (1 - plan.mass_cut)));
+        pk_obs_set(o, "phi_target_resolved", json_real(plan.phi_resolved));
+        pk_obs_set(o, "phi_target_mix", json_real(plan.phi_mix));
+    }
     pk_obs_set(o, "mass_cut_fraction", json_real(plan.mass_cut));
     pk_obs_set(o, "d_min", json_real(job.d_min));
     pk_obs_set(o, "delta_d", json_real(job.delta_d));

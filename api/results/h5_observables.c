@@ -56,7 +56,7 @@ int pk_h5_obs_rows(pk_h5 *h, const pk_unit_row *rows, json_t *values, const pk_u
             pk_h5_obs_double(h, rows->name, json_number_value(v), unit);
         else if (json_is_string(v))
             pk_h5_obs_string(h, rows->name, json_string_value(v));
-        else
+        else if (v) /* absent: not defined for this run (e.g. no φ target when jammed) */
             rc = -1;
     }
     return rc ? -1 : 0;

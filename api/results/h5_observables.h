@@ -26,7 +26,8 @@ int pk_obs_set(json_t *values, const char *name, json_t *v);
 /* Each row of rows (ending with {NULL}) with its value in values as
  * /observables/<name>: a real → float64 with the row's unit in u, an integer
  * → int64 (float64 when it has a unit), a string → a string.  A row without
- * a value is an error: the summary and the file would differ.  0 or -1. */
+ * a value is not written (not defined for this run: no φ target for a packing
+ * grown until jammed); a value of another type is an error.  0 or -1. */
 int pk_h5_obs_rows(pk_h5 *h, const pk_unit_row *rows, json_t *values, const pk_units *u);
 
 /* The row of name in rows, or NULL. */

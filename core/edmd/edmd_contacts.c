@@ -3,8 +3,8 @@
 #include "edmd_contacts.h"
 
 #include <math.h>
-#include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "core/space/grid.h"
 
@@ -19,46 +19,98 @@ typedef struct cctx {
     const pk_particles *p;
     size_t self;
     double delta_d, tol;
-    int32_t *pi, *pj;
-    size_t n, cap;
+    pk_contact_network net;
+    size_t cap;
     int failed;
 } cctx;
 
-static int visit(size_t j, const double dx[PK_MAXDIM], double dist2, void *ctx)
+static int grow_pairs(cctx *c)
 {
-    (void)dx;
-    cctx *c = ctx;
-    if (j <= c->self)
-        return 0;
-    double R = c->p->r[c->self] + c->p->r[j];
-    if (sqrt(dist2) - R > c->delta_d + c->tol * R)
-        return 0;
-    if (c->n == c->cap) {
-        size_t cap = c->cap ? 2 * c->cap : 1024;
-        int32_t *a = realloc(c->pi, cap * sizeof *a);
-        if (!a) {
-            c->failed = 1;
-            return 1;
-        }
-        c->pi = a;
-        int32_t *b = realloc(c->pj, cap * sizeof *b);
-        if (!b) {
-            c->failed = 1;
-            return 1;
-        }
-        c->pj = b;
-        c->cap = cap;
-    }
-    c->pi[c->n] = (int32_t)c->self;
-    c->pj[c->n] = (int32_t)j;
-    c->n++;
+    size_t cap = c->cap ? 2 * c->cap : 1024;
+    int32_t *a = realloc(c->net.pi, cap * sizeof *a);
+    if (!a)
+        return -1;
+    c->net.pi = a;
+    int32_t *b = realloc(c->net.pj, cap * sizeof *b);
+    if (!b)
+        return -1;
+    c->net.pj = b;
+    double *nr = realloc(c->net.normal, 3 * cap * sizeof *nr);
+    if (!nr)
+        return -1;
+    c->net.normal = nr;
+    c->cap = cap;
     return 0;
 }
 
-int pk_contact_stats_compute(const pk_box *b, const pk_particles *p, double delta_d, double tol,
-                             pk_contact_stats *cs)
+static int visit(size_t j, const double dx[PK_MAXDIM], double dist2, void *ctx)
+{
+    cctx *c = ctx;
+    if (j <= c->self)
+        return 0;
+    double R = c->p->r[c->self] + c->p->r[j], dist = sqrt(dist2);
+    if (dist - R > c->delta_d + c->tol * R)
+        return 0;
+    if (c->net.npair == c->cap && grow_pairs(c) != 0) {
+        c->failed = 1;
+        return 1;
+    }
+    size_t k = c->net.npair++;
+    c->net.pi[k] = (int32_t)c->self;
+    c->net.pj[k] = (int32_t)j;
+    for (int a = 0; a < 3; a++)
+        c->net.normal[3 * k + a] = a < c->p->dim && dist > 0 ? dx[a] / dist : 0;
+    return 0;
+}
+
+/* Wall contacts: clearance to a wall of a walled axis ≤ wall_gap + tol·2r. */
+static int wall_contacts(const pk_box *b, const pk_particles *p, double wall_gap, double tol,
+                         pk_contact_network *net)
+{
+    size_t cap = 0;
+    for (size_t i = 0; i < p->n; i++)
+        for (int k = 0; k < b->dim; k++) {
+            if (b->periodic[k])
+                continue;
+            const double x = p->x[3 * i + k], r = p->r[i], reach = wall_gap + tol * 2 * r;
+            const int lo = x - r <= reach, hi = b->L[k] - x - r <= reach;
+            for (int s = 0; s < lo + hi; s++) {
+                if (net->nwall == cap) {
+                    cap = cap ? 2 * cap : 256;
+                    int32_t *w = realloc(net->wi, cap * sizeof *w);
+                    if (!w)
+                        return -1;
+                    net->wi = w;
+                    int8_t *a = realloc(net->waxis, cap);
+                    if (!a)
+                        return -1;
+                    net->waxis = a;
+                }
+                net->wi[net->nwall] = (int32_t)i;
+                net->waxis[net->nwall++] = (int8_t)k;
+            }
+        }
+    return 0;
+}
+
+void pk_contact_network_free(pk_contact_network *net)
+{
+    free(net->pi);
+    free(net->pj);
+    free(net->normal);
+    free(net->wi);
+    free(net->waxis);
+    free(net->rattler);
+    memset(net, 0, sizeof *net);
+}
+
+int pk_contact_network_compute(const pk_box *b, const pk_particles *p, double delta_d,
+                               double wall_gap, double tol, pk_contact_network *out,
+                               pk_contact_stats *cs)
 {
     *cs = (pk_contact_stats){0};
+    if (out)
+        memset(out, 0, sizeof *out);
     if (p->n == 0)
         return 0;
     double rmin = INFINITY, rmax = 0;
@@ -73,6 +125,7 @@ int pk_contact_stats_compute(const pk_box *b, const pk_particles *p, double delt
     if (pk_grid_init(&g, b, rmin, rmax, extra, p->n) != 0)
         return -1;
     cctx c = {.p = p, .delta_d = delta_d, .tol = tol};
+    pk_contact_network *net = &c.net;
     int rc = -1;
     int32_t *deg = calloc(p->n, sizeof *deg);
     uint8_t *gone = calloc(p->n, 1);
@@ -87,28 +140,37 @@ int pk_contact_stats_compute(const pk_box *b, const pk_particles *p, double delt
         c.self = i;
         pk_grid_query(&g, p, &p->x[3 * i], p->r[i], 0.0, visit, &c);
     }
-    if (c.failed)
+    if (c.failed || wall_contacts(b, p, wall_gap, tol, net) != 0)
         goto out;
-    for (size_t k = 0; k < c.n; k++) {
-        deg[c.pi[k]]++;
-        deg[c.pj[k]]++;
+    for (size_t k = 0; k < net->npair; k++) {
+        deg[net->pi[k]]++;
+        deg[net->pj[k]]++;
     }
+    for (size_t k = 0; k < net->nwall; k++)
+        deg[net->wi[k]]++;
     /* adjacency (CSR), then peel: a grain with fewer than dim+1 contacts to
-     * the remaining grains cannot be locally jammed */
-    off = calloc(p->n + 1, sizeof *off);
-    adj = malloc((2 * c.n + 1) * sizeof *adj);
+     * the remaining grains and the walls cannot be locally jammed */
+    off = malloc((p->n + 1) * sizeof *off);
     stack = malloc(p->n * sizeof *stack);
-    if (!off || !adj || !stack)
+    if (!off || !stack)
         goto out;
+    off[0] = 0;
     for (size_t i = 0; i < p->n; i++)
         off[i + 1] = off[i] + (size_t)deg[i];
-    for (size_t k = 0; k < c.n; k++) {
-        adj[off[c.pi[k]]++] = c.pj[k];
-        adj[off[c.pj[k]]++] = c.pi[k];
+    adj = malloc((off[p->n] + 1) * sizeof *adj);
+    size_t *fill = malloc((p->n + 1) * sizeof *fill);
+    if (!adj || !fill) {
+        free(fill);
+        goto out;
     }
-    for (size_t i = p->n; i > 0; i--)
-        off[i] = off[i - 1];
-    off[0] = 0;
+    memcpy(fill, off, (p->n + 1) * sizeof *fill);
+    for (size_t k = 0; k < net->npair; k++) {
+        adj[fill[net->pi[k]]++] = net->pj[k];
+        adj[fill[net->pj[k]]++] = net->pi[k];
+    }
+    for (size_t k = 0; k < net->nwall; k++)
+        adj[fill[net->wi[k]]++] = -1; /* a wall: never peeled */
+    free(fill);
     size_t top = 0;
     for (size_t i = 0; i < p->n; i++)
         if (deg[i] < p->dim + 1) {
@@ -119,6 +181,8 @@ int pk_contact_stats_compute(const pk_box *b, const pk_particles *p, double delt
         size_t i = (size_t)stack[--top];
         cs->rattlers++;
         for (size_t q = off[i]; q < off[i + 1]; q++) {
+            if (adj[q] < 0)
+                continue;
             size_t j = (size_t)adj[q];
             if (gone[j])
                 continue;
@@ -128,25 +192,41 @@ int pk_contact_stats_compute(const pk_box *b, const pk_particles *p, double delt
             }
         }
     }
-    cs->contacts = c.n;
+    cs->contacts = net->npair;
+    cs->wall_contacts = net->nwall;
     cs->rattler_fraction = (double)cs->rattlers / (double)p->n;
-    size_t backbone = p->n - cs->rattlers;
-    if (backbone) {
-        double z = 0;
+    cs->backbone = p->n - cs->rattlers;
+    if (cs->backbone) {
+        size_t z = 0;
         for (size_t i = 0; i < p->n; i++)
             if (!gone[i])
-                z += deg[i];
-        cs->mean_contacts = z / (double)backbone;
+                z += (size_t)deg[i];
+        size_t walls = 0; /* each pair counted twice in z, each wall contact once */
+        for (size_t k = 0; k < net->nwall; k++)
+            walls += !gone[net->wi[k]];
+        cs->backbone_contacts = (z - walls) / 2 + walls;
+        cs->mean_contacts = (double)z / (double)cs->backbone;
     }
     rc = 0;
+    if (out) {
+        net->rattler = gone;
+        gone = NULL;
+        *out = *net;
+        memset(net, 0, sizeof *net);
+    }
 out:
     free(deg);
     free(gone);
     free(off);
     free(adj);
     free(stack);
-    free(c.pi);
-    free(c.pj);
+    pk_contact_network_free(net);
     pk_grid_free(&g);
     return rc;
+}
+
+int pk_contact_stats_compute(const pk_box *b, const pk_particles *p, double delta_d, double tol,
+                             pk_contact_stats *cs)
+{
+    return pk_contact_network_compute(b, p, delta_d, 0.5 * delta_d, tol, NULL, cs);
 }

@@ -43,10 +43,13 @@ static void pack_lines(FILE *f, const json_t *s, const char *phi)
     fprintf(f, "  grains    %lld placed of %lld requested\n",
             (long long)json_integer_value(json_object_get(s, "count_placed")),
             (long long)json_integer_value(json_object_get(s, "count_requested")));
-    if (json_is_number(json_object_get(s, "phi_resolved")))
+    /* a packing grown to its own φ (until jammed) has no target and no φ of the mix */
+    if (json_is_number(json_object_get(s, "phi_target_resolved")))
         fprintf(f, "  %s %.4f resolved (target %.4f), %.4f of the mix (target %.4f)\n", phi,
                 num(s, "phi_resolved"), num(s, "phi_target_resolved"), num(s, "phi_mix"),
                 num(s, "phi_target_mix"));
+    else if (json_is_number(json_object_get(s, "phi_resolved")))
+        fprintf(f, "  %s %.4f resolved\n", phi, num(s, "phi_resolved"));
     if (json_is_number(json_object_get(s, "smallest_gap"))) {
         long long below = json_integer_value(json_object_get(s, "pairs_below_delta_d"));
         char gap[32];

@@ -9,6 +9,8 @@
 #include "edmd_fixture.h"
 #include "core/edmd/edmd.h"
 #include "core/edmd/edmd_contacts.h"
+#include "core/edmd/edmd_rigidity.h"
+#include "api/solver/sparse_cholmod.h"
 #include "core/space/gap_audit.h"
 
 static void check_no_overlap(const pk_box *b, const pk_particles *p)
@@ -87,6 +89,8 @@ typedef struct jam_out {
     pk_edmd_stats st;
     pk_contact_stats cs;
     double tol;
+    pk_rigidity rg; /* the certificate (pk_jam_certify) */
+    double cert_tol;
 } jam_out;
 
 /* n grains of the given radii (copied) from zero radii in the periodic box
@@ -114,6 +118,12 @@ static void jam_run(int dim, const double *r, int n, double rate, double dphi, j
     check_no_overlap(&b, &p);
     o->tol = pk_contact_tolerance(dim, o->st.pressure);
     CHECK(pk_contact_stats_compute(&b, &p, 0, o->tol, &o->cs) == 0);
+    pk_contact_stats cc;
+    CHECK(pk_jam_certify(&b, &p, 0, 0, o->tol, &pk_sparse_cholmod, &cc, &o->rg, &o->cert_tol) == 0);
+    printf(
+        "  certificate: rigid %d at tol %.2g, backbone %zu, %zu contacts (Maxwell %zu), z %.3f\n",
+        o->rg.rigid, o->cert_tol, o->rg.backbone, o->rg.contacts, o->rg.maxwell_min,
+        cc.mean_contacts);
     printf(
         "  dim=%d n=%d rate=%g %s: phi=%.5f p=%.3g events=%llu z=%.3f rattlers=%.3f (tol %.2g)\n",
         dim, n, rate, pk_edmd_criterion_name(o->st.criterion), o->st.phi, o->st.pressure,
@@ -132,12 +142,15 @@ static void test_mono_3d_reaches_1e12_isostatic(void)
     for (int i = 0; i < 128; i++)
         r[i] = 0.5;
     jam_out o, q;
-    jam_run(3, r, 128, 0.05, 0, &o);
+    jam_run(3, r, 128, 0.01, 0, &o);
     CHECK(o.st.criterion == PK_EDMD_CRIT_PRESSURE && o.st.reason == PK_STOP_JAMMED);
     CHECK(o.st.pressure >= 1e12);
     CHECK_MSG(o.cs.mean_contacts >= 6 * 0.96, "z = %g", o.cs.mean_contacts);
     CHECK_MSG(o.cs.rattler_fraction <= 0.1, "rattlers %g", o.cs.rattler_fraction);
-    jam_run(3, r, 128, 0.05, 1e-9, &q);
+    /* certified: a rigid backbone at the Maxwell count, within a gap of
+     * PK_JAM_TOL_MAX (the pressure's own tolerance alone left it 1 % short) */
+    CHECK(o.rg.rigid && o.rg.contacts >= o.rg.maxwell_min && o.cert_tol <= PK_JAM_TOL_MAX);
+    jam_run(3, r, 128, 0.01, 1e-9, &q);
     CHECK(q.st.criterion == PK_EDMD_CRIT_DELTA_PHI);
     CHECK(q.st.pressure < o.st.pressure);
     printf("  delta_phi stop: phi %.5f vs %.5f at 1e12 (%+.2g), events %.2f of theirs\n", q.st.phi,
@@ -158,6 +171,7 @@ static void test_wide_grading_2d_reaches_1e12(void)
     CHECK(o.st.criterion == PK_EDMD_CRIT_PRESSURE && o.st.reason == PK_STOP_JAMMED);
     CHECK(o.st.pressure >= 1e12);
     CHECK_MSG(o.cs.mean_contacts >= 4 * 0.96, "z = %g", o.cs.mean_contacts);
+    CHECK(o.rg.rigid && o.rg.contacts >= o.rg.maxwell_min);
 }
 
 int main(void)
