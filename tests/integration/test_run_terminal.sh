@@ -61,7 +61,7 @@ assert '\n' not in e and e.endswith('\r\x1b[K'), repr(e[-40:])   # one line, era
 "
 check run_tty_human_summary python3 -c "
 o = open('$T/tty.out', 'rb').read().decode().replace('\r\n', '\n')
-assert o.startswith('pack (edmd): successful, complete\n'), o
+assert o.startswith('pack (edmd): successful, complete (target)\n'), o  # the stop named
 for s in ('grains    2500 placed of 2500 requested', 'φ         0.8000 resolved (target 0.8000)',
           'time ', 'output    $T/tty.h5'):
     assert s in o, (s, o)
