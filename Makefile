@@ -53,8 +53,10 @@ MPI     ?= auto
 mpi_on   = $(if $(filter auto,$(MPI)),$(shell pkg-config --exists ompi-c 2>/dev/null && echo 1),$(filter 1,$(MPI)))
 EXT_LIBS += $(if $(mpi_on),$(shell pkg-config --libs ompi-c))
 $(BUILD)/obj/api/par/mpi_world.o: EXT_CFLAGS += $(if $(mpi_on),-DPK_HAVE_MPI $(shell pkg-config --cflags ompi-c))
-# mpi_world.o is rebuilt when that changes
-MPI_STAMP := $(BUILD)/.mpi-$(or $(mpi_on),0)
+# mpi_world.o is rebuilt when that changes: the stamp holds the choice and is
+# rewritten (so newer) only when it differs — a name per choice would not do,
+# as a missing .SECONDARY file without prerequisites forces nothing.
+MPI_STAMP := $(BUILD)/.mpi
 
 tree        = $(shell find $(1) -name '*.c' | sort)
 CORE_SRC   := $(call tree,core)
@@ -72,7 +74,7 @@ LIB_OBJ    := $(DAEMON_OBJ) $(API_OBJ) $(CORE_OBJ)
 UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 BENCH_BIN  := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
-.PHONY: all deps test test-run sanitize bench bench-fe2 run clean check-schemas install format tradeoffs tradeoff-plots
+.PHONY: FORCE all deps test test-run sanitize bench bench-fe2 run clean check-schemas install format tradeoffs tradeoff-plots
 .SECONDARY:
 
 all: $(DEPS_OK) $(BUILD)/packd $(BENCH_BIN)
@@ -97,10 +99,11 @@ $(BUILD)/obj/core/%.o: core/%.c | $(DEPS_OK)
 	@mkdir -p $(@D)
 	$(CC) $(CORE_CFLAGS) -c $< -o $@
 
-$(MPI_STAMP):
+$(MPI_STAMP): FORCE | $(DEPS_OK)
 	@mkdir -p $(@D)
-	@rm -f $(BUILD)/.mpi-*
-	@touch $@
+	@v='$(or $(mpi_on),0)'; [ "$$(cat $@ 2>/dev/null)" = "$$v" ] || echo "$$v" >$@
+
+FORCE:
 
 $(BUILD)/obj/api/par/mpi_world.o: $(MPI_STAMP)
 

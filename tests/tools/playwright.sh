@@ -14,8 +14,9 @@ if ! command -v npm >/dev/null 2>&1; then
     exit 0
 fi
 if ! PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm install --prefix "$DIR" --prefer-offline --no-audit \
-    --no-fund --silent "playwright-core@$VERSION" >"$DIR/npm.log" 2>&1; then
-    echo "playwright.sh: npm install playwright-core@$VERSION failed: $(tail -1 "$DIR/npm.log")" >&2
-    echo "npm install playwright-core@$VERSION failed (offline?): $(grep -m1 -i err "$DIR/npm.log" || tail -1 "$DIR/npm.log")" >"$DIR/npm.log"
+    --no-fund --loglevel=error "playwright-core@$VERSION" >"$DIR/npm.log" 2>&1; then
+    why=$(grep -m1 'reason:' "$DIR/npm.log" || grep -m1 'ERR!' "$DIR/npm.log" || tail -1 "$DIR/npm.log")
+    echo "playwright.sh: npm install playwright-core@$VERSION failed: $why" >&2
+    echo "npm install playwright-core@$VERSION failed: ${why:-no reason given}" >"$DIR/npm.log"
 fi
 exit 0

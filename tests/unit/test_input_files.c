@@ -108,7 +108,8 @@ static void test_service_checks_open_nothing(void)
     pk_schema_errors_free(&errs);
     errs = (pk_schema_errors){0};
     CHECK(pk_process_validate_inputs(p, in, &local, &errs) == 1 &&
-          strstr(errs.items[0].message, "FIFO") && !strcmp(errs.items[0].pointer, "/domain/mesh"));
+          strstr(errs.items[0].message, "FIFO") &&
+          !strcmp(errs.items[0].pointer, "/domain/mesh/file"));
     pk_schema_errors_free(&errs);
     json_decref(in);
     /* a box domain is not meshed for a request, but its size limit still holds:
