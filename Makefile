@@ -17,10 +17,11 @@
 # compiler records which headers each object read (-MMD -MP, build/**/*.d).
 
 BUILD   ?= build
-# Build on every core unless the caller chose (-jN): a fresh `make run` compiles
-# ~200 files.
-ifeq ($(filter -j%,$(MAKEFLAGS))$(filter j,$(firstword $(MAKEFLAGS))),)
-MAKEFLAGS += -j$(shell nproc 2>/dev/null || echo 2)
+# Build on every core (JOBS=N for fewer; -jN on the command line is not seen
+# here): a fresh `make run` compiles ~200 files.  Sub-makes share the jobs.
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+ifeq ($(MAKELEVEL),0)
+MAKEFLAGS += -j$(JOBS)
 endif
 CC      ?= cc
 OPT     ?= -O2

@@ -60,7 +60,7 @@ static const pk_unit_row fe2_units[] = {
     {"fe2/micro", PK_U_LENGTH}, /* the RVE centres micro/gauss_point_<g> */
     {"fe2/newton/solves/abs_residual_0", PK_U_FORCE_PER_THICKNESS},
     {"fe2/E_n", PK_U_STIFFNESS},
-    {NULL},
+    {NULL, PK_U_NONE},
 };
 
 const char *pk_fe2_unit_of(const char *name, const pk_units *u)

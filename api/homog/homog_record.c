@@ -265,7 +265,7 @@ static const pk_unit_row homog_units[] = {
     {"homogenize/tangent/seconds", PK_U_SECONDS},
     {"homogenize/final_state/position", PK_U_LENGTH},
     {"homogenize/final_state/fluctuation", PK_U_LENGTH},
-    {NULL},
+    {NULL, PK_U_NONE},
 };
 
 const char *pk_homog_unit_of(const char *name, const void *units)

@@ -423,7 +423,7 @@ static const pk_unit_row edmd_units[] = {
     {"wall_gap_guaranteed", PK_U_LENGTH},
     {"start_seconds", PK_U_SECONDS},
     {"collisions_per_second", PK_U_HERTZ},
-    {NULL},
+    {NULL, PK_U_NONE},
 };
 
 const pk_placer pk_placer_edmd = {.name = "edmd",

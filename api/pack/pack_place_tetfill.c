@@ -344,7 +344,7 @@ static const pk_unit_row tetfill_units[] = {
     {"mesh_edge_mean", PK_U_LENGTH},
     {"mesh_origin", PK_U_LENGTH},
     {"seconds_geometric", PK_U_SECONDS},
-    {NULL},
+    {NULL, PK_U_NONE},
 };
 
 const pk_placer pk_placer_tetfill = {.name = "tetfill",

@@ -94,7 +94,7 @@ static const pk_unit_row pack_observables[] = {
     {"timing/sizes_s", PK_U_SECONDS},
     {"timing/place_s", PK_U_SECONDS},
     {"timing/audit_s", PK_U_SECONDS},
-    {NULL},
+    {NULL, PK_U_NONE},
 };
 
 const pk_unit_row *pk_pack_observables(void) { return pack_observables; }

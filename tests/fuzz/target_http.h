@@ -37,6 +37,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "daemon/executor.h"
 #include "daemon/http/http.h"
 #include "daemon/log.h"
 #include "daemon/service.h"
@@ -97,10 +98,10 @@ static inline void fuzz_http_start(void)
     svc->q = pk_queue_open(path, err, sizeof err);
     svc->tokens = svc->q ? pk_tokens_open(path, err, sizeof err) : NULL;
     signal(SIGPIPE, SIG_IGN);
-    svc->sup =
-        svc->tokens ? pk_supervisor_start(svc->q, "/bin/false", svc->cfg.data, 0, 60, 1) : NULL;
+    svc->exec =
+        svc->tokens ? pk_executor_start(svc->q, "/bin/false", &svc->cfg, err, sizeof err) : NULL;
     svc->started = pk_queue_now();
-    if (!svc->sup || !pk_http_start(svc, &fuzz_http_state.port, err, sizeof err)) {
+    if (!svc->exec || !pk_http_start(svc, &fuzz_http_state.port, err, sizeof err)) {
         fprintf(stderr, "fuzz_http: cannot start the service: %s\n", err);
         abort();
     }
