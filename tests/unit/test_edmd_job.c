@@ -23,7 +23,7 @@ static json_t *run_job(const char *extra)
         "\"periodic\":true}},\"grading\":{\"type\":\"classes\",\"classes\":[{\"d\":1.4,"
         "\"volume_percent\":50},{\"d\":1.0,\"volume_percent\":50}]},\"sampling\":\"discrete\","
         "\"count\":150,\"algorithm\":\"edmd\",\"edmd\":{\"start\":\"zero\",\"until\":\"jammed\","
-        "\"growth_rate\":0.05%s},\"seed\":2}}",
+        "\"growth_rate\":0.01%s},\"seed\":2}}",
         extra);
     json_error_t e;
     json_t *job = json_loads(text, 0, &e);
