@@ -97,21 +97,20 @@ kill_rank() { # rank, output prefix
     wait $MPIRUN_PID
     rc=$?
     MPIRUN_PID=""
-    dt=$(echo "$(date +%s.%N) - $t0" | bc)
+    dt=$(awk "BEGIN { print $(date +%s.%N) - $t0 }")
     echo "killed rank $1 (pid $victim): mpirun ended with $rc after $dt s"
 }
-fast_end() { [ "$rc" -ne 0 ] && [ "$rc" -ne 124 ] && [ "$(echo "$dt < 30" | bc)" = 1 ]; }
+fast_end() { [ "$rc" -ne 0 ] && [ "$rc" -ne 124 ] && awk "BEGIN { exit !($dt < 30) }"; }
 
 # rank 2: rank 0 names it, keeps the converged steps, marks the file incomplete
 if ! kill_rank 2 k2; then
     fail fe2_mpi_rank_killed "rank 2 not found running (progress: $(tail -c 300 k2.err))"
 else
     check fe2_mpi_rank_killed_ends_failed_fast fast_end
-    check fe2_mpi_rank_killed_reason_names_rank python3 -c "
-import json; s = json.load(open('k2.json'))
-assert s['complete'] is False and s['termination_reason'] == 'rank_lost', s['termination_reason']
-assert 'MPI rank' in s['failure'] and ' 2 of 3 (Gauss points 24..35)' in s['failure'], s['failure']
-assert 1 <= s['steps'] < 3001, s['steps']"
+    # the reason on stderr (stdout's long JSON summary can be cut by mpirun,
+    # which stops forwarding once it has killed the ranks)
+    check fe2_mpi_rank_killed_reason_names_rank sh -c "grep 'packd run: failed' k2.err |
+        grep -q 'MPI rank 2 of 3 (Gauss points 24..35)'"
     grep 'failed' k2.err | grep -v '"stage"' | head -2 | sed 's/^/  /'
     check fe2_mpi_rank_killed_file_incomplete sh -c "
         h5dump -d /observables/verdict/complete k2.h5 | grep -q '(0): 0' &&
