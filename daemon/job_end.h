@@ -5,7 +5,7 @@
  * reason lost.  Its end (status, message, summary, result digest) is kept
  * with its slot instead and written again every second until it commits;
  * the first failure, and one a minute after it, is logged with the
- * database's error.  Used by the supervisor's thread only. */
+ * database's error.  Used by the local executor's thread only. */
 #ifndef PK_JOB_END_H
 #define PK_JOB_END_H
 

@@ -141,7 +141,8 @@ for kv in "JobName=packd-$J" NumCPUs=1 TimeLimit=00:02:00 Requeue=1 MinMemoryNod
     check "slurm_job_has_$(echo "$kv" | cut -d= -f1)" grep -q " $kv " "$T/sc.txt"
 done
 check slurm_script_term_before_limit grep -qx '#SBATCH --signal=TERM@60' "$T/d1/jobs/$J/slurm.sh"
-check slurm_script_srun_packd_run grep -q "^srun .*'$PWD/$PACKD' run job.json" "$T/d1/jobs/$J/slurm.sh"
+case $PACKD in /*) packd_abs=$PACKD ;; *) packd_abs=$PWD/$PACKD ;; esac
+check slurm_script_srun_packd_run grep -q "^srun .*'$packd_abs' run job.json" "$T/d1/jobs/$J/slurm.sh"
 # the signal Slurm sends at TimeLimit - 60 s (to the steps: srun forwards it)
 # stops the worker, which keeps what it placed (sent once the worker reports)
 reporting() { [ "$(wc -l 2>/dev/null <"$T/d1/jobs/$1/progress.jsonl")" -ge 2 ] 2>/dev/null; }
