@@ -315,7 +315,8 @@ static void ask_slurm(const char *jid, char *state, size_t sn, char *node, size_
         char *bar = strchr(out, '|');
         if (bar) {
             *bar = 0;
-            snprintf(state, sn, "%s", out);
+            if (snprintf(state, sn, "%s", out) >= (int)sn) /* a state name: cut is fine */
+                state[sn - 1] = 0;
             char *bar2 = strchr(bar + 1, '|');
             if (bar2) {
                 *bar2 = 0;
@@ -332,7 +333,7 @@ static void ask_slurm(const char *jid, char *state, size_t sn, char *node, size_
 static json_t *ended(json_t *job, const char *jid, const sq_entry *e, const pk_config *c)
 {
     const char *id = json_string_value(json_object_get(job, "id"));
-    char dir[1200], path[1300], msg[1600], tail[1024] = "";
+    char dir[1200], path[1300], msg[4096], tail[1024] = "";
     pk_job_dir(c->data, id, dir, sizeof dir);
     json_t *ch = change(id, "finish");
     char ref[64];
@@ -379,8 +380,8 @@ static json_t *ended(json_t *job, const char *jid, const sq_entry *e, const pk_c
     if (slurm_exit == PK_SLURM_NO_DIR || code == PK_SLURM_NO_DIR ||
         (!started && !strcmp(reason, "JobLaunchFailure")))
         snprintf(msg, sizeof msg,
-                 "failed: the job directory %s is not visible on node %s (Slurm job %s, %s%s%s;"
-                 " it must be on a filesystem the nodes share)",
+                 "failed: the job directory %s is not visible on node %s (Slurm job %s, "
+                 "%s%s%s; it must be on a filesystem the nodes share)",
                  dir, node[0] ? node : "(unknown)", jid, state[0] ? state : "ended",
                  reason[0] ? ", " : "", reason);
     else if (code > 0)
