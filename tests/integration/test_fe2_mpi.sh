@@ -45,6 +45,11 @@ if ! command -v mpirun >/dev/null 2>&1; then
     skip fe2_mpi_ranks "mpirun not installed (Debian's openmpi-bin)"
     exit 0
 fi
+# under make sanitize: Open MPI's allocations that outlive MPI_Finalize are not
+# packd's leaks (tests/sanitizer/openmpi.supp); the slow unwinder reaches the
+# library's frames, which are built without frame pointers
+export LSAN_OPTIONS="suppressions=$SRC/tests/sanitizer/openmpi.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
+export ASAN_OPTIONS="fast_unwind_on_malloc=0${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
 # root needs --allow-run-as-root; 3 ranks on a 2-core machine need --oversubscribe
 MPIRUN="mpirun --allow-run-as-root --oversubscribe"
 
