@@ -64,14 +64,15 @@ static void test_job_asks(void)
                          " \"limits\": {\"wall_time_s\": 90}}}");
     json_t *fe2_default = job_of("{\"process\": \"fe2\", \"inputs\": {}}");
     /* only fe2 spreads over ranks: another process's field would start copies */
-    json_t *pack = job_of("{\"process\": \"pack\", \"inputs\": {\"parallel\": {\"mpi_ranks\": 3}}}");
+    json_t *pack =
+        job_of("{\"process\": \"pack\", \"inputs\": {\"parallel\": {\"mpi_ranks\": 3}}}");
     CHECK(pk_slurm_job_ranks(fe2) == 3);
     CHECK(pk_slurm_job_ranks(fe2_default) == 1);
     CHECK(pk_slurm_job_ranks(pack) == 1);
     CHECK(pk_slurm_job_wall(fe2, 86400) == 90);
-    CHECK(pk_slurm_job_wall(fe2, 60) == 60);             /* the operator's cap */
+    CHECK(pk_slurm_job_wall(fe2, 60) == 60);               /* the operator's cap */
     CHECK(pk_slurm_job_wall(fe2_default, 86400) == 86400); /* none: the cap */
-    CHECK(pk_slurm_minutes(90) == 3);                    /* 90 s + the 60 s TERM margin */
+    CHECK(pk_slurm_minutes(90) == 3);                      /* 90 s + the 60 s TERM margin */
     json_decref(fe2);
     json_decref(fe2_default);
     json_decref(pack);
@@ -82,8 +83,14 @@ static void test_one_task(void)
     pk_config c;
     pk_config_defaults(&c);
     c.slurm_mem_mb = 1000;
-    pk_slurm_job j = {.id = "one", .dir = dir, .owner = "lab", .packd = "/opt/packd",
-                      .threads = 2, .ranks = 1, .wall_s = 90, .checkpoint_interval_s = 30};
+    pk_slurm_job j = {.id = "one",
+                      .dir = dir,
+                      .owner = "lab",
+                      .packd = "/opt/packd",
+                      .threads = 2,
+                      .ranks = 1,
+                      .wall_s = 90,
+                      .checkpoint_interval_s = 30};
     char *s = script_of(&j, &c);
     CHECK(s != NULL);
     if (!s)
@@ -92,10 +99,12 @@ static void test_one_task(void)
     CHECK(has_line(s, "#SBATCH --time=3") && has_line(s, "#SBATCH --mem=1000"));
     CHECK(!strstr(s, "--mem-per-cpu") && !strstr(s, "--mpi"));
     const char *srun = line_of(s, "srun ");
-    CHECK(srun && !strncmp(srun, "srun --ntasks=1 --cpus-per-task=2 --kill-on-bad-exit=1 "
-                                 "'/opt/packd' run job.json",
-                           strlen("srun --ntasks=1 --cpus-per-task=2 --kill-on-bad-exit=1 "
-                                  "'/opt/packd' run job.json")));
+    CHECK(srun &&
+          !strncmp(srun,
+                   "srun --ntasks=1 --cpus-per-task=2 --kill-on-bad-exit=1 "
+                   "'/opt/packd' run job.json",
+                   strlen("srun --ntasks=1 --cpus-per-task=2 --kill-on-bad-exit=1 "
+                          "'/opt/packd' run job.json")));
     free(s);
 }
 
@@ -104,8 +113,14 @@ static void test_ranks(void)
     pk_config c;
     pk_config_defaults(&c);
     c.slurm_mem_mb = 1001;
-    pk_slurm_job j = {.id = "ranks", .dir = dir, .owner = "lab", .packd = "/opt/packd",
-                      .threads = 2, .ranks = 3, .wall_s = 600, .checkpoint_interval_s = 30};
+    pk_slurm_job j = {.id = "ranks",
+                      .dir = dir,
+                      .owner = "lab",
+                      .packd = "/opt/packd",
+                      .threads = 2,
+                      .ranks = 3,
+                      .wall_s = 600,
+                      .checkpoint_interval_s = 30};
     char *s = script_of(&j, &c);
     CHECK(s != NULL);
     if (!s)
@@ -115,10 +130,12 @@ static void test_ranks(void)
     CHECK(has_line(s, "#SBATCH --mem-per-cpu=501") && !line_of(s, "#SBATCH --mem="));
     CHECK(has_line(s, "#SBATCH --time=11"));
     const char *srun = line_of(s, "srun ");
-    CHECK(srun && !strncmp(srun, "srun --ntasks=3 --cpus-per-task=2 --mpi='pmix' "
-                                 "--kill-on-bad-exit=1 '/opt/packd' run job.json",
-                           strlen("srun --ntasks=3 --cpus-per-task=2 --mpi='pmix' "
-                                  "--kill-on-bad-exit=1 '/opt/packd' run job.json")));
+    CHECK(srun &&
+          !strncmp(srun,
+                   "srun --ntasks=3 --cpus-per-task=2 --mpi='pmix' "
+                   "--kill-on-bad-exit=1 '/opt/packd' run job.json",
+                   strlen("srun --ntasks=3 --cpus-per-task=2 --mpi='pmix' "
+                          "--kill-on-bad-exit=1 '/opt/packd' run job.json")));
     CHECK(srun && strstr(srun, " --threads 2 "));
     free(s);
     /* the operator's plugin, quoted for sh */
