@@ -323,29 +323,6 @@ static void ask_slurm(const char *jid, char *state, size_t sn, char *node, size_
         *exit = atoi(code);
 }
 
-/* The first task srun reports as ended badly ("srun: error: <node>: task
- * <k>: <how>", in worker.log: the script sends srun's stderr there): its
- * rank, and "<node>: task <k>: <how>" in what.  -1 if none. */
-static int first_bad_task(const char *log, char *what, size_t n)
-{
-    FILE *f = fopen(log, "r");
-    if (!f)
-        return -1;
-    char line[1024];
-    int rank = -1;
-    while (rank < 0 && fgets(line, sizeof line, f)) {
-        const char *p = strncmp(line, "srun: error: ", 13) ? NULL : strstr(line, ": task ");
-        if (p && sscanf(p, ": task %d:", &rank) == 1) {
-            line[strcspn(line, "\n")] = 0;
-            snprintf(what, n, "%s", line + 13);
-        } else {
-            rank = -1;
-        }
-    }
-    fclose(f);
-    return rank;
-}
-
 /* The change that ends a held job whose Slurm job is over (or gone). */
 static json_t *ended(json_t *job, const char *jid, const sq_entry *e, const pk_config *c)
 {
@@ -404,7 +381,7 @@ static json_t *ended(json_t *job, const char *jid, const sq_entry *e, const pk_c
                  "%s%s%s; it must be on a filesystem the nodes share)",
                  dir, node[0] ? node : "(unknown)", jid, state[0] ? state : "ended",
                  reason[0] ? ", " : "", reason);
-    else if (code > 0 && ranks > 1 && (lost = first_bad_task(log, what, sizeof what)) >= 0)
+    else if (code > 0 && ranks > 1 && (lost = pk_slurm_first_bad_task(log, what, sizeof what)) >= 0)
         /* under srun the lost rank takes the step down (SIGKILL after KillWait) before
          * rank 0 can always write its own report (exit 3, above) */
         snprintf(msg, sizeof msg,

@@ -124,3 +124,23 @@ int pk_slurm_script_write(const pk_slurm_job *j, const pk_config *c, char *path,
     }
     return 0;
 }
+
+int pk_slurm_first_bad_task(const char *log, char *what, size_t n)
+{
+    FILE *f = fopen(log, "r");
+    if (!f)
+        return -1;
+    char line[1024];
+    int rank = -1;
+    while (rank < 0 && fgets(line, sizeof line, f)) {
+        const char *p = strncmp(line, "srun: error: ", 13) ? NULL : strstr(line, ": task ");
+        if (p && sscanf(p, ": task %d:", &rank) == 1) {
+            line[strcspn(line, "\n")] = 0;
+            snprintf(what, n, "%s", line + 13);
+        } else {
+            rank = -1;
+        }
+    }
+    fclose(f);
+    return rank;
+}

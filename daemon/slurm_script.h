@@ -46,4 +46,9 @@ long pk_slurm_minutes(double wall_s);
 int pk_slurm_script_write(const pk_slurm_job *j, const pk_config *c, char *path, size_t pathlen,
                           char *why, size_t n);
 
+/* The first task srun reports as ended badly in log (the script's
+ * worker.log, where srun's stderr goes: "srun: error: <node>: task <k>:
+ * <how>"): its rank k, with "<node>: task <k>: <how>" in what; -1 if none. */
+int pk_slurm_first_bad_task(const char *log, char *what, size_t n);
+
 #endif

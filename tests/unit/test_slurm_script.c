@@ -1,7 +1,8 @@
 /* test_slurm_script.c — daemon/slurm_script.c: what a job asks of Slurm
  * (tasks from an fe2 job's mpi_ranks, time from its wall limit) and the
  * lines of the batch script for one task and for MPI ranks: --ntasks,
- * --cpus-per-task, memory per node or per rank, --time, srun's --mpi. */
+ * --cpus-per-task, memory per node or per rank, --time, srun's --mpi; the
+ * lost rank read back from srun's report. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -145,6 +146,37 @@ static void test_ranks(void)
     free(s);
 }
 
+/* srun's stderr (worker.log) when rank 1 of 2 was killed -9 and Slurm's PMIx
+ * plugin ended the step, as measured on the one-node test cluster */
+static void test_lost_rank_named(void)
+{
+    char log[128], what[256];
+    snprintf(log, sizeof log, "%s/worker.log", dir);
+    FILE *f = fopen(log, "w");
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    fputs("[vm:17064] Read -1, expected 6624, errno = 3\n"
+          "srun: error: vm: task 1: Killed\n"
+          "srun: launch/slurm: _step_signal: Terminating StepId=5.0\n"
+          "slurmstepd-vm: error: *** STEP 5.0 ON vm CANCELLED AT 2026-12-07T15:56:11 ***\n"
+          "srun: Job step aborted: Waiting up to 4 seconds for job step to finish.\n"
+          "srun: error: vm: task 0: Killed\n",
+          f);
+    fclose(f);
+    CHECK(pk_slurm_first_bad_task(log, what, sizeof what) == 1);
+    CHECK(!strcmp(what, "vm: task 1: Killed"));
+    /* several tasks in one report name no single lost rank; no log: none */
+    f = fopen(log, "w");
+    if (f) {
+        fputs("packd run: failed: cannot open job.json\nsrun: error: vm: tasks 0-1: Killed\n", f);
+        fclose(f);
+    }
+    CHECK(pk_slurm_first_bad_task(log, what, sizeof what) == -1);
+    unlink(log);
+    CHECK(pk_slurm_first_bad_task(log, what, sizeof what) == -1);
+}
+
 int main(void)
 {
     if (!mkdtemp(dir))
@@ -152,6 +184,7 @@ int main(void)
     RUN(test_job_asks);
     RUN(test_one_task);
     RUN(test_ranks);
+    RUN(test_lost_rank_named);
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     if (system(cmd) != 0)
