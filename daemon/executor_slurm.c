@@ -372,6 +372,8 @@ static json_t *ended(json_t *job, const char *jid, const sq_entry *e, const pk_c
     int ranks = pk_slurm_job_ranks(job), lost;
     pk_job_file_path(dir, PK_JOB_LOG, log, sizeof log);
     pk_worker_last_line(log, tail, sizeof tail);
+    if (!strncmp(tail, PK_SLURM_ATTEMPT_MARK, strlen(PK_SLURM_ATTEMPT_MARK)))
+        tail[0] = 0; /* the worker said nothing */
     pk_job_file_path(dir, PK_JOB_PROGRESS, path, sizeof path);
     int started = access(path, F_OK) == 0; /* the script's first line is there */
     if (slurm_exit == PK_SLURM_NO_DIR || code == PK_SLURM_NO_DIR ||

@@ -97,6 +97,9 @@ int pk_slurm_script_write(const pk_slurm_job *j, const pk_config *c, char *path,
             pk_job_file_name(PK_JOB_RESULT));
     fprintf(f, "printf '{\"attempt\": %%d, \"node\": \"%%s\"}\\n' \"$attempt\" \"$node\" > %s\n",
             pk_job_file_name(PK_JOB_PROGRESS));
+    /* worker.log keeps every attempt: a mark where this one begins */
+    fprintf(f, "echo \"%s $attempt on $node\" >> %s\n", PK_SLURM_ATTEMPT_MARK,
+            pk_job_file_name(PK_JOB_LOG));
     /* one line for one task or R ranks; a rank that dies ends the step at once */
     fprintf(f, "srun --ntasks=%d --cpus-per-task=%d ", ranks, j->threads);
     if (ranks > 1) {
@@ -132,13 +135,18 @@ int pk_slurm_first_bad_task(const char *log, char *what, size_t n)
         return -1;
     char line[1024];
     int rank = -1;
-    while (rank < 0 && fgets(line, sizeof line, f)) {
+    while (fgets(line, sizeof line, f)) {
+        if (!strncmp(line, PK_SLURM_ATTEMPT_MARK " ",
+                     strlen(PK_SLURM_ATTEMPT_MARK) + 1)) { /* a later attempt */
+            rank = -1;
+            continue;
+        }
         const char *p = strncmp(line, "srun: error: ", 13) ? NULL : strstr(line, ": task ");
-        if (p && sscanf(p, ": task %d:", &rank) == 1) {
+        int k;
+        if (rank < 0 && p && sscanf(p, ": task %d:", &k) == 1) {
+            rank = k;
             line[strcspn(line, "\n")] = 0;
             snprintf(what, n, "%s", line + 13);
-        } else {
-            rank = -1;
         }
     }
     fclose(f);

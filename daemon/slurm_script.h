@@ -7,6 +7,7 @@
  *   - exits 96 at once when the job directory is not visible on the node
  *     (the daemon then names the node),
  *   - starts progress.jsonl with {"attempt": SLURM_RESTART_COUNT + 1, "node"},
+ *     and marks the attempt's start in worker.log ("packd: attempt <k> on <node>"),
  *   - runs `srun packd run job.json -o result.h5 --progress-file progress.jsonl
  *     --checkpoint checkpoint.h5 ...` (cancel and signals reach the worker),
  *     as `ranks` MPI ranks (srun --mpi=<slurm_mpi>) when there are several,
@@ -18,6 +19,9 @@
 #include <stddef.h>
 
 #include "config.h"
+
+/* worker.log: "packd: attempt <k> on <node>" where an attempt begins */
+#define PK_SLURM_ATTEMPT_MARK "packd: attempt"
 
 enum { PK_SLURM_NO_DIR = 96 }; /* exit status: job directory not visible on the node */
 
@@ -46,9 +50,10 @@ long pk_slurm_minutes(double wall_s);
 int pk_slurm_script_write(const pk_slurm_job *j, const pk_config *c, char *path, size_t pathlen,
                           char *why, size_t n);
 
-/* The first task srun reports as ended badly in log (the script's
- * worker.log, where srun's stderr goes: "srun: error: <node>: task <k>:
- * <how>"): its rank k, with "<node>: task <k>: <how>" in what; -1 if none. */
+/* The first task srun reports as ended badly in the last attempt of log
+ * (the script's worker.log, where srun's stderr goes: "srun: error: <node>:
+ * task <k>: <how>"): its rank k, with "<node>: task <k>: <how>" in what; -1
+ * if none. */
 int pk_slurm_first_bad_task(const char *log, char *what, size_t n);
 
 #endif

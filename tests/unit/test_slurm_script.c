@@ -99,6 +99,7 @@ static void test_one_task(void)
     CHECK(has_line(s, "#SBATCH --ntasks=1") && has_line(s, "#SBATCH --cpus-per-task=2"));
     CHECK(has_line(s, "#SBATCH --time=3") && has_line(s, "#SBATCH --mem=1000"));
     CHECK(!strstr(s, "--mem-per-cpu") && !strstr(s, "--mpi"));
+    CHECK(has_line(s, "echo \"" PK_SLURM_ATTEMPT_MARK " $attempt on $node\" >> worker.log"));
     const char *srun = line_of(s, "srun ");
     CHECK(srun &&
           !strncmp(srun,
@@ -166,6 +167,22 @@ static void test_lost_rank_named(void)
     fclose(f);
     CHECK(pk_slurm_first_bad_task(log, what, sizeof what) == 1);
     CHECK(!strcmp(what, "vm: task 1: Killed"));
+    /* an earlier attempt's report (preempted: srun's tasks terminated) is not this one's */
+    f = fopen(log, "w");
+    if (f) {
+        fputs("packd: attempt 1 on vm\nsrun: error: vm: task 0: Terminated\n"
+              "packd: attempt 2 on vm\nsrun: error: vm: task 1: Killed\n"
+              "srun: error: vm: task 0: Killed\n",
+              f);
+        fclose(f);
+    }
+    CHECK(pk_slurm_first_bad_task(log, what, sizeof what) == 1);
+    f = fopen(log, "a");
+    if (f) {
+        fputs("packd: attempt 3 on vm\npackd run: failed: cannot read job.json\n", f);
+        fclose(f);
+    }
+    CHECK(pk_slurm_first_bad_task(log, what, sizeof what) == -1);
     /* several tasks in one report name no single lost rank; no log: none */
     f = fopen(log, "w");
     if (f) {
