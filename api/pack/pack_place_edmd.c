@@ -11,6 +11,7 @@
 #include "core/edmd/edmd_contacts.h"
 #include "core/edmd/edmd_rigidity.h"
 #include "core/edmd/edmd_walls.h"
+#include "core/space/gap_audit.h"
 #include "pack_placer.h"
 #include "api/solver/sparse_cholmod.h"
 
@@ -335,13 +336,33 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
         st->goal_reached = stop_ok && rg.rigid && es.reason == PK_STOP_JAMMED;
     }
     if (dd_short) {
+        /* walls that see the true grains (w = the job's Δd/2) let a shell h < w
+         * through them by w − h: the grains are pulled inside and Δd is what
+         * the pairs keep afterwards */
+        double pulled = 1, shell_dd = es.delta_d;
+        if (w > 0 && (pulled = pk_edmd_pull_inside(&job->box, p)) < 1) {
+            pk_gap_report rep;
+            if (pk_gap_audit(&job->box, p, es.delta_d, 0, es.delta_d + 1e-300, &rep) != 0) {
+                snprintf(err, errlen, "out of memory in the gap audit");
+                return -1;
+            }
+            es.delta_d = fmin(es.delta_d, rep.min_gap);
+        }
         st->short_delta_d = 1;
         st->audit_delta_d = es.delta_d;
-        snprintf(st->warning, sizeof st->warning,
-                 "shell growth stopped (%s) at Δd = %.6g, short of the job's delta_d = %.6g: every "
-                 "gap of the result is >= %.6g; lower phi or delta_d, or try a smaller "
-                 "edmd.growth_rate",
-                 pk_edmd_criterion_name(es.criterion), es.delta_d, job->delta_d, es.delta_d);
+        int len =
+            snprintf(st->warning, sizeof st->warning,
+                     "shell growth stopped (%s) at Δd = %.6g, short of the job's delta_d = "
+                     "%.6g: every gap of the result is >= %.6g",
+                     pk_edmd_criterion_name(es.criterion), es.delta_d, job->delta_d, es.delta_d);
+        if (pulled < 1 && len > 0 && (size_t)len < sizeof st->warning)
+            len += snprintf(st->warning + len, sizeof st->warning - (size_t)len,
+                            " (the shell reached %.6g; the grains it let through the walls "
+                            "were pulled inside, walled coordinates scaled by %.6f)",
+                            shell_dd, pulled);
+        if (len > 0 && (size_t)len < sizeof st->warning)
+            snprintf(st->warning + len, sizeof st->warning - (size_t)len,
+                     "; lower phi or delta_d, or try a smaller edmd.growth_rate");
     }
     json_t *obs = json_object();
     json_object_set_new(obs, "phi_final", json_real(es.phi));
