@@ -6,8 +6,9 @@
 # pair gap >= delta_d_reached, every grain inside the walls: wall_gap none).
 # Titscher's meshable A16 (80 mm, d_min 2, Δd 1, φ_M 0.545: Δd 0.971–0.983)
 # takes ~17 CPU s a run; reduced here to a 30 mm cube, d_min 4 (56 grains),
-# φ_M 0.5 with Δd 2 asked (the shell stalls at 1.90 and lets 40 grains
-# 0.05 mm through the walls) — 0.2 s; `maximize: delta_d` asked 3 (2.17).
+# φ_M 0.5 with Δd 2 asked (kept at 1.73; before, the shell stalled at 1.90,
+# 40 grains 0.05 mm through the walls: failed) — 0.2 s; `maximize:
+# delta_d` asked 3 (kept at 1.66; before 2.17, 45 grains through: failed).
 . "${PACKD_SRC:-.}/tests/integration/check.inc"
 PACKD=${PACKD:-build/packd}
 T=$(mktemp -d)
