@@ -154,6 +154,7 @@ static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, void **
  * to resume. */
 typedef struct ckpt_file {
     const char *path, *digest;
+    char unit_digest[160]; /* the job's digest, marked: the state is in the unit ℓ */
     char err[300];
 } ckpt_file;
 
@@ -345,7 +346,11 @@ static int place_edmd_unit(const pk_pack_job *job, const pk_pack_job *user, doub
     pk_edmd_checkpoint ck = {0};
     pk_edmd_snapshot snap = {0};
     cf.path = run->checkpoint.path;
-    cf.digest = run->checkpoint.digest ? run->checkpoint.digest : "";
+    /* a snapshot in the job's unit (written before the engine ran in ℓ) is
+     * another job's: not resumed */
+    snprintf(cf.unit_digest, sizeof cf.unit_digest, "%s/unit-edge",
+             run->checkpoint.digest ? run->checkpoint.digest : "");
+    cf.digest = cf.unit_digest;
     ck.interval_s = run->checkpoint.interval_s;
     int loaded = 1;
     if (cf.path) {
@@ -465,7 +470,9 @@ static int place_edmd_unit(const pk_pack_job *job, const pk_pack_job *user, doub
     json_object_set_new(obs, "termination_criterion",
                         json_string(pk_edmd_criterion_name(es.criterion)));
     json_object_set_new(obs, "delta_d_reached", json_real(es.delta_d));
-    json_object_set_new(obs, "wall_gap_guaranteed", json_real(fmax(0.5 * es.delta_d - w, 0)));
+    /* a shell that reached w: its clearance beyond w is round-off */
+    const double wall_gap = 0.5 * es.delta_d - w;
+    json_object_set_new(obs, "wall_gap_guaranteed", json_real(wall_gap > 1e-12 * w ? wall_gap : 0));
     json_object_set_new(obs, "start", json_string(prm.start_zero ? "zero" : "rsa"));
     if (!prm.start_zero) {
         json_object_set_new(obs, "start_delta", json_real(prm.delta));
