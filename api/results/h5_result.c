@@ -165,7 +165,7 @@ pk_h5 *pk_h5_create(const char *path, const char *author, char *err, size_t errl
      * errno of ours, and HDF5 never holds a file it failed to flush (its exit
      * handler would close it again and crash).  The temporary file is created
      * now so a directory that cannot take it fails before the work. */
-    h->fd = open(h->tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0640);
+    h->fd = open(h->tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, PK_RESULT_FILE_MODE);
     if (h->fd < 0) {
         snprintf(err, errlen, "cannot create %s: %s", h->tmp, strerror(errno));
         free(h->path);
@@ -196,7 +196,8 @@ pk_h5 *pk_h5_create(const char *path, const char *author, char *err, size_t errl
     int ver[2] = {1, 1};
     attr_ints(md, "version", ver, 2, 0);
     hid_t au = make_group(md, "author", H5P_DEFAULT);
-    attr_string(au, "name", author && *author ? author : "packd");
+    /* the person responsible; the name is mandatory, so an unknown one says so */
+    attr_string(au, "name", author && *author ? author : PK_H5_AUTHOR_UNKNOWN);
     H5Gclose(au);
     /* the units module: every dimensional dataset carries a `unit` string of
      * SI symbols ("mm", "N mm-2"); H5MD units module 1.0 */
@@ -459,7 +460,8 @@ int pk_h5_time_element(pk_h5 *h, const char *path, const char *clock, const int6
     } else {
         rc |= pk_h5_write_array(h, p, PK_H5_I64, 1, dims, step, NULL);
         snprintf(p, sizeof p, "%s/time", path);
-        rc |= pk_h5_write_array(h, p, PK_H5_F64, 1, dims, time, time_unit);
+        rc |= pk_h5_write_array(h, p, PK_H5_F64, 1, dims, time,
+                                time_unit ? time_unit : PK_H5_UNIT_NUMBER);
     }
     snprintf(p, sizeof p, "%s/value", path);
     rc |= pk_h5_write_array(h, p, type, rank, dims, value, unit);

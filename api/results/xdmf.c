@@ -1,6 +1,7 @@
 /* xdmf.c — the XDMF 3 sidecar of a result file (contract in xdmf.h). */
 #include "xdmf.h"
 
+#include <fcntl.h>
 #include <hdf5.h>
 #include <limits.h>
 #include <stdio.h>
@@ -351,8 +352,12 @@ int pk_xdmf_write(const char *h5_path, const char *h5_ref, const char *xdmf_path
     char ref[1024], tmp[1100];
     xml_escape(h5_ref, ref, sizeof ref);
     snprintf(tmp, sizeof tmp, "%s.tmp.%ld", xdmf_path, (long)getpid());
-    FILE *f = fopen(tmp, "w");
+    /* the mode of the result file it describes */
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, PK_RESULT_FILE_MODE);
+    FILE *f = fd < 0 ? NULL : fdopen(fd, "w");
     if (!f) {
+        if (fd >= 0)
+            close(fd);
         H5Fclose(h);
         snprintf(err, errlen, "cannot write %s", tmp);
         return -1;
