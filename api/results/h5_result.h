@@ -99,10 +99,6 @@ int pk_h5_connectivity(pk_h5 *h, const char *path, const int64_t *pairs, size_t 
 /* A second name (hard link) for an existing object, e.g. a shared box group. */
 int pk_h5_link(pk_h5 *h, const char *existing, const char *path);
 
-/* A view of src[k] (an HDF5 virtual dataset in this file, no copy of the
- * data) at path: src has rank 2 or 3, the view its last dimensions. */
-int pk_h5_slice_view(pk_h5 *h, const char *src, size_t k, const char *path);
-
 /* Close, fsync and rename into place.  Frees h.  0 on success. */
 int pk_h5_commit(pk_h5 *h, char *err, size_t errlen);
 /* Close and remove the temporary file.  Frees h. */
