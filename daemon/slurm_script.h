@@ -20,7 +20,7 @@ enum { PK_SLURM_NO_DIR = 96 }; /* exit status: job directory not visible on the 
 
 typedef struct pk_slurm_job {
     const char *id, *dir, *author; /* author: pk_worker_author, "" unknown */
-    const char *packd; /* packd on the nodes */
+    const char *packd;             /* packd on the nodes */
     int threads;
     double wall_s; /* the job's wall-time limit (its limits, capped by the operator's) */
     double checkpoint_interval_s;

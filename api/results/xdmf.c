@@ -124,8 +124,8 @@ static int item(FILE *f, const char *ind, hid_t h, const char *ref, const char *
     fprintf(f, "%s<DataItem Dimensions=\"", ind);
     for (int a = 0; a < rank; a++)
         fprintf(f, a ? " %llu" : "%llu", (unsigned long long)d[a]);
-    fprintf(f, "\" NumberType=\"%s\" Precision=\"%d\" Format=\"HDF\">%s:%s</DataItem>\n", type, prec,
-            ref, path);
+    fprintf(f, "\" NumberType=\"%s\" Precision=\"%d\" Format=\"HDF\">%s:%s</DataItem>\n", type,
+            prec, ref, path);
     return 0;
 }
 
@@ -146,8 +146,7 @@ static int has_offset(hid_t h, const char *path)
  * shape is the value's without its first dimension; Name says which row.
  * 0, or -1 when the dataset is absent, not contiguous (no offset) or k is
  * past its end. */
-static int row_item(FILE *f, const char *ind, hid_t h, const char *ref, const char *path,
-                    hsize_t k)
+static int row_item(FILE *f, const char *ind, hid_t h, const char *ref, const char *path, hsize_t k)
 {
     hsize_t d[3];
     int rank = dims_of(h, path, d);
@@ -219,7 +218,8 @@ static void vertices(FILE *f, const char *ind, hid_t h, const char *ref, const c
             "NodesPerElement=\"1\">\n",
             ind, n);
     if (dims_of(h, id, d) != 1 || d[0] != n || item(f, inner, h, ref, id) != 0) {
-        fprintf(f, "%s<DataItem Dimensions=\"%zu\" NumberType=\"Int\" Precision=\"8\" Format=\"XML\">",
+        fprintf(f,
+                "%s<DataItem Dimensions=\"%zu\" NumberType=\"Int\" Precision=\"8\" Format=\"XML\">",
                 inner, n);
         for (size_t i = 0; i < n; i++)
             fprintf(f, i % 16 == 15 ? "%zu\n" : "%zu ", i);

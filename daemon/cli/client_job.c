@@ -295,8 +295,8 @@ int pk_client_fetch(const pk_client *c, const char *id, const char *out, json_t 
         char partial[4200];
         snprintf(partial, sizeof partial, "%s.partial", out);
         if (href &&
-            download_verified(c, href, partial,
-                              json_string_value(json_object_get(part, "sha256")), info) == 0)
+            download_verified(c, href, partial, json_string_value(json_object_get(part, "sha256")),
+                              info) == 0)
             fprintf(stderr, "packd fetch: partial result of the failed job in %s (not %s)\n",
                     partial, out);
         if (json_object_get(doc, "summary"))
