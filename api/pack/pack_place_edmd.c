@@ -84,7 +84,7 @@ static void read_params(const pk_pack_job *job, const pk_pack_plan *plan, pk_edm
 }
 
 /* EDMD growing every diameter until jammed (relative growth) bounds the sizes
- * only by φ <= 1 (core/edmd/edmd.c, spec §3.3d): the largest grain, shell included,
+ * only by φ <= 1 (core/edmd/edmd.c): the largest grain, shell included,
  * may reach (d_max + Δd)·φ_s^(-1/dim), φ_s the shells' fraction at the target
  * sizes.  On a periodic axis that must stay below L/2, or a pair could meet
  * two images of each other (minimum image).  φ_s is bounded below by

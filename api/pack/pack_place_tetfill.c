@@ -56,7 +56,8 @@ static const pk_option_table tetfill_options =
     PK_OPT_TABLE("pack.inputs.schema.json", pk_tetfill_options, tetfill_rows, preset);
 
 /* Radii from r_min / r_max / ratio; ratio alone uses Jerier's mesh rule
- * r̄ = ℓ_mean / 8 (spec §4.1): r_min = 2 r̄/(R+1), r_max = 2 r̄ − r_min. */
+ * r̄ = ℓ_mean / 8 (Jerier §2.2: r = ℓ/8 on an edge; the ratio rule of Jerier's
+ * YADE code): r_min = 2 r̄/(R+1), r_max = 2 r̄ − r_min. */
 static int radii(const pk_tetfill_options *o, double edge_mean, double *rmin, double *rmax)
 {
     double a = o->r_min, b = o->r_max, R = o->ratio;

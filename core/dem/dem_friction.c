@@ -27,7 +27,7 @@ int pk_fric_return_map(const pk_fric_law *law, double fn, double gamma, double g
     out->dlambda = dl;
     out->gamma_pl = gamma_pl_n + dl * sg; /* (7.17), erratum of (7.12) */
     out->alpha = alpha_n + dl;
-    /* |f_t| = |f_tr| − E_t Δλ in the form that cannot flip sign (spec §5.3) and
+    /* |f_t| = |f_tr| − E_t Δλ in the form that cannot flip sign and
      * is exactly 0 for c = h = 0 */
     out->ft = sg * (h * fabs(ftr) + Et * h * alpha_n + Et * c) / (Et + h);
     return 1;

@@ -1,5 +1,5 @@
 /* edmd.c — the EDMD growth-packing driver: set-up, event loop, stop criteria.
- * Contract: core/edmd/edmd.h; folder guide core/edmd/README.md (spec §3).
+ * Contract: core/edmd/edmd.h; folder guide core/edmd/README.md.
  *
  * Time unit: the time a grain at the rms speed per axis (u = mean target
  * diameter d̄ per unit time) needs to cross d̄.  Relative growth: every
@@ -143,7 +143,7 @@ static double kinetic(const edmd_state *s)
 }
 
 /* In a fully periodic box the centre of mass is at rest (Meier's Eq. 3.9
- * does not conserve momentum for unequal rates; spec §3.5). */
+ * does not conserve momentum for unequal rates). */
 static void remove_drift(edmd_state *s)
 {
     if (!all_periodic(s))
@@ -185,8 +185,8 @@ static int rebuild_all(edmd_state *s, pk_edmd_criterion *crit)
     return rc;
 }
 
-/* Synchronise everyone and move the time origin to now (spec §6: |t| stays
- * small against Δt).  Predictions are shifted, not recomputed. */
+/* Synchronise everyone and move the time origin to now (|t| stays small
+ * against Δt).  Predictions are shifted, not recomputed. */
 static void rebase(edmd_state *s)
 {
     double T = s->t;
@@ -202,7 +202,7 @@ static void rebase(edmd_state *s)
 }
 
 /* Kinetic-energy rescaling: every trajectory changes, so all predictions are
- * redone (spec §3.5).  p holds the positions now while the velocities change. */
+ * redone.  p holds the positions now while the velocities change. */
 static void rescale(edmd_state *s, double K0)
 {
     for (size_t i = 0; i < s->n; i++)
@@ -352,8 +352,8 @@ static double setup(edmd_state *s, const pk_particles *p, const pk_edmd_params *
     for (int k = 0; k < dim; k++)
         if (s->box.periodic[k])
             Lper = fmin(Lper, s->box.L[k]);
-    /* periodic images: a pair must have one image within reach (spec §3.3d) */
-    double grow_max = 1; /* growing until jammed: bound the sizes by φ <= 1 (spec §3.3d) */
+    /* periodic images: a pair must have one image within reach (Meier et al. §3) */
+    double grow_max = 1; /* growing until jammed: bound the sizes by φ <= 1 */
     if (prm->until == PK_EDMD_UNTIL_JAMMED && prm->growth == PK_EDMD_GROW_RELATIVE)
         grow_max = pow(1 / fmax(phi_sim(s, t_ref), 1e-300), 1.0 / dim);
     double room = 0.25 * Lper - rho_max * grow_max;

@@ -1,4 +1,4 @@
-/* edmd.h — event-driven growth packing (Lubachevsky–Stillinger; spec §3).
+/* edmd.h — event-driven growth packing (Lubachevsky–Stillinger; Titscher & Unger §5).
  *
  * Hard disks/spheres fly freely and grow linearly, ρ_i(t) = a_i + g_i t
  * (simulated radius, shell Δd/2 included); collisions follow one of the
@@ -113,7 +113,7 @@ typedef struct pk_edmd_stats {
     pk_edmd_criterion criterion;
     double phi;              /* φ of the true radii at the stop */
     double phi_sim;          /* φ of the simulated (shell) radii */
-    double pressure;         /* reduced pressure of the last window (Eq. spec §3.7) */
+    double pressure;         /* reduced pressure PV/NkT of the last window */
     double phi_jam_estimate; /* φ/(1 − d/p) */
     double delta_d;          /* gap guaranteed at the stop (2 h) */
     double t_stop, t_end;    /* simulated times (unit d̄/u) */

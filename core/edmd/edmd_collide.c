@@ -1,4 +1,5 @@
-/* edmd_collide.c — growth-aware collision rules (spec §3.4; pk_edmd_rule).
+/* edmd_collide.c — growth-aware collision rules (Meier et al. Eqs. 9–10,
+ * Titscher & Unger Eqs. 24–28; pk_edmd_rule).
  * Contract: edmd_collide_pair / edmd_collide_wall in core/edmd/edmd_state.h.
  *
  * Titscher's elastic rule (Eq. 27) alone leaves a growing pair approaching
@@ -16,7 +17,7 @@
 /* Meier–Kuhl–Steinmann 2007 Eq. (9): v_ni' = min(v_ni, v_nj) − g_i,
  * v_nj' = max(v_ni, v_nj) + g_j (n from i to j); ε_v is added only when
  * the normal speeds are equal, where Eq. (9) would leave the pair grazing.
- * Returns σ·J with J = ½(m_i|Δv_ni| + m_j|Δv_nj|) (spec §3.7). */
+ * Returns σ·J with J = ½(m_i|Δv_ni| + m_j|Δv_nj|) (the virial of the reduced pressure). */
 static double collide_meier(edmd_state *s, size_t i, size_t j, const double n[3], double dist)
 {
     double *vi = s->k[i].v, *vj = s->k[j].v;
@@ -89,7 +90,7 @@ void edmd_collide_wall(edmd_state *s, size_t i, int code)
     double *vk = &s->k[i].v[k];
     const double g = s->k[i].g;
     const double before = *vk;
-    /* outward speed u (> g admissible, spec §3.4): the lift rule takes the
+    /* outward speed u (> g admissible: the gap then opens): the lift rule takes the
      * least admissible one, the others reflect the gap rate u − g */
     const double u = code % 2 == 0 ? -before : before; /* elastic outward speed */
     const double out = s->rule == PK_EDMD_RULE_LIFT ? fmax(u, g + s->eps_v) : u + 2 * g + s->eps_v;

@@ -1,4 +1,4 @@
-/* edmd_nlist.c — Donev-style neighbour lists for growing grains (spec §3.3c).
+/* edmd_nlist.c — Donev-style neighbour lists for growing grains.
  * Contract: the edmd_nlist_* declarations in core/edmd/edmd_state.h.
  *
  * At its build time particle i gets a bounding sphere (centre c_i = x_i,

@@ -1,4 +1,4 @@
-/* edmd_predict.c — event times: pair collisions (spec §3.3a, cancellation-free
+/* edmd_predict.c — event times: pair collisions (Titscher & Unger Eqs. 21–22, cancellation-free
  * roots), walls (§3.3b), leaving the neighbour-list bounding sphere (§3.3c).
  * Contract: core/edmd/edmd.h (pk_edmd_pair_time, pk_edmd_exit_time) and the
  * edmd_predict declarations in core/edmd/edmd_state.h. */

@@ -86,7 +86,7 @@ typedef struct edmd_state {
     double *m;         /* mass */
     double h0, h1;     /* shell h(t) = h0 + h1 t */
     double t;          /* current time (re-based) */
-    double eps_v;      /* extra separation speed (spec §3.4) */
+    double eps_v;      /* extra separation speed (a grazing pair separates) */
     pk_edmd_rule rule; /* pair (and wall) collision rule */
     /* events: one (and a runner-up) per particle, 32-byte aligned */
     edmd_event *ev;
@@ -243,7 +243,7 @@ void edmd_nlist_free(edmd_state *s);
 
 /* Event-time roots (edmd_predict.c; tested on their own in test_edmd). */
 
-/* Time τ ≥ 0 until |Δp + Δv τ| = R + G τ (spec §3.3a, cancellation-free
+/* Time τ ≥ 0 until |Δp + Δv τ| = R + G τ (Titscher & Unger Eqs. 21–22, cancellation-free
  * roots); INFINITY if never.  *overlap set to 1 when C < −1e-9 R².  dim 2/3. */
 double pk_edmd_pair_time(const double dp[3], const double dv[3], double R, double G, int *overlap);
 

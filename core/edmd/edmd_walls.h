@@ -1,8 +1,8 @@
 /* edmd_walls.h — EDMD with walls that do not see the Δd/2 shell.
  *
  * The engine (core/edmd/edmd.h) reflects the simulated sphere, shell included, at
- * the walls, so every wall clearance of its result is ≥ Δd/2 (spec §1.7
- * [D]).  Titscher & Unger require the gap Δd only *between* grains (§3,
+ * the walls, so every wall clearance of its result is ≥ Δd/2.  Titscher &
+ * Unger require the gap Δd only *between* grains (§3,
  * §6.3: "a minimal distance Δd between the particles"; §8: the particles
  * "now have a distance Δd between each other"), and their A16 example
  * (a = 80 mm, Δd = 1 mm, φ_M = 53.5 %) is out of reach with the extra Δd/2

@@ -163,7 +163,7 @@ typedef struct shrink_ctx {
     size_t i;
 } shrink_ctx;
 
-/* Jerier §2.2 / spec §4.3: r_i, r_j ← k r_i, k r_j with k = 1 + g/(r_i + r_j)
+/* Jerier §2.2: r_i, r_j ← k r_i, k r_j with k = 1 + g/(r_i + r_j)
  * brings the pair to contact; radii only decrease, so one sweep suffices. */
 static int visit_shrink(size_t j, const double dx[PK_MAXDIM], double d2, void *vctx)
 {
@@ -244,7 +244,7 @@ static int visit_collect(size_t j, const double dx[PK_MAXDIM], double d2, void *
     return 0;
 }
 
-/* Acceptance tests of a candidate (x, r) (spec §4.2 "Acceptance tests [J]").
+/* Acceptance tests of a candidate (x, r) (Jerier §2.2).
  * 1 = added, 0 = rejected, -1 = out of memory. */
 static int try_candidate(filler *F, const double x[3], double r)
 {
@@ -391,7 +391,7 @@ static int try_locus(filler *F, const double q[3], int void_only)
                         F->st->singular++;
                         continue;
                     }
-                    /* root choice (spec §4.2 [R]): inside the quadruple's tet first,
+                    /* root choice: inside the quadruple's tet first,
                      * then the smaller */
                     int order[2] = {0, 1};
                     if (nroot == 2 && !pk_point_in_tet(cc, x[0]) && pk_point_in_tet(cc, x[1])) {

@@ -1,5 +1,5 @@
 /* tetfill.h — fill a tetrahedral mesh with spheres: Jerier et al. (2010)
- * geometric method (spec §4).
+ * geometric method (Jerier et al. 2010 §2).
  *
  * Steps, in the paper's order (§2.2, Fig. 1):
  *   2–3  spheres on the mid-edges (r = ℓ/8) and nodes (r = ℓ_s, the shortest
@@ -34,7 +34,7 @@
  * after reducing the radius so that no overlap with a sphere or a boundary
  * face exceeds ε·r_min ("in last resort", §2.1), still r >= r_min and it
  * touches at least z_min spheres or boundary faces (gap <= τ,
- * τ = max(ε r_min, 1e-9 r_min), spec §4.4; with the contact rule
+ * τ = max(ε r_min, 1e-9 r_min); with the contact rule
  * "touching", gap <= 0 as in Jerier's own code, see below).
  *
  * packd addition (not in the paper): when the four-sphere root exceeds r_max

@@ -1,4 +1,4 @@
-/* tetfill_stats.h — characterisation of a filled mesh (Jerier §3.1, spec §4.4):
+/* tetfill_stats.h — characterisation of a filled mesh (Jerier §3.1):
  * overlaps, coordination (Eq. 15), fabric tensor (Eq. 17) and eigenvalues,
  * solid fraction overall and per mesh region, spheres per tet, boundary
  * clearance.
@@ -6,8 +6,8 @@
  * Contacts (sphere pairs only; boundary faces and virtual spheres are not
  * counted; z = 2 N_c / N over all spheres, Eq. 15).  The paper gives no
  * tolerance, so three nested definitions are reported:
- *   contact  gap <= τ = max(ε, 1e-9)·r_min — the filler's own z_min test
- *            (spec §4.4 [R]); z_mean, the histogram and the fabric use it;
+ *   contact  gap <= τ = max(ε, 1e-9)·r_min — the filler's own z_min test;
+ *            z_mean, the histogram and the fabric use it;
  *   tangent  gap <= PK_TETFILL_TANGENT_TOL·r_min — the tangencies the solve
  *            creates (a root whose residual exceeds this bound is dropped,
  *            tetfill.c) plus every overlap; z counted this way is flat from

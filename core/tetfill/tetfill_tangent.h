@@ -1,5 +1,5 @@
 /* tetfill_tangent.h — Jerier's geometric procedure: a fifth sphere tangent to
- * four given spheres (Jerier et al. 2010 §2.1, Eqs. 1–9; spec §4.2, §6).
+ * four given spheres (Jerier et al. 2010 §2.1, Eqs. 1–9).
  *
  * Subtracting Eq. 1 from Eqs. 2–4 gives A x = b(r) (Eqs. 5–8), so
  * x = r x_a + x_b (Eq. 9), and Eq. 1 becomes α r² + 2β r + κ = 0 with

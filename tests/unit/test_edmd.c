@@ -1,4 +1,4 @@
-/* test_edmd.c — EDMD engine: collision-time roots (spec §3.3a), list-exit
+/* test_edmd.c — EDMD engine: collision-time roots (Titscher & Unger Eqs. 21–22), list-exit
  * times, walled-cube limits (Titscher §6.1), overlap-free results under the
  * independent gap audit, stopping exactly at a target, cancellation. */
 #include <math.h>

@@ -149,7 +149,7 @@ static void test_a16_reaches_delta_d_1_at_phi_535(void)
     pk_particles_init(&p, 3, 6000);
     double keep;
     CHECK(a16_start(0.535, 1, &b, &p, &keep) == 0);
-    /* expected count 5125 (spec §1.6, Titscher "about 5 000") */
+    /* expected count 5125 (the size law of §2–3; Titscher "about 5 000") */
     CHECK_MSG(p.n > 4900 && p.n < 5350, "n = %zu", p.n);
     pk_edmd_params prm;
     shell_params(&prm, 1.0, 1);
@@ -163,8 +163,8 @@ static void test_a16_reaches_delta_d_1_at_phi_535(void)
     /* φ_M of the sizes drawn: Algorithm 1 overshoots by less than one grain
      * per class (a 16 mm grain is 0.4 % of V·φ_eff): ±0.005 */
     CHECK_NEAR(pk_particles_solid_measure(&p) / V / keep, 0.535, 0.005);
-    /* the shell spheres fill φ ≈ 0.69 of the box (spec §1.6 expects 0.693
-     * from the size law; measured 0.691–0.695 over 6 seeds).  Titscher's
+    /* the shell spheres fill φ ≈ 0.69 of the box (0.693 expected from
+     * the size law; measured 0.691–0.695 over 6 seeds).  Titscher's
      * "φ_Δd = 25 %, total 67 %" matches this volume over the 81 mm box the
      * shells occupy when the walls see the true surface (0.694·(80/81)³) */
     CHECK_NEAR(st.phi_sim, 0.693, 0.01);

@@ -1,5 +1,5 @@
 /* test_pack_job.c — the pack job's plan (what a job implies before drawing)
- * reproduces the reference counts of spec §1.6 through the JSON inputs, and
+ * reproduces Titscher & Unger's counts (§3, Eq. 13) through the JSON inputs, and
  * a full run's sampled count agrees with the plan within its spread. */
 #include <math.h>
 #include <stdio.h>
@@ -83,8 +83,8 @@ static const char *first_warning(const json_t *sum)
     return json_string_value(json_array_get(json_object_get(sum, "warnings"), 0));
 }
 
-/* Expected counts at a = 150 mm, φ_M = 0.70, d_min = 2 mm (spec §1.6;
- * Titscher §3 "≈ 44 000 / 40 000"; Eq. 13 sign-corrected for Fuller).  ±1
+/* Expected counts at a = 150 mm, φ_M = 0.70, d_min = 2 mm (Titscher §3
+ * "≈ 44 000 / 40 000"; Eq. 13 sign-corrected for Fuller).  ±1
  * absorbs the rounding of the published integers. */
 static void test_plan_reference_counts(void)
 {

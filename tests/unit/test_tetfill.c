@@ -38,7 +38,7 @@ static int load(const char *name, pk_mesh *m)
     return 0;
 }
 
-/* Jerier's rule with the ratio alone: r̄ = mean edge / 8 (spec §4.1). */
+/* Jerier's rule with the ratio alone: r̄ = mean edge / 8 (Jerier §2.2; YADE's ratio rule). */
 static void ratio_radii(const pk_mesh *m, double R, pk_tetfill_params *prm)
 {
     double rbar = m->edge_mean / 8;

@@ -26,7 +26,7 @@ static void test_regular_tetrahedron(void)
 {
     /* four mutually touching spheres r = √2 on a regular tet: the hole sphere
      * is r = √3 − √2 at the origin; the other root −(√3 + √2) (enclosing) is
-     * dropped (spec §4.2 unit test) */
+     * dropped */
     double c[4][3] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
     double r[4] = {sqrt(2.0), sqrt(2.0), sqrt(2.0), sqrt(2.0)}, x[2][3], rr[2];
     int n;
