@@ -173,7 +173,7 @@ static inline int full_bytes(uint64_t w)
 }
 
 /* The listed voxels turn into a list of their open groups, no longer than
- * theirs.  Draws looked up from the voxel list are dropped (rejected
+ * theirs.  Draws picked from the voxel list are dropped (rejected
  * whatever their place: the law of the others is kept). */
 static void list_groups(pk_rsa_vox *v)
 {
@@ -192,8 +192,11 @@ static void list_groups(pk_rsa_vox *v)
     v->nlist = k;
     v->nstale = 0;
     v->grouped = 1;
+    /* every pending draw is dropped, looked up or not: a pick not yet looked
+     * up is uniform over the voxel list's length, and the group list may be
+     * longer (up to GROUPS_PER_VOXEL times) — it would reach only its front */
     for (int s = 0; s < PK_RSA_DRAW_AHEAD; s++)
-        v->id[s] = UINT32_MAX;
+        v->pick[s] = v->id[s] = UINT32_MAX;
 }
 
 /* Drop the voxels (groups) left without an open sub-voxel from the list (in
