@@ -30,7 +30,8 @@
  * every job runs on its packing (core/space/gap_audit.h, horizon r_max as the jobs
  * pass it), timed after the placement, with its ratio to the placement.
  * `rsa mono` runs only the default-path monodisperse cases (1e4, 1e5, 1e6)
- * and the scaling line: a quick re-measurement.
+ * and the scaling line: a quick re-measurement.  `rsa gap` runs only A16 with
+ * Δd 1 mm at 10^3..10^6 grains and Titscher's 150 mm specimen (gap()).
  * The first line, case=machine, is the machine's state at the time: the
  * latency of a dependent load from a 64 MB array (a random cycle).  The
  * placer is bound by such loads, and this VM's latency wanders (150-200 ns
@@ -297,10 +298,61 @@ static void jobs(void)
     fflush(stdout);
 }
 
+/* `rsa gap`: RSA with a gap at scale (issue targets: A16 with Δd 1 mm at
+ * >= 10^5 grains per CPU second, flat from 10^3 to 10^6 grains; Titscher's
+ * 150 mm specimen < 5 CPU s).  a16-dd1-4e3 in cubes of edge 172 mm ·
+ * (N / 37 937)^(1/3) (the 172 mm cube holds 37 937 grains), then the
+ * specimen; a summary line says which targets hold. */
+static void gap(void)
+{
+    static const struct {
+        const char *name;
+        double edge_mm;
+        int reps;
+    } size[] = {{"a16_dd1_1e3", 51, 5},
+                {"a16_dd1_1e4", 111, 3},
+                {"a16_dd1_1e5", 238, 1},
+                {"a16_dd1_1e6", 513, 1}};
+    enum { NSIZE = sizeof size / sizeof size[0] };
+    double rate[NSIZE], lo = INFINITY;
+    for (int k = 0; k < NSIZE; k++) {
+        char patch[128];
+        snprintf(patch, sizeof patch, "{\"domain\":{\"box\":{\"size\":[%g,%g,%g]}}}",
+                 size[k].edge_mm, size[k].edge_mm, size[k].edge_mm);
+        rate[k] = job_case(size[k].name, "a16-dd1-4e3", patch, size[k].reps);
+        lo = fmin(lo, rate[k]);
+    }
+    bench_job t;
+    double t_cpu = NAN;
+    long t_rss = 0;
+    if (bench_job_run("titscher150-a16-dmin05", NULL, &t) == 0) {
+        t_cpu = t.cpu_s;
+        t_rss = t.maxrss_kb;
+        printf("bench=rsa case=titscher150_a16_dmin05_dd05 n=%.0f placed=%.0f reason=%s "
+               "cpu_s=%.3f maxrss_kb=%ld draws_per_grain=%.2f smallest_gap=%.6g\n",
+               bench_num(t.sum, "count_requested"), bench_num(t.sum, "count_placed"),
+               json_string_value(json_object_get(t.sum, "termination_reason")), t.cpu_s,
+               t.maxrss_kb, bench_num(json_object_get(t.sum, "rsa"), "draws_per_grain"),
+               bench_num(t.sum, "smallest_gap"));
+        json_decref(t.sum);
+    } else {
+        printf("bench=rsa case=titscher150_a16_dmin05_dd05 error=\"%s\"\n", t.err);
+    }
+    printf("bench=rsa case=gap_targets rate_min=%.0f rate_ratio_1e6_over_1e3=%.3f "
+           "rate_target=100000 rate_met=%d titscher_cpu_s=%.3f titscher_maxrss_kb=%ld "
+           "titscher_target_cpu_s=5 titscher_met=%d\n",
+           lo, rate[NSIZE - 1] / rate[0], lo >= 1e5, t_cpu, t_rss, t_cpu < 5);
+    fflush(stdout);
+}
+
 int main(int argc, char **argv)
 {
     printf("bench=rsa case=machine dram_chase_ns=%.1f\n", dram_chase_ns());
     fflush(stdout);
+    if (argc > 1 && strcmp(argv[1], "gap") == 0) {
+        gap();
+        return 0;
+    }
     if (argc > 1 && strcmp(argv[1], "mono") == 0) {
         double r4 = mono("mono3d_phi030_1e4", 3, 10000, 0.30, BATCHED, REPS_1E4);
         double r5 = mono("mono3d_phi030_1e5", 3, 100000, 0.30, BATCHED, REPS_1E5);

@@ -209,15 +209,18 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
         snprintf(err, errlen, "out of memory");
         goto out;
     }
-    /* initial_stress balanced: f_int of the start state at u = 0 joins every
-     * load (a trial evaluation, nothing committed) */
-    if (job->balanced) {
+    /* f_int of the start state at u = 0 (a trial evaluation, nothing
+     * committed).  balanced: it joins every load.  free: the first step's
+     * parts start from it, so the prestress is released along that step and
+     * a step cut releases part of it (released at once, a cut could not make
+     * the step smaller: the block-small RVE of seed 7 ended at det F < 0
+     * whatever the cut). */
+    {
         char why[256] = "";
         f0 = calloc(s.ndof + 1, sizeof *f0);
         int r0 = f0 ? pk_fe2_residual(&pb, st.u, NULL, f0, NULL, why, sizeof why) : -1;
         if (r0 != 0) {
-            snprintf(err, errlen, "initial_stress balanced: the start state: %s",
-                     r0 > 0 ? why : "out of memory");
+            snprintf(err, errlen, "the start state (u = 0): %s", r0 > 0 ? why : "out of memory");
             goto out;
         }
     }
@@ -242,8 +245,10 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
             pc.step = done + 1;
             double t = (double)i / (double)s.increments[k];
             pk_fe2_setup_targets(&s, k, t, uD, fext);
-            for (size_t d = 0; f0 && d < s.ndof; d++)
+            for (size_t d = 0; job->balanced && d < s.ndof; d++)
                 fext[d] += f0[d];
+            if (done == 0 && !job->balanced)
+                memcpy(st.fext, f0, s.ndof * sizeof *f0);
             pk_fe2_step_report rep;
             memset(&rep, 0, sizeof rep);
             int r = pk_fe2_step(&pb, &job->newton, &st, uD, fext, &rep, &wm);

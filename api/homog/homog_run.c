@@ -149,6 +149,22 @@ static json_t *tensor_json(const double T[9], int dim)
     return a;
 }
 
+/* Why a grain could leave a restricted-Taylor RVE: its hull (rve->hull_gap). */
+static const char *hull_note(const pk_homog_rve *rve)
+{
+    static _Thread_local char note[200];
+    if (rve->bc != PK_BC_RESTRICTED_TAYLOR || !isfinite(rve->hull_gap))
+        return "";
+    snprintf(note, sizeof note,
+             rve->hull_gap < 1 ? "; the hull is full (widest gap between neighbouring hull grains "
+                                 "%.3g × the smallest diameter, Meier 2009 §3.5): a grain was "
+                                 "squeezed through it"
+                               : "; the hull is not full (widest gap between neighbouring hull "
+                                 "grains %.3g × the smallest diameter ≥ 1, Meier 2009 §3.5)",
+             rve->hull_gap);
+    return note;
+}
+
 int pk_homog_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
                  const char *out_path, json_t **summary, char *err, size_t errlen)
 {
@@ -211,7 +227,7 @@ int pk_homog_run(const void *parsed, const pk_run_ctx *run, const char *job_json
     pk_homog_step st, last;
     pk_homog_audit au;
     const char *reason = "complete";
-    char failure[600] = "", what[400];
+    char failure[900] = "", what[400];
     /* a re-queued job continues after its last saved step (checkpoint file
      * of `packd run --checkpoint`: committed state, record, counters) */
     pk_homog_ckpt ck = {0};
@@ -236,8 +252,8 @@ int pk_homog_run(const void *parsed, const pk_run_ctx *run, const char *job_json
             reason = pk_dr_stop_name(st.dr.stop);
         else if (pk_homog_audit_step(&rve, &o, &tr, &st, &au)) {
             pk_homog_audit_describe(&au, &st, what, sizeof what);
-            snprintf(failure, sizeof failure, "the pre-compression step failed its audit: %s",
-                     what);
+            snprintf(failure, sizeof failure, "the pre-compression step failed its audit: %s%s",
+                     what, (au.failed & PK_AUDIT_ESCAPED) ? hull_note(&rve) : "");
             reason = "audit_failed";
         } else
             pk_homog_commit(&com, &tr);
@@ -279,8 +295,8 @@ int pk_homog_run(const void *parsed, const pk_run_ctx *run, const char *job_json
             max_iter_step = st.dr.iterations;
         if (bad) { /* the committed history would carry the defect on: stop here */
             pk_homog_audit_describe(&au, &st, what, sizeof what);
-            snprintf(failure, sizeof failure, "load step %zu of %zu failed its audit: %s", k,
-                     job.nstep, what);
+            snprintf(failure, sizeof failure, "load step %zu of %zu failed its audit: %s%s", k,
+                     job.nstep, what, (bad & PK_AUDIT_ESCAPED) ? hull_note(&rve) : "");
             not_converged += !!(bad & PK_AUDIT_NOT_CONVERGED);
             reason = "audit_failed";
             break;
@@ -400,6 +416,17 @@ int pk_homog_run(const void *parsed, const pk_run_ctx *run, const char *job_json
                         job.wall_time_s, done, job.nstep);
     else if (!strcmp(reason, "cancelled"))
         pk_verdict_fail(sum, "cancelled after %zu of %zu load steps", done, job.nstep);
+    if (rve.bc == PK_BC_RESTRICTED_TAYLOR && isfinite(rve.hull_gap)) {
+        json_object_set_new(sum, "hull",
+                            json_pack("{s:f,s:b}", "widest_gap_over_d_min", rve.hull_gap, "full",
+                                      rve.hull_gap < 1));
+        if (!(rve.hull_gap < 1))
+            pk_verdict_warn(sum,
+                            "the hull is not full (Meier 2009 §3.5): neighbouring hull grains "
+                            "leave a gap of %.3g × the smallest diameter, wide enough for an inner "
+                            "grain to leave the RVE",
+                            rve.hull_gap);
+    }
     if (unjammed)
         pk_verdict_warn(sum,
                         "%zu of %zu load steps had no jammed grain (every free grain a "

@@ -57,6 +57,7 @@ int pk_homog_rve_from_arrays(int dim, pk_homog_bc bc, size_t n, const double *X,
     for (int k = 0; k < 3; k++)
         rve->L[k] = L ? L[k] : 0;
     rve->V = V;
+    rve->hull_gap = NAN;
     memcpy(rve->X, X, 3 * n * sizeof *X);
     memcpy(rve->r, r, n * sizeof *r);
     memcpy(rve->fixed, fixed, n);
@@ -81,6 +82,7 @@ static int build_periodic(const pk_box *b, const pk_particles *p, double f, pk_h
     }
     rve->n = p->n;
     rve->periodic = 1;
+    rve->hull_gap = NAN;
     for (size_t i = 0; i < p->n; i++) {
         for (int k = 0; k < 3; k++)
             rve->X[3 * i + k] = k < b->dim ? p->x[3 * i + k] : 0;
@@ -89,6 +91,54 @@ static int build_periodic(const pk_box *b, const pk_particles *p, double f, pk_h
     }
     if (p->n)
         rve->fixed[0] = rve->hull[0] = 1; /* the pinned grain */
+    return 0;
+}
+
+typedef struct side_key {
+    double along;
+    size_t i;
+} side_key;
+
+static int by_along(const void *a, const void *b)
+{
+    double u = ((const side_key *)a)->along, v = ((const side_key *)b)->along;
+    return (u > v) - (u < v);
+}
+
+/* rve->hull_gap (homog_rve.h) of a 2D unfolded RVE: per side, the hull
+ * particles meeting it (the hull's band, as in build_unfolded) in order
+ * along it, and the gaps between consecutive ones.  -1: out of memory. */
+static int measure_hull_gap(pk_homog_rve *rve, const double band[2])
+{
+    rve->hull_gap = NAN;
+    if (rve->dim != 2)
+        return 0;
+    side_key *key = malloc((rve->n ? rve->n : 1) * sizeof *key);
+    if (!key)
+        return -1;
+    double dmin = INFINITY, widest = 0;
+    for (size_t i = 0; i < rve->n; i++)
+        dmin = fmin(dmin, 2 * rve->r[i]);
+    for (int a = 0; a < 2; a++)
+        for (int hi = 0; hi < 2; hi++) {
+            size_t m = 0;
+            for (size_t i = 0; i < rve->n; i++) {
+                const double *X = &rve->X[3 * i];
+                int meets =
+                    hi ? X[a] + rve->r[i] >= rve->L[a] - band[a] : X[a] - rve->r[i] <= band[a];
+                if (rve->hull[i] && meets)
+                    key[m++] = (side_key){X[1 - a], i};
+            }
+            qsort(key, m, sizeof *key, by_along);
+            for (size_t k = 1; k < m; k++) {
+                const double *P = &rve->X[3 * key[k - 1].i], *Q = &rve->X[3 * key[k].i];
+                double gap =
+                    hypot(Q[0] - P[0], Q[1] - P[1]) - rve->r[key[k - 1].i] - rve->r[key[k].i];
+                widest = fmax(widest, gap);
+            }
+        }
+    free(key);
+    rve->hull_gap = dmin < INFINITY ? widest / dmin : NAN;
     return 0;
 }
 
@@ -143,6 +193,14 @@ static int build_unfolded(const pk_box *b, const pk_particles *p, double f, pk_h
     rve->n = n;
     for (size_t i = 0; i < n; i++)
         rve->fixed[i] = rve->bc == PK_BC_TAYLOR ? 1 : rve->hull[i];
+    for (int k = 0; k < 3; k++)
+        rve->L[k] = k < dim ? b->L[k] : 0;
+    rve->dim = dim;
+    double band[2] = {b->periodic[0] ? 0 : dmin, b->periodic[1] ? 0 : dmin};
+    if (measure_hull_gap(rve, band) != 0) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
     return 0;
 }
 

@@ -39,6 +39,12 @@ typedef struct pk_homog_rve {
     int periodic;     /* contacts by minimum image across L */
     double L[3];
     double V; /* undeformed RVE measure */
+    /* widest gap |l_ij| − r_i − r_j between neighbouring hull particles
+     * along a side (consecutive by the coordinate along it), over the
+     * smallest diameter: the hull is "full" below 1 (Meier 2009 §3.5; spec
+     * H9) and a larger gap lets an inner grain out under restricted Taylor.
+     * 2D Taylor / restricted Taylor; NAN otherwise (no order along a 3D face) */
+    double hull_gap;
 } pk_homog_rve;
 
 /* Build the RVE from a packing.  radius_factor (>= 1) inflates every radius

@@ -9,15 +9,17 @@
 #include "core/rsa/batch/rsa_batch.h"
 #include "rsa_voxels.h"
 
-/* Draws come from a voxel set (rsa_voxels.h) built for a run of sizes
- * r in [r_build / SEGMENT_RATIO, r_build]; it is rebuilt when the sizes fall
- * below.  Larger ratios mean fewer rebuilds but weaker covers. */
-#define SEGMENT_RATIO 1.25
-/* A set is built only if it stays O(grains): voxels <= this many per grain of
- * its segment (plus a constant).  Otherwise (e.g. a few fine grains in a box
- * 1000× their size) the plain draws are used. */
-#define VOXELS_PER_GRAIN 16
+/* Draws come from one voxel set (rsa_voxels.h) built for the smallest grain
+ * still to place, so it serves the rest of the run and each placed grain is
+ * marked once.  It is built only if it stays O(grains): voxels <= this many
+ * per grain still to place (plus a constant); otherwise (e.g. a few fine
+ * grains in a box 1000× their size) the plain draws are used.  A16 with
+ * Δd 1 mm needs 26 per grain, Titscher's 150 mm specimen 37. */
+#define VOXELS_PER_GRAIN 64
 #define VOXELS_FREE 65536
+/* and at most this many in all: 12 bytes a voxel, 1.6 GB (A16 with Δd 1 mm:
+ * ~5·10⁶ grains); beyond, plain draws */
+#define VOXELS_MAX ((uint64_t)1 << 27)
 
 /* Marking covered sub-voxels costs more than it saves while most draws
  * succeed: it starts once a window of WINDOW placements took more than
@@ -29,80 +31,56 @@
 typedef struct segment {
     pk_rsa_vox vox;
     int on;
-    int covering;       /* placed grains mark their exclusion zones */
-    int unstored;       /* a segment grain went to the grid instead of a voxel */
-    size_t first;       /* grains first.. (in `out`) are stored in vox, not yet in the grid */
-    double retry_below; /* no new build is tried while r >= retry_below */
+    int tried;     /* a set was built or refused for the grains from here on */
+    int covering;  /* placed grains mark their exclusion zones */
+    size_t marked; /* grains 0..marked-1 (in `out`) have marked the set */
     uint64_t win_draws, win_placed;
 } segment;
 
-/* Every grain placed so far marks its exclusion zone: the grains of earlier
- * segments, then this segment's in voxel order (neighbouring marks share
- * cache lines).  Marks are optional for correctness (a bit left set only
- * costs a draw), so a cancel request may cut this short. */
-static void start_covering(segment *sg, const pk_particles *out, pk_monitor *mon, pk_progress *pg)
+/* Every grain placed and not yet marked marks its exclusion zone.  Marks are
+ * optional for correctness (a bit left set only costs a draw), so a cancel
+ * request may cut this short. */
+static void mark_placed(segment *sg, const pk_particles *out, pk_monitor *mon, pk_progress *pg)
 {
     sg->covering = 1;
-    size_t upto = sg->unstored ? out->n : sg->first;
-    for (size_t j = 0; j < upto; j++) {
-        pk_rsa_vox_cover(&sg->vox, &out->x[3 * j], out->r[j]);
-        if ((j & 0xfff) == 0xfff && pk_monitor_tick(mon, pg, 0))
+    for (; sg->marked < out->n; sg->marked++) {
+        pk_rsa_vox_cover(&sg->vox, &out->x[3 * sg->marked], out->r[sg->marked]);
+        /* a coarse grain marks ~10⁵ voxels of a fine set: tick often */
+        if ((sg->marked & 0x3f) == 0x3f && pk_monitor_tick(mon, pg, 0)) {
+            sg->marked++;
             return;
-    }
-    if (!sg->unstored)
-        for (uint64_t v = 0; v < sg->vox.nvox; v++) {
-            if (sg->vox.cell[v].x[0] != INFINITY)
-                pk_rsa_vox_cover(&sg->vox, sg->vox.cell[v].x, sg->vox.cell[v].r);
-            if ((v & 0xffff) == 0xffff && pk_monitor_tick(mon, pg, 0))
-                return;
         }
+    }
 }
 
-/* Build the voxel set for grain i onwards (all bits set; the placed grains
- * mark their zones once start_covering runs). */
+/* Build the voxel set for grain i onwards, valid down to the smallest grain
+ * (all bits set; the placed grains mark their zones once covering starts). */
 static void begin_segment(segment *sg, const pk_box *b, const double *diameters, size_t i, size_t n,
-                          double gap, double wall, const pk_particles *out)
+                          double gap, double wall)
 {
-    double r = 0.5 * diameters[i];
-    double r_valid = fmax(0.5 * diameters[n - 1], r / SEGMENT_RATIO);
-    size_t count = 0;
-    while (i + count < n && 0.5 * diameters[i + count] >= r_valid)
-        count++;
-    sg->retry_below = r_valid;
-    uint64_t nv = pk_rsa_vox_count(b, r_valid, r, gap, wall);
-    if (nv == 0 || nv > (uint64_t)VOXELS_PER_GRAIN * count + VOXELS_FREE)
+    sg->tried = 1;
+    double r_valid = 0.5 * diameters[n - 1];
+    uint64_t nv = pk_rsa_vox_count(b, r_valid, 0.5 * diameters[i], gap, wall);
+    if (nv == 0 || nv > VOXELS_MAX || nv > (uint64_t)VOXELS_PER_GRAIN * (n - i) + VOXELS_FREE)
         return;
-    if (pk_rsa_vox_init(&sg->vox, b, r_valid, r, gap, wall) != 0)
+    if (pk_rsa_vox_init(&sg->vox, b, r_valid, 0.5 * diameters[i], gap, wall) != 0)
         return; /* out of memory for the set: plain draws still work */
-    sg->first = out->n;
     sg->on = 1;
-    sg->covering = sg->unstored = 0;
+    sg->covering = 0;
+    sg->marked = 0;
     sg->win_draws = sg->win_placed = 0;
 }
 
-/* Hand the segment's grains to the grid (the one neighbour structure). */
-static int end_segment(segment *sg, pk_grid *grid, const pk_particles *out)
-{
-    int rc = 0;
-    for (size_t j = sg->first; j < out->n; j++)
-        rc |= pk_grid_insert(grid, out, j);
-    pk_rsa_vox_free(&sg->vox);
-    sg->on = 0;
-    return rc;
-}
-
-/* A batched run's entry hook (pk_rsa_batch_env.enter): the grid must hold
- * every grain placed so far. */
-typedef struct segment_exit {
-    segment *sg;
-    pk_grid *grid;
-    const pk_particles *out;
-} segment_exit;
-
+/* A batched run's entry hook (pk_rsa_batch_env.enter): the batched path has
+ * sets of its own, so this one is freed; the grains after the run build a
+ * new one. */
 static int leave_segment(void *ctx)
 {
-    segment_exit *x = ctx;
-    return x->sg->on ? end_segment(x->sg, x->grid, x->out) : 0;
+    segment *sg = ctx;
+    if (sg->on)
+        pk_rsa_vox_free(&sg->vox);
+    sg->on = sg->tried = 0;
+    return 0;
 }
 
 int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *species, size_t n,
@@ -144,9 +122,8 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
     double solid = pk_particles_solid_measure(out);
     pk_progress pg = {.stage = "rsa", .total = n, .eta_s = -1};
 
-    segment sg = {.on = 0, .retry_below = prm->draws == PK_RSA_DRAWS_PLAIN ? 0 : INFINITY};
+    segment sg = {.on = 0, .tried = prm->draws == PK_RSA_DRAWS_PLAIN};
     size_t no_batch_below = prm->test.one_at_a_time ? SIZE_MAX : 0;
-    segment_exit flush = {&sg, &grid, out};
     const pk_rsa_batch_env env = {.b = b,
                                   .prm = prm,
                                   .grid = &grid,
@@ -158,7 +135,7 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
                                   .out = out,
                                   .st = st,
                                   .enter = leave_segment,
-                                  .ctx = &flush};
+                                  .ctx = &sg};
     for (size_t i = 0; i < n; i++) {
         double r = 0.5 * diameters[i];
         /* Draw range per axis: walls keep the grain `wall` away (spec §2.1). */
@@ -197,19 +174,17 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
         }
         if (i >= no_batch_below)
             no_batch_below = i + run; /* the rest of this run goes one at a time too */
-        if (sg.on && r < sg.vox.r_valid && end_segment(&sg, &grid, out) != 0) {
-            st->reason = PK_STOP_ERROR;
-            break;
-        }
-        if (!sg.on && r < sg.retry_below)
-            begin_segment(&sg, b, diameters, i, n, gap, wall, out);
-        uint64_t failed = 0, vid = 0;
+        if (!sg.tried && prm->draws == PK_RSA_DRAWS_OPEN)
+            begin_segment(&sg, b, diameters, i, n, gap, wall);
+        if (sg.on && sg.covering && sg.marked < out->n)
+            mark_placed(&sg, out, mon, &pg); /* grains of a batched run before */
+        uint64_t failed = 0;
         double x[PK_MAXDIM] = {0, 0, 0};
         int saturated = 0;
         for (;;) {
             int ok;
             if (sg.on) {
-                int rc = pk_rsa_vox_draw(&sg.vox, &rng, x, &vid);
+                int rc = pk_rsa_vox_draw(&sg.vox, &rng, x);
                 if (rc < 0) {
                     saturated = 1;
                     break;
@@ -220,8 +195,7 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
                 for (int k = 0; ok && k < b->dim; k++)
                     if (!b->periodic[k] && (x[k] < lo[k] || x[k] > lo[k] + span[k]))
                         ok = 0;
-                ok = ok && !pk_rsa_vox_overlaps(&sg.vox, x, r) &&
-                    !pk_grid_overlaps(&grid, out, x, r);
+                ok = ok && !pk_grid_overlaps(&grid, out, x, r);
             } else {
                 for (int k = 0; k < b->dim; k++)
                     x[k] = lo[k] + span[k] * pk_rng_uniform(&rng);
@@ -233,7 +207,7 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
             if (++failed >= prm->max_failed_draws)
                 break;
             if (failed == COVER_AFTER_FAILS && sg.on && !sg.covering)
-                start_covering(&sg, out, mon, &pg);
+                mark_placed(&sg, out, mon, &pg);
             if ((failed & 0xffff) == 0 && pk_monitor_tick(mon, &pg, 0))
                 break;
         }
@@ -250,22 +224,16 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
             break;
         }
         size_t j = pk_particles_push(out, x, r, species[i]);
-        int stored = 0;
-        if (j != (size_t)-1 && sg.on) {
-            /* the grid check stays exact for a grain the voxels could not take */
-            stored = pk_rsa_vox_store(&sg.vox, vid, x, r) == 0;
-            sg.unstored |= !stored;
-            if (sg.covering) {
-                pk_rsa_vox_cover(&sg.vox, x, r);
-            } else if (sg.win_draws += failed + 1, ++sg.win_placed == WINDOW) {
-                if (sg.win_draws > COVER_AFTER * WINDOW)
-                    start_covering(&sg, out, mon, &pg);
-                sg.win_draws = sg.win_placed = 0;
-            }
-        }
-        if (j == (size_t)-1 || (!stored && pk_grid_insert(&grid, out, j) != 0)) {
+        if (j == (size_t)-1 || pk_grid_insert(&grid, out, j) != 0) {
             st->reason = PK_STOP_ERROR;
             break;
+        }
+        if (sg.on && sg.covering) {
+            mark_placed(&sg, out, mon, &pg);
+        } else if (sg.on && (sg.win_draws += failed + 1, ++sg.win_placed == WINDOW)) {
+            if (sg.win_draws > COVER_AFTER * WINDOW)
+                mark_placed(&sg, out, mon, &pg);
+            sg.win_draws = sg.win_placed = 0;
         }
         st->placed++;
         solid += pk_ball_measure(b->dim, r);
@@ -285,8 +253,8 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
     pg.phi = solid / box_measure;
     if (mon && !mon->cancelled)
         pk_monitor_tick(mon, &pg, 1);
-    if (sg.on && end_segment(&sg, &grid, out) != 0)
-        st->reason = PK_STOP_ERROR;
+    if (sg.on)
+        pk_rsa_vox_free(&sg.vox);
     pk_grid_free(&grid);
     st->seconds = pk_wall_seconds() - t0;
     return st->reason == PK_STOP_ERROR ? -1 : 0;

@@ -6,11 +6,22 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define NO_SLOT UINT32_MAX
-#define MAX_VOXELS ((uint64_t)1 << 31)
+/* list entries voxel·8 + group fit 32 bits */
+#define MAX_VOXELS ((uint64_t)1 << 29)
+/* The list is compacted once 1/STALE_PER_LIST of its groups are full: draws
+ * into those are certain rejections, a compaction is one pass over the list.
+ * 2: TODO */
+#define STALE_PER_LIST 2
 
-/* Voxel edge bound: a voxel's diagonal stays below the smallest contact
- * distance 2 r_valid + Δd, so it holds at most one centre (rsa_voxels.h). */
+/* Groups are listed instead of voxels once there are at most this many open
+ * ones per listed voxel: a draw then lands in an open sub-voxel
+ * 8/GROUPS_PER_VOXEL times as often, for a list at most this many times as
+ * long.  2: A16 Δd 1 mm at 10⁵ grains, the same CPU time as groups all along with 55 MB instead of 82 (docs/perf/rsa-gap.md) */
+#define GROUPS_PER_VOXEL 2
+
+/* Voxel edge: the diagonal of the smallest contact distance 2 r_valid + Δd
+ * (64 sub-voxels of a quarter (3D) or an eighth (2D) of it resolve the
+ * marks; rsa_voxels.h). */
 static double edge_bound(int dim, double r_valid, double gap)
 {
     return (2 * r_valid + gap) / sqrt((double)dim) * (1 - 1e-9);
@@ -57,6 +68,31 @@ uint64_t pk_rsa_vox_count(const pk_box *b, double r_valid, double r_top, double 
     return total;
 }
 
+/* Groups of 2×2×2 (3D) or 4×2 (2D) sub-voxels, one byte each: a pocket of
+ * open space a few sub-voxels wide keeps only its groups listed. */
+static void set_bit_layout(pk_rsa_vox *v)
+{
+    for (int l = 0; l < v->sub; l++) {
+        if (v->box.dim == 3) {
+            v->boff[0][l] = (uint8_t)((l >> 1) * 8 + (l & 1));
+            v->boff[1][l] = (uint8_t)((l >> 1) * 16 + (l & 1) * 2);
+            v->boff[2][l] = (uint8_t)((l >> 1) * 32 + (l & 1) * 4);
+        } else {
+            v->boff[0][l] = (uint8_t)((l >> 2) * 8 + (l & 3));
+            v->boff[1][l] = (uint8_t)((l >> 1) * 16 + (l & 1) * 4);
+        }
+    }
+    int S = v->sub, Sz = v->box.dim == 3 ? S : 1;
+    for (int lz = 0; lz < Sz; lz++)
+        for (int ly = 0; ly < S; ly++)
+            for (int lx = 0; lx < S; lx++) {
+                unsigned bit = v->boff[0][lx] + v->boff[1][ly] + v->boff[2][lz];
+                v->lsub[bit][0] = (uint8_t)lx;
+                v->lsub[bit][1] = (uint8_t)ly;
+                v->lsub[bit][2] = (uint8_t)lz;
+            }
+}
+
 int pk_rsa_vox_init(pk_rsa_vox *v, const pk_box *b, double r_valid, double r_top, double gap,
                     double wall)
 {
@@ -66,7 +102,6 @@ int pk_rsa_vox_init(pk_rsa_vox *v, const pk_box *b, double r_valid, double r_top
         return -1;
     v->box = *b;
     v->r_valid = r_valid;
-    v->r_top = r_top;
     v->gap = gap;
     double lmax = 0;
     for (int k = 0; k < PK_MAXDIM; k++) {
@@ -84,36 +119,29 @@ int pk_rsa_vox_init(pk_rsa_vox *v, const pk_box *b, double r_valid, double r_top
      * coordinates, far below any length that matters to the statistics. */
     v->margin = 1e-9 * (2 * r_top + gap) + 1e-12 * lmax;
     v->nvox = nv;
-    v->sub = b->dim == 3 ? 4 : 8; /* 4³ or 8² sub-voxels: one 64-bit mask */
+    v->sub = b->dim == 3 ? 4 : 8; /* 4³ or 8² sub-voxels: one 64-bit word */
     for (int k = 0; k < PK_MAXDIM; k++)
         v->se[k] = v->e[k] / (double)v->sub;
-    v->cell = malloc(nv * sizeof *v->cell);
-    v->slot = malloc(nv * sizeof *v->slot);
-    v->active = malloc(nv * sizeof *v->active);
-    if (!v->cell || !v->slot || !v->active) {
+    set_bit_layout(v);
+    /* zeroed pages are mapped on first touch: no pass over the voxels here,
+     * and the list is the identity until its first compaction */
+    v->covered = calloc(nv, sizeof *v->covered);
+    if (!v->covered) {
         pk_rsa_vox_free(v);
         return -1;
     }
-    for (uint64_t i = 0; i < nv; i++) {
-        v->cell[i] = (pk_rsa_cell){.x = {INFINITY, 0, 0}, .r = 0, .mask = ~(uint64_t)0};
-        v->slot[i] = (uint32_t)i;
-        v->active[i] = (uint32_t)i;
-    }
-    v->nactive = nv;
+    v->nlist = nv;
+    v->open_groups = nv * PK_RSA_VOX_GROUPS;
     return 0;
 }
 
 void pk_rsa_vox_free(pk_rsa_vox *v)
 {
-    free(v->cell);
-    free(v->slot);
-    free(v->active);
+    free(v->covered);
+    free(v->list);
+
     memset(v, 0, sizeof *v);
 }
-
-/* Periodic image of an unwrapped index: the ranges scanned here reach at most
- * one period beyond the lattice (reach < L/2), so no division is needed. */
-static inline int64_t image_of(int64_t i, int64_t n) { return i < 0 ? -1 : (i >= n ? 1 : 0); }
 
 /* Index range [*lo, *hi] of voxels along axis k meeting [a, c]; walled axes
  * are clipped to the lattice, periodic ones stay unwrapped. */
@@ -130,15 +158,77 @@ static inline void axis_range(const pk_rsa_vox *v, int k, double a, double c, in
     }
 }
 
-static inline void remove_voxel(pk_rsa_vox *v, uint64_t vid)
+static inline int group_open(const pk_rsa_vox *v, uint32_t e)
 {
-    uint32_t s = v->slot[vid];
-    if (s == NO_SLOT)
-        return;
-    uint32_t last = v->active[--v->nactive];
-    v->active[s] = last;
-    v->slot[last] = s;
-    v->slot[vid] = NO_SLOT;
+    return (uint8_t)(v->covered[e >> 3] >> (8 * (e & 7))) != 0xff;
+}
+
+/* Bytes of w with all 8 bits set (exact: no carry crosses a byte). */
+static inline int full_bytes(uint64_t w)
+{
+    const uint64_t lo7 = 0x7f7f7f7f7f7f7f7full;
+    uint64_t t = ~w;
+    uint64_t y = ~(((t & lo7) + lo7) | t | lo7) >> 7; /* 1 in each full byte */
+    return (int)((y * 0x0101010101010101ull) >> 56);
+}
+
+/* The listed voxels turn into a list of their open groups, no longer than
+ * theirs.  Draws picked from the voxel list are dropped (rejected
+ * whatever their place: the law of the others is kept). */
+static void list_groups(pk_rsa_vox *v)
+{
+    uint32_t *g = malloc((v->open_groups + 1) * sizeof *g);
+    if (!g)
+        return; /* draws stay on voxels */
+    uint64_t k = 0;
+    for (uint64_t i = 0; i < v->nlist; i++) {
+        uint32_t vox = v->list ? v->list[i] : (uint32_t)i;
+        for (uint32_t q = 0; q < PK_RSA_VOX_GROUPS; q++)
+            if (group_open(v, vox * PK_RSA_VOX_GROUPS + q))
+                g[k++] = vox * PK_RSA_VOX_GROUPS + q;
+    }
+    free(v->list);
+    v->list = g;
+    v->nlist = k;
+    v->nstale = 0;
+    v->grouped = 1;
+    /* every pending draw is dropped, looked up or not: a pick not yet looked
+     * up is uniform over the voxel list's length, and the group list may be
+     * longer (up to GROUPS_PER_VOXEL times) — it would reach only its front */
+    for (int s = 0; s < PK_RSA_DRAW_AHEAD; s++)
+        v->pick[s] = v->id[s] = UINT32_MAX;
+}
+
+/* Drop the voxels (groups) left without an open sub-voxel from the list (in
+ * place, in list order, so the bits are read as a stream); the first
+ * compaction makes the list.  Once the open groups are fewer than half the
+ * listed voxels, groups are listed instead (4 bytes a voxel at most). */
+static void compact(pk_rsa_vox *v)
+{
+    if (!v->grouped && v->open_groups <= GROUPS_PER_VOXEL * v->nlist) {
+        list_groups(v);
+        if (v->grouped)
+            return;
+    }
+    uint64_t k = 0;
+    if (!v->list) {
+        v->list = malloc((v->nlist - v->nstale + 1) * sizeof *v->list);
+        if (!v->list)
+            return; /* draws stay on the identity list */
+        for (uint64_t i = 0; i < v->nlist; i++)
+            if (~v->covered[i])
+                v->list[k++] = (uint32_t)i;
+    } else if (!v->grouped) {
+        for (uint64_t i = 0; i < v->nlist; i++)
+            if (~v->covered[v->list[i]])
+                v->list[k++] = v->list[i];
+    } else {
+        for (uint64_t i = 0; i < v->nlist; i++)
+            if (group_open(v, v->list[i]))
+                v->list[k++] = v->list[i];
+    }
+    v->nlist = k;
+    v->nstale = 0;
 }
 
 /* Squared distance from c to the nearest point of voxel interval i on axis k. */
@@ -147,6 +237,14 @@ static inline double near2(const pk_rsa_vox *v, int k, int64_t i, double c)
     double a = v->org[k] + v->e[k] * (double)i;
     double f = c < a ? a - c : (c > a + v->e[k] ? c - a - v->e[k] : 0);
     return f * f;
+}
+
+/* Squared distance from c to the farthest point of voxel interval i on axis k. */
+static inline double far2(const pk_rsa_vox *v, int k, int64_t i, double c)
+{
+    double a = v->org[k] + v->e[k] * (double)i;
+    double d = c < a + 0.5 * v->e[k] ? a + v->e[k] - c : c - a;
+    return d * d;
 }
 
 static inline int64_t wrap_index(const pk_rsa_vox *v, int k, int64_t i)
@@ -185,11 +283,23 @@ void pk_rsa_vox_cover(pk_rsa_vox *v, const double x[PK_MAXDIM], double r)
         axis_range(v, 2, x[2] - R, x[2] + R, &zlo, &zhi);
     axis_range(v, 1, x[1] - R, x[1] + R, &ylo, &yhi);
     axis_range(v, 0, x[0] - R, x[0] + R, &xlo, &xhi);
+    /* the rows' words are far apart: fetch them all before the work (the
+     * loads were most of this function's time) */
+    for (int64_t iz = zlo; iz <= zhi; iz++) {
+        uint64_t zbase = (uint64_t)wrap_index(v, 2, iz) * (uint64_t)v->n[1];
+        for (int64_t iy = ylo; iy <= yhi; iy++) {
+            const uint64_t *row =
+                &v->covered[(zbase + (uint64_t)wrap_index(v, 1, iy)) * (uint64_t)v->n[0]];
+            __builtin_prefetch(&row[wrap_index(v, 0, xlo)]);
+            __builtin_prefetch(&row[wrap_index(v, 0, xhi)]);
+        }
+    }
     double fz[8] = {0}, fy[8], fx[8];
     for (int64_t iz = zlo; iz <= zhi; iz++) {
         double nz = dim == 3 ? near2(v, 2, iz, x[2]) : 0;
         if (nz >= R2)
             continue;
+        double fz_all = dim == 3 ? far2(v, 2, iz, x[2]) : 0;
         if (dim == 3)
             sub_far2(v, 2, iz, x[2], fz);
         uint64_t zbase = (uint64_t)wrap_index(v, 2, iz) * (uint64_t)v->n[1];
@@ -199,30 +309,43 @@ void pk_rsa_vox_cover(pk_rsa_vox *v, const double x[PK_MAXDIM], double r)
                 continue;
             sub_far2(v, 1, iy, x[1], fy);
             uint64_t base = (zbase + (uint64_t)wrap_index(v, 1, iy)) * (uint64_t)v->n[0];
+            double fzy = fz_all + far2(v, 1, iy, x[1]);
             for (int64_t ix = xlo; ix <= xhi; ix++) {
                 if (nzy + near2(v, 0, ix, x[0]) >= R2)
                     continue;
                 uint64_t vid = base + (uint64_t)wrap_index(v, 0, ix);
-                uint64_t m = v->cell[vid].mask;
-                if (!m)
+                uint64_t was = v->covered[vid];
+                if (!~was)
                     continue;
+                if (fzy + far2(v, 0, ix, x[0]) <= R2) { /* the whole voxel is inside */
+                    v->covered[vid] = ~(uint64_t)0;
+                    uint64_t filled = (uint64_t)(PK_RSA_VOX_GROUPS - full_bytes(was));
+                    v->open_groups -= filled;
+                    v->nstale += v->grouped ? filled : 1;
+                    continue;
+                }
                 sub_far2(v, 0, ix, x[0], fx);
                 uint64_t covered = 0;
-                unsigned bit = 0; /* (lz·S + ly)·S + lx, as in pk_rsa_vox_draw */
                 for (int lz = 0; lz < Sz; lz++)
                     for (int ly = 0; ly < S; ly++) {
                         double rem = R2 - fz[lz] - fy[ly];
-                        for (int lx = 0; lx < S; lx++, bit++)
-                            covered |= (uint64_t)(fx[lx] <= rem) << bit;
+                        unsigned row = (unsigned)v->boff[2][lz] + v->boff[1][ly];
+                        for (int lx = 0; lx < S; lx++)
+                            covered |= (uint64_t)(fx[lx] <= rem) << (row + v->boff[0][lx]);
                     }
-                if (m & covered) {
-                    v->cell[vid].mask = m & ~covered;
-                    if (!v->cell[vid].mask)
-                        remove_voxel(v, vid);
+                if (covered & ~was) {
+                    uint64_t now = was | covered;
+                    v->covered[vid] = now;
+                    uint64_t filled = (uint64_t)(full_bytes(now) - full_bytes(was));
+                    v->open_groups -= filled;
+                    v->nstale += v->grouped ? filled : (uint64_t) !~now;
                 }
             }
         }
     }
+    if (v->nstale * STALE_PER_LIST > v->nlist ||
+        (!v->grouped && v->open_groups <= GROUPS_PER_VOXEL * v->nlist))
+        compact(v);
 }
 
 /* Uniform integer in [0, n), n < 2^32, without bias (Lemire's method). */
@@ -240,77 +363,58 @@ static inline uint64_t uniform_below(pk_rng *g, uint32_t n)
     return m >> 32;
 }
 
-int pk_rsa_vox_draw(const pk_rsa_vox *v, pk_rng *g, double x[PK_MAXDIM], uint64_t *vid)
+/* Draws are picked DRAW_AHEAD calls before their use and their group is
+ * looked up halfway, so the two cache misses of a draw (list entry, bits)
+ * overlap with other draws' work.  Still exact: a pick is uniform over the
+ * list when made; if it lies beyond the list's end at the look-up (a
+ * compaction since) it is a rejected draw, otherwise its voxel is uniform
+ * over the list of that moment, whose open space contains all space still
+ * open at the use, where the bits and the exact test are applied.  8: TODO */
+static inline void pick(pk_rsa_vox *v, pk_rng *g, int s)
 {
-    if (v->nactive == 0)
+    v->pick[s] = (uint32_t)uniform_below(g, (uint32_t)v->nlist);
+    if (v->list)
+        __builtin_prefetch(&v->list[v->pick[s]]);
+}
+
+static inline void look_up(pk_rsa_vox *v, int s)
+{
+    uint32_t k = v->pick[s];
+    v->id[s] = k >= v->nlist ? UINT32_MAX : (v->list ? v->list[k] : k);
+    if (v->id[s] != UINT32_MAX)
+        __builtin_prefetch(&v->covered[v->grouped ? v->id[s] >> 3 : v->id[s]]);
+}
+
+int pk_rsa_vox_draw(pk_rsa_vox *v, pk_rng *g, double x[PK_MAXDIM])
+{
+    if (v->nlist == 0)
         return -1;
-    uint64_t id = v->active[uniform_below(g, (uint32_t)v->nactive)];
-    *vid = id;
-    unsigned bit = (unsigned)(pk_rng_next(g) >> 58); /* uniform sub-voxel of 64 */
-    if (!(v->cell[id].mask >> bit & 1))
+    if (!v->primed) {
+        for (int s = 0; s < PK_RSA_DRAW_AHEAD; s++)
+            pick(v, g, s);
+        for (int s = 0; s < PK_RSA_DRAW_AHEAD / 2; s++)
+            look_up(v, s);
+        v->primed = 1;
+    }
+    int h = v->head;
+    v->head = (h + 1) % PK_RSA_DRAW_AHEAD;
+    uint64_t id = v->id[h];
+    pick(v, g, h);
+    look_up(v, (h + PK_RSA_DRAW_AHEAD / 2) % PK_RSA_DRAW_AHEAD);
+    if (id == UINT32_MAX)
+        return 1; /* past the list's end: a compaction dropped its group */
+    /* a uniform sub-voxel of the group's 8, or of the voxel's 64 */
+    uint64_t t = v->grouped ? id >> 3 : id;
+    unsigned bit = v->grouped ? (unsigned)(id & 7) * 8 + (unsigned)(pk_rng_next(g) >> 61)
+                              : (unsigned)(pk_rng_next(g) >> 58);
+    if (v->covered[t] >> bit & 1)
         return 1; /* covered sub-voxel: the exact test would reject any point in it */
-    uint64_t t = id;
     x[2] = 0;
     for (int k = 0; k < v->box.dim; k++) {
         int64_t i = (int64_t)(t % (uint64_t)v->n[k]);
         t /= (uint64_t)v->n[k];
-        int64_t j = i * v->sub + (int64_t)(bit % (unsigned)v->sub);
-        bit /= (unsigned)v->sub;
+        int64_t j = i * v->sub + v->lsub[bit][k];
         x[k] = v->org[k] + v->se[k] * ((double)j + pk_rng_uniform(g));
     }
-    return 0;
-}
-
-int pk_rsa_vox_overlaps(const pk_rsa_vox *v, const double x[PK_MAXDIM], double r)
-{
-    const int dim = v->box.dim;
-    const double reach = r + v->r_top + v->gap + v->margin, reach2 = reach * reach;
-    int64_t zlo = 0, zhi = 0, ylo, yhi;
-    if (dim == 3)
-        axis_range(v, 2, x[2] - reach, x[2] + reach, &zlo, &zhi);
-    axis_range(v, 1, x[1] - reach, x[1] + reach, &ylo, &yhi);
-    const double L0 = v->box.L[0], L1 = v->box.L[1], L2 = v->box.L[2];
-    for (int64_t iz = zlo; iz <= zhi; iz++) {
-        double dz2 = dim == 3 ? near2(v, 2, iz, x[2]) : 0;
-        if (dz2 >= reach2)
-            continue;
-        int64_t wz = wrap_index(v, 2, iz);
-        double sz = dim == 3 && v->box.periodic[2] ? L2 * (double)image_of(iz, v->n[2]) : 0;
-        uint64_t zbase = (uint64_t)wz * (uint64_t)v->n[1];
-        for (int64_t iy = ylo; iy <= yhi; iy++) {
-            double rem = reach2 - dz2 - near2(v, 1, iy, x[1]);
-            if (rem <= 0)
-                continue;
-            double w = sqrt(rem);
-            int64_t xlo, xhi;
-            axis_range(v, 0, x[0] - w, x[0] + w, &xlo, &xhi);
-            double sy = v->box.periodic[1] ? L1 * (double)image_of(iy, v->n[1]) : 0;
-            uint64_t base = (zbase + (uint64_t)wrap_index(v, 1, iy)) * (uint64_t)v->n[0];
-            const double py = x[1] - sy, pz = x[2] - sz;
-            for (int64_t ix = xlo; ix <= xhi; ix++) {
-                double sx = v->box.periodic[0] ? L0 * (double)image_of(ix, v->n[0]) : 0;
-                const pk_rsa_cell *cj = &v->cell[base + (uint64_t)wrap_index(v, 0, ix)];
-                /* empty voxel: x[0] = +inf, so d2 = +inf never counts */
-                double d0 = cj->x[0] - (x[0] - sx), d1 = cj->x[1] - py, d2 = cj->x[2] - pz;
-                double s = r + cj->r + v->gap;
-                if (d0 * d0 + d1 * d1 + d2 * d2 < s * s)
-                    return 1;
-            }
-        }
-    }
-    return 0;
-}
-
-int pk_rsa_vox_store(pk_rsa_vox *v, uint64_t vid, const double x[PK_MAXDIM], double r)
-{
-    if (vid >= v->nvox || v->cell[vid].x[0] != INFINITY)
-        return -1;
-    pk_rsa_cell *c = &v->cell[vid];
-    c->x[0] = x[0];
-    c->x[1] = x[1];
-    c->x[2] = v->box.dim == 3 ? x[2] : 0;
-    c->r = r;
-    if (r > v->r_top)
-        v->r_top = r;
     return 0;
 }

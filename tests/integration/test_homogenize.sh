@@ -51,7 +51,7 @@ assert len(g('final_state/position')) == g('rve_particles') and len(g('final_sta
 "
 
 # 3. the three boundary conditions on the same RVE: energy ranking of §9.3
-#    (Taylor stiffest, periodic softest) and σ̄11 ranking under compression
+#    (Taylor stiffest, periodic softest) and σ̄11 ranking under compression; the hull's widest gap
 for bc in taylor restricted_taylor periodic; do
     python3 -c "
 import json; j = json.load(open('$EX/homogenize-periodic-2d.json'))
@@ -67,7 +67,12 @@ e = [s[b]['energy_density'] for b in ('taylor', 'restricted_taylor', 'periodic')
 p = [-s[b]['sigma'][0] for b in ('taylor', 'restricted_taylor', 'periodic')]
 assert e[0] > e[1] > e[2], e
 assert p[0] > p[1] > p[2], p
-assert all(s[b]['complete'] for b in s)"
+assert all(s[b]['complete'] for b in s)
+# the example's hull is full (Meier 2009 §3.5), reported for restricted Taylor only
+h = s['restricted_taylor']['hull']
+assert h['full'] and 0 < h['widest_gap_over_d_min'] < 1, h
+assert 'hull' not in s['taylor'] and 'hull' not in s['periodic']
+assert not any('hull' in w for w in s['restricted_taylor'].get('warnings', []))"
 
 # 3b. the Newton solver runs through the process and records its exits (the equality with DR
 #     at one state is a unit test: along a path with rearrangements the two may pick different

@@ -305,6 +305,35 @@ static void test_bad_F_refused(void)
     pk_homog_rve_free(&rve);
 }
 
+/* Meier 2009 §3.5: the hull is "full" when neighbouring hull grains along a
+ * side leave gaps narrower than the smallest diameter.  Two grains cut by the
+ * side x = 0 (and their replicas at x = L) of a periodic 10 × 10 box, one
+ * small inner grain (d_min 0.5): gaps 3 (6 d_min) and 0.2 (0.4 d_min). */
+static void test_hull_gap_full_rule(void)
+{
+    const double ys[2][2] = {{2.0, 6.0}, {2.0, 3.2}}, want[2] = {6.0, 0.4};
+    for (int c = 0; c < 2; c++) {
+        pk_box b = {.dim = 2, .L = {10, 10, 0}, .periodic = {true, true, false}};
+        pk_particles p;
+        pk_particles_init(&p, 2, 3);
+        for (int k = 0; k < 2; k++)
+            pk_particles_push(&p, (double[3]){0.2, ys[c][k], 0}, 0.5, 0);
+        pk_particles_push(&p, (double[3]){5, 5, 0}, 0.25, 0);
+        for (int bc = 0; bc < 3; bc++) {
+            char err[128];
+            pk_homog_rve rve;
+            CHECK(pk_homog_rve_build(&b, &p, (pk_homog_bc)bc, 1.0, &rve, err, sizeof err) == 0);
+            if (bc == PK_BC_PERIODIC)
+                CHECK(isnan(rve.hull_gap));
+            else
+                CHECK_MSG(fabs(rve.hull_gap - want[c]) < 1e-12, "case %d bc %d: %g", c, bc,
+                          rve.hull_gap);
+            pk_homog_rve_free(&rve);
+        }
+        pk_particles_free(&p);
+    }
+}
+
 int main(void)
 {
     RUN(test_square_lattice_taylor_factor);
@@ -315,5 +344,6 @@ int main(void)
     RUN(test_objectivity);
     RUN(test_trial_commit);
     RUN(test_bad_F_refused);
+    RUN(test_hull_gap_full_rule);
     return check_summary();
 }

@@ -247,12 +247,13 @@ static void test_cover_is_exact(void)
                 for (int64_t j0 = 0; j0 < nsub[0]; j0++) {
                     int64_t j[3] = {j0, j1, j2};
                     uint64_t vid = 0;
-                    unsigned bit = 0;
+                    int l[3] = {0, 0, 0};
                     for (int k = dim - 1; k >= 0; k--) {
                         vid = vid * (uint64_t)v.n[k] + (uint64_t)(j[k] / v.sub);
-                        bit = bit * (unsigned)v.sub + (unsigned)(j[k] % v.sub);
+                        l[k] = (int)(j[k] % v.sub);
                     }
-                    int cleared = !(v.cell[vid].mask >> bit & 1);
+                    unsigned bit = pk_rsa_vox_bit(&v, l);
+                    int cleared = (int)(v.covered[vid] >> bit & 1);
                     int inside = 0, deep = 0;
                     for (int q = 0; q < nb; q++) {
                         double f2 = sub_far2_brute(&v, j, c[q]);
