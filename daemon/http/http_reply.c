@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "cors.h"
 #include "http.h"
 #include "daemon/data_paths.h"
 #include "daemon/log.h"
@@ -118,6 +119,8 @@ enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp)
     }
     if (status < 600)
         __atomic_add_fetch(&r->svc->responses[status], 1, __ATOMIC_RELAXED);
+    pk_config cfg = pk_service_config(r->svc);
+    pk_cors_response_headers(&cfg, pk_header(r, "Origin"), resp);
     MHD_add_response_header(resp, "Server", "packd/" PACKD_VERSION);
     MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
     enum MHD_Result rc = MHD_queue_response(r->conn, status, resp);
