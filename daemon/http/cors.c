@@ -6,11 +6,11 @@
 
 /* The headers a browser client reads from the API's answers; the safelisted
  * ones (Content-Type, Content-Length, Cache-Control, …) are readable anyway. */
-#define EXPOSED                                                                                   \
-    "Location, Link, Preference-Applied, Idempotent-Replayed, ETag, Retry-After, "               \
+#define EXPOSED                                                                                    \
+    "Location, Link, Preference-Applied, Idempotent-Replayed, ETag, Retry-After, "                 \
     "Content-Disposition, Content-Range, Accept-Ranges, Repr-Digest, X-Content-SHA256"
 /* The request headers the API reads beyond the safelisted ones. */
-#define ALLOWED_HEADERS                                                                           \
+#define ALLOWED_HEADERS                                                                            \
     "Authorization, Content-Type, Prefer, Idempotency-Key, If-None-Match, Range, Last-Event-ID"
 /* How long a browser may keep a preflight's answer (seconds). */
 #define PREFLIGHT_MAX_AGE "600"
