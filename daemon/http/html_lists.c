@@ -36,8 +36,9 @@ static void links_cell(pk_html *h, json_t *o, const char *skip_rel)
 
 void pk_html_processes(pk_html *h, json_t *doc)
 {
-    pk_html_raw(h, "<table><thead><tr><th>process</th><th>title</th><th>description</th>"
-                   "<th>version</th><th>links</th></tr></thead><tbody>\n");
+    pk_html_raw(h,
+                "<table><thead><tr><th>process</th><th>title</th><th>description</th>"
+                "<th>version</th><th>links</th></tr></thead><tbody>\n");
     size_t i;
     json_t *p;
     json_array_foreach (json_object_get(doc, "processes"), i, p) {
@@ -69,9 +70,10 @@ void pk_html_jobs(pk_html *h, json_t *doc)
             pk_html_raw(h, " ");
         }
     }
-    pk_html_raw(h, "</p>\n<table><thead><tr><th>job</th><th>process</th><th>status</th>"
-                   "<th>progress</th><th>message</th><th>created</th><th>finished</th>"
-                   "<th>links</th></tr></thead><tbody>\n");
+    pk_html_raw(h,
+                "</p>\n<table><thead><tr><th>job</th><th>process</th><th>status</th>"
+                "<th>progress</th><th>message</th><th>created</th><th>finished</th>"
+                "<th>links</th></tr></thead><tbody>\n");
     json_t *j;
     json_array_foreach (json_object_get(doc, "jobs"), i, j) {
         const char *status = str(j, "status");

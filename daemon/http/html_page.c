@@ -8,8 +8,8 @@
 #include "route_dashboard.h"
 
 /* No script at all; styles only from the service's own stylesheet. */
-#define HTML_CSP                                                                                  \
-    "default-src 'none'; style-src 'self'; img-src 'self'; base-uri 'none'; form-action 'none'; " \
+#define HTML_CSP                                                                                   \
+    "default-src 'none'; style-src 'self'; img-src 'self'; base-uri 'none'; form-action 'none'; "  \
     "frame-ancestors 'none'"
 
 static void put(pk_html *h, const char *s, size_t n)
@@ -31,10 +31,7 @@ static void put(pk_html *h, const char *s, size_t n)
     h->buf[h->len] = 0;
 }
 
-void pk_html_raw(pk_html *h, const char *s)
-{
-    put(h, s, strlen(s));
-}
+void pk_html_raw(pk_html *h, const char *s) { put(h, s, strlen(s)); }
 
 void pk_html_text(pk_html *h, const char *s)
 {
@@ -101,16 +98,18 @@ static char *with_format(const char *href, const char *value)
 
 static void page_start(pk_html *h, const char *title, json_t *doc)
 {
-    pk_html_raw(h, "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-                   "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
-                   "<title>");
+    pk_html_raw(h,
+                "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+                "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
+                "<title>");
     pk_html_text(h, title);
     /* relative links: every page sits at the top level, under public_url's path too */
-    pk_html_raw(h, " — packd</title><link rel=\"stylesheet\" href=\"dashboard/style.css\">"
-                   "<link rel=\"icon\" href=\"dashboard/favicon.svg\" type=\"image/svg+xml\">"
-                   "</head>\n<body><header><h1><a href=\"./\">packd</a></h1>"
-                   "<a href=\"processes?f=html\">processes</a> <a href=\"jobs?f=html\">jobs</a> "
-                   "<a href=\"api?f=html\">API</a></header>\n<main><h2>");
+    pk_html_raw(h,
+                " — packd</title><link rel=\"stylesheet\" href=\"dashboard/style.css\">"
+                "<link rel=\"icon\" href=\"dashboard/favicon.svg\" type=\"image/svg+xml\">"
+                "</head>\n<body><header><h1><a href=\"./\">packd</a></h1>"
+                "<a href=\"processes?f=html\">processes</a> <a href=\"jobs?f=html\">jobs</a> "
+                "<a href=\"api?f=html\">API</a></header>\n<main><h2>");
     pk_html_text(h, title);
     pk_html_raw(h, "</h2>\n");
     const char *self = link_href(doc, "self");

@@ -17,8 +17,8 @@ typedef struct pk_html {
     int oom;
 } pk_html;
 
-void pk_html_raw(pk_html *h, const char *s); /* markup, as is */
-void pk_html_text(pk_html *h, const char *s);  /* text or attribute value, escaped; NULL: nothing */
+void pk_html_raw(pk_html *h, const char *s);  /* markup, as is */
+void pk_html_text(pk_html *h, const char *s); /* text or attribute value, escaped; NULL: nothing */
 /* <a href="href">text</a>, both escaped */
 void pk_html_link(pk_html *h, const char *href, const char *text);
 /* A JSON value as text: a string as is, a number or literal printed, else nothing. */

@@ -7,6 +7,7 @@
 # f=html; hostile strings escaped; no inline script) and the service-doc page.
 . "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
 start_daemon conv --workers 1 || { fail serve_starts; exit 1; }
+CONV_DATA="$T/conv"
 
 # --- Prefer (RFC 7240) ---------------------------------------------------------
 c -D "$T/async.h" -o /dev/null -H 'Content-Type: application/json' -H 'Prefer: respond-async' \
@@ -62,3 +63,65 @@ check cors_get_other_origin_no_allow sh -c "! grep -qi '^access-control-allow-or
 c -o /dev/null -D "$T/opt_none.h" -X OPTIONS "$B/no/such/path"
 check options_unknown_path_404 grep -q '^HTTP/1.1 404' "$T/opt_none.h"
 B=$OFF
+
+# --- HTML views of /processes and /jobs; the service-doc ---------------------------
+BROWSER_ACCEPT='text/html,application/xhtml+xml,application/xml;q=0.9,*/*;q=0.8'
+# a job whose stored message is hostile markup (as a failure reason quoting a file could be)
+HOSTILE='<script>alert(1)</script><img src=x onerror=alert(2)>"'"'"'&'
+id=$(submit "$T/fast.json")
+wait_status "$id" successful 60 || fail html_job_finished
+python3 -c "
+import sqlite3, sys
+db = sqlite3.connect(sys.argv[1], timeout=10)
+db.execute('UPDATE jobs SET message = ? WHERE id = ?', (sys.argv[2], sys.argv[3]))
+db.commit()" "$CONV_DATA/queue.db" "$HOSTILE" "$id"
+for list in processes jobs; do
+    c -D "$T/$list.h" -o "$T/$list.html" -H "Accept: $BROWSER_ACCEPT" "$B/$list"
+    check "html_${list}_by_accept" grep -qi '^content-type: text/html' "$T/$list.h"
+    check "html_${list}_csp_no_script" sh -c "grep -i '^content-security-policy:' '$T/$list.h' | grep -q \"default-src 'none'\" && ! grep -i '^content-security-policy:' '$T/$list.h' | grep -qiE 'script-src|unsafe'"
+    check "html_${list}_no_script" python3 "$SRC/tests/integration/html_check.py" "$T/$list.html"
+    c -D "$T/${list}_f.h" -o "$T/${list}_f.html" -H 'Accept: application/json' "$B/$list?f=html"
+    check "html_${list}_by_f" grep -qi '^content-type: text/html' "$T/${list}_f.h"
+    c -D "$T/${list}_j.h" -o "$T/$list.json" -H "Accept: $BROWSER_ACCEPT" "$B/$list?f=json"
+    check "html_${list}_f_json" sh -c "grep -qi '^content-type: application/json' '$T/${list}_j.h' && python3 -c \"
+import json; d = json.load(open('$T/$list.json'))
+assert any(l['rel'] == 'alternate' and l['type'] == 'text/html' for l in d['links']), d['links']\""
+    check "html_${list}_f_bad_400" test "$(c -o /dev/null -w '%{http_code}' "$B/$list?f=xml")" = 400
+done
+check html_processes_lists_all sh -c "grep -q '<code>pack</code>' '$T/processes.html' && grep -q '<code>fe2</code>' '$T/processes.html'"
+check html_jobs_lists_job grep -q "$id" "$T/jobs.html"
+check html_jobs_hostile_escaped grep -qF '&lt;script&gt;alert(1)&lt;/script&gt;&lt;img src=x onerror=alert(2)&gt;&quot;&#39;&amp;' "$T/jobs.html"
+# JSON clients are unchanged: no Accept, or JSON preferred
+c -D "$T/pj.h" -o "$T/pj.json" "$B/processes"
+check html_processes_json_default grep -qi '^content-type: application/json' "$T/pj.h"
+
+c -o "$T/landing.json" "$B/"
+check service_doc_link python3 -c "
+import json; d = json.load(open('$T/landing.json'))
+l = [l for l in d['links'] if l['rel'] == 'service-doc']
+assert len(l) == 1 and l[0]['type'] == 'text/html' and l[0]['href'].endswith('/api?f=html'), d['links']"
+c -D "$T/apih.h" -o "$T/api.html" "$B/api?f=html"
+check service_doc_page sh -c "grep -qi '^content-type: text/html' '$T/apih.h' && grep -q 'swagger-ui-bundle.js' '$T/api.html'"
+check service_doc_no_inline_script sh -c "python3 '$SRC/tests/integration/html_check.py' '$T/api.html' && grep -i '^content-security-policy:' '$T/apih.h' | grep -q \"script-src 'self';\""
+c -o "$T/bundle.js" -w '%{http_code}' "$B/dashboard/swagger-ui-bundle.js" >"$T/bundle.code"
+check service_doc_bundle_served sh -c "test \"\$(cat '$T/bundle.code')\" = 200 && cmp -s '$T/bundle.js' '$SRC/web/swagger-ui-bundle.js'"
+check service_doc_license_served sh -c "c() { curl -s --max-time 20 \"\$@\"; }; c '$B/dashboard/swagger-ui-LICENSE.txt' | grep -q 'Apache License'"
+c -D "$T/apij.h" -o "$T/api.json" "$B/api"
+check api_json_unchanged sh -c "grep -qi '^content-type: application/vnd.oai.openapi+json' '$T/apij.h' && cmp -s '$T/api.json' '$SRC/schemas/openapi.json'"
+
+# --- the pages in a browser: Swagger UI renders the operations under the CSP --------
+BUILD=$(cd "${PACKD_BUILD:-$(dirname "$PACKD")}" && pwd)
+PW="$BUILD/node/node_modules/playwright-core"
+CHROMIUM=$(command -v chromium || true)
+if [ -z "$CHROMIUM" ] || ! command -v node >/dev/null || [ ! -f "$PW/package.json" ]; then
+    skip html_browser "needs Debian's chromium, node and playwright-core in $BUILD/node (make test installs them)"
+    exit 0
+fi
+ops=$(python3 -c "
+import json; d = json.load(open('$SRC/schemas/openapi.json'))
+print(sum(1 for p in d['paths'].values() for m in p if m in ('get', 'post', 'delete', 'put', 'patch')))")
+mkdir -p "$BUILD/screenshots"
+PLAYWRIGHT_CORE="$PW" CHROMIUM="$CHROMIUM" SLOW=$SLOW HOME="$T" timeout $((120 * SLOW)) \
+    node "$SRC/tests/integration/apidoc_driver.js" "$B" "$BUILD/screenshots" "$ops" >"$T/drv.txt" 2>&1
+grep -E '^(PASS|FAIL|SKIP) ' "$T/drv.txt"
+cat "$T/drv.txt" >&2; grep -qE '^(PASS|FAIL) ' "$T/drv.txt" || fail apidoc_driver "$(grep -m1 -iE 'error|timeout' "$T/drv.txt" || tail -1 "$T/drv.txt")"
