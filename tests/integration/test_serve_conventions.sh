@@ -109,6 +109,30 @@ check service_doc_license_served sh -c "c() { curl -s --max-time 20 \"\$@\"; }; 
 c -D "$T/apij.h" -o "$T/api.json" "$B/api"
 check api_json_unchanged sh -c "grep -qi '^content-type: application/vnd.oai.openapi+json' '$T/apij.h' && cmp -s '$T/api.json' '$SRC/schemas/openapi.json'"
 
+# --- openapi.json says what the daemon answers ---------------------------------------
+check openapi_421_415_html python3 -c "
+import json; d = json.load(open('$SRC/schemas/openapi.json'))
+ops = [(p, m, o) for p, i in d['paths'].items() for m, o in i.items() if m in ('get', 'post', 'delete', 'options')]
+miss = [m + ' ' + p for p, m, o in ops if '421' not in o['responses']]
+assert not miss, 'no 421: ' + ', '.join(miss)
+for p in ('/processes/{processId}/execution', '/files'):
+    assert '415' in d['paths'][p]['post']['responses'], p
+for p in ('/processes', '/jobs', '/api'):
+    g = d['paths'][p]['get']
+    assert 'text/html' in g['responses']['200']['content'], p
+    assert any(x.get('\$ref', '').endswith('/f') for x in g.get('parameters', [])), p
+assert all('options' in i for i in d['paths'].values())"
+REDOCLY="$(cd "${PACKD_BUILD:-$(dirname "$PACKD")}" && pwd)/node/node_modules/.bin/redocly"
+if [ -x "$REDOCLY" ]; then
+    if HOME="$T" timeout $((120 * SLOW)) "$REDOCLY" lint --format=stylish "$SRC/schemas/openapi.json" >"$T/lint.txt" 2>&1; then
+        pass openapi_redocly_lint
+    else
+        fail openapi_redocly_lint "$(grep -m1 ' error ' "$T/lint.txt" || tail -1 "$T/lint.txt")"
+    fi
+else
+    skip openapi_redocly_lint "@redocly/cli is not in build/node (make test installs it: sh tests/tools/playwright.sh build/node)"
+fi
+
 # --- the pages in a browser: Swagger UI renders the operations under the CSP --------
 BUILD=$(cd "${PACKD_BUILD:-$(dirname "$PACKD")}" && pwd)
 PW="$BUILD/node/node_modules/playwright-core"
