@@ -29,6 +29,30 @@ else
     fail process_refs_resolve "$(head -5 "$T/refs.txt" | tr '\n' ' ')"
 fi
 
+# python-jsonschema (with its referencing library, 4.18+) validates the examples with
+# each served inputsSchema alone: a registry that fetches nothing
+if python3 -c 'import referencing' 2>/dev/null; then
+    check inputs_schema_standalone python3 - "$B" "$SRC" <<'PY'
+import glob, json, sys, urllib.request
+from jsonschema import Draft202012Validator
+from referencing import Registry
+from referencing.exceptions import Unresolvable
+base, src = sys.argv[1], sys.argv[2]
+def retrieve(uri):
+    raise Unresolvable(uri)
+for p in ("pack", "homogenize", "fe2"):
+    schema = json.load(urllib.request.urlopen(base + "/processes/" + p, timeout=20))["inputsSchema"]
+    v = Draft202012Validator(schema, registry=Registry(retrieve=retrieve))
+    for f in glob.glob(src + "/examples/fe2/*.json") if p == "fe2" else []:
+        inputs = json.load(open(f))["inputs"]
+        assert not list(v.iter_errors(inputs)), f
+        inputs["micro"]["rve"] = {"pack": {"dim": 7}}  # checked by the bundled pack schema
+        assert any(list(e.absolute_path) == ["micro", "rve", "pack", "dim"] for e in v.iter_errors(inputs)), f
+PY
+else
+    skip inputs_schema_standalone "python3-jsonschema without the referencing library (4.18+)"
+fi
+
 # --- CORS: off by default; preflight answered for configured origins only --------
 preflight() { # BASE ORIGIN OUTFILE
     c -o /dev/null -D "$3" -X OPTIONS -H "Origin: $2" -H 'Access-Control-Request-Method: POST' \
