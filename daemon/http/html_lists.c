@@ -9,23 +9,33 @@ static const char *str(json_t *o, const char *key)
     return json_string_value(json_object_get(o, key));
 }
 
-/* A table cell with a member's value (escaped). */
-static void cell(pk_html *h, json_t *o, const char *key)
+/* A table cell with a member's string as code (an id). */
+static void code_cell(pk_html *h, json_t *o, const char *key)
 {
-    pk_html_raw(h, "<td>");
-    pk_html_value(h, json_object_get(o, key));
-    pk_html_raw(h, "</td>");
+    pk_html_raw(h, "<td><code>");
+    pk_html_text(h, str(o, key));
+    pk_html_raw(h, "</code></td>");
+}
+
+/* A table cell with each named member's value (escaped); keys end with NULL. */
+static void cells(pk_html *h, json_t *o, const char *const *keys)
+{
+    for (; *keys; keys++) {
+        pk_html_raw(h, "<td>");
+        pk_html_value(h, json_object_get(o, *keys));
+        pk_html_raw(h, "</td>");
+    }
 }
 
 /* Every link of o as "<a>title or rel</a>", separated by blanks. */
-static void links_cell(pk_html *h, json_t *o, const char *skip_rel)
+static void links_cell(pk_html *h, json_t *o)
 {
     pk_html_raw(h, "<td>");
     size_t i;
     json_t *l;
     json_array_foreach (json_object_get(o, "links"), i, l) {
         const char *href = str(l, "href"), *rel = str(l, "rel");
-        if (!href || (rel && skip_rel && !strcmp(rel, skip_rel)))
+        if (!href)
             continue;
         const char *slash = rel ? strrchr(rel, '/') : NULL; /* an OGC relation URI: its last word */
         pk_html_link(h, href, slash ? slash + 1 : rel ? rel : href);
@@ -42,13 +52,11 @@ void pk_html_processes(pk_html *h, json_t *doc)
     size_t i;
     json_t *p;
     json_array_foreach (json_object_get(doc, "processes"), i, p) {
-        pk_html_raw(h, "<tr><td><code>");
-        pk_html_text(h, str(p, "id"));
-        pk_html_raw(h, "</code></td>");
-        cell(h, p, "title");
-        cell(h, p, "description");
-        cell(h, p, "version");
-        links_cell(h, p, NULL);
+        static const char *const shown[] = {"title", "description", "version", NULL};
+        pk_html_raw(h, "<tr>");
+        code_cell(h, p, "id");
+        cells(h, p, shown);
+        links_cell(h, p);
         pk_html_raw(h, "</tr>\n");
     }
     pk_html_raw(h, "</tbody></table>\n");
@@ -77,20 +85,18 @@ void pk_html_jobs(pk_html *h, json_t *doc)
     json_t *j;
     json_array_foreach (json_object_get(doc, "jobs"), i, j) {
         const char *status = str(j, "status");
-        pk_html_raw(h, "<tr><td><code>");
-        pk_html_text(h, str(j, "jobID"));
-        pk_html_raw(h, "</code></td>");
-        cell(h, j, "processID");
+        static const char *const process[] = {"processID", NULL};
+        static const char *const shown[] = {"progress", "message", "created", "finished", NULL};
+        pk_html_raw(h, "<tr>");
+        code_cell(h, j, "jobID");
+        cells(h, j, process);
         pk_html_raw(h, "<td class=\"status st-");
         pk_html_text(h, status);
         pk_html_raw(h, "\">");
         pk_html_text(h, status);
         pk_html_raw(h, "</td>");
-        cell(h, j, "progress");
-        cell(h, j, "message");
-        cell(h, j, "created");
-        cell(h, j, "finished");
-        links_cell(h, j, NULL);
+        cells(h, j, shown);
+        links_cell(h, j);
         pk_html_raw(h, "</tr>\n");
     }
     pk_html_raw(h, "</tbody></table>\n");

@@ -104,16 +104,14 @@ static void allowed_methods(pk_req *r, char *allow, size_t size)
         }
 }
 
-/* OPTIONS (RFC 9110 9.3.7) of a known path: 204 with Allow, and for a CORS
- * preflight from a configured origin the methods and headers it may use
- * (cors.h).  Answered before authorisation: a preflight carries no token. */
-static enum MHD_Result options(pk_req *r)
+static int has_body(pk_req *r);
+
+/* OPTIONS (RFC 9110 9.3.7) of a known path, whose methods are allow: 204
+ * with Allow, and for a CORS preflight from a configured origin the methods
+ * and headers it may use (cors.h).  Answered before authorisation: a
+ * preflight carries no token. */
+static enum MHD_Result options(pk_req *r, const char *allow)
 {
-    char allow[128];
-    allowed_methods(r, allow, sizeof allow);
-    if (!allow[0])
-        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such resource", NULL,
-                               0);
     struct MHD_Response *resp = MHD_create_response_from_buffer(0, "", MHD_RESPMEM_PERSISTENT);
     if (!resp)
         return MHD_NO;
@@ -131,6 +129,8 @@ static enum MHD_Result no_route(pk_req *r)
     if (!allow[0])
         return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such resource", NULL,
                                0);
+    if (!strcmp(r->method, "OPTIONS") && !has_body(r))
+        return options(r, allow);
     char detail[200];
     snprintf(detail, sizeof detail, "%s is not allowed here; allowed: %s", r->method, allow);
     struct MHD_Response *resp =
@@ -217,8 +217,6 @@ static enum MHD_Result on_headers(pk_req *r)
         return pk_send_problem(r, 421, PK_PROBLEM_GENERIC, "Misdirected Request",
                                "this service does not answer to that Host name (allowed_hosts)",
                                NULL, 0);
-    if (!rt && !strcmp(r->method, "OPTIONS") && !has_body(r))
-        return options(r);
     if (!rt)
         return no_route(r);
     if (!pk_authorize(r, rt->access, &refused))

@@ -107,23 +107,19 @@ static enum MHD_Result send_asset(pk_req *r, const pk_web_asset *a)
     return send_asset_csp(r, a, CSP);
 }
 
-enum MHD_Result pk_send_api_page(pk_req *r)
+/* A page of web/ under its own policy. */
+static enum MHD_Result send_page(pk_req *r, const char *name, const char *csp)
 {
-    const pk_web_asset *a = asset("api.html");
+    const pk_web_asset *a = asset(name);
     if (!a)
         return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error",
-                               "the API page is not compiled in", NULL, 0);
-    return send_asset_csp(r, a, API_PAGE_CSP);
+                               "the page is not compiled in", NULL, 0);
+    return send_asset_csp(r, a, csp);
 }
 
-enum MHD_Result pk_send_dashboard_page(pk_req *r)
-{
-    const pk_web_asset *a = asset("index.html");
-    if (!a)
-        return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error",
-                               "the dashboard is not compiled in", NULL, 0);
-    return send_asset(r, a);
-}
+enum MHD_Result pk_send_api_page(pk_req *r) { return send_page(r, "api.html", API_PAGE_CSP); }
+
+enum MHD_Result pk_send_dashboard_page(pk_req *r) { return send_page(r, "index.html", CSP); }
 
 enum MHD_Result route_dashboard_asset(pk_req *r)
 {

@@ -90,7 +90,8 @@ static inline void fuzz_http_start(void)
     svc->cfg.workers = 0;
     svc->cfg.sync_wait_s = 0.2; /* a synchronous execution waits for no worker */
     svc->cfg.log_level = PK_LOG_ERROR;
-    snprintf(svc->cfg.cors_origins, sizeof svc->cfg.cors_origins, "http://lab.example"); /* cors.c */
+    snprintf(svc->cfg.cors_origins, sizeof svc->cfg.cors_origins,
+             "http://lab.example"); /* cors.c */
     pk_log_set_level(PK_LOG_ERROR);
     char path[1200];
     snprintf(path, sizeof path, "%s/jobs", svc->cfg.data);
