@@ -83,6 +83,9 @@ static const struct key {
     {"allowed_hosts", K_STR, F(allowed_hosts), 0, 0,
      "Host names requests may carry, comma-separated, * = any (unset: bind address, localhost, "
      "this machine's names and addresses, public_url's host); others get 421"},
+    {"cors_origins", K_STR, F(cors_origins), 0, 0,
+     "origins whose pages may call the API from a browser (CORS), comma-separated "
+     "scheme://host[:port], * = any (unset: none)"},
     {"trusted_proxy", K_ADDR, F(trusted_proxy), 0, 0,
      "address of the reverse proxy whose X-Packd-Owner is honoured"},
     {"executor", K_EXEC, F(executor), 0, 0,

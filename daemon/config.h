@@ -47,6 +47,7 @@ typedef struct pk_config {
     pk_auth_mode auth;       /* bearer tokens required (daemon/http/auth.c) */
     char trusted_proxy[64];  /* peer whose X-Packd-Owner is honoured; "" = none */
     char allowed_hosts[512]; /* Host header names accepted, comma-separated ("" = this machine's) */
+    char cors_origins[512];  /* origins browsers may call from, comma-separated ("" = CORS off) */
     pk_executor_kind executor;  /* local workers or a Slurm cluster */
     char slurm_partition[64];   /* sbatch --partition; "" = the cluster's default */
     char slurm_account[64];     /* sbatch --account; "" = the user's default */

@@ -81,6 +81,24 @@ static json_t *standalone_schema(json_t *ps, json_t *defs)
     return out;
 }
 
+/* The process's whole inputs schema, self-contained: the other embedded
+ * schemas it refers to by file name join its "$defs" whole, each under its
+ * own "$id" (a JSON Schema 2020-12 compound document), where those
+ * references resolve; its own definitions stay as they are. */
+static json_t *bundled_schema(json_t *schema)
+{
+    json_t *defs = json_object_get(schema, "$defs");
+    json_t *need = json_object();
+    collect_defs(schema, defs, need);
+    json_t *out = json_deep_copy(schema);
+    if (defs)
+        json_object_update_missing(need, defs);
+    if (json_object_size(need))
+        json_object_set(out, "$defs", need);
+    json_decref(need);
+    return out;
+}
+
 json_t *pk_process_description(const pk_process *p)
 {
     json_t *d = pk_process_summary(p);
@@ -123,7 +141,7 @@ json_t *pk_process_description(const pk_process *p)
         json_object_set_new(outputs, o->id, out);
     }
     json_object_set_new(d, "outputs", outputs);
-    json_object_set(d, "inputsSchema", schema ? schema : json_null());
+    json_object_set_new(d, "inputsSchema", schema ? bundled_schema(schema) : json_null());
     return d;
 }
 

@@ -72,6 +72,9 @@ void pk_absolute_links(pk_req *r, json_t *doc);
 /* The inverse for a request's inputs: links into this service given as
  * absolute URLs (as its documents give them) become paths again. */
 void pk_own_links_as_paths(pk_req *r, json_t *inputs);
+/* A document as a client sees it: no path of the data directory, links
+ * absolute (what pk_send_json does before sending). */
+void pk_client_view(pk_req *r, json_t *doc);
 /* JSON body (stolen); etag may be NULL. */
 enum MHD_Result pk_send_json(pk_req *r, unsigned status, json_t *body, const char *etag);
 /* A response with a JSON body (stolen, indented, ends with a newline). */

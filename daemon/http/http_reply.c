@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "cors.h"
 #include "http.h"
 #include "daemon/data_paths.h"
 #include "daemon/log.h"
@@ -89,7 +90,7 @@ void pk_absolute_links(pk_req *r, json_t *doc)
 }
 
 /* A document as a client sees it: no path of the data directory, links absolute. */
-static void client_view(pk_req *r, json_t *doc)
+void pk_client_view(pk_req *r, json_t *doc)
 {
     pk_config cfg = pk_service_config(r->svc);
     pk_hide_data_paths_json(doc, cfg.data);
@@ -118,6 +119,8 @@ enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp)
     }
     if (status < 600)
         __atomic_add_fetch(&r->svc->responses[status], 1, __ATOMIC_RELAXED);
+    pk_config cfg = pk_service_config(r->svc);
+    pk_cors_response_headers(&cfg, pk_header(r, "Origin"), resp);
     MHD_add_response_header(resp, "Server", "packd/" PACKD_VERSION);
     MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
     enum MHD_Result rc = MHD_queue_response(r->conn, status, resp);
@@ -149,7 +152,7 @@ struct MHD_Response *pk_json_response(json_t *body, const char *ctype)
 
 enum MHD_Result pk_send_json(pk_req *r, unsigned status, json_t *body, const char *etag)
 {
-    client_view(r, body);
+    pk_client_view(r, body);
     struct MHD_Response *resp = pk_json_response(body, "application/json");
     if (resp && etag)
         MHD_add_response_header(resp, "ETag", etag);
@@ -167,7 +170,7 @@ enum MHD_Result pk_send_text(pk_req *r, unsigned status, const char *ctype, cons
 
 enum MHD_Result pk_send_problem_doc(pk_req *r, unsigned status, json_t *doc, int retry_after)
 {
-    client_view(r, doc);
+    pk_client_view(r, doc);
     struct MHD_Response *resp = pk_json_response(doc, "application/problem+json");
     if (resp && retry_after > 0) {
         char ra[32];

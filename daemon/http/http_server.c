@@ -1,6 +1,7 @@
 /* http_server.c — libmicrohttpd set-up, request bodies (with the size limit
  * and the media type of JSON routes) and dispatch through the route table:
- * unknown path 404, known path with another method 405 + Allow.
+ * unknown path 404, known path with another method 405 + Allow, OPTIONS of
+ * a known path 204 + Allow (and CORS preflights, cors.h).
  *
  * Connections are served by http_threads epoll event loops (MHD's thread
  * pool), never a thread per connection: a slow or idle client costs a
@@ -19,6 +20,7 @@
 
 #include "auth.h"
 #include "conn_guard.h"
+#include "cors.h"
 #include "host_check.h"
 #include "http.h"
 #include "http_park.h"
@@ -85,23 +87,50 @@ static const pk_route *find_route(pk_req *r)
     return NULL;
 }
 
-static enum MHD_Result no_route(pk_req *r)
+/* The methods of the routes of this path ("GET, HEAD, DELETE"); "" if none. */
+static void allowed_methods(pk_req *r, char *allow, size_t size)
 {
-    char allow[128] = "";
+    allow[0] = 0;
     if (split_path(r, r->url) == 0)
         for (const pk_route *rt = pk_routes; rt->method; rt++) {
             if (!match(r, rt->pattern) || strstr(allow, rt->method))
                 continue;
             size_t l = strlen(allow);
-            snprintf(allow + l, sizeof allow - l, "%s%s", l ? ", " : "", rt->method);
+            snprintf(allow + l, size - l, "%s%s", l ? ", " : "", rt->method);
             if (!strcmp(rt->method, "GET") && !strstr(allow, "HEAD")) {
                 l = strlen(allow);
-                snprintf(allow + l, sizeof allow - l, ", HEAD");
+                snprintf(allow + l, size - l, ", HEAD");
             }
         }
+}
+
+static int has_body(pk_req *r);
+
+/* OPTIONS (RFC 9110 9.3.7) of a known path, whose methods are allow: 204
+ * with Allow, and for a CORS preflight from a configured origin the methods
+ * and headers it may use (cors.h).  Answered before authorisation: a
+ * preflight carries no token. */
+static enum MHD_Result options(pk_req *r, const char *allow)
+{
+    struct MHD_Response *resp = MHD_create_response_from_buffer(0, "", MHD_RESPMEM_PERSISTENT);
+    if (!resp)
+        return MHD_NO;
+    MHD_add_response_header(resp, "Allow", allow);
+    pk_config cfg = pk_service_config(r->svc);
+    if (pk_header(r, "Access-Control-Request-Method"))
+        pk_cors_preflight_headers(&cfg, pk_header(r, "Origin"), allow, resp);
+    return pk_send(r, 204, resp);
+}
+
+static enum MHD_Result no_route(pk_req *r)
+{
+    char allow[128];
+    allowed_methods(r, allow, sizeof allow);
     if (!allow[0])
         return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such resource", NULL,
                                0);
+    if (!strcmp(r->method, "OPTIONS") && !has_body(r))
+        return options(r, allow);
     char detail[200];
     snprintf(detail, sizeof detail, "%s is not allowed here; allowed: %s", r->method, allow);
     struct MHD_Response *resp =

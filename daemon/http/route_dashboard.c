@@ -16,6 +16,12 @@
 /* Pictures and downloads of an auth'd page are fetched with the token and
  * shown from blob: URLs. */
 #define CSP "default-src 'self'; img-src 'self' blob:; object-src 'none'; frame-ancestors 'none'"
+/* The API page runs only its own scripts too; Swagger UI sets style
+ * attributes and draws icons from data: URLs, and calls only this service. */
+#define API_PAGE_CSP                                                                               \
+    "default-src 'none'; script-src 'self'; style-src 'self' 'unsafe-inline'; "                    \
+    "img-src 'self' data:; connect-src 'self'; base-uri 'none'; form-action 'none'; "              \
+    "frame-ancestors 'none'"
 
 /* q of the most specific range of accept matching type ("text/html"):
  * an exact type, then its major type with a wildcard subtype, then any
@@ -74,7 +80,7 @@ static const char *media_type(const char *name)
     static const char *const types[][2] = {
         {".html", "text/html; charset=utf-8"}, {".js", "text/javascript; charset=utf-8"},
         {".css", "text/css; charset=utf-8"},   {".svg", "image/svg+xml"},
-        {".json", "application/json"},
+        {".json", "application/json"},         {".txt", "text/plain; charset=utf-8"},
     };
     const char *dot = strrchr(name, '.');
     for (size_t i = 0; dot && i < sizeof types / sizeof *types; i++)
@@ -83,32 +89,44 @@ static const char *media_type(const char *name)
     return "application/octet-stream";
 }
 
-static enum MHD_Result send_asset(pk_req *r, const pk_web_asset *a)
+static enum MHD_Result send_asset_csp(pk_req *r, const pk_web_asset *a, const char *csp)
 {
     struct MHD_Response *resp =
         MHD_create_response_from_buffer(a->len, (void *)a->data, MHD_RESPMEM_PERSISTENT);
     if (resp) {
         MHD_add_response_header(resp, "Content-Type", media_type(a->name));
-        MHD_add_response_header(resp, "Content-Security-Policy", CSP);
+        MHD_add_response_header(resp, "Content-Security-Policy", csp);
         MHD_add_response_header(resp, "Cache-Control", "no-cache");
         MHD_add_response_header(resp, "Vary", "Accept");
     }
     return pk_send(r, 200, resp);
 }
 
-enum MHD_Result pk_send_dashboard_page(pk_req *r)
+static enum MHD_Result send_asset(pk_req *r, const pk_web_asset *a)
 {
-    const pk_web_asset *a = asset("index.html");
+    return send_asset_csp(r, a, CSP);
+}
+
+/* A page of web/ under its own policy. */
+static enum MHD_Result send_page(pk_req *r, const char *name, const char *csp)
+{
+    const pk_web_asset *a = asset(name);
     if (!a)
         return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error",
-                               "the dashboard is not compiled in", NULL, 0);
-    return send_asset(r, a);
+                               "the page is not compiled in", NULL, 0);
+    return send_asset_csp(r, a, csp);
 }
+
+enum MHD_Result pk_send_api_page(pk_req *r) { return send_page(r, "api.html", API_PAGE_CSP); }
+
+enum MHD_Result pk_send_dashboard_page(pk_req *r) { return send_page(r, "index.html", CSP); }
 
 enum MHD_Result route_dashboard_asset(pk_req *r)
 {
-    /* the page itself is served at / only: its links are relative to it */
-    const pk_web_asset *a = strcmp(r->seg[1], "index.html") ? asset(r->seg[1]) : NULL;
+    /* the pages are served at / and /api only: their links are relative to them,
+     * and each has its own Content-Security-Policy */
+    const char *dot = strrchr(r->seg[1], '.');
+    const pk_web_asset *a = dot && !strcmp(dot, ".html") ? NULL : asset(r->seg[1]);
     if (!a)
         return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such dashboard file",
                                NULL, 0);

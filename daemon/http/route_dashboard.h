@@ -10,6 +10,8 @@
 int pk_prefers_html(pk_req *r);
 /* The dashboard's page (web/index.html). */
 enum MHD_Result pk_send_dashboard_page(pk_req *r);
+/* The interactive API page (web/api.html: Swagger UI over GET /api). */
+enum MHD_Result pk_send_api_page(pk_req *r);
 
 enum MHD_Result route_dashboard_asset(pk_req *r);    /* GET /dashboard/{file} */
 enum MHD_Result route_dashboard_examples(pk_req *r); /* GET /dashboard/examples */

@@ -5,7 +5,8 @@
  * "Prefer: respond-sync" (RFC 7240, optionally "wait=N") waits up to
  * sync_wait_s for the job, parked without a thread (http_park.h), and answers
  * 200 with its results as "response"/"outputs" ask; a job not finished by
- * then is answered 201 as usual. */
+ * then is answered 201 as usual.  "Prefer: respond-async" is always
+ * honoured: its 201 says so in Preference-Applied. */
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -41,26 +42,42 @@ static void sync_wait_free(void *p)
     free(w);
 }
 
-/* Seconds "Prefer" asks to wait for the answer: 0 unless it holds
- * respond-sync; its wait=N (RFC 7240 4.3) shortens the service's bound. */
-static double sync_seconds(const char *prefer, double bound)
+/* The preferences of a "Prefer" header (RFC 7240) this route knows:
+ * respond-sync, respond-async, and wait=N (4.3), which shortens the
+ * service's bound on a synchronous answer. */
+typedef struct prefer {
+    int sync, async;
+    double wait;
+} prefer;
+
+static prefer parse_prefer(const char *header, double bound)
 {
-    int sync = 0;
-    double wait = bound;
-    for (const char *p = prefer; p && *p;) {
+    prefer pr = {.wait = bound};
+    for (const char *p = header; p && *p;) {
         p += strspn(p, " \t,");
         size_t n = strcspn(p, ",;");
+        while (n && (p[n - 1] == ' ' || p[n - 1] == '\t'))
+            n--;
         if (n == 12 && !strncasecmp(p, "respond-sync", 12))
-            sync = 1;
+            pr.sync = 1;
+        else if (n == 13 && !strncasecmp(p, "respond-async", 13))
+            pr.async = 1;
         else if (n > 5 && !strncasecmp(p, "wait=", 5)) {
             double v = strtod(p + 5, NULL);
-            if (v >= 0 && v < wait)
-                wait = v;
+            if (v >= 0 && v < pr.wait)
+                pr.wait = v;
         }
         p += n;
         p += strcspn(p, ","); /* parameters of a preference (";…") are not used */
     }
-    return sync ? wait : 0;
+    return pr;
+}
+
+/* Seconds the client asks to wait for the answer: 0 unless it prefers respond-sync. */
+static double sync_seconds(const char *header, double bound)
+{
+    prefer pr = parse_prefer(header, bound);
+    return pr.sync ? pr.wait : 0;
 }
 
 static enum MHD_Result reply_job(pk_req *r, const char *id, int replayed);
@@ -131,6 +148,10 @@ static enum MHD_Result reply_job(pk_req *r, const char *id, int replayed)
     MHD_add_response_header(resp, "Location", loc);
     if (replayed)
         MHD_add_response_header(resp, "Idempotent-Replayed", "true");
+    /* asked for and given (OGC /req/core/process-execute-default-execution-mode):
+     * a respond-sync that ran out of time is not named, the answer is async all the same */
+    if (resp && parse_prefer(pk_header(r, "Prefer"), 0).async)
+        MHD_add_response_header(resp, "Preference-Applied", "respond-async");
     return pk_send(r, 201, resp);
 }
 

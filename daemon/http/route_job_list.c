@@ -6,7 +6,8 @@
  * the job's created time, minDuration/maxDuration (seconds) on started..finished
  * (..now while running).  limit is 1..10000 (default 10; above the maximum it
  * is the maximum, not an error).  A bad value is a 400 naming the parameter
- * and its rule.  Paging links (self, next, prev) keep the filters. */
+ * and its rule.  Paging links (self, next, prev) keep the filters.  Also as
+ * HTML (f=html or Accept: text/html; html_page.h). */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -14,6 +15,7 @@
 #include <string.h>
 
 #include "auth.h"
+#include "html_page.h"
 #include "http.h"
 #include "api/http/http_status_info.h"
 #include "api/http/http_time.h"
@@ -289,11 +291,10 @@ enum MHD_Result route_jobs(pk_req *r)
     if (offset > 0)
         add_link(links, "prev", limit, offset > limit ? offset - limit : 0, qs);
     free(qs);
-    rc =
-        pk_send_json(r, 200,
+    rc = pk_send_doc(r,
                      json_pack("{s:o,s:i,s:I,s:o}", "jobs", jobs, "numberMatched", total,
                                "numberReturned", (json_int_t)json_array_size(jobs), "links", links),
-                     NULL);
+                     "Jobs", pk_html_jobs);
 out:
     json_decref(q.status);
     json_decref(q.process);

@@ -1,7 +1,9 @@
 /* GET /, /conformance, /api — what the service is and which standards it follows.
- * A browser asking for / gets the dashboard instead (route_dashboard.c). */
+ * A browser asking for / gets the dashboard instead, for /api (or /api?f=html)
+ * the interactive API page, the landing page's service-doc (route_dashboard.c). */
 #include <string.h>
 
+#include "html_page.h"
 #include "http.h"
 #include "route_dashboard.h"
 #include "api/schemas/schemas_embedded.h"
@@ -21,6 +23,9 @@ enum MHD_Result route_landing(pk_req *r)
                           mklink("/api", "service-desc",
                                  "application/vnd.oai.openapi+json;version=3.0",
                                  "the API definition (OpenAPI 3.0)"));
+    json_array_append_new(links,
+                          mklink("/api?f=html", "service-doc", "text/html",
+                                 "the API documentation (interactive: Swagger UI)"));
     json_array_append_new(links,
                           mklink("/conformance",
                                  "http://www.opengis.net/def/rel/ogc/1.0/conformance",
@@ -55,6 +60,11 @@ enum MHD_Result route_conformance(pk_req *r)
 
 enum MHD_Result route_api(pk_req *r)
 {
+    int html = pk_wants_html(r);
+    if (html < 0)
+        return pk_send_bad_format(r);
+    if (html)
+        return pk_send_api_page(r);
     const char *doc = pk_schema_text("openapi.json"); /* schemas/openapi.json, served as is */
     if (!doc)
         return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error",

@@ -90,6 +90,8 @@ static inline void fuzz_http_start(void)
     svc->cfg.workers = 0;
     svc->cfg.sync_wait_s = 0.2; /* a synchronous execution waits for no worker */
     svc->cfg.log_level = PK_LOG_ERROR;
+    snprintf(svc->cfg.cors_origins, sizeof svc->cfg.cors_origins,
+             "http://lab.example"); /* cors.c */
     pk_log_set_level(PK_LOG_ERROR);
     char path[1200];
     snprintf(path, sizeof path, "%s/jobs", svc->cfg.data);
@@ -166,7 +168,22 @@ static inline void fuzz_http(const uint8_t *data, size_t size)
     struct sockaddr_in a = {.sin_family = AF_INET,
                             .sin_port = htons((uint16_t)fuzz_http_state.port)};
     a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (s < 0 || connect(s, (struct sockaddr *)&a, sizeof a) != 0) {
+    int c = s < 0 ? -1 : connect(s, (struct sockaddr *)&a, sizeof a);
+    if (c != 0 && s >= 0 && errno == EINTR) {
+        /* libFuzzer's -timeout alarm interrupted it: the connection goes on; wait for it */
+        struct pollfd w = {.fd = s, .events = POLLOUT};
+        int ready;
+        do
+            ready = poll(&w, 1, FUZZ_HTTP_ANSWER_S * 1000);
+        while (ready < 0 && errno == EINTR);
+        int err = ready > 0 ? 0 : ETIMEDOUT;
+        socklen_t len = sizeof err;
+        if (ready > 0)
+            getsockopt(s, SOL_SOCKET, SO_ERROR, &err, &len);
+        c = err ? -1 : 0;
+        errno = err;
+    }
+    if (c != 0) {
         perror("fuzz_http: connect");
         abort();
     }
