@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "http.h"
+#include "http_durations.h"
 #include "daemon/data_paths.h"
 #include "daemon/log.h"
 #include "api/digest.h"
@@ -118,6 +119,7 @@ enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp)
     }
     if (status < 600)
         __atomic_add_fetch(&r->svc->responses[status], 1, __ATOMIC_RELAXED);
+    pk_http_duration_observe(r->matched, status, pk_queue_now() - r->started);
     MHD_add_response_header(resp, "Server", "packd/" PACKD_VERSION);
     MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
     enum MHD_Result rc = MHD_queue_response(r->conn, status, resp);
