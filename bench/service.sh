@@ -28,6 +28,25 @@ out() { echo "bench=service $*"; }
 CASES=" ${*:-poll_status flood sse kill9_burst} "
 want() { case $CASES in *" $1 "*) return 0 ;; esac; return 1; }
 
+# server_le Q BEFORE AFTER: the upper bound (ms) of the bucket of
+# packd_http_request_duration_seconds that holds quantile Q of the status polls
+# (GET /jobs/{jobId}, 200) answered between two /metrics scrapes: the daemon's
+# own share of the latency, without wrk's queueing
+server_le() {
+    cat "$2" "$3" | awk -v q="$1" -v before="$(wc -l <"$2")" '
+        index($0, "packd_http_request_duration_seconds_bucket{method=\"GET\",route=\"/jobs/{jobId}\",code=\"200\"") == 1 {
+            match($0, /le="[^"]*"/); le = substr($0, RSTART + 4, RLENGTH - 5)
+            if (NR <= before) b[le] = $2; else { a[le] = $2; order[++n] = le }
+        }
+        END {
+            total = a["+Inf"] - b["+Inf"]
+            for (i = 1; i <= n; i++)
+                if (a[order[i]] - b[order[i]] >= q * total) {
+                    print (order[i] == "+Inf" ? "inf" : order[i] * 1000); exit
+                }
+        }'
+}
+
 # wrk's "1.23ms" / "456.00us" / "1.02s" -> milliseconds
 wrk_ms() { awk -v v="$1" 'BEGIN { n = v + 0; if (v ~ /us$/) n /= 1000; else if (v ~ /[0-9]s$/) n *= 1000; printf "%.2f", n }'; }
 
@@ -41,7 +60,9 @@ J2=$(submit "$T/edmd.json")
 wait_status "$J1" running 30
 wait_status "$J2" running 30
 if want poll_status && command -v wrk >/dev/null 2>&1; then
+    c "$B/metrics" >"$T/metrics0.txt"
     wrk -t2 -c100 -d20s --latency "$B/jobs/$J1" >"$T/wrk.txt" 2>&1
+    c "$B/metrics" >"$T/metrics1.txt"
     rps=$(sed -n 's/^Requests\/sec:[[:space:]]*//p' "$T/wrk.txt")
     p50=$(wrk_ms "$(awk '$1 == "50%" { print $2 }' "$T/wrk.txt")")
     p99=$(wrk_ms "$(awk '$1 == "99%" { print $2 }' "$T/wrk.txt")")
@@ -49,7 +70,10 @@ if want poll_status && command -v wrk >/dev/null 2>&1; then
         awk '{ print $1 + $2 + $3 + $4 }')
     non2xx=$(sed -n 's/.*Non-2xx or 3xx responses: \([0-9]*\).*/\1/p' "$T/wrk.txt")
     out "case=poll_status conns=100 seconds=20 workers_busy=$(c "$B/healthz" | sed -n 's/.*"busy": \([0-9]*\).*/\1/p')" \
-        "rps=$rps p50_ms=$p50 p99_ms=$p99 errors=$((${sock:-0} + ${non2xx:-0}))"
+        "rps=$rps p50_ms=$p50 p99_ms=$p99 errors=$((${sock:-0} + ${non2xx:-0}))" \
+        "server_p50_le_ms=$(server_le 0.5 "$T/metrics0.txt" "$T/metrics1.txt")" \
+        "server_p99_le_ms=$(server_le 0.99 "$T/metrics0.txt" "$T/metrics1.txt")" \
+        "load=$(cut -d' ' -f1 /proc/loadavg)"
 elif want poll_status; then
     echo "# poll_status skipped: wrk is not installed (Debian: apt-get install wrk)"
 fi
