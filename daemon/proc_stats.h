@@ -5,12 +5,12 @@
 #define PK_PROC_STATS_H
 
 typedef struct pk_proc_stats {
-    double start_time_s;        /* when the process started, seconds since the epoch */
-    double cpu_s;               /* user + system CPU seconds */
-    long long rss_bytes;        /* resident set size */
-    long long vsize_bytes;      /* virtual memory size */
-    long long open_fds;         /* open file descriptors */
-    long long max_fds;          /* soft limit of open files; -1: unlimited */
+    double start_time_s;   /* when the process started, seconds since the epoch */
+    double cpu_s;          /* user + system CPU seconds */
+    long long rss_bytes;   /* resident set size */
+    long long vsize_bytes; /* virtual memory size */
+    long long open_fds;    /* open file descriptors */
+    long long max_fds;     /* soft limit of open files; -1: unlimited */
 } pk_proc_stats;
 
 /* Fill s from /proc; 0, or -1 when /proc/self/stat cannot be read (the

@@ -46,8 +46,10 @@ void pk_http_duration_observe(const pk_route *rt, unsigned code, double seconds)
  * '*' segment named after the collection before it. */
 static void route_template(const char *pattern, char *out, size_t n)
 {
-    static const char *const names[][2] = {{"processes", "{processId}"}, {"jobs", "{jobId}"},
-                                           {"results", "{outputId}"},    {"files", "{fileId}"},
+    static const char *const names[][2] = {{"processes", "{processId}"},
+                                           {"jobs", "{jobId}"},
+                                           {"results", "{outputId}"},
+                                           {"files", "{fileId}"},
                                            {"dashboard", "{file}"}};
     size_t k = 0;
     const char *prev = "", *p = pattern;
@@ -108,9 +110,10 @@ static void expose_series(pk_text_buf *b, const char *method, const char *route,
 
 void pk_http_durations_expose(pk_text_buf *b)
 {
-    pk_text_put(b, "# HELP packd_http_request_duration_seconds Time from a request's complete "
-                   "head to its response queued, by method, route template and status code.\n"
-                   "# TYPE packd_http_request_duration_seconds histogram\n");
+    pk_text_put(b,
+                "# HELP packd_http_request_duration_seconds Time from a request's complete "
+                "head to its response queued, by method, route template and status code.\n"
+                "# TYPE packd_http_request_duration_seconds histogram\n");
     size_t routes = 0;
     while (pk_routes[routes].method)
         routes++;
