@@ -12,7 +12,8 @@
 #                 is present and ends successful; PRAGMA integrity_check
 # Needs wrk for poll_status (Debian package `wrk`; that case is skipped without it),
 # python3 and sqlite3.  Usage: PACKD=build/packd sh bench/service.sh [CASE...]
-# (no CASE: all four).
+# (no CASE: all four).  BENCH_SERVE_ARGS: more `packd serve` options, e.g.
+# "--worker-nice 10".
 PACKD_SRC=${PACKD_SRC:-$(pwd)}
 . "$PACKD_SRC/tests/integration/serve_helpers.inc"
 PY=$(python3 -c 'import sys; print(sys.executable)')
@@ -50,7 +51,8 @@ server_le() {
 # wrk's "1.23ms" / "456.00us" / "1.02s" -> milliseconds
 wrk_ms() { awk -v v="$1" 'BEGIN { n = v + 0; if (v ~ /us$/) n /= 1000; else if (v ~ /[0-9]s$/) n *= 1000; printf "%.2f", n }'; }
 
-start_daemon bench --workers 2 --max-queued-per-owner 1000 || exit 1
+# shellcheck disable=SC2086
+start_daemon bench --workers 2 --max-queued-per-owner 1000 ${BENCH_SERVE_ARGS:-} || exit 1
 PORT=${B##*:}
 
 # --- poll_status
@@ -70,7 +72,7 @@ if want poll_status && command -v wrk >/dev/null 2>&1; then
         awk '{ print $1 + $2 + $3 + $4 }')
     non2xx=$(sed -n 's/.*Non-2xx or 3xx responses: \([0-9]*\).*/\1/p' "$T/wrk.txt")
     out "case=poll_status conns=100 seconds=20 workers_busy=$(c "$B/healthz" | sed -n 's/.*"busy": \([0-9]*\).*/\1/p')" \
-        "rps=$rps p50_ms=$p50 p99_ms=$p99 errors=$((${sock:-0} + ${non2xx:-0}))" \
+        "serve_args=$(printf %s "${BENCH_SERVE_ARGS:-none}" | tr " " ,) rps=$rps p50_ms=$p50 p99_ms=$p99 errors=$((${sock:-0} + ${non2xx:-0}))" \
         "server_p50_le_ms=$(server_le 0.5 "$T/metrics0.txt" "$T/metrics1.txt")" \
         "server_p99_le_ms=$(server_le 0.99 "$T/metrics0.txt" "$T/metrics1.txt")" \
         "load=$(cut -d' ' -f1 /proc/loadavg)"
