@@ -97,7 +97,11 @@ static const struct key {
     {"slurm_packd", K_STR, F(slurm_packd), 0, 0,
      "path of packd on the compute nodes (unset: this binary's path)"},
     {"slurm_mem_mb", K_INT, F(slurm_mem_mb), 0, 1e8,
-     "sbatch --mem of each job in MB (0: the partition's default)"},
+     "memory of each job in MB, of each rank for an fe2 job of several (0: the partition's "
+     "default)"},
+    {"slurm_mpi", K_STR, F(slurm_mpi), 0, 0,
+     "srun --mpi plugin that starts the MPI ranks of an fe2 job asking for several "
+     "(srun --mpi=list on a node)"},
     {"slurm_max_jobs", K_INT, F(slurm_max_jobs), 1, 1e6,
      "jobs submitted to Slurm and not yet ended, at most"},
     {"slurm_local_below_s", K_DOUBLE, F(slurm_local_below_s), 0, 1e9,
@@ -143,6 +147,7 @@ void pk_config_defaults(pk_config *c)
     c->checkpoint_interval_s = 30;
     c->log_level = PK_LOG_INFO;
     c->slurm_max_jobs = 1000;
+    snprintf(c->slurm_mpi, sizeof c->slurm_mpi, "pmix"); /* Debian's OpenMPI starts under it */
 }
 
 static const struct key *find_key(const char *name)

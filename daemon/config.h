@@ -54,7 +54,8 @@ typedef struct pk_config {
     char slurm_qos[64];         /* sbatch --qos; "" = the default */
     char slurm_options[512];    /* more sbatch options, split at blanks */
     char slurm_packd[1024];     /* packd on the nodes; "" = this binary's path */
-    int slurm_mem_mb;           /* sbatch --mem per job; 0 = the partition's default */
+    int slurm_mem_mb;           /* MB per job (per rank of an MPI job); 0 = the default */
+    char slurm_mpi[32];         /* srun --mpi of a job of several ranks (pmix) */
     int slurm_max_jobs;         /* jobs on Slurm at once (submitted, not ended) */
     double slurm_local_below_s; /* limits.wall_time_s at most this: run locally (0 = never) */
     char config_file[1024];     /* the file read, "" if none (kept for SIGHUP) */

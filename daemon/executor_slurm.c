@@ -171,13 +171,6 @@ static json_t *change(const char *id, const char *op)
     return json_pack("{s:s,s:s}", "id", id, "op", op);
 }
 
-static double job_wall(json_t *job, double cap)
-{
-    double w = json_number_value(
-        json_object_get(json_object_get(json_object_get(job, "inputs"), "limits"), "wall_time_s"));
-    return w > 0 && w < cap ? w : cap;
-}
-
 /* sbatch one claimed job: its change (held, requeued or failed). */
 static json_t *submit(slurm_exec *s, json_t *job, const pk_config *c)
 {
@@ -190,7 +183,8 @@ static json_t *submit(slurm_exec *s, json_t *job, const pk_config *c)
                        .owner = own ? own : "packd",
                        .packd = c->slurm_packd[0] ? c->slurm_packd : s->exe,
                        .threads = c->job_threads,
-                       .wall_s = job_wall(job, c->max_wall_time_s),
+                       .ranks = pk_slurm_job_ranks(job),
+                       .wall_s = pk_slurm_job_wall(job, c->max_wall_time_s),
                        .checkpoint_interval_s = c->checkpoint_interval_s};
     json_t *ch;
     char path[1300];
@@ -362,6 +356,7 @@ static json_t *ended(json_t *job, const char *jid, const sq_entry *e, const pk_c
         free(o.summary);
         return ch;
     }
+    pk_worker_remove_tmp(dir); /* what a killed worker was writing */
     char state[32] = "", reason[128] = "", slurm_node[128] = "";
     snprintf(state, sizeof state, "%s", e ? e->state : "");
     if (!node[0] && e)
@@ -373,8 +368,12 @@ static json_t *ended(json_t *job, const char *jid, const sq_entry *e, const pk_c
         if (!node[0])
             snprintf(node, sizeof node, "%s", slurm_node);
     }
-    pk_job_file_path(dir, PK_JOB_LOG, path, sizeof path);
-    pk_worker_last_line(path, tail, sizeof tail);
+    char log[1300], what[1024];
+    int ranks = pk_slurm_job_ranks(job), lost;
+    pk_job_file_path(dir, PK_JOB_LOG, log, sizeof log);
+    pk_worker_last_line(log, tail, sizeof tail);
+    if (!strncmp(tail, PK_SLURM_ATTEMPT_MARK, strlen(PK_SLURM_ATTEMPT_MARK)))
+        tail[0] = 0; /* the worker said nothing */
     pk_job_file_path(dir, PK_JOB_PROGRESS, path, sizeof path);
     int started = access(path, F_OK) == 0; /* the script's first line is there */
     if (slurm_exit == PK_SLURM_NO_DIR || code == PK_SLURM_NO_DIR ||
@@ -384,6 +383,13 @@ static json_t *ended(json_t *job, const char *jid, const sq_entry *e, const pk_c
                  "%s%s%s; it must be on a filesystem the nodes share)",
                  dir, node[0] ? node : "(unknown)", jid, state[0] ? state : "ended",
                  reason[0] ? ", " : "", reason);
+    else if (code > 0 && ranks > 1 && (lost = pk_slurm_first_bad_task(log, what, sizeof what)) >= 0)
+        /* under srun the lost rank takes the step down (SIGKILL after KillWait) before
+         * rank 0 can always write its own report (exit 3, above) */
+        snprintf(msg, sizeof msg,
+                 "failed: MPI rank %d of %d was lost (srun: %s); Slurm ended the job's other "
+                 "ranks (exit status %d on node %s, no result kept)",
+                 lost, ranks, what, code, node);
     else if (code > 0)
         snprintf(msg, sizeof msg, "worker exited with status %d on node %s%s%s", code, node,
                  tail[0] ? ": " : "", tail);

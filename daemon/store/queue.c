@@ -803,7 +803,7 @@ json_t *pk_queue_held_jobs(pk_queue *q, const char *backend)
 {
     pthread_mutex_lock(&q->mu);
     json_t *r = rows(prep(q,
-                          "SELECT id, status, attempts, progress, message, owner, inputs,"
+                          "SELECT id, process, status, attempts, progress, message, owner, inputs,"
                           " executor_ref FROM jobs WHERE executor_ref LIKE ?1 || ':%' AND"
                           " executor_ref NOT LIKE '%:ended' ORDER BY seq",
                           "s", backend));

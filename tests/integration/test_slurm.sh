@@ -4,6 +4,8 @@
 # configs under $T, stopped by PID at the end):
 #   - examples through Slurm give the digests of tests/data/example-digests.txt
 #     (what the local executor and `packd run` give);
+#   - an fe2 job asking for 2 MPI ranks: 2 Slurm tasks (srun --mpi=pmix), the
+#     digest of `packd run --threads 1`; a rank killed -9: failed, naming it;
 #   - a running job is in squeue, and in the jobcomp record after;
 #   - DELETE of a running job: scancel, gone from squeue within 5 s;
 #   - kill -9 of the daemon and restart: the running Slurm job is adopted,
@@ -96,6 +98,54 @@ check slurm_jobcomp_records grep -q "Name=packd-$LAST " "$T/slurm/jobcomp.txt"
 kill "$LPID" "$EPID"
 wait "$LPID" "$EPID" 2>/dev/null
 start_daemon d1 --config "$T/slurm.conf" || { fail serve_starts; exit 1; }
+
+# 1b. fe2 over MPI ranks: a job asking for inputs.parallel.mpi_ranks = 2 is one
+#     Slurm job of 2 tasks (srun --mpi=pmix) and gives the digest of `packd run
+#     --threads 1`; in a second one (a long push), rank 1 killed -9 after a
+#     converged load step: the job fails naming the rank, within seconds
+python3 - "$SRC/tests/data/fe2/block-small.json" "$T" <<'PY'
+import json, copy, sys
+job = json.load(open(sys.argv[1]))  # test_fe2_mpi's block
+job["inputs"]["output"]["micro_states"] = [0, 5, 15]  # 15: on rank 1
+job["inputs"]["parallel"] = {"mpi_ranks": 2}
+json.dump({"inputs": job["inputs"]}, open(sys.argv[2] + "/fe2.body", "w"))
+k = copy.deepcopy(job["inputs"])
+k["mesh"]["rectangle"]["elements"] = [3, 3]
+k["stages"][1] = {"name": "push", "increments": 3000, "targets": {"top_y": -0.2}}
+json.dump({"inputs": k}, open(sys.argv[2] + "/fe2-kill.body", "w"))
+PY
+submit_fe2() { c -o "$T/submit.json" -H 'Content-Type: application/json' --data-binary "@$1" \
+    "$B/processes/fe2/execution" && member "$T/submit.json" jobID; }
+if "$PACKD" run --help 2>&1 | grep -q 'built without MPI'; then
+    skip slurm_fe2_ranks "this packd was built without MPI (install libopenmpi-dev, make again)"
+else
+    M=$(submit_fe2 "$T/fe2.body")
+    MK=$(submit_fe2 "$T/fe2-kill.body")
+    converged() { grep -qE '"stage":"fe2".*"done":[1-9]' "$T/d1/jobs/$MK/progress.jsonl" 2>/dev/null; }
+    check slurm_fe2_ranks_job_runs wait_for 120 converged
+    MKJ=$(squeue -h -n "packd-$MK" -o %i)
+    # scontrol listpids: PID JOBID STEPID LOCALID GLOBALID; step 0 is srun's, GLOBALID the rank
+    victim=$(scontrol listpids "$MKJ" | awk '$3 == "0" && $5 == "1" {print $1}')
+    t0=$(date +%s%N)
+    kill -9 $victim
+    check slurm_fe2_lost_rank_fails wait_status "$MK" failed 30
+    echo "rank 1 of 2 killed (pid $victim): failed after $((($(date +%s%N) - t0) / 1000000)) ms: $(member "$T/st.json" message)"
+    check slurm_fe2_lost_rank_named grep -q '"message": "failed: .*MPI rank 1 of 2' "$T/st.json"
+    if wait_status "$M" successful 120; then
+        MS="$T/d1/jobs/$M/summary.json"
+        # the reference: the same job file (the daemon adds the operator's wall-time
+        # limit to the inputs the digest covers), one process, one thread
+        "$PACKD" run "$T/d1/jobs/$M/job.json" -o "$T/fe2-ref.h5" --threads 1 --json \
+            >"$T/fe2-ref.json" 2>/dev/null
+        # (the digest covers every dataset: test_fe2_mpi compares them one by one)
+        check slurm_fe2_two_ranks test "$(jget "$MS" 'd["mpi_ranks"]')" = 2
+        check slurm_fe2_two_slurm_tasks grep -q "Name=packd-$M .* ProcCnt=2 " "$T/slurm/jobcomp.txt"
+        ref=$(jget "$T/fe2-ref.json" 'd["result_digest"]') got=$(jget "$MS" 'd["result_digest"]')
+        check slurm_fe2_ranks_digest_of_threads_1 sh -c "[ -n '$ref' ] && [ '$ref' = '$got' ]"
+    else
+        fail slurm_fe2_ranks_job "status $(status_of "$M"): $(member "$T/st.json" message)"
+    fi
+fi
 
 # 2. a running job shows in squeue, its progress reaches the client
 slow_body 8 >"$T/slow.body"
