@@ -53,7 +53,7 @@ wait_for 30 test -e "$T/locked" || fail lock_taken
 
 # the worker's next progress line (every 0.5 s) puts the writer behind the lock
 slowest=0
-for i in 1 2 3 4 5 6 7 8; do
+for _ in 1 2 3 4 5 6 7 8; do
     t=$(seconds "" "$B/healthz")
     below "$t" "$slowest" || slowest=$t
     sleep 0.25 # samples across the writer's busy wait
