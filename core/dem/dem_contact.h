@@ -1,5 +1,5 @@
 /* dem_contact.h — soft frictionless contacts between disks/spheres (Meier 2009
- * §4.2, spec §2.1–2.4): overlap ε = r_i + r_j − |l| (4.1), contact iff ε ≥ 0
+ * §4.2, (4.1)–(4.16)): overlap ε = r_i + r_j − |l| (4.1), contact iff ε ≥ 0
  * (4.2), potential Φ = E/2 ε² (4.3), force on i f_ij = −E ε n_ij (4.8),
  * off-diagonal stiffness block k_ij = E/|l| [ε 1 − (r_i+r_j) n⊗n] (4.12)
  * with k_ii = −Σ_j k_ij (4.14).  The same formulas serve 2D and 3D.
@@ -7,7 +7,7 @@
  * Geometry: spatial centres x (stride 3) under a macroscopic F̄.  On a
  * periodic RVE the branch vector is the minimum image taken in the reference
  * frame, l = F̄·minimg(F̄⁻¹(x_j − x_i)), i.e. the lattice vectors are F̄L
- * (spec §2.5.4 "equivalent simpler form").  Candidate pairs (a Verlet list
+ * (the simpler equivalent of (4.28)–(4.34)).  Candidate pairs (a Verlet list
  * with a skin) come from the shared pk_grid built on reference coordinates;
  * each keeps the lattice image it had at the build (pk_dem_pairs.sh).
  *

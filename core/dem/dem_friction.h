@@ -1,5 +1,5 @@
 /* dem_friction.h — inter-particle friction of 2D disks (Meier 2009 ch. 7,
- * spec §5, Table 7.1): total slip γ by the backward-Euler update (7.5),
+ * Table 7.1): total slip γ by the backward-Euler update (7.5),
  * elastic predictor f_t = E_t(γ − γ_plⁿ) and closed-form return map (7.16),
  * (7.17) on the Coulomb limit |f_t| ≤ f_n tan ρ + hα (7.11), with the erratum
  * of (7.12) (γ̇_pl = λ sgn, no E_t).  Forces and couples are the EXACT

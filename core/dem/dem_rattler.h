@@ -1,8 +1,7 @@
 /* dem_rattler.h — rattler removal (Meier 2009 §4.3.5, Table 4.3 generalised
  * to 2D and 3D).  A free grain is jammed iff the directions of its contacts
  * with jammed or prescribed neighbours positively span R^dim, i.e. no closed
- * half-plane / hemisphere holds them all (Remark 4.6; the largest-gap form of
- * spec §2.6 in 2D, which also covers the 180° and 4×90° special cases).
+ * half-plane / hemisphere holds them all (Remark 4.6; in 2D its largest-gap form, which also covers the 180° and 4×90° special cases).
  * Removal is iterated to the fixed point: a rattler's contacts no longer
  * count for its neighbours. */
 #ifndef PK_DEM_RATTLER_H

@@ -375,20 +375,252 @@ static double setup(edmd_state *s, const pk_particles *p, const pk_edmd_params *
     return t_stop;
 }
 
-int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_monitor *mon,
-                pk_edmd_stats *st)
+/* The driver's bookkeeping beside the engine state: the event windows and
+ * schedules (stall, pressure, re-base, re-sort, checkpoints), the run's
+ * current growth rate and the progress record. */
+typedef struct run_loop {
+    const pk_edmd_params *prm;
+    pk_edmd_stats *st;
+    pk_monitor *mon;
+    pk_edmd_checkpoint *ckpt;
+    size_t *perm;          /* perm[k] = grain of the caller's p at engine index k */
+    double w0, hcell;      /* wall clock at the start; the Z-order cell */
+    double t_stop, t_base; /* stop time; absolute time of the re-based origin t = 0 */
+    double K0, K_hi, K_lo; /* kinetic energy kept within (K_lo, K_hi) by rescaling */
+    double gam_now;        /* the growth rate now (slowed near jamming) */
+    double stall_acc, phi_prev, pressure, skin_built;
+    int slowed, stall_auto;
+    uint64_t c_win, next_check;   /* the pressure / Δφ window */
+    uint64_t stall_win, stall_ev; /* the stall window */
+    uint64_t hist_stride, hist_count;
+    uint64_t rebase_win, last_rebase;
+    uint64_t resort_win, next_resort;
+    pk_progress pr;
+    char msg[160];
+} run_loop;
+
+/* Carry out event i, due now: a pair collision (or its stale prediction), a
+ * neighbour-list exit, a wall collision.  -1 out of memory. */
+static int dispatch(edmd_state *s, pk_edmd_stats *st, size_t i)
 {
-    memset(st, 0, sizeof *st);
-    st->reason = PK_STOP_ERROR;
-    st->criterion = PK_EDMD_CRIT_ERROR;
-    if (!b || !p || !prm || p->dim != b->dim || p->n == 0 || p->n > INT32_MAX)
-        return -1;
-    double w0 = pk_wall_seconds();
-    edmd_state S;
-    memset(&S, 0, sizeof S);
-    edmd_state *s = &S;
-    pk_particles q = {0};
-    size_t *perm = NULL;
+    edmd_event *e = &s->ev[i];
+    const int32_t w = e->with;
+    if (w >= 0) {
+        size_t j = (size_t)w;
+        if (e->stamp != s->ncoll[j]) { /* partner changed course since */
+            st->invalid++;
+            if (e->t2 < INFINITY) { /* the runner-up, predicted with i's flight */
+                *e = (edmd_event){e->t2, INFINITY, e->with2, EDMD_EV_NONE, e->stamp2, 0};
+                st->second++;
+            } else {
+                edmd_predict(s, i);
+            }
+            edmd_queue_update(s, i);
+            return 0;
+        }
+        /* both predictions below read the neighbours' records: start all
+         * those loads now (edmd_prefetch_list) */
+        edmd_prefetch_list(s, i);
+        edmd_prefetch_list(s, j);
+        s->virial += edmd_collide_pair(s, i, j);
+        s->ncoll[i]++;
+        s->ncoll[j]++;
+        st->pair++;
+        edmd_predict(s, i);
+        edmd_queue_update(s, i);
+        edmd_predict(s, j);
+        edmd_queue_update(s, j);
+        return 0;
+    } else if (w == EDMD_EV_NLIST) {
+        if (edmd_nlist_rebuild(s, i) != 0)
+            return -1;
+        st->nlist++;
+    } else if (w <= EDMD_EV_WALL0) {
+        edmd_collide_wall(s, i, EDMD_EV_WALL0 - w);
+        s->ncoll[i]++;
+        st->wall++;
+    }
+    edmd_predict(s, i);
+    edmd_queue_update(s, i);
+    return 0;
+}
+
+/* Take the first event and carry it out, the clock moved to it; *crit set
+ * when the run ends before it (the stop time, or no event ever).  -1 out of
+ * memory. */
+static int step(edmd_state *s, run_loop *L, pk_edmd_criterion *crit)
+{
+    size_t i = edmd_queue_top(s);
+    double te = s->ev[i].t;
+    if (te >= L->t_stop - L->t_base) {
+        double tt = fmax(L->t_stop - L->t_base, s->t);
+        s->kint += s->K * (tt - s->t);
+        s->t = tt;
+        *crit = PK_EDMD_CRIT_TARGET;
+        return 0;
+    }
+    if (!(te < INFINITY)) {
+        *crit = PK_EDMD_CRIT_STALL; /* nothing will ever happen (no growth, no motion) */
+        return 0;
+    }
+    s->kint += s->K * (te - s->t);
+    L->stall_acc += te - s->t;
+    s->t = te;
+    L->st->events++;
+    return dispatch(s, L->st, i);
+}
+
+/* The stall window: the sizes grew by less than the stall threshold over it. */
+static int stalled(const run_loop *L)
+{
+    /* the default: 10^-12, and until jammed below a hundredth of what a
+     * packing at the window's pressure p grows (~γ/p per window), so the
+     * stall never preempts the pressure test */
+    double stall_growth = L->prm->stall_growth;
+    if (L->stall_auto)
+        stall_growth = L->prm->until == PK_EDMD_UNTIL_JAMMED
+            ? fmin(1e-12, 1e-2 * L->gam_now / fmax(L->pressure, 1))
+            : 1e-12;
+    return L->stall_acc * L->gam_now < stall_growth;
+}
+
+/* Progress to the monitor; its stop (cancel, wall time) as a criterion. */
+static pk_edmd_criterion progress(const edmd_state *s, run_loop *L)
+{
+    const pk_edmd_params *prm = L->prm;
+    const pk_edmd_stats *st = L->st;
+    pk_progress *pr = &L->pr;
+    pr->done = (size_t)st->events;
+    if (isfinite(L->t_stop)) {
+        pr->fraction = fmin(1, (L->t_base + s->t) / L->t_stop);
+        pr->eta_s =
+            pr->fraction > 0 ? (pk_wall_seconds() - L->w0) * (1 - pr->fraction) / pr->fraction : -1;
+    } else { /* until jammed: the reduced pressure on its way to p_max, on a log scale */
+        double f = L->pressure > 1 && prm->p_max > 1 ? log(L->pressure) / log(prm->p_max) : 0;
+        if (prm->max_events)
+            f = fmax(f, (double)st->events / (double)prm->max_events);
+        pr->fraction = fmax(pr->fraction, fmin(f, 0.99));
+    }
+    snprintf(L->msg, sizeof L->msg, "events=%llu collisions=%llu reduced_pressure=%.4g",
+             (unsigned long long)st->events, (unsigned long long)st->pair, L->pressure);
+    pr->message = L->msg;
+    int m = pk_monitor_tick(L->mon, pr, 0);
+    return m ? monitor_criterion(m) : PK_EDMD_CRIT_NONE;
+}
+
+/* The end of a pressure window: the reduced pressure, the history, the
+ * jamming criteria, the skins, the slowdown, a checkpoint.  -1 out of
+ * memory; *crit set when the run ends. */
+static int window(edmd_state *s, run_loop *L, pk_edmd_criterion *crit)
+{
+    const pk_edmd_params *prm = L->prm;
+    pk_edmd_stats *st = L->st;
+    L->next_check = st->events + L->c_win;
+    double phi = phi_true(s, s->t);
+    double phis = phi_sim(s, s->t); /* grows in both modes (shell: φ_true is fixed) */
+    L->pressure = s->kint > 0 ? 1 + s->virial / (2 * s->kint) : 0;
+    s->virial = s->kint = 0;
+    L->pr.phi = phi;
+    if (++L->hist_count % L->hist_stride == 0)
+        hist_push(st, &L->hist_stride, st->events, L->t_base + s->t, phi, L->pressure);
+    if (prm->until == PK_EDMD_UNTIL_JAMMED) {
+        if (L->pressure >= prm->p_max) {
+            *crit = PK_EDMD_CRIT_PRESSURE;
+            return 0;
+        }
+        /* Meier Eq. 3.11; only in a dense state (p > 10^3): from zero radii
+         * φ ∝ t^d barely moves over the first windows */
+        if (prm->dphi_crit > 0 && L->pressure > 1e3 && phis - L->phi_prev < prm->dphi_crit) {
+            *crit = PK_EDMD_CRIT_DELTA_PHI;
+            return 0;
+        }
+    }
+    /* near jamming the grains rattle in cages of width ~ d/p: shrink the
+     * skins with the pressure (shorter lists, fewer pair predictions; the
+     * lists stay exact for any skin), and rebuild all lists when they have
+     * halved since the last full build */
+    s->skin_scale = L->pressure > SKIN_P0 ? fmax(SKIN_P0 / L->pressure, SKIN_MIN) : 1;
+    if (s->skin_scale < 0.5 * L->skin_built) {
+        L->skin_built = s->skin_scale;
+        int rb = rebuild_all(s, crit);
+        if (rb != 0)
+            return rb < 0 ? -1 : 0;
+    }
+    L->phi_prev = phis;
+    /* past the structural arrest the growth slows (Lubachevsky–Stillinger,
+     * Skoge et al. 2006): at a fast rate the pressure reaches 10^12 on a
+     * hypostatic network the growth drives (3D mono N = 500, γ = 0.02:
+     * z = 5.59 on 7 % rattlers), at a tenth of it the backbone is isostatic
+     * (z = 5.95, 2.4 %) */
+    if (prm->until == PK_EDMD_UNTIL_JAMMED && !L->slowed && L->pressure > JAM_SLOW_P) {
+        scale_growth(s, prm->jam_rate_factor);
+        L->gam_now *= prm->jam_rate_factor;
+        L->slowed = 1;
+        st->growth_changes++;
+    }
+    if (edmd_checkpoint_due(L->ckpt)) { /* re-based first: the snapshot starts at t = 0 */
+        L->t_base += s->t;
+        rebase(s);
+        st->rebases++;
+        L->last_rebase = st->events;
+        edmd_ckpt_loop now = {L->t_base,      L->K0,         L->pressure, L->pr.fraction,
+                              L->hist_stride, L->hist_count, L->gam_now,  L->slowed};
+        edmd_checkpoint_take(s, L->perm, st, &now, L->ckpt);
+    }
+    return 0;
+}
+
+/* Everything after an event, each on its own schedule: rescaling, the stall
+ * and event limits, progress, the pressure window, the clock's re-base, the
+ * Z-order re-sort.  -1 out of memory; *crit set when the run ends. */
+static int after_event(edmd_state *s, run_loop *L, pk_edmd_criterion *crit)
+{
+    const pk_edmd_params *prm = L->prm;
+    pk_edmd_stats *st = L->st;
+    if (prm->rescale && (s->K > L->K_hi || s->K < L->K_lo)) {
+        rescale(s, L->K0);
+        st->rescales++;
+    }
+    if (st->events - L->stall_ev >= L->stall_win) {
+        if (stalled(L)) {
+            *crit = PK_EDMD_CRIT_STALL;
+            return 0;
+        }
+        L->stall_ev = st->events;
+        L->stall_acc = 0;
+    }
+    if (prm->max_events && st->events >= prm->max_events) {
+        *crit = PK_EDMD_CRIT_MAX_EVENTS;
+        return 0;
+    }
+    if ((st->events & 1023) == 0 && (*crit = progress(s, L)) != PK_EDMD_CRIT_NONE)
+        return 0;
+    if (st->events >= L->next_check && (window(s, L, crit) != 0 || *crit))
+        return *crit ? 0 : -1;
+    if (st->events - L->last_rebase >= L->rebase_win) {
+        /* positions are p + v·t: keep |v·t| small */
+        L->t_base += s->t;
+        rebase(s);
+        st->rebases++;
+        L->last_rebase = st->events;
+    }
+    if (L->resort_win && st->events >= L->next_resort) {
+        L->next_resort = st->events + L->resort_win;
+        if (edmd_reorder(s, L->perm, L->hcell) != 0)
+            return -1;
+        st->resorts++;
+        return rebuild_all(s, crit) < 0 ? -1 : 0;
+    }
+    return 0;
+}
+
+/* The engine's copy q of the grains, in Z-order (or the snapshot's order on
+ * resume), set up and predicted; L's windows and schedules started.  0, or
+ * -1 on bad input or out of memory. */
+static int open_run(const pk_box *b, pk_particles *p, pk_particles *q, edmd_state *s, run_loop *L)
+{
+    const pk_edmd_params *prm = L->prm;
+    pk_edmd_stats *st = L->st;
     s->box = *b;
     s->dim = b->dim;
     for (int k = 0; k < 3; k++) {
@@ -399,11 +631,9 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
     }
     s->n = p->n;
     s->rule = prm->rule;
-    int rc = -1;
     if (state_alloc(s, s->n) != 0)
-        goto out;
-    /* zero start: uniform positions (stream 3); then the engine works on a
-     * copy q in Z-order (perm[k] = grain of p at engine index k) */
+        return -1;
+    /* zero start: uniform positions (stream 3) */
     if (prm->start_zero) {
         pk_rng rng;
         pk_rng_seed(&rng, prm->seed, 3);
@@ -414,243 +644,70 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
     double hcell = 0;
     for (size_t i = 0; i < p->n; i++)
         hcell += 2 * p->r[i] / (double)p->n;
-    perm = malloc(p->n * sizeof *perm);
+    L->hcell = hcell > 0 ? hcell : 1;
+    L->perm = malloc(p->n * sizeof *L->perm);
     /* a resumed run takes the engine order of its snapshot */
-    pk_edmd_checkpoint *ckpt = prm->checkpoint;
-    const int resume = ckpt && ckpt->resume;
-    if (!perm || pk_particles_init(&q, p->dim, p->n) != 0 ||
-        (resume ? edmd_checkpoint_perm(ckpt->resume, p->n, p->dim, perm)
-                : edmd_spatial_order(b, p->x, p->n, hcell > 0 ? hcell : 1, perm)) != 0)
-        goto out;
+    const pk_edmd_snapshot *from = L->ckpt ? L->ckpt->resume : NULL;
+    if (!L->perm || pk_particles_init(q, p->dim, p->n) != 0 ||
+        (from ? edmd_checkpoint_perm(from, p->n, p->dim, L->perm)
+              : edmd_spatial_order(b, p->x, p->n, L->hcell, L->perm)) != 0)
+        return -1;
     for (size_t k = 0; k < p->n; k++)
-        pk_particles_push(&q, &p->x[3 * perm[k]], p->r[perm[k]], p->species[perm[k]]);
-    double t_stop = setup(s, &q, prm, st);
-    if (isnan(t_stop))
-        goto out;
+        pk_particles_push(q, &p->x[3 * L->perm[k]], p->r[L->perm[k]], p->species[L->perm[k]]);
+    L->t_stop = setup(s, q, prm, st);
+    if (isnan(L->t_stop))
+        return -1;
     s->skin_scale = 1;
-    edmd_ckpt_loop L = {.hist_stride = 1, .fraction = -1};
-    if (resume)
-        edmd_checkpoint_restore(s, st, &L, ckpt);
-    double skin_built = s->skin_scale;
+    edmd_ckpt_loop c = {.hist_stride = 1, .fraction = -1};
+    if (from)
+        edmd_checkpoint_restore(s, st, &c, L->ckpt);
+    L->skin_built = s->skin_scale;
     if (edmd_nlist_build_all(s) != 0)
-        goto out;
+        return -1;
     s->K = kinetic(s);
-    const double K0 = resume ? L.K0 : s->K;
-    const double K_hi = K0 * (1 + prm->rescale_tol), K_lo = K0 / (1 + prm->rescale_tol);
+    L->K0 = from ? c.K0 : s->K;
+    L->K_hi = L->K0 * (1 + prm->rescale_tol);
+    L->K_lo = L->K0 / (1 + prm->rescale_tol);
     predict_all(s);
 
-    const uint64_t c_win = prm->dphi_events ? prm->dphi_events : (uint64_t)s->n;
+    L->c_win = prm->dphi_events ? prm->dphi_events : (uint64_t)s->n;
     /* stall window: at least one event per grain (Titscher: 1000 events) */
-    uint64_t stall_win = prm->stall_events ? prm->stall_events : 1000;
-    if (stall_win < (uint64_t)s->n)
-        stall_win = (uint64_t)s->n;
-    double gam_now = resume ? L.growth_rate : prm->growth_rate;
-    int slowed = (resume && L.slowed) || !(prm->jam_rate_factor > 0 && prm->jam_rate_factor < 1);
-    const int stall_auto = isnan(prm->stall_growth);
-    uint64_t next_check = st->events + c_win, hist_stride = L.hist_stride,
-             hist_count = L.hist_count;
-    uint64_t stall_ev = st->events;
-    uint64_t last_rebase = st->events, rebase_win = REBASE_WINDOWS * (uint64_t)s->n;
-    const uint64_t resort_win = s->n >= RESORT_MIN_N ? RESORT_WINDOWS * (uint64_t)s->n : 0;
-    uint64_t next_resort = st->events + resort_win;
-    double t_base = L.t_base; /* absolute time of the re-based origin t = 0 */
-    double stall_acc = 0, phi_prev = phi_sim(s, 0), pressure = L.pressure;
-    pk_progress pr = {.stage = "edmd", .fraction = L.fraction, .phi = phi_true(s, 0), .eta_s = -1};
-    char msg[160];
-    pk_monitor_begin(mon);
-    s->mon = mon; /* ticked inside the full list builds from here on */
-    s->pr = &pr;
-    if (!resume)
-        hist_push(st, &hist_stride, 0, 0, pr.phi, 0);
-    pk_edmd_criterion crit = PK_EDMD_CRIT_NONE;
+    L->stall_win = prm->stall_events ? prm->stall_events : 1000;
+    if (L->stall_win < (uint64_t)s->n)
+        L->stall_win = (uint64_t)s->n;
+    L->gam_now = from ? c.growth_rate : prm->growth_rate;
+    L->slowed = (from && c.slowed) || !(prm->jam_rate_factor > 0 && prm->jam_rate_factor < 1);
+    L->stall_auto = isnan(prm->stall_growth);
+    L->next_check = st->events + L->c_win;
+    L->hist_stride = c.hist_stride;
+    L->hist_count = c.hist_count;
+    L->stall_ev = L->last_rebase = st->events;
+    L->rebase_win = REBASE_WINDOWS * (uint64_t)s->n;
+    L->resort_win = s->n >= RESORT_MIN_N ? RESORT_WINDOWS * (uint64_t)s->n : 0;
+    L->next_resort = st->events + L->resort_win;
+    L->t_base = c.t_base;
+    L->phi_prev = phi_sim(s, 0);
+    L->pressure = c.pressure;
+    L->pr =
+        (pk_progress){.stage = "edmd", .fraction = c.fraction, .phi = phi_true(s, 0), .eta_s = -1};
+    pk_monitor_begin(L->mon);
+    s->mon = L->mon; /* ticked inside the full list builds from here on */
+    s->pr = &L->pr;
+    if (!from)
+        hist_push(st, &L->hist_stride, 0, 0, L->pr.phi, 0);
+    return 0;
+}
 
-    for (;;) {
-        size_t i = edmd_queue_top(s);
-        edmd_event *e = &s->ev[i];
-        double te = e->t;
-        if (te >= t_stop - t_base) {
-            double tt = fmax(t_stop - t_base, s->t);
-            s->kint += s->K * (tt - s->t);
-            s->t = tt;
-            crit = PK_EDMD_CRIT_TARGET;
-            break;
-        }
-        if (!(te < INFINITY)) {
-            crit = PK_EDMD_CRIT_STALL; /* nothing will ever happen (no growth, no motion) */
-            break;
-        }
-        s->kint += s->K * (te - s->t);
-        stall_acc += te - s->t;
-        s->t = te;
-        st->events++;
-        const int32_t w = e->with;
-        if (w >= 0) {
-            size_t j = (size_t)w;
-            if (e->stamp != s->ncoll[j]) { /* partner changed course since */
-                st->invalid++;
-                if (e->t2 < INFINITY) { /* the runner-up, predicted with i's flight */
-                    *e = (edmd_event){e->t2, INFINITY, e->with2, EDMD_EV_NONE, e->stamp2, 0};
-                    st->second++;
-                } else {
-                    edmd_predict(s, i);
-                }
-                edmd_queue_update(s, i);
-            } else {
-                /* both predictions below read the neighbours' records:
-                 * start all those loads now (edmd_prefetch_list) */
-                edmd_prefetch_list(s, i);
-                edmd_prefetch_list(s, j);
-                s->virial += edmd_collide_pair(s, i, j);
-                s->ncoll[i]++;
-                s->ncoll[j]++;
-                st->pair++;
-                edmd_predict(s, i);
-                edmd_queue_update(s, i);
-                edmd_predict(s, j);
-                edmd_queue_update(s, j);
-            }
-        } else if (w == EDMD_EV_NLIST) {
-            if (edmd_nlist_rebuild(s, i) != 0)
-                goto out;
-            st->nlist++;
-            edmd_predict(s, i);
-            edmd_queue_update(s, i);
-        } else if (w <= EDMD_EV_WALL0) {
-            edmd_collide_wall(s, i, EDMD_EV_WALL0 - w);
-            s->ncoll[i]++;
-            st->wall++;
-            edmd_predict(s, i);
-            edmd_queue_update(s, i);
-        } else {
-            edmd_predict(s, i);
-            edmd_queue_update(s, i);
-        }
-        if (prm->rescale && (s->K > K_hi || s->K < K_lo)) {
-            rescale(s, K0);
-            st->rescales++;
-        }
-        if (st->events - stall_ev >= stall_win) {
-            /* the default: 10^-12, and until jammed below a hundredth of
-             * what a packing at the window's pressure p grows (~γ/p per
-             * window), so the stall never preempts the pressure test */
-            double stall_growth = prm->stall_growth;
-            if (stall_auto)
-                stall_growth = prm->until == PK_EDMD_UNTIL_JAMMED
-                    ? fmin(1e-12, 1e-2 * gam_now / fmax(pressure, 1))
-                    : 1e-12;
-            if (stall_acc * gam_now < stall_growth) {
-                crit = PK_EDMD_CRIT_STALL;
-                break;
-            }
-            stall_ev = st->events;
-            stall_acc = 0;
-        }
-        if (prm->max_events && st->events >= prm->max_events) {
-            crit = PK_EDMD_CRIT_MAX_EVENTS;
-            break;
-        }
-        if ((st->events & 1023) == 0) {
-            pr.done = (size_t)st->events;
-            if (isfinite(t_stop)) {
-                pr.fraction = fmin(1, (t_base + s->t) / t_stop);
-                pr.eta_s = pr.fraction > 0
-                    ? (pk_wall_seconds() - w0) * (1 - pr.fraction) / pr.fraction
-                    : -1;
-            } else { /* until jammed: the reduced pressure on its way to p_max, on a log scale */
-                double f = pressure > 1 && prm->p_max > 1 ? log(pressure) / log(prm->p_max) : 0;
-                if (prm->max_events)
-                    f = fmax(f, (double)st->events / (double)prm->max_events);
-                pr.fraction = fmax(pr.fraction, fmin(f, 0.99));
-            }
-            snprintf(msg, sizeof msg, "events=%llu collisions=%llu reduced_pressure=%.4g",
-                     (unsigned long long)st->events, (unsigned long long)st->pair, pressure);
-            pr.message = msg;
-            int m = pk_monitor_tick(mon, &pr, 0);
-            if (m) {
-                crit = monitor_criterion(m);
-                break;
-            }
-        }
-        if (st->events >= next_check) {
-            next_check = st->events + c_win;
-            double phi = phi_true(s, s->t);
-            double phis = phi_sim(s, s->t); /* grows in both modes (shell: φ_true is fixed) */
-            pressure = s->kint > 0 ? 1 + s->virial / (2 * s->kint) : 0;
-            s->virial = s->kint = 0;
-            pr.phi = phi;
-            if (++hist_count % hist_stride == 0)
-                hist_push(st, &hist_stride, st->events, t_base + s->t, phi, pressure);
-            if (prm->until == PK_EDMD_UNTIL_JAMMED) {
-                if (pressure >= prm->p_max) {
-                    crit = PK_EDMD_CRIT_PRESSURE;
-                    break;
-                }
-                /* Meier Eq. 3.11; only in a dense state (p > 10^3): from zero
-                 * radii φ ∝ t^d barely moves over the first windows */
-                if (prm->dphi_crit > 0 && pressure > 1e3 && phis - phi_prev < prm->dphi_crit) {
-                    crit = PK_EDMD_CRIT_DELTA_PHI;
-                    break;
-                }
-            }
-            /* near jamming the grains rattle in cages of width ~ d/p: shrink
-             * the skins with the pressure (shorter lists, fewer pair
-             * predictions; the lists stay exact for any skin), and rebuild
-             * all lists when they have halved since the last full build */
-            s->skin_scale = pressure > SKIN_P0 ? fmax(SKIN_P0 / pressure, SKIN_MIN) : 1;
-            if (s->skin_scale < 0.5 * skin_built) {
-                skin_built = s->skin_scale;
-                int rb = rebuild_all(s, &crit);
-                if (rb < 0)
-                    goto out;
-                if (rb > 0)
-                    break;
-            }
-            phi_prev = phis;
-            /* past the structural arrest the growth slows (Lubachevsky–
-             * Stillinger, Skoge et al. 2006): at a fast rate the pressure
-             * reaches 10^12 on a hypostatic network the growth drives
-             * (3D mono N = 500, γ = 0.02: z = 5.59 on 7 % rattlers), at a
-             * tenth of it the backbone is isostatic (z = 5.95, 2.4 %) */
-            if (prm->until == PK_EDMD_UNTIL_JAMMED && !slowed && pressure > JAM_SLOW_P) {
-                scale_growth(s, prm->jam_rate_factor);
-                gam_now *= prm->jam_rate_factor;
-                slowed = 1;
-                st->growth_changes++;
-            }
-            if (edmd_checkpoint_due(ckpt)) { /* re-based first: the snapshot starts at t = 0 */
-                t_base += s->t;
-                rebase(s);
-                st->rebases++;
-                last_rebase = st->events;
-                edmd_ckpt_loop now = {t_base,      K0,         pressure, pr.fraction,
-                                      hist_stride, hist_count, gam_now,  slowed};
-                edmd_checkpoint_take(s, perm, st, &now, ckpt);
-            }
-        }
-        if (st->events - last_rebase >= rebase_win) {
-            /* positions are p + v·t: keep |v·t| small */
-            t_base += s->t;
-            rebase(s);
-            st->rebases++;
-            last_rebase = st->events;
-        }
-        if (resort_win && st->events >= next_resort) {
-            next_resort = st->events + resort_win;
-            if (edmd_reorder(s, perm, hcell > 0 ? hcell : 1) != 0)
-                goto out;
-            st->resorts++;
-            int rb = rebuild_all(s, &crit);
-            if (rb < 0)
-                goto out;
-            if (rb > 0)
-                break;
-        }
-    }
-    /* final state */
+/* The engine's final state back into the caller's p (its own order), and the
+ * run's figures into st. */
+static void close_run(const pk_box *b, pk_particles *p, edmd_state *s, run_loop *L,
+                      pk_edmd_criterion crit)
+{
+    pk_edmd_stats *st = L->st;
     if (s->kint > 0)
-        pressure = 1 + s->virial / (2 * s->kint);
+        L->pressure = 1 + s->virial / (2 * s->kint);
     for (size_t i = 0; i < s->n; i++) {
-        double *x = &p->x[3 * perm[i]], xi[3];
+        double *x = &p->x[3 * L->perm[i]], xi[3];
         edmd_pos(s, i, xi);
         for (int k = 0; k < 3; k++)
             x[k] = k < s->dim ? xi[k] : 0;
@@ -658,7 +715,7 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
         for (int k = 0; k < s->dim; k++) /* walled axes: keep round-off inside */
             if (!b->periodic[k])
                 x[k] = fmin(fmax(x[k], 0), b->L[k]);
-        p->r[perm[i]] = true_radius(s, i, s->t);
+        p->r[L->perm[i]] = true_radius(s, i, s->t);
     }
     st->criterion = crit;
     switch (crit) {
@@ -666,7 +723,7 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
     case PK_EDMD_CRIT_PRESSURE:
     case PK_EDMD_CRIT_DELTA_PHI: st->reason = PK_STOP_JAMMED; break;
     case PK_EDMD_CRIT_STALL: /* growing until jammed, a stall is the jam (Titscher §6.4) */
-        st->reason = prm->until == PK_EDMD_UNTIL_JAMMED ? PK_STOP_JAMMED : PK_STOP_STALLED;
+        st->reason = L->prm->until == PK_EDMD_UNTIL_JAMMED ? PK_STOP_JAMMED : PK_STOP_STALLED;
         break;
     case PK_EDMD_CRIT_MAX_EVENTS: st->reason = PK_STOP_STALLED; break;
     case PK_EDMD_CRIT_CANCEL: st->reason = PK_STOP_CANCELLED; break;
@@ -675,19 +732,38 @@ int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_
     }
     st->phi = phi_true(s, s->t);
     st->phi_sim = phi_sim(s, s->t);
-    st->pressure = pressure;
-    st->phi_jam_estimate = pressure > s->dim ? st->phi / (1 - s->dim / pressure) : NAN;
+    st->pressure = L->pressure;
+    st->phi_jam_estimate = L->pressure > s->dim ? st->phi / (1 - s->dim / L->pressure) : NAN;
     st->delta_d = 2 * (s->h0 + s->h1 * s->t);
-    st->t_stop = t_base + s->t;
+    st->t_stop = L->t_base + s->t;
     st->overlaps = s->n_overlap;
     st->max_overlap_rel = s->max_overlap_rel;
-    st->kinetic_ratio = K0 > 0 ? kinetic(s) / K0 : NAN;
-    hist_push(st, &hist_stride, st->events, t_base + s->t, st->phi, pressure);
-    rc = 0;
-out:
-    st->seconds = pk_wall_seconds() - w0;
-    state_free(s);
+    st->kinetic_ratio = L->K0 > 0 ? kinetic(s) / L->K0 : NAN;
+    hist_push(st, &L->hist_stride, st->events, L->t_base + s->t, st->phi, L->pressure);
+}
+
+int pk_edmd_run(const pk_box *b, pk_particles *p, const pk_edmd_params *prm, pk_monitor *mon,
+                pk_edmd_stats *st)
+{
+    memset(st, 0, sizeof *st);
+    st->reason = PK_STOP_ERROR;
+    st->criterion = PK_EDMD_CRIT_ERROR;
+    if (!b || !p || !prm || p->dim != b->dim || p->n == 0 || p->n > INT32_MAX)
+        return -1;
+    edmd_state s = {0};
+    pk_particles q = {0};
+    run_loop L = {
+        .prm = prm, .st = st, .mon = mon, .ckpt = prm->checkpoint, .w0 = pk_wall_seconds()};
+    pk_edmd_criterion crit = PK_EDMD_CRIT_NONE;
+    int rc = open_run(b, p, &q, &s, &L);
+    /* take the first event, carry it out, then whatever is due after it */
+    while (rc == 0 && !crit && (rc = step(&s, &L, &crit)) == 0 && !crit)
+        rc = after_event(&s, &L, &crit);
+    if (rc == 0)
+        close_run(b, p, &s, &L, crit);
+    st->seconds = pk_wall_seconds() - L.w0;
+    state_free(&s);
     pk_particles_free(&q);
-    free(perm);
+    free(L.perm);
     return rc;
 }

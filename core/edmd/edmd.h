@@ -161,14 +161,4 @@ int pk_edmd_start_rsa(const pk_box *b, const double *d, const int32_t *species, 
 double pk_edmd_start_delta(int dim, const double *d, size_t n, double delta_d, double box_measure,
                            double phi_start);
 
-/* --- building blocks (exposed for tests) --- */
-
-/* Time τ ≥ 0 until |Δp + Δv τ| = R + G τ (spec §3.3a, cancellation-free
- * roots); INFINITY if never.  *overlap set to 1 when C < −1e-9 R².  dim 2/3. */
-double pk_edmd_pair_time(const double dp[3], const double dv[3], double R, double G, int *overlap);
-
-/* Time until |q + v τ| + ρ0 + g τ = σ (the grain leaves its bounding sphere
- * of radius σ centred at q = 0); INFINITY if never. */
-double pk_edmd_exit_time(const double q[3], const double v[3], double rho0, double g, double sigma);
-
 #endif

@@ -241,4 +241,14 @@ int edmd_nlist_build_all(edmd_state *s);
 int edmd_nlist_rebuild(edmd_state *s, size_t i);
 void edmd_nlist_free(edmd_state *s);
 
+/* Event-time roots (edmd_predict.c; tested on their own in test_edmd). */
+
+/* Time τ ≥ 0 until |Δp + Δv τ| = R + G τ (spec §3.3a, cancellation-free
+ * roots); INFINITY if never.  *overlap set to 1 when C < −1e-9 R².  dim 2/3. */
+double pk_edmd_pair_time(const double dp[3], const double dv[3], double R, double G, int *overlap);
+
+/* Time until |q + v τ| + ρ0 + g τ = σ (the grain leaves its bounding sphere
+ * of radius σ centred at q = 0); INFINITY if never. */
+double pk_edmd_exit_time(const double q[3], const double v[3], double rho0, double g, double sigma);
+
 #endif

@@ -5,8 +5,8 @@
  * Plane strain with a 2D RVE: the RVE gives the in-plane stresses only
  * (σ̄₃₃ is not computed), so the von Mises stress is that of the 2×2 Cauchy
  * stress, σ_dev = σ̄ − ½ tr σ̄ 1, σ_mises = √(3/2 σ_dev:σ_dev) — the
- * thesis's formula with the 2×2 deviator (spec §4.6 leaves the choice
- * open). */
+ * thesis's formula with the 2×2 deviator (the thesis leaves
+ * the choice open). */
 #ifndef PK_FE2_FIELDS_H
 #define PK_FE2_FIELDS_H
 

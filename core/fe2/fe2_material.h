@@ -3,7 +3,7 @@
  *
  * Plane strain, per unit thickness: F̄, P̄ are 2×2, stored as 4-vectors in
  * the order (11, 12, 21, 22); Ā is 4×4 with A[I·4 + J] = ∂P̄_I/∂F̄_J in that
- * order (spec §4.5).  F̄₃₃ = 1.
+ * order (docs/result-format.md).  F̄₃₃ = 1.
  *
  * History (Remark 4.4): eval is a trial — it starts from the state committed
  * for Gauss point g and never changes it; commit(g) makes g's last trial the
@@ -35,14 +35,5 @@ typedef struct pk_fe2_material {
     /* g's last trial becomes its committed state.  0 / −1 (memory). */
     int (*commit)(void *ctx, size_t g);
 } pk_fe2_material;
-
-/* The linear elastic surrogate (patch tests, the macro solver's own tests):
- * P̄ = λ tr(ε) 1 + 2μ ε with ε = sym(F̄ − 1), Ā constant, no history. */
-typedef struct pk_fe2_linear_elastic {
-    double lambda, mu;
-} pk_fe2_linear_elastic;
-
-/* A material over le (borrowed; it must outlive the material). */
-pk_fe2_material pk_fe2_linear_elastic_material(const pk_fe2_linear_elastic *le);
 
 #endif

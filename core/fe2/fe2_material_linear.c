@@ -1,7 +1,7 @@
 /* fe2_material_linear.c — the linear elastic surrogate of the RVE: small
  * strain, P̄ = λ tr(ε) 1 + 2μ ε with ε = sym(F̄ − 1), constant Ā (the patch
- * tests and the macro solver's own tests).  Contract: fe2_material.h. */
-#include "fe2_material.h"
+ * tests and the macro solver's own tests).  Contract: fe2_material_linear.h. */
+#include "fe2_material_linear.h"
 
 #include <string.h>
 

@@ -7,11 +7,12 @@
  * (5.16) (Taylor, exactly), (5.19) (restricted Taylor) and (5.22) (periodic)
  * once the free particles are in equilibrium (the second sum of (5.6)
  * vanishes).  σ̄ = J̄⁻¹P̄F̄ᵗ = (1/v) Σ f_ij ⊗ l_ij (the symmetric full contact
- * sum, spec §3.4 erratum of (5.20)).  For Taylor and restricted Taylor the
+ * sum: (5.20) as printed sums over 𝓑 only and gives half of it;
+ * docs/homogenization.md "Stress and energy").  For Taylor and restricted Taylor the
  * reaction form (5.16)/(5.19), (1/V) Σ_{i prescribed} r_i ⊗ X_i, is computed
  * as well; its distance to P̄ measures the relaxation residual.
  *
- * History (Remark 4.4, spec §4.6): pk_homog_eval reads the committed state
+ * History (Remark 4.4): pk_homog_eval reads the committed state
  * and writes a separate trial state; only pk_homog_commit makes a trial the
  * new history, so a macro Newton driver can evaluate trial F̄ freely. */
 #ifndef PK_HOMOG_BC_H

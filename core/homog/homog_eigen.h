@@ -1,6 +1,6 @@
 /* homog_eigen.h — extreme-eigenvalue estimates of the jammed free stiffness
  * for the optimal dynamic-relaxation parameters (4.47).  The thesis leaves
- * the estimator open (spec §2.7.2): λ_max from a Gershgorin bound (an upper
+ * the estimator open (§4.4.2): λ_max from a Gershgorin bound (an upper
  * bound: under-estimating λ_max is the unstable error), λ_min from a short
  * Lanczos run (its smallest Ritz value), later lowered by Rayleigh quotients
  * of the DR residual (pk_homog_rayleigh), which is dominated by the slowest

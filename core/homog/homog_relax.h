@@ -1,5 +1,5 @@
 /* homog_relax.h — dynamic relaxation of the free particles (Meier 2009 §4.4,
- * spec §2.7): M(ẍ + γẋ) = f with M = 1, central differences (4.38)–(4.41),
+ * (4.37)–(4.49)): M(ẍ + γẋ) = f with M = 1, central differences (4.38)–(4.41),
  * optimal Δt and γ from the extreme eigenvalues of the jammed free stiffness
  * (4.47).  Convergence: |f| <= max(tol·|f⁰|, abs_floor) (4.42 with an
  * absolute floor, spec H5), capped at max_iter.  The eigenvalue estimates are

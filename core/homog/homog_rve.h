@@ -1,9 +1,9 @@
 /* homog_rve.h — the discrete RVE of a homogenization run (Meier 2009 §3.5,
- * §4.3; spec §2.5).
+ * §4.3).
  *
  *  - periodic BC: the primaries of a fully periodic packing; contacts by
  *    minimum image under the deformed lattice F̄L; grain 0 is pinned at F̄X₀
- *    to remove the translation mode (spec §2.5.4 "equivalent simpler form",
+ *    to remove the translation mode (the simpler equivalent of (4.28)–(4.34),
  *    which handles particle flux, Remark 5.3, by construction).
  *  - Taylor / restricted Taylor: the packing is unfolded — every grain that
  *    crosses a periodic side gets its replicas (up to 4 copies in 2D, 8 in
@@ -12,7 +12,7 @@
  *    replicas) the hull is the grains within one smallest diameter of a wall.
  *    Taylor prescribes every particle (4.24), restricted Taylor the hull
  *    (4.27).
- * V_rve = the undeformed box measure (= |L_ab × L_ad| of spec §3.1). */
+ * V_rve = the undeformed box measure (= |L_ab × L_ad|, (5.1)). */
 #ifndef PK_HOMOG_RVE_H
 #define PK_HOMOG_RVE_H
 

@@ -25,20 +25,3 @@ int pk_homog_add_pair_K(pk_sparse_sym *K, int dim, int32_t di, int32_t dj, const
         }
     return rc ? -1 : 0;
 }
-
-int pk_homog_assemble_K(const pk_dem_pairs *c, int dim, double E, const int32_t *dof,
-                        const uint8_t *skip, pk_sparse_sym *K)
-{
-    for (size_t p = 0; p < c->n; p++) {
-        if (!(c->eps[p] >= 0) || !(c->len[p] > 0))
-            continue;
-        size_t i = (size_t)c->i[p], j = (size_t)c->j[p];
-        if ((skip && (skip[i] || skip[j])) || (dof[i] < 0 && dof[j] < 0))
-            continue;
-        double H[9];
-        pk_homog_pair_hessian(pk_dem_pair_E(c, p, E), c->len[p], c->eps[p], &c->l[3 * p], H);
-        if (pk_homog_add_pair_K(K, dim, dof[i], dof[j], H) != 0)
-            return -1;
-    }
-    return 0;
-}

@@ -16,10 +16,4 @@ void pk_homog_pair_hessian(double E, double len, double eps, const double *l, do
 /* Add one contact's blocks; di/dj = first DOF of i/j or −1 if not a DOF. 0 / -1. */
 int pk_homog_add_pair_K(pk_sparse_sym *K, int dim, int32_t di, int32_t dj, const double H[9]);
 
-/* K over the particles with dof[i] >= 0 from the contacts of the last
- * pk_dem_eval, skipping contacts that touch a particle with skip[i] != 0
- * (may be NULL).  K->n must be set by the caller.  0 / -1. */
-int pk_homog_assemble_K(const pk_dem_pairs *c, int dim, double E, const int32_t *dof,
-                        const uint8_t *skip, pk_sparse_sym *K);
-
 #endif

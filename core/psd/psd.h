@@ -1,8 +1,7 @@
 /* psd.h — grading (sieve) curves → particle sizes: the "take" phase.
  *
  * Sources: Titscher & Unger §2–3 (Eqs. 1–17, Algorithm 1), Meier, Kuhl &
- * Steinmann Eqs. 12–13, DIN 1045-2 curves.  Implementation notes:
- * ../shared/specs/packing_titscher_jerier_meier.md §1.
+ * Steinmann Eqs. 12–13, DIN 1045-2 curves.
  *
  * Everything works in solid *measure* (area in 2D, volume in 3D): with one
  * grain density, mass fractions equal volume fractions and ρ cancels.
@@ -18,12 +17,12 @@
 
 #include <stddef.h>
 #include <stdint.h>
-
+*
 #include "core/base/rng.h"
 
 #define PK_PSD_MAX_CLASSES 256
 
-typedef struct pk_size_class {
+    typedef struct pk_size_class {
     double d_lo, d_hi;    /* class bounds, d_lo < d_hi (continuous mode) */
     double d_rep;         /* representative diameter (discrete mode): Meier's lower sieve */
     double mass_fraction; /* share of the *whole* curve's mass, 0..1 */
@@ -91,7 +90,7 @@ double pk_class_number_cdf(const pk_size_class *c, int dim, double d);
 /* Inverse of the above, Eq. (10) for dim = 3, β = 0. */
 double pk_class_sample(const pk_size_class *c, int dim, double u);
 /* Expected number of grains of a class holding solid measure `measure`
- * (closed form of Eq. 6 generalised; spec §1.2). */
+ * (closed form of Eq. 6 generalised). */
 double pk_class_expected_count(const pk_size_class *c, int dim, double measure);
 
 /* Expected total count when the whole curve (before truncation) has solid

@@ -38,7 +38,7 @@ int pk_results_opts_save(pk_req *r, const char *id, const pk_exec_opts *o)
     pk_job_file_path(dir, PK_JOB_EXEC_OPTS, path, sizeof path);
     char jobs[1300];
     snprintf(jobs, sizeof jobs, "%s/jobs", cfg.data);
-    mkdir(jobs, 0750); /* the supervisor makes the same directories when it claims the job */
+    mkdir(jobs, 0750); /* the executor makes the same directories when it claims the job */
     mkdir(dir, 0750);
     int rc = json_dump_file(j, path, JSON_COMPACT) == 0 ? 0 : -1;
     json_decref(j);

@@ -1,5 +1,5 @@
 /* job_files.h — the files of a job's directory DATA/jobs/<id>, named in one
- * place: the supervisor writes them, the routes serve them, links resolve
+ * place: the executor writes them, the routes serve them, links resolve
  * to them, a dismissal deletes them.  (The pictures a worker draws there
  * are named by api/picture/picture.h.) */
 #ifndef PK_JOB_FILES_H

@@ -84,7 +84,7 @@ const char *pk_queue_finish(pk_queue *q, const char *id, const char *status, con
                             const char *summary_json, const char *sha256, long long size);
 
 /* DELETE /jobs/{id}: accepted/running -> dismissed (running ones get
- * cancel_requested, the supervisor stops their worker); finished ->
+ * cancel_requested, the executor stops their worker); finished ->
  * dismissed.  *was receives the previous status.  Returns 0, -1 if unknown. */
 int pk_queue_dismiss(pk_queue *q, const char *id, char was[16]);
 

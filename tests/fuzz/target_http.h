@@ -1,7 +1,7 @@
 /* target_http.h — the 'http' fuzz target: whole HTTP requests into the
  * running service.  One daemon per process, started at the first input the
  * way `packd serve` starts it (queue and token store on a scratch data
- * directory, the supervisor with no workers, the libmicrohttpd listener on
+ * directory, the local executor with no workers, the libmicrohttpd listener on
  * 127.0.0.1), so the request meets every layer a client's does: the HTTP
  * parser, the connection guard, Host and auth checks, the route table, the
  * handlers, the queue, the replies.

@@ -18,7 +18,7 @@ edmd_slow_body 60 >"$T/slow-edmd.json" # an EDMD job that runs until cancelled
 printf 'workers = 1\nmax_queued = 1\nlog_level = info\n' >"$T/packd.conf"
 start_daemon w1 --config "$T/packd.conf" || { fail serve_starts; exit 1; }
 
-# 1. cancel a running EDMD job: the supervisor cancels its worker, which
+# 1. cancel a running EDMD job: the executor cancels its worker, which
 #    ends, the job dismissed; SSE shows live progress and the final status,
 #    then ends
 S=$(submit "$T/slow-edmd.json")
@@ -30,15 +30,15 @@ W=$(worker_pid "$S")
 wait_for 30 grep -q '^event: progress' "$T/live.txt" # it has reported progress
 t0=$(date +%s%N)
 code=$(c -o "$T/del.json" -w '%{http_code}' -X DELETE "$B/jobs/$S")
-# the worker gets SIGTERM at the supervisor's next poll and stops at its next
+# the worker gets SIGTERM at the executor's next poll and stops at its next
 # cancel check (SIGKILL 2 s after SIGTERM if still saving)
 [ -n "$W" ] && wait_for 30 gone "$W"
 echo "cancel: worker gone $(( ($(date +%s%N) - t0) / 1000000 )) ms after DELETE"
 check cancel_dismissed test "$code $(jget "$T/del.json" 'd["status"]')" = "200 dismissed"
 check cancel_worker_stopped sh -c "[ -n '$W' ] && ! kill -0 '$W' 2>/dev/null"
 wait_for 10 logged "worker ended" "$S"
-cancelled_by_supervisor() { logged "cancelling worker" "$S" && logged "worker ended" "$S.*\"status\":\"dismissed\""; }
-check cancel_by_supervisor cancelled_by_supervisor
+cancelled_by_executor() { logged "cancelling worker" "$S" && logged "worker ended" "$S.*\"status\":\"dismissed\""; }
+check cancel_by_executor cancelled_by_executor
 wait_for 10 gone $sse
 check sse_live_progress_then_dismissed sh -c "! kill -0 $sse 2>/dev/null && grep -q '^event: progress' '$T/live.txt' && grep -q '\"status\":\"running\"' '$T/live.txt' && tail -3 '$T/live.txt' | grep -q '\"status\":\"dismissed\"'"
 problem() { # name, code, curl args... (status + problem+json)

@@ -10,6 +10,7 @@
 #include "api/solver/sparse_cholmod.h"
 #include "core/fe2/fe2_rve.h"
 #include "core/fe2/fe2_solver.h"
+#include "core/fe2/fe2_material_linear.h"
 
 /* Mesh from arrays (copied); finished and checked. */
 static inline void mesh_from(pk_fe2_mesh *m, size_t nnode, const double *xy, size_t nelem,

@@ -1,4 +1,4 @@
-/* test_dem_contact.c — contact law (spec §2.2–2.4), periodic detection with
+/* test_dem_contact.c — contact law (Meier 2009 (4.3)–(4.16)), periodic detection with
  * the shared grid, rattler test (Table 4.3 generalised). */
 #include <math.h>
 #include <stdlib.h>
@@ -153,7 +153,7 @@ static void dirs2(double *d, const double *deg, int m)
     }
 }
 
-/* Remark 4.6 and the special cases of spec §2.6 */
+/* Remark 4.6 and its special cases in 2D (180°, 4×90°) */
 static void test_jamming_test_2d(void)
 {
     double d[3 * 8];

@@ -1,4 +1,4 @@
-/* test_dem_friction.c — inter-particle friction (Meier 2009 ch. 7, spec §5):
+/* test_dem_friction.c — inter-particle friction (Meier 2009 ch. 7):
  * the Table 7.1 return map, the two-grain stick/slip force, (7.19) as the
  * derivative of (7.5), ρ = h = 0 reproducing the frictionless RVE exactly,
  * the trial/commit protocol, dissipation over a closed cycle, and the only
@@ -11,7 +11,7 @@
 #include "core/dem/dem_friction.h"
 #include "homog_fixture.h"
 
-/* After a slip correction Y = f_n tan ρ exactly (spec §5.3 derived check);
+/* After a slip correction Y = f_n tan ρ exactly (from (7.16));
  * below the limit the predictor stands.  Closed forms: 1e-14 relative. */
 static void test_return_map(void)
 {
@@ -102,7 +102,7 @@ static void test_two_grain_stick_slip(void)
     pk_fric_pairs_free(&t.fc.w);
 }
 
-/* (7.19) is −∂Φ_t/∂x_j of (7.5) at fixed rotations (spec §5.3 derived check):
+/* (7.19) is −∂Φ_t/∂x_j of (7.5) at fixed rotations:
  * central differences of Φ_t = f_t²/(2E_t) while sticking.  h = 1e-6, the
  * error O(h²) relative to |f_t| ~ 1e-2: tolerance 1e-8.  Rotation: γ grows by
  * Δu |l|/(r_i + r_j) (7.5). */

@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "core/edmd/edmd.h"
+#include "core/edmd/edmd_state.h"
 #include "core/space/gap_audit.h"
 #include "core/base/rng.h"
 

@@ -4,10 +4,8 @@
  * minimum image is reported once.  Walled axes hold grains whose centres
  * lie outside the box (EDMD's bounding spheres are centred ahead of a
  * grain: up to a skin beyond a wall), filed in the end cells; query points
- * lie outside too, by less than their radius.  (Written for round 7's
- * culled rows, since dropped (grid_uniform.c); it caught end cells of a
- * walled axis bounded at the wall, 10 % less reach², one cell less at a
- * row's end.) */
+ * lie outside too, by less than their radius: the end cells of a walled
+ * axis must reach past the wall. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

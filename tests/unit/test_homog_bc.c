@@ -1,5 +1,5 @@
 /* test_homog_bc.c — boundary conditions, relaxation and stress of the RVE
- * (Meier 2009 ch. 4–5; spec §2.5–3.5, §9.1).  The jammed RVEs are built here:
+ * (Meier 2009 §4.3–4.4, ch. 5).  The jammed RVEs are built here:
  * random overlapping disks/spheres relaxed under periodic BC at F̄ = 1. */
 #include <math.h>
 #include <stdlib.h>
@@ -8,7 +8,7 @@
 #include "check.h"
 #include "homog_fixture.h"
 
-/* Remark 6.1 with the basis erratum (spec §4.2): square √N×√N lattice of
+/* Remark 6.1 with its basis corrected (docs/homogenization.md, Tangent): square √N×√N lattice of
  * touching disks under Taylor: A_1111 = E √N/(√N−1), shear stiffness 0.
  * Contacts are linear in the compression (ε = 2rδ exactly), so the one-sided
  * difference is exact up to round-off: tolerance 1e-9 relative. */
@@ -159,7 +159,7 @@ static void test_identities(void)
 }
 
 /* P̄ = ∂Φ̄/∂F̄ by central differences, each perturbed state relaxed from the
- * same committed state at fixed topology (spec §4.5).  h = 1e-6 with DR tol
+ * same committed state at fixed topology (Remark 4.4).  h = 1e-6 with DR tol
  * 1e-12: truncation O(h²), round-off ~1e-16 Φ̄/h, relaxation error O(tol²)
  * in Φ̄ → relative error well below the required 1e-6. */
 static void test_stress_is_energy_derivative(void)

@@ -61,7 +61,7 @@ static void test_fire_reaches_dr_minimum(void)
     relax_problem_free(&pb);
 }
 
-/* FIRE as first written (round 7): P = f·v, v ← v + Δt f, the mixed move
+/* FIRE in its textbook form: P = f·v, v ← v + Δt f, the mixed move
  * and |f| as four separate passes — the oracle of the fused loop
  * (homog_fire.c: one pass after each evaluation), which must follow it bit
  * for bit: near jamming a difference in the last bit moves the plastic

@@ -9,6 +9,25 @@
 #include "core/homog/homog_stiffness.h"
 #include "api/solver/sparse_cholmod.h"
 
+/* K over the particles with dof[i] >= 0 from the contacts of the last
+ * pk_dem_eval, skipping contacts that touch a particle with skip[i] != 0. */
+static int assemble_K(const pk_dem_pairs *c, int dim, double E, const int32_t *dof,
+                      const uint8_t *skip, pk_sparse_sym *K)
+{
+    for (size_t p = 0; p < c->n; p++) {
+        if (!(c->eps[p] >= 0) || !(c->len[p] > 0))
+            continue;
+        size_t i = (size_t)c->i[p], j = (size_t)c->j[p];
+        if ((skip && (skip[i] || skip[j])) || (dof[i] < 0 && dof[j] < 0))
+            continue;
+        double H[9];
+        pk_homog_pair_hessian(pk_dem_pair_E(c, p, E), c->len[p], c->eps[p], &c->l[3 * p], H);
+        if (pk_homog_add_pair_K(K, dim, dof[i], dof[j], H) != 0)
+            return -1;
+    }
+    return 0;
+}
+
 static void geom_of_rve(const pk_homog_rve *rve, const double F[9], pk_dem_geom *g)
 {
     memset(g, 0, sizeof *g);
@@ -47,7 +66,7 @@ static void inspect_state(const pk_homog_rve *rve, const pk_homog_opts *o, const
     }
     pk_sparse_sym K = {0};
     K.n = (size_t)nd;
-    CHECK(pk_homog_assemble_K(&c, dim, o->E_n, dof, rat, &K) == 0);
+    CHECK(assemble_K(&c, dim, o->E_n, dof, rat, &K) == 0);
     pk_sparse_info info;
     pk_sparse_factor *fac = pk_sparse_cholmod.factor(&K, &info);
     *pd = info.status == PK_SPARSE_OK;

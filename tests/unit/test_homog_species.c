@@ -1,5 +1,5 @@
 /* Pair-specific normal stiffness E_n,ij by species (Meier 2009 Eq. 4.3:
- * "E_n ij may be pair-specific"; spec §10 E_n_per_pair). */
+ * "E_n ij may be pair-specific"). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

@@ -1,5 +1,4 @@
-/* test_homog_tangent.c — Ā = dP̄/dF̄ by static condensation (Meier 2009 ch. 6,
- * spec §4), with the CHOLMOD solver injected from api/. */
+/* test_homog_tangent.c — Ā = dP̄/dF̄ by static condensation (Meier 2009 ch. 6), with the CHOLMOD solver injected from api/. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

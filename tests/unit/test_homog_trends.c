@@ -1,4 +1,4 @@
-/* Qualitative trends of Meier 2009 §9.3 (spec §9.3) on small RVEs under a
+/* Qualitative trends of Meier 2009 §5.4 on small RVEs under a
  * loading path: the periodic shear-stress plateau, nearly independent of N,
  * far below Taylor's; the restricted-Taylor ratchet under cyclic shear.
  * RVEs: jammed periodic 2D packings (radii 0.8–1.2, φ_nominal 0.88, E_n = 1),

@@ -23,7 +23,7 @@ static void test_names_distinct(void)
     size_t n = sizeof all / sizeof *all;
     for (size_t i = 0; i < n; i++) {
         CHECK(strlen(pk_job_file_name(all[i])) > 0 && !strchr(pk_job_file_name(all[i]), '/'));
-        /* no name holds ".tmp": the supervisor removes those as leftovers */
+        /* no name holds ".tmp": the executor removes those as leftovers */
         CHECK(!strstr(pk_job_file_name(all[i]), ".tmp"));
         for (size_t j = 0; j < i; j++)
             CHECK(strcmp(pk_job_file_name(all[i]), pk_job_file_name(all[j])) != 0);

@@ -1,6 +1,6 @@
 /* test_psd.c — grading curve → particle sizes (core/psd/psd.c).
- * Reference numbers: ../shared/specs/packing_titscher_jerier_meier.md §1
- * (Titscher & Unger [T], Meier et al. [M], DIN 1045-2). */
+ * Reference numbers: Titscher & Unger §2–3 (Eqs. 1–13), Meier, Kuhl & Steinmann
+ * Eqs. 12–13, DIN 1045-2. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -134,7 +134,7 @@ static void test_meier_tables(void)
     for (int i = 1; i < 6; i++)
         CHECK(cnt[i] >= 1);
 
-    /* 3D shares (spec §1.4, d³ weighting), same 4-decimal tolerance. */
+    /* 3D shares (d³ weighting), same 4-decimal tolerance. */
     const double a32_3d[6] = {0, 0.0602, 0.3041, 1.5204, 7.2978, 90.8175};
     pk_discrete_number_shares(&g, 3, sh);
     for (int i = 0; i < 6; i++)
@@ -217,7 +217,7 @@ static void test_din(void)
                   cases[i].dmin, n, cases[i].N);
         CHECK_NEAR(cases[i].phiM * (1 - g.mass_below), cases[i].phieff, cases[i].phitol);
     }
-    /* The per-class closed form of spec §1.2 (3D, β = 0) written out. */
+    /* The per-class closed form of Titscher & Unger Eq. 6 (3D, β = 0) written out. */
     CHECK(pk_grading_preset(&g, "A16") == 0);
     CHECK(pk_grading_truncate(&g, 2) == 0);
     double cnt[PK_PSD_MAX_CLASSES], tot = 0;
