@@ -17,7 +17,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
-*
+
 #include "core/base/rng.h"
 
 #define PK_PSD_MAX_CLASSES 256
