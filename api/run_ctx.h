@@ -24,11 +24,11 @@ typedef struct pk_run_ctx {
     int threads;
     pk_monitor *mon; /* progress, cancel and wall time; NULL = none */
     pk_run_checkpoint checkpoint;
-    const char *author; /* the result's /h5md/author name; NULL = "packd" */
+    const char *author; /* the result's /h5md/author name; NULL or "" = unknown */
 } pk_run_ctx;
 
 /* What a run gets when its caller states nothing: 1 thread, no monitor, no
- * checkpoint, author "packd". */
+ * checkpoint, author unknown. */
 #define PK_RUN_CTX_DEFAULT                                                                         \
     ((pk_run_ctx){.threads = 1, .checkpoint = {.interval_s = 30}, .author = NULL})
 

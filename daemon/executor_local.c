@@ -153,9 +153,7 @@ static int launch(local_exec *s, slot *sl, json_t *job)
         return -1;
     }
     char threads[16], interval[32], owner[128];
-    /* the job's owner is its result's /h5md/author */
-    const char *own = json_string_value(json_object_get(job, "owner"));
-    snprintf(owner, sizeof owner, "%s", own ? own : "packd");
+    snprintf(owner, sizeof owner, "%s", pk_worker_author(job));
     pthread_mutex_lock(&s->mu);
     snprintf(threads, sizeof threads, "%d", s->job_threads);
     int niceness = s->worker_nice;

@@ -175,12 +175,11 @@ static json_t *change(const char *id, const char *op)
 static json_t *submit(slurm_exec *s, json_t *job, const pk_config *c)
 {
     const char *id = json_string_value(json_object_get(job, "id"));
-    const char *own = json_string_value(json_object_get(job, "owner"));
     char dir[1200], why[1400], script[1300];
     pk_job_dir(c->data, id, dir, sizeof dir);
     pk_slurm_job sj = {.id = id,
                        .dir = dir,
-                       .owner = own ? own : "packd",
+                       .author = pk_worker_author(job),
                        .packd = c->slurm_packd[0] ? c->slurm_packd : s->exe,
                        .threads = c->job_threads,
                        .ranks = pk_slurm_job_ranks(job),

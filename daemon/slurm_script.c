@@ -114,7 +114,7 @@ int pk_slurm_script_write(const pk_slurm_job *j, const pk_config *c, char *path,
             pk_job_file_name(PK_JOB_PROGRESS), j->threads);
     fprintf(f, " --checkpoint %s --checkpoint-interval %g --author ",
             pk_job_file_name(PK_JOB_CHECKPOINT), j->checkpoint_interval_s);
-    put_quoted(f, j->owner);
+    put_quoted(f, j->author);
     fprintf(f, " > %s 2>> %s\n", pk_job_file_name(PK_JOB_SUMMARY), pk_job_file_name(PK_JOB_LOG));
     fprintf(f, "rc=$?\necho \"$rc $attempt $node\" > %s.tmp && mv %s.tmp %s\nexit $rc\n",
             pk_job_file_name(PK_JOB_EXIT), pk_job_file_name(PK_JOB_EXIT),

@@ -26,11 +26,11 @@
 enum { PK_SLURM_NO_DIR = 96 }; /* exit status: job directory not visible on the node */
 
 typedef struct pk_slurm_job {
-    const char *id, *dir, *owner;
-    const char *packd; /* packd on the nodes */
-    int threads;       /* CPUs of each task */
-    int ranks;         /* tasks: an fe2 job's inputs.parallel.mpi_ranks, else 1 */
-    double wall_s;     /* the job's wall-time limit (its limits, capped by the operator's) */
+    const char *id, *dir, *author; /* author: pk_worker_author, "" unknown */
+    const char *packd;             /* packd on the nodes */
+    int threads;                   /* CPUs of each task */
+    int ranks;                     /* tasks: an fe2 job's inputs.parallel.mpi_ranks, else 1 */
+    double wall_s; /* the job's wall-time limit (its limits, capped by the operator's) */
     double checkpoint_interval_s;
 } pk_slurm_job;
 

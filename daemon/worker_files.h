@@ -13,6 +13,12 @@
  * row.  0, or -1 with why. */
 int pk_worker_prepare(const char *dir, json_t *job, char *why, size_t n);
 
+/* The job's /h5md/author for `packd run --author`: its owner when that names
+ * a person (a token's name, the proxy's X-Packd-Owner), "" when the owner is
+ * only the client's address (auth off): the file then says the author is
+ * unknown rather than naming a machine. */
+const char *pk_worker_author(json_t *job);
+
 /* Remove *.tmp files in dir (an interrupted run's). */
 void pk_worker_remove_tmp(const char *dir);
 

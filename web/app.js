@@ -32,6 +32,22 @@ async function api(path, opts) {
   return body;
 }
 
+// An RFC 3339 time of the API in the browser's time zone, which it names
+// ("7 Dec 2026, 22:14:05 GMT+5:30"); '' when absent.
+function localTime(iso) {
+  const t = iso ? new Date(iso) : null;
+  if (!t || isNaN(t)) return '';
+  return t.toLocaleString(undefined, {
+    year: 'numeric', month: 'short', day: 'numeric', hour: '2-digit', minute: '2-digit',
+    second: '2-digit', timeZoneName: 'short',
+  });
+}
+
+// The line of a progress event: its stage and φ (the worker's object)
+function progressLine(d) {
+  return d.stage + (d.phi ? ', φ = ' + Number(d.phi).toFixed(4) : '');
+}
+
 function el(tag, text, cls) {
   const e = document.createElement(tag);
   if (text !== undefined && text !== null) e.textContent = String(text);
@@ -104,7 +120,7 @@ function onListEvent(id) {
     if (!row) return;
     if (d.status) setStatus(row, d.status);
     if (typeof d.message === 'string') row.msg.textContent = d.message;
-    if (kind === 'progress' && d.stage) row.msg.textContent = d.stage + (d.phi ? ', φ = ' + Number(d.phi).toFixed(4) : '');
+    if (kind === 'progress' && d.stage) row.msg.textContent = progressLine(d);
     setProgress(row, d.progress);
   };
 }
@@ -127,7 +143,9 @@ function jobRow(j) {
     const pct = el('span', '', 'pct');
     barc.append(bar, pct);
     row = { tr, status: el('td'), bar, pct, msg: el('td') };
-    tr.append(idc, el('td', j.processID), row.status, barc, row.msg, el('td', (j.created || '').replace('T', ' ').replace('Z', '')));
+    const created = el('td', localTime(j.created), 'created');
+    created.title = j.created || '';
+    tr.append(idc, el('td', j.processID), row.status, barc, row.msg, created);
     rows.set(j.jobID, row);
   }
   setStatus(row, j.status);
@@ -195,7 +213,7 @@ function fillRVE() {
   sel.replaceChildren(el('option', wants && !packResults.length ? '(first run a pack example)' : '(as in the example)'));
   sel.options[0].value = '';
   for (const j of packResults) {
-    const o = el('option', j.jobID.slice(0, 8) + ' ' + (j.created || ''));
+    const o = el('option', j.jobID.slice(0, 8) + ' ' + localTime(j.created));
     o.value = '/jobs/' + j.jobID + '/results/result';
     sel.appendChild(o);
   }
@@ -282,18 +300,49 @@ function summaryRows(obj, prefix, tbody, depth) {
   }
 }
 
-function showJobStatus(s) {
-  $('job-status').textContent = s.status;
-  $('job-status').className = 'status st-' + s.status;
+// A statusInfo document or an event of the job's stream: progress events
+// carry no status, so the last known one stays.
+function showJobStatus(s, kind) {
+  if (s.status) {
+    $('job-status').textContent = s.status;
+    $('job-status').className = 'status st-' + s.status;
+    $('cancel').hidden = !['accepted', 'running'].includes(s.status);
+  }
   const p = s.status === 'successful' ? 100 : s.progress;
   if (typeof p === 'number') { $('job-progress').value = p; $('job-percent').textContent = p + ' %'; }
   if (typeof s.message === 'string') $('job-message').textContent = s.message;
+  else if (kind === 'progress' && s.stage) $('job-message').textContent = progressLine(s);
+  if (s.created) {
+    $('job-times').textContent = ['created', 'started', 'finished']
+      .filter((k) => s[k]).map((k) => k + ' ' + localTime(s[k])).join(' · ');
+  }
+}
+
+async function cancelJob() {
+  const id = pageJob;
+  try {
+    showJobStatus(await api('jobs/' + encodeURIComponent(id), { method: 'DELETE' }));
+  } catch (e) { showError('Cancel: ' + e.message); }
+}
+
+// A failed job: why it stopped, its summary, and its partial result file
+// when the worker left one (the statusInfo's partial-result link).
+async function showFailed(id, s) {
+  $('job-reason').textContent = 'Why it failed: ' + (s.failure || s.message || 'no reason recorded');
+  $('job-reason').hidden = false;
+  if ((s.links || []).some((l) => l.rel === 'partial-result'))
+    download(id, 'result', id + '.partial.h5', 'partial HDF5 result (as far as the job got)');
+  try {
+    summaryRows(await api(fileURL(id, 'summary')), '', $('summary').tBodies[0], 0);
+  } catch (e) { showError('Summary: ' + e.message); }
 }
 
 async function showJob(id) {
   pageJob = id;
   $('job-id').textContent = id;
-  for (const k of ['pictures', 'downloads', 'job-message', 'job-percent', 'job-inputs']) $(k).replaceChildren();
+  for (const k of ['pictures', 'downloads', 'job-message', 'job-percent', 'job-inputs', 'job-times', 'job-reason']) $(k).replaceChildren();
+  $('job-reason').hidden = true;
+  $('cancel').hidden = true;
   $('summary').tBodies[0].replaceChildren();
   let s;
   try { s = await api('jobs/' + encodeURIComponent(id)); } catch (e) { showError('Job: ' + e.message); return; }
@@ -304,11 +353,12 @@ async function showJob(id) {
   if (!FINAL.includes(s.status)) {
     stream(id, (kind, d) => {
       if (pageJob !== id) return;
-      showJobStatus(d);
+      showJobStatus(d, kind);
       if (d.status && FINAL.includes(d.status)) showJob(id);
     });
     return;
   }
+  if (s.status === 'failed') return showFailed(id, s);
   if (s.status !== 'successful') return;
   let res;
   try { res = await api('jobs/' + encodeURIComponent(id) + '/results'); } catch (e) { showError('Results: ' + e.message); return; }
@@ -356,6 +406,7 @@ document.addEventListener('DOMContentLoaded', () => {
     route();
   });
   $('submit-form').addEventListener('submit', submitExample);
+  $('cancel').addEventListener('click', cancelJob);
   window.addEventListener('hashchange', route);
   loadExamples();
   route();

@@ -240,19 +240,6 @@ static int series(pk_h5 *h, const pk_fe2_record *r, char *clock, const char *nam
     return rc;
 }
 
-/* Per-step views of a series (what the XDMF sidecar reads). */
-static int views(pk_h5 *h, const pk_fe2_record *r, const char *name)
-{
-    int rc = 0;
-    char src[160], dst[160];
-    snprintf(src, sizeof src, "/observables/fe2/%s/value", name);
-    for (size_t k = 0; k < r->nstep && !rc; k++) {
-        snprintf(dst, sizeof dst, "/observables/fe2/views/%s/%zu", name, k);
-        rc = pk_h5_slice_view(h, src, k, dst);
-    }
-    return rc;
-}
-
 int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r, const pk_units *u)
 {
     char clock[200] = "";
@@ -355,8 +342,5 @@ int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r, const pk_units *u)
     rc |= iarr(h, "/observables/fe2/newton/iterations/solve", r->it_part.v, ni);
     rc |= arr(h, "/observables/fe2/newton/iterations/relative_residual", 1, &ni, r->it_res.v, NULL);
     rc |= arr(h, "/observables/fe2/newton/iterations/line_search", 1, &ni, r->it_eta.v, NULL);
-    if (!rc)
-        rc |= views(h, r, "position") | views(h, r, "displacement") |
-            views(h, r, "von_mises_element");
     return rc ? -1 : 0;
 }

@@ -50,8 +50,7 @@ int pk_fe2_record_newton(pk_fe2_record *r, size_t step, const pk_fe2_step_report
 int pk_fe2_record_step(pk_fe2_record *r, size_t step, double time, size_t stage, int cuts,
                        const pk_fe2_state *st, const double *const *micro_pos);
 
-/* Everything under /observables/fe2 (and the per-step views of the XDMF
- * sidecar).  0 / −1. */
+/* Everything under /observables/fe2.  0 / −1. */
 int pk_fe2_record_write(pk_h5 *h, const pk_fe2_record *r, const pk_units *u);
 
 #endif

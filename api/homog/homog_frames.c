@@ -78,6 +78,7 @@ int pk_homog_frames_write(pk_h5 *h, const pk_homog_frames *fr, const pk_homog_rv
     int rc = pk_h5_link(h, "/particles/grains/box", "/particles/rve/box");
     pk_h5_write_array(h, "/particles/rve/radius", PK_H5_F64, 1, &n, rve->r, unit);
     pk_h5_write_array(h, "/particles/rve/grain", PK_H5_I32, 1, &n, rve->grain, NULL);
+    pk_h5_write_array(h, "/particles/rve/species", PK_H5_I32, 1, &n, rve->species, NULL);
     int64_t *id = malloc((n ? n : 1) * sizeof *id);
     if (!id)
         return -1;
@@ -87,22 +88,13 @@ int pk_homog_frames_write(pk_h5 *h, const pk_homog_frames *fr, const pk_homog_rv
     free(id);
     if (!c)
         return rc ? -1 : 0;
-    /* H5MD time-dependent elements: step, time (shared), value */
-    const char *el[2] = {"position", "contact_force"};
+    /* H5MD time-dependent elements: step, time (shared), value (the XDMF
+     * sidecar reads a step as a row of value, by its byte offset) */
     size_t dx[3] = {c, n, (size_t)fr->dim}, df[2] = {c, n};
     pk_h5_time_element(h, "/particles/rve/position", NULL, fr->step, fr->time, NULL, PK_H5_F64, 3,
                        dx, fr->x, unit);
     pk_h5_time_element(h, "/particles/rve/contact_force", "/particles/rve/position", NULL, NULL,
                        NULL, PK_H5_F64, 2, df, fr->force, "N");
-    /* per step views position/<k> [n][dim] and contact_force/<k> [n] for the
-     * XDMF sidecar: ParaView's Xdmf3 reader reads no HyperSlab */
-    for (size_t k = 0; k < c; k++)
-        for (int e = 0; e < 2; e++) {
-            char src[64], p[64];
-            snprintf(src, sizeof src, "/particles/rve/%s/value", el[e]);
-            snprintf(p, sizeof p, "/particles/rve/views/%s/%zu", el[e], k);
-            pk_h5_slice_view(h, src, k, p);
-        }
     return rc ? -1 : 0;
 }
 

@@ -21,7 +21,7 @@
 #include "core/homog/homog_rve.h"
 
 #define PK_HOMOG_FRAMES_MAX ((size_t)1000000)
-#define PK_HOMOG_FRAMES_MAX_STEPS ((size_t)1000) /* two views per step in the file */
+#define PK_HOMOG_FRAMES_MAX_STEPS ((size_t)1000) /* two XDMF grids per step in the sidecar */
 
 typedef struct pk_homog_frames {
     int dim, keep;

@@ -4,6 +4,7 @@
  * with "wall_gap": "none", only the true grains inside (core/edmd/edmd_walls.h). */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "core/edmd/edmd.h"
@@ -11,6 +12,8 @@
 #include "core/edmd/edmd_contacts.h"
 #include "core/edmd/edmd_rigidity.h"
 #include "core/edmd/edmd_walls.h"
+#include "core/space/gap_audit.h"
+#include "core/space/length_snap.h"
 #include "pack_placer.h"
 #include "api/solver/sparse_cholmod.h"
 
@@ -151,6 +154,7 @@ static void check_edmd(const pk_pack_job *job, const pk_pack_plan *plan, void **
  * to resume. */
 typedef struct ckpt_file {
     const char *path, *digest;
+    char unit_digest[160]; /* the job's digest, marked: the state is in the unit ℓ */
     char err[300];
 } ckpt_file;
 
@@ -198,9 +202,90 @@ static json_t *doubles(const double *a, size_t n)
     return arr;
 }
 
+/* The engine runs in units of the first box edge ℓ (core/space/length_snap.h):
+ * that edge is 1, equal edges too, other walled edges snapped inside the
+ * job's walls (periodic ones exact: L/ℓ); diameters snapped one lattice step
+ * below (never larger than drawn: every sieve they pass they still pass), Δd
+ * one step above (every gap of the job's unit still >= the job's Δd).  So a
+ * job in another length unit computes the same bits. */
+typedef struct edmd_unit {
+    double ell;
+    pk_pack_job job; /* the job in the unit (box, delta_d) */
+    pk_sizes sz;     /* the drawn sizes in the unit */
+} edmd_unit;
+
+static double snap_step(double v)
+{
+    int e;
+    frexp(v, &e);
+    return ldexp(1, e - PK_SNAP_BITS);
+}
+
+static int to_unit(const pk_pack_job *job, const pk_sizes *sz, edmd_unit *u)
+{
+    const double ell = job->box.L[0];
+    u->ell = ell;
+    u->job = *job;
+    for (int k = 0; k < job->box.dim; k++) {
+        const double L = job->box.L[k], v = L / ell;
+        u->job.box.L[k] = L == ell ? 1 : job->box.periodic[k] ? v : pk_snap_within(v, ell, L);
+    }
+    const double dd = job->delta_d / ell;
+    u->job.delta_d = dd > 0 ? pk_snap(dd) + snap_step(pk_snap(dd)) : dd;
+    u->sz = *sz;
+    u->sz.d = malloc((sz->n ? sz->n : 1) * sizeof *u->sz.d);
+    if (!u->sz.d)
+        return -1;
+    for (size_t i = 0; i < sz->n; i++) {
+        const double d = pk_snap(sz->d[i] / ell);
+        u->sz.d[i] = d - snap_step(d);
+    }
+    return 0;
+}
+
+/* The grains back in the job's unit. */
+static void from_unit(const edmd_unit *u, pk_particles *p)
+{
+    for (size_t i = 0; i < p->n; i++) {
+        for (int k = 0; k < 3; k++)
+            p->x[3 * i + k] *= u->ell;
+        p->r[i] *= u->ell;
+    }
+}
+
+static int place_edmd_unit(const pk_pack_job *job, const pk_pack_job *user, double ell,
+                           const pk_pack_plan *plan, const pk_sizes *sz, const pk_run_ctx *run,
+                           pk_particles *p, pk_place_stats *st, char *err, size_t errlen);
+
 static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk_sizes *sz,
                       const pk_run_ctx *run, pk_particles *p, pk_place_stats *st, char *err,
                       size_t errlen)
+{
+    edmd_unit u;
+    if (to_unit(job, sz, &u) != 0) {
+        snprintf(err, errlen, "out of memory for %zu grains", sz->n);
+        return -1;
+    }
+    int rc = place_edmd_unit(&u.job, job, u.ell, plan, &u.sz, run, p, st, err, errlen);
+    free(u.sz.d);
+    if (rc != 0)
+        return rc;
+    from_unit(&u, p);
+    st->audit_delta_d *= u.ell;
+    static const char *const lengths[] = {"delta_d_reached", "wall_gap_guaranteed"};
+    for (size_t k = 0; k < 2 && st->obs; k++) {
+        json_t *v = json_object_get(st->obs, lengths[k]);
+        if (v)
+            json_object_set_new(st->obs, lengths[k], json_real(json_real_value(v) * u.ell));
+    }
+    return 0;
+}
+
+/* place_edmd in the unit ℓ: job and sz in it, user the job as given (its
+ * numbers in the warnings). */
+static int place_edmd_unit(const pk_pack_job *job, const pk_pack_job *user, double ell,
+                           const pk_pack_plan *plan, const pk_sizes *sz, const pk_run_ctx *run,
+                           pk_particles *p, pk_place_stats *st, char *err, size_t errlen)
 {
     pk_monitor *mon = run->mon;
     pk_edmd_params prm;
@@ -261,7 +346,11 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     pk_edmd_checkpoint ck = {0};
     pk_edmd_snapshot snap = {0};
     cf.path = run->checkpoint.path;
-    cf.digest = run->checkpoint.digest ? run->checkpoint.digest : "";
+    /* a snapshot in the job's unit (written before the engine ran in ℓ) is
+     * another job's: not resumed */
+    snprintf(cf.unit_digest, sizeof cf.unit_digest, "%s/unit-edge",
+             run->checkpoint.digest ? run->checkpoint.digest : "");
+    cf.digest = cf.unit_digest;
     ck.interval_s = run->checkpoint.interval_s;
     int loaded = 1;
     if (cf.path) {
@@ -299,7 +388,7 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     /* the shell short of the job's Δd (jammed, stalled, out of time): the
      * packing is kept, audited at the Δd reached and says so */
     const int dd_short =
-        prm.growth == PK_EDMD_GROW_SHELL && es.delta_d < job->delta_d * (1 - 1e-12);
+        prm.growth == PK_EDMD_GROW_SHELL && es.delta_d * ell < user->delta_d * (1 - 1e-12);
     *st = (pk_place_stats){.reason = es.reason,
                            .termination = pk_edmd_criterion_name(es.criterion),
                            .phi_own = prm.until == PK_EDMD_UNTIL_JAMMED &&
@@ -335,13 +424,33 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
         st->goal_reached = stop_ok && rg.rigid && es.reason == PK_STOP_JAMMED;
     }
     if (dd_short) {
+        /* walls that see the true grains (w = the job's Δd/2) let a shell h < w
+         * through them by w − h: the grains are pulled inside and Δd is what
+         * the pairs keep afterwards */
+        double pulled = 1, shell_dd = es.delta_d;
+        if (w > 0 && (pulled = pk_edmd_pull_inside(&job->box, p)) < 1) {
+            pk_gap_report rep;
+            if (pk_gap_audit(&job->box, p, es.delta_d, 0, es.delta_d + 1e-300, &rep) != 0) {
+                snprintf(err, errlen, "out of memory in the gap audit");
+                return -1;
+            }
+            es.delta_d = fmin(es.delta_d, rep.min_gap);
+        }
         st->short_delta_d = 1;
         st->audit_delta_d = es.delta_d;
-        snprintf(st->warning, sizeof st->warning,
-                 "shell growth stopped (%s) at Δd = %.6g, short of the job's delta_d = %.6g: every "
-                 "gap of the result is >= %.6g; lower phi or delta_d, or try a smaller "
-                 "edmd.growth_rate",
-                 pk_edmd_criterion_name(es.criterion), es.delta_d, job->delta_d, es.delta_d);
+        int len = snprintf(st->warning, sizeof st->warning,
+                           "shell growth stopped (%s) at Δd = %.6g, short of the job's delta_d = "
+                           "%.6g: every gap of the result is >= %.6g",
+                           pk_edmd_criterion_name(es.criterion), es.delta_d * ell, user->delta_d,
+                           es.delta_d * ell);
+        if (pulled < 1 && len > 0 && (size_t)len < sizeof st->warning)
+            len += snprintf(st->warning + len, sizeof st->warning - (size_t)len,
+                            " (the shell reached %.6g; the grains it let through the walls "
+                            "were pulled inside, walled coordinates scaled by %.6f)",
+                            shell_dd * ell, pulled);
+        if (len > 0 && (size_t)len < sizeof st->warning)
+            snprintf(st->warning + len, sizeof st->warning - (size_t)len,
+                     "; lower phi or delta_d, or try a smaller edmd.growth_rate");
     }
     json_t *obs = json_object();
     json_object_set_new(obs, "phi_final", json_real(es.phi));
@@ -361,7 +470,9 @@ static int place_edmd(const pk_pack_job *job, const pk_pack_plan *plan, const pk
     json_object_set_new(obs, "termination_criterion",
                         json_string(pk_edmd_criterion_name(es.criterion)));
     json_object_set_new(obs, "delta_d_reached", json_real(es.delta_d));
-    json_object_set_new(obs, "wall_gap_guaranteed", json_real(fmax(0.5 * es.delta_d - w, 0)));
+    /* a shell that reached w: its clearance beyond w is round-off */
+    const double wall_gap = 0.5 * es.delta_d - w;
+    json_object_set_new(obs, "wall_gap_guaranteed", json_real(wall_gap > 1e-12 * w ? wall_gap : 0));
     json_object_set_new(obs, "start", json_string(prm.start_zero ? "zero" : "rsa"));
     if (!prm.start_zero) {
         json_object_set_new(obs, "start_delta", json_real(prm.delta));

@@ -12,6 +12,7 @@
 #include "pack_placer.h"
 #include "core/tetfill/tetfill.h"
 #include "core/tetfill/tetfill_stats.h"
+#include "core/space/length_snap.h"
 
 /* Kuhn cubes of edge h have mean unique-edge length (3 + 3√2 + √3)/7 · h. */
 #define KUHN_MEAN_EDGE 1.2820
@@ -20,6 +21,10 @@ typedef struct tetfill_setup {
     pk_mesh mesh;
     pk_mesh_report rep;
     double origin[3]; /* mesh frame = particle frame + origin */
+    /* The filler runs in units of r_min (core/space/length_snap.h): mesh and
+     * prm in that unit, lengths snapped, so a job in any length unit computes
+     * the same bits; the job's r_min and r_max in its own unit. */
+    double ell, r_min, r_max;
     pk_tetfill_params prm;
     char unit[32]; /* the job's length unit */
 } tetfill_setup;
@@ -73,6 +78,15 @@ static int radii(const pk_tetfill_options *o, double edge_mean, double *rmin, do
     return *rmax >= *rmin ? 0 : -1;
 }
 
+/* The radii resolved in the job's unit → the filler's unit r_min. */
+static void to_unit(tetfill_setup *S)
+{
+    S->ell = S->r_min = S->prm.r_min;
+    S->r_max = S->prm.r_max;
+    S->prm.r_min = 1;
+    S->prm.r_max = pk_snap(S->r_max / S->ell);
+}
+
 /* Build the mesh and the parameters.  0, or -1 with a pointer and message. */
 static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, const char **rule,
                  char *err, size_t errlen)
@@ -118,6 +132,16 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
             pk_mesh_free(&S->mesh);
             return -1;
         }
+        to_unit(S);
+        for (size_t i = 0; i < 3 * S->mesh.nnode; i++)
+            S->mesh.x[i] = pk_snap(S->mesh.x[i] / S->ell);
+        pk_mesh_report again;
+        *rule = "mesh";
+        *ptr = json_object_get(mesh, "file") ? "/domain/mesh/file" : "/domain/mesh";
+        if (pk_mesh_check(&S->mesh, max_tets, &again, err, errlen) != 0) {
+            pk_mesh_free(&S->mesh);
+            return -1;
+        }
     } else {
         *ptr = "/tetfill";
         *rule = "radii";
@@ -143,10 +167,14 @@ static int setup(const pk_pack_job *job, tetfill_setup *S, const char **ptr, con
             }
         *ptr = "/domain/box";
         *rule = "mesh";
+        to_unit(S);
+        double L[3]; /* inside the job's walls when mapped back */
+        for (int k = 0; k < 3; k++)
+            L[k] = pk_snap_within(job->box.L[k] / S->ell, S->ell, job->box.L[k]);
         double h = 8 * 0.5 * (prm->r_min + prm->r_max) / KUHN_MEAN_EDGE; /* ℓ ≈ 8 r̄ */
         /* a request's check only counts the tets: the worker meshes the box */
-        if (job->service ? pk_mesh_box_count(job->box.L, h, max_tets, err, errlen) != 0
-                         : pk_mesh_box(&S->mesh, job->box.L, h, max_tets, err, errlen) != 0)
+        if (job->service ? pk_mesh_box_count(L, h, max_tets, err, errlen) != 0
+                         : pk_mesh_box(&S->mesh, L, h, max_tets, err, errlen) != 0)
             return -1;
     }
     prm->phi_target = job->has_phi ? job->phi : 0;
@@ -178,11 +206,11 @@ static json_t *observables(const tetfill_setup *S, const pk_tetfill_stats *ts,
     const pk_tetfill_params *prm = &S->prm;
     const pk_mesh *m = &S->mesh;
     json_t *o = json_object();
-    json_object_set_new(o, "r_min", json_real(prm->r_min));
-    json_object_set_new(o, "r_max", json_real(prm->r_max));
-    json_object_set_new(o, "ratio", json_real(prm->r_max / prm->r_min));
+    json_object_set_new(o, "r_min", json_real(S->r_min));
+    json_object_set_new(o, "r_max", json_real(S->r_max));
+    json_object_set_new(o, "ratio", json_real(S->r_max / S->r_min));
     json_object_set_new(o, "epsilon", json_real(prm->eps));
-    json_object_set_new(o, "overlap_bound", json_real(prm->eps * prm->r_min));
+    json_object_set_new(o, "overlap_bound", json_real(prm->eps * S->r_min));
     json_object_set_new(o, "z_min", json_integer(prm->z_min));
     json_object_set_new(o, "count_direct", json_integer((json_int_t)ts->n_direct));
     json_object_set_new(o, "count_trimmed", json_integer((json_int_t)ts->n_trimmed));
@@ -220,8 +248,8 @@ static json_t *observables(const tetfill_setup *S, const pk_tetfill_stats *ts,
     json_object_set_new(o, "mesh_nodes_count", json_integer((json_int_t)m->nnode));
     json_object_set_new(o, "mesh_tets_count", json_integer((json_int_t)m->ntet));
     json_object_set_new(o, "mesh_boundary_faces", json_integer((json_int_t)m->nbface));
-    json_object_set_new(o, "mesh_volume", json_real(m->volume));
-    json_object_set_new(o, "mesh_edge_mean", json_real(m->edge_mean));
+    json_object_set_new(o, "mesh_volume", json_real(m->volume * S->ell * S->ell * S->ell));
+    json_object_set_new(o, "mesh_edge_mean", json_real(m->edge_mean * S->ell));
     json_object_set_new(o, "mesh_reoriented", json_integer((json_int_t)S->rep.reoriented));
     json_object_set_new(o, "mesh_slivers", json_integer((json_int_t)S->rep.slivers));
     json_object_set_new(o, "mesh_first_sliver",
@@ -230,19 +258,27 @@ static json_t *observables(const tetfill_setup *S, const pk_tetfill_stats *ts,
     return o;
 }
 
-/* The mesh itself, in the particles' frame: mesh_nodes [nnode][3] (the
+/* The mesh as filled, in the particles' frame: mesh_nodes [nnode][3] (the
  * job's length unit), mesh_tets [ntet][4] (0-based), mesh_regions [ntet]. */
 static int write_mesh(pk_h5 *h, const char *prefix, void *extra)
 {
-    const pk_mesh *m = &((tetfill_setup *)extra)->mesh;
+    const tetfill_setup *S = extra;
+    const pk_mesh *m = &S->mesh;
     char name[128];
     int64_t *t = malloc(4 * m->ntet * sizeof *t);
-    if (!t)
+    double *x = malloc(3 * m->nnode * sizeof *x);
+    if (!t || !x) {
+        free(t);
+        free(x);
         return -1;
+    }
     int rc = 0;
     size_t dn[2] = {m->nnode, 3}, dt[2] = {m->ntet, 4};
+    for (size_t i = 0; i < 3 * m->nnode; i++)
+        x[i] = m->x[i] * S->ell;
     snprintf(name, sizeof name, "/observables/%s/mesh_nodes", prefix);
-    pk_h5_write_array(h, name, PK_H5_F64, 2, dn, m->x, ((tetfill_setup *)extra)->unit);
+    pk_h5_write_array(h, name, PK_H5_F64, 2, dn, x, S->unit);
+    free(x);
     for (size_t i = 0; i < 4 * m->ntet; i++)
         t[i] = m->t[i];
     snprintf(name, sizeof name, "/observables/%s/mesh_tets", prefix);
@@ -317,19 +353,26 @@ static int place_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, const
             free_setup(S);
         return -1;
     }
+    const double ell = S->ell; /* back to the job's unit */
+    for (size_t i = 0; i < p->n; i++) {
+        for (int k = 0; k < 3; k++)
+            p->x[3 * i + k] *= ell;
+        p->r[i] *= ell;
+    }
     *st = (pk_place_stats){.reason = ts.reason,
                            .placed = p->n,
                            .requested = job->count,
                            .seconds = ts.seconds,
                            .has_domain = 1,
-                           .domain_measure = S->mesh.volume,
-                           .overlap_tol = S->prm.eps * S->prm.r_min,
+                           .domain_measure = job->mesh ? S->mesh.volume * ell * ell * ell
+                                                       : pk_box_measure(&job->box),
+                           .overlap_tol = S->prm.eps * S->r_min,
                            .extra = S,
                            .write_extra = write_mesh,
                            .free_extra = own ? free_setup : NULL};
     st->domain_box.dim = 3;
-    for (int k = 0; k < 3; k++)
-        st->domain_box.L[k] = S->mesh.hi[k];
+    for (int k = 0; k < 3; k++) /* the job's walls, or the mesh's bounding box */
+        st->domain_box.L[k] = job->mesh ? S->mesh.hi[k] * ell : job->box.L[k];
     st->obs = observables(S, &ts, &ms);
     pk_tetfill_measures_free(&ms);
     return 0;

@@ -165,7 +165,7 @@ pk_h5 *pk_h5_create(const char *path, const char *author, char *err, size_t errl
      * errno of ours, and HDF5 never holds a file it failed to flush (its exit
      * handler would close it again and crash).  The temporary file is created
      * now so a directory that cannot take it fails before the work. */
-    h->fd = open(h->tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0640);
+    h->fd = open(h->tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, PK_RESULT_FILE_MODE);
     if (h->fd < 0) {
         snprintf(err, errlen, "cannot create %s: %s", h->tmp, strerror(errno));
         free(h->path);
@@ -196,7 +196,8 @@ pk_h5 *pk_h5_create(const char *path, const char *author, char *err, size_t errl
     int ver[2] = {1, 1};
     attr_ints(md, "version", ver, 2, 0);
     hid_t au = make_group(md, "author", H5P_DEFAULT);
-    attr_string(au, "name", author && *author ? author : "packd");
+    /* the person responsible; the name is mandatory, so an unknown one says so */
+    attr_string(au, "name", author && *author ? author : PK_H5_AUTHOR_UNKNOWN);
     H5Gclose(au);
     /* the units module: every dimensional dataset carries a `unit` string of
      * SI symbols ("mm", "N mm-2"); H5MD units module 1.0 */
@@ -353,38 +354,6 @@ int pk_h5_link(pk_h5 *h, const char *existing, const char *path)
         h, H5Lcreate_hard(h->file, existing, h->file, path, h->lcpl, H5P_DEFAULT) < 0 ? -1 : 0);
 }
 
-int pk_h5_slice_view(pk_h5 *h, const char *src, size_t k, const char *path)
-{
-    hid_t ds = H5Dopen2(h->file, src, H5P_DEFAULT);
-    if (ds < 0)
-        return sticky(h, -1);
-    hid_t ss = H5Dget_space(ds), t = H5Dget_type(ds);
-    hsize_t d[3], start[3] = {(hsize_t)k, 0, 0}, count[3];
-    int rank = H5Sget_simple_extent_ndims(ss), rc = -1;
-    if (rank >= 2 && rank <= 3 && H5Sget_simple_extent_dims(ss, d, NULL) == rank &&
-        (hsize_t)k < d[0]) {
-        count[0] = 1;
-        for (int a = 1; a < rank; a++)
-            count[a] = d[a];
-        hid_t vs = H5Screate_simple(rank - 1, d + 1, NULL), p = dcpl_untimed();
-        H5Sselect_hyperslab(ss, H5S_SELECT_SET, start, NULL, count, NULL);
-        /* "." : the source is in this file, whatever its name */
-        hid_t v = H5Pset_virtual(p, vs, ".", src, ss) < 0
-            ? -1
-            : H5Dcreate2(h->file, path, t, vs, h->lcpl, p, H5P_DEFAULT);
-        if (v >= 0) {
-            H5Dclose(v);
-            rc = 0;
-        }
-        H5Pclose(p);
-        H5Sclose(vs);
-    }
-    H5Tclose(t);
-    H5Sclose(ss);
-    H5Dclose(ds);
-    return sticky(h, rc);
-}
-
 int pk_h5_obs_json_units(pk_h5 *h, const char *prefix, json_t *obj, pk_h5_unit_fn unit_of,
                          const void *ctx)
 {
@@ -459,7 +428,8 @@ int pk_h5_time_element(pk_h5 *h, const char *path, const char *clock, const int6
     } else {
         rc |= pk_h5_write_array(h, p, PK_H5_I64, 1, dims, step, NULL);
         snprintf(p, sizeof p, "%s/time", path);
-        rc |= pk_h5_write_array(h, p, PK_H5_F64, 1, dims, time, time_unit);
+        rc |= pk_h5_write_array(h, p, PK_H5_F64, 1, dims, time,
+                                time_unit ? time_unit : PK_H5_UNIT_NUMBER);
     }
     snprintf(p, sizeof p, "%s/value", path);
     rc |= pk_h5_write_array(h, p, type, rank, dims, value, unit);

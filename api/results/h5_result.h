@@ -27,9 +27,14 @@
 
 typedef struct pk_h5 pk_h5;
 
+/* The mode of a result file and of its sidecars (before the umask): the
+ * owner and the group (the service's readers) read, others not. */
+#define PK_RESULT_FILE_MODE 0640
+
 /* Creates "<path>.tmp.<pid>" with /h5md/author name author (the job's owner
- * for a service job, the user for `packd run`; NULL or "" = "packd").  NULL
- * on failure with a message in err. */
+ * for a service job, the user for `packd run`; NULL or "" =
+ * PK_H5_AUTHOR_UNKNOWN).  NULL on failure with a message in err. */
+#define PK_H5_AUTHOR_UNKNOWN "unknown"
 pk_h5 *pk_h5_create(const char *path, const char *author, char *err, size_t errlen);
 
 int pk_h5_write_particles(pk_h5 *h, const pk_box *b, const pk_particles *p, const char *unit);
@@ -62,13 +67,19 @@ typedef const char *(*pk_h5_unit_fn)(const char *name, const void *ctx);
 int pk_h5_obs_json_units(pk_h5 *h, const char *prefix, json_t *obj, pk_h5_unit_fn unit_of,
                          const void *ctx);
 
+/* The unit string of a dimensionless number (the units module's numeric
+ * factor alone): what a `time` that is no physical time carries. */
+#define PK_H5_UNIT_NUMBER "1"
+
 /* An n-d array (rank <= 5) at an absolute path ("/particles/rve/position/value"),
  * intermediate groups made; unit may be NULL.  0 on success. */
 typedef enum { PK_H5_F64, PK_H5_I64, PK_H5_I32 } pk_h5_type;
 int pk_h5_write_array(pk_h5 *h, const char *path, pk_h5_type type, int rank, const size_t *dims,
                       const void *data, const char *unit);
 /* An H5MD time-dependent element at path: path/step int64[S], path/time
- * float64[S] (time_unit may be NULL), path/value of rank dims (dims[0] = S).
+ * float64[S] with the unit time_unit (NULL: PK_H5_UNIT_NUMBER, the times
+ * packd records are numbers: EDMD's reduced time, load fractions), path/value
+ * of rank dims (dims[0] = S).
  * With clock (the path of an element already written), step and time are
  * hard links to clock's (H5MD shares them so).  0 on success. */
 int pk_h5_time_element(pk_h5 *h, const char *path, const char *clock, const int64_t *step,
@@ -87,10 +98,6 @@ int pk_h5_connectivity(pk_h5 *h, const char *path, const int64_t *pairs, size_t 
                        const char *particles_group);
 /* A second name (hard link) for an existing object, e.g. a shared box group. */
 int pk_h5_link(pk_h5 *h, const char *existing, const char *path);
-
-/* A view of src[k] (an HDF5 virtual dataset in this file, no copy of the
- * data) at path: src has rank 2 or 3, the view its last dimensions. */
-int pk_h5_slice_view(pk_h5 *h, const char *src, size_t k, const char *path);
 
 /* Close, fsync and rename into place.  Frees h.  0 on success. */
 int pk_h5_commit(pk_h5 *h, char *err, size_t errlen);

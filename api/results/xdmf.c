@@ -1,6 +1,7 @@
 /* xdmf.c — the XDMF 3 sidecar of a result file (contract in xdmf.h). */
 #include "xdmf.h"
 
+#include <fcntl.h>
 #include <hdf5.h>
 #include <limits.h>
 #include <stdio.h>
@@ -94,14 +95,80 @@ static int dims_of(hid_t f, const char *path, hsize_t d[3])
     return rank;
 }
 
-/* A DataItem of an HDF dataset: dims as written, number type and size. */
-static void item(FILE *f, const char *ind, const char *dims, const char *type, int prec,
-                 const char *ref, const char *path)
+/* The XDMF number type, precision and byte order of a dataset's type; -1
+ * for a type the sidecar does not describe. */
+static int number_type(hid_t ds, const char **type, int *prec, const char **endian)
 {
+    hid_t t = H5Dget_type(ds);
+    H5T_class_t c = H5Tget_class(t);
+    *prec = (int)H5Tget_size(t);
+    *type = c == H5T_FLOAT ? "Float" : c == H5T_INTEGER ? "Int" : NULL;
+    *endian = H5Tget_order(t) == H5T_ORDER_BE ? "Big" : "Little";
+    H5Tclose(t);
+    return *type && (*prec == 4 || *prec == 8) ? 0 : -1;
+}
+
+/* A DataItem of the whole dataset at path, with its own shape and number
+ * type (what a reader finds there).  0, or -1 when it is absent. */
+static int item(FILE *f, const char *ind, hid_t h, const char *ref, const char *path)
+{
+    hsize_t d[3];
+    int rank = dims_of(h, path, d);
+    hid_t ds = rank > 0 ? H5Dopen2(h, path, H5P_DEFAULT) : -1;
+    const char *type, *endian;
+    int prec, ok = ds >= 0 && number_type(ds, &type, &prec, &endian) == 0;
+    if (ds >= 0)
+        H5Dclose(ds);
+    if (!ok)
+        return -1;
+    fprintf(f, "%s<DataItem Dimensions=\"", ind);
+    for (int a = 0; a < rank; a++)
+        fprintf(f, a ? " %llu" : "%llu", (unsigned long long)d[a]);
+    fprintf(f, "\" NumberType=\"%s\" Precision=\"%d\" Format=\"HDF\">%s:%s</DataItem>\n", type,
+            prec, ref, path);
+    return 0;
+}
+
+/* 1 when the dataset at path is stored in one piece at a known offset. */
+static int has_offset(hid_t h, const char *path)
+{
+    hid_t ds = H5Dopen2(h, path, H5P_DEFAULT);
+    int ok = ds >= 0 && H5Dget_offset(ds) != HADDR_UNDEF;
+    if (ds >= 0)
+        H5Dclose(ds);
+    return ok;
+}
+
+/* Row k of the dataset at path (a time-dependent element's value, [S][…]),
+ * read by its bytes: ParaView's Xdmf3 reader crashes on a HyperSlab
+ * (SIGSEGV in vtkXdmf3DataSet::CopyShape, ParaView 5.11) but reads a Binary
+ * item at an offset of the same file, as the legacy reader does.  The row's
+ * shape is the value's without its first dimension; Name says which row.
+ * 0, or -1 when the dataset is absent, not contiguous (no offset) or k is
+ * past its end. */
+static int row_item(FILE *f, const char *ind, hid_t h, const char *ref, const char *path, hsize_t k)
+{
+    hsize_t d[3];
+    int rank = dims_of(h, path, d);
+    hid_t ds = rank >= 2 ? H5Dopen2(h, path, H5P_DEFAULT) : -1;
+    const char *type, *endian;
+    int prec, ok = ds >= 0 && k < d[0] && number_type(ds, &type, &prec, &endian) == 0;
+    haddr_t at = ok ? H5Dget_offset(ds) : HADDR_UNDEF;
+    if (ds >= 0)
+        H5Dclose(ds);
+    if (at == HADDR_UNDEF)
+        return -1;
+    unsigned long long row = (unsigned long long)prec;
+    for (int a = 1; a < rank; a++)
+        row *= d[a];
+    fprintf(f, "%s<DataItem Name=\"%s[%llu]\" Dimensions=\"", ind, path, (unsigned long long)k);
+    for (int a = 1; a < rank; a++)
+        fprintf(f, a > 1 ? " %llu" : "%llu", (unsigned long long)d[a]);
     fprintf(f,
-            "%s<DataItem Dimensions=\"%s\" NumberType=\"%s\" Precision=\"%d\" "
-            "Format=\"HDF\">%s:%s</DataItem>\n",
-            ind, dims, type, prec, ref, path);
+            "\" NumberType=\"%s\" Precision=\"%d\" Format=\"Binary\" Endian=\"%s\" "
+            "Seek=\"%llu\">%s</DataItem>\n",
+            type, prec, endian, (unsigned long long)at + row * k, ref);
+    return 0;
 }
 
 /* The n doubles of the 1-D dataset path (a time axis), malloc'd; NULL on failure. */
@@ -119,55 +186,59 @@ static double *read_doubles(hid_t h, const char *path, hsize_t n)
     return v;
 }
 
-/* <Attribute> holding one DataItem; ind is the attribute's indentation. */
+/* <Attribute> holding the dataset at path (k < 0) or its row k; ind is the
+ * attribute's indentation.  Nothing when the dataset is absent. */
 static void attribute(FILE *f, const char *ind, const char *name, const char *atype,
-                      const char *center, const char *dims, const char *type, int prec,
-                      const char *ref, const char *path)
+                      const char *center, hid_t h, const char *ref, const char *path, long long k)
 {
     char inner[32];
+    hsize_t d[3];
+    if (dims_of(h, path, d) < 1)
+        return;
     snprintf(inner, sizeof inner, "%s  ", ind);
     fprintf(f, "%s<Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"%s\">\n", ind, name, atype,
             center);
-    item(f, inner, dims, type, prec, ref, path);
+    if (k < 0)
+        item(f, inner, h, ref, path);
+    else
+        row_item(f, inner, h, ref, path, (hsize_t)k);
     fprintf(f, "%s</Attribute>\n", ind);
 }
 
-/* The grains: one vertex cell per grain (the Xdmf3 reader makes no cells
- * without the connectivity 0..N-1: /particles/grains/id, inline for files
- * without it). */
-static void grains_grid(FILE *f, hid_t h, const char *ref, size_t n, int dim)
+/* A Polyvertex topology of n vertex cells whose connectivity is the id
+ * dataset 0..n-1 (the Xdmf3 reader makes no cells without one), inline for
+ * files without it. */
+static void vertices(FILE *f, const char *ind, hid_t h, const char *ref, const char *id, size_t n)
 {
     hsize_t d[3];
-    char s[64];
+    char inner[32];
+    snprintf(inner, sizeof inner, "%s  ", ind);
     fprintf(f,
-            "    <Grid Name=\"grains\" GridType=\"Uniform\">\n"
-            "      <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
+            "%s<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
             "NodesPerElement=\"1\">\n",
-            n);
-    snprintf(s, sizeof s, "%zu 1", n);
-    if (dims_of(h, "/particles/grains/id", d) == 1) {
-        item(f, "        ", s, "Int", 8, ref, "/particles/grains/id");
-    } else {
+            ind, n);
+    if (dims_of(h, id, d) != 1 || d[0] != n || item(f, inner, h, ref, id) != 0) {
         fprintf(f,
-                "        <DataItem Dimensions=\"%s\" NumberType=\"Int\" Precision=\"8\" "
-                "Format=\"XML\">",
-                s);
+                "%s<DataItem Dimensions=\"%zu\" NumberType=\"Int\" Precision=\"8\" Format=\"XML\">",
+                inner, n);
         for (size_t i = 0; i < n; i++)
             fprintf(f, i % 16 == 15 ? "%zu\n" : "%zu ", i);
         fprintf(f, "</DataItem>\n");
     }
-    fprintf(f, "      </Topology>\n      <Geometry GeometryType=\"%s\">\n",
-            dim == 3 ? "XYZ" : "XY");
-    snprintf(s, sizeof s, "%zu %d", n, dim);
-    item(f, "        ", s, "Float", 8, ref, "/particles/grains/position");
-    snprintf(s, sizeof s, "%zu", n);
+    fprintf(f, "%s</Topology>\n", ind);
+}
+
+/* The grains: one vertex cell per grain with radius, species and id. */
+static void grains_grid(FILE *f, hid_t h, const char *ref, size_t n, int dim)
+{
+    fprintf(f, "    <Grid Name=\"grains\" GridType=\"Uniform\">\n");
+    vertices(f, "      ", h, ref, "/particles/grains/id", n);
+    fprintf(f, "      <Geometry GeometryType=\"%s\">\n", dim == 3 ? "XYZ" : "XY");
+    item(f, "        ", h, ref, "/particles/grains/position");
     fprintf(f, "      </Geometry>\n");
-    attribute(f, "      ", "radius", "Scalar", "Node", s, "Float", 8, ref,
-              "/particles/grains/radius");
-    attribute(f, "      ", "species", "Scalar", "Node", s, "Int", 4, ref,
-              "/particles/grains/species");
-    if (dims_of(h, "/particles/grains/id", d) == 1)
-        attribute(f, "      ", "id", "Scalar", "Node", s, "Int", 8, ref, "/particles/grains/id");
+    attribute(f, "      ", "radius", "Scalar", "Node", h, ref, "/particles/grains/radius", -1);
+    attribute(f, "      ", "species", "Scalar", "Node", h, ref, "/particles/grains/species", -1);
+    attribute(f, "      ", "id", "Scalar", "Node", h, ref, "/particles/grains/id", -1);
     fprintf(f, "    </Grid>\n");
 }
 
@@ -189,78 +260,55 @@ static void mesh_grid(FILE *f, hid_t h, const char *ref)
                                                   : 0;
     if (!nn || !nt)
         return;
-    char s[64];
     fprintf(f,
             "    <Grid Name=\"mesh\" GridType=\"Uniform\">\n"
             "      <Topology TopologyType=\"Tetrahedron\" NumberOfElements=\"%llu\" "
             "NodesPerElement=\"4\">\n",
             nt);
-    if (rt == 2)
-        snprintf(s, sizeof s, "%llu 4", nt);
-    else
-        snprintf(s, sizeof s, "%llu", 4 * nt);
-    item(f, "        ", s, "Int", 8, ref, tets);
+    item(f, "        ", h, ref, tets);
     fprintf(f, "      </Topology>\n      <Geometry GeometryType=\"XYZ\">\n");
-    if (rn == 2)
-        snprintf(s, sizeof s, "%llu 3", nn);
-    else
-        snprintf(s, sizeof s, "%llu", 3 * nn);
-    item(f, "        ", s, "Float", 8, ref, nodes);
+    item(f, "        ", h, ref, nodes);
     fprintf(f, "      </Geometry>\n");
-    if (dims_of(h, regions, dr) == 1 && dr[0] == nt) {
-        snprintf(s, sizeof s, "%llu", (unsigned long long)dr[0]);
-        attribute(f, "      ", "region", "Scalar", "Cell", s, "Int", 8, ref, regions);
-    }
+    if (dims_of(h, regions, dr) == 1 && dr[0] == nt)
+        attribute(f, "      ", "region", "Scalar", "Cell", h, ref, regions, -1);
     fprintf(f, "    </Grid>\n");
 }
 
 /* A homogenize result's load path: a temporal collection with one grid per
- * recorded step (deformed centres, radius, contact force per grain) from
- * /particles/rve, read through the per-step views views/<element>/<k>
- * (ParaView's Xdmf3 reader crashes on a HyperSlab geometry and drops a
- * HyperSlab attribute). */
+ * recorded step from /particles/rve (deformed centres: row k of
+ * position/value; radius, species, id; the contact force per grain: row k
+ * of contact_force/value). */
 static int steps_grid(FILE *f, hid_t h, const char *ref)
 {
     const char *pos = "/particles/rve/position/value", *frc = "/particles/rve/contact_force/value",
                *tim = "/particles/rve/position/time";
     hsize_t dx[3], df[3], dt[3], dd[3];
     if (dims_of(h, pos, dx) != 3 || dims_of(h, tim, dt) != 1 || dt[0] != dx[0] || !dx[0] ||
-        (dx[2] != 2 && dx[2] != 3) || dims_of(h, "/particles/rve/id", dd) != 1 || dd[0] != dx[1] ||
-        dims_of(h, "/particles/rve/views/position/0", dd) != 2)
+        (dx[2] != 2 && dx[2] != 3) || dims_of(h, "/particles/rve/id", dd) != 1 || dd[0] != dx[1])
         return 0;
-    int with_force = dims_of(h, frc, df) == 2 && df[0] == dx[0] && df[1] == dx[1] &&
-        dims_of(h, "/particles/rve/views/contact_force/0", dd) == 1;
-    double *t = read_doubles(h, tim, dt[0]);
+    /* the rows are read by their offset: a dataset without one is no load path here */
+    int readable = has_offset(h, pos);
+    double *t = readable ? read_doubles(h, tim, dt[0]) : NULL;
     if (!t)
         return 0;
-    const unsigned long long n = dx[1];
-    char s[64];
+    int with_force = dims_of(h, frc, df) == 2 && df[0] == dx[0] && df[1] == dx[1];
+    const size_t n = (size_t)dx[1];
     fprintf(f,
             "    <Grid Name=\"load steps\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
     for (hsize_t k = 0; k < dx[0]; k++) {
         fprintf(f,
                 "      <Grid Name=\"step %llu\" GridType=\"Uniform\">\n"
-                "        <Time Value=\"%.17g\"/>\n"
-                "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%llu\" "
-                "NodesPerElement=\"1\">\n",
-                (unsigned long long)k, t[k], n);
-        snprintf(s, sizeof s, "%llu 1", n);
-        item(f, "          ", s, "Int", 8, ref, "/particles/rve/id");
-        fprintf(f, "        </Topology>\n        <Geometry GeometryType=\"%s\">\n",
-                dx[2] == 3 ? "XYZ" : "XY");
-        char view[64];
-        snprintf(view, sizeof view, "/particles/rve/views/position/%llu", (unsigned long long)k);
-        snprintf(s, sizeof s, "%llu %llu", n, (unsigned long long)dx[2]);
-        item(f, "          ", s, "Float", 8, ref, view);
+                "        <Time Value=\"%.17g\"/>\n",
+                (unsigned long long)k, t[k]);
+        vertices(f, "        ", h, ref, "/particles/rve/id", n);
+        fprintf(f, "        <Geometry GeometryType=\"%s\">\n", dx[2] == 3 ? "XYZ" : "XY");
+        row_item(f, "          ", h, ref, pos, k);
         fprintf(f, "        </Geometry>\n");
-        snprintf(s, sizeof s, "%llu", n);
-        attribute(f, "        ", "radius", "Scalar", "Node", s, "Float", 8, ref,
-                  "/particles/rve/radius");
-        if (with_force) {
-            snprintf(view, sizeof view, "/particles/rve/views/contact_force/%llu",
-                     (unsigned long long)k);
-            attribute(f, "        ", "contact_force", "Scalar", "Node", s, "Float", 8, ref, view);
-        }
+        attribute(f, "        ", "radius", "Scalar", "Node", h, ref, "/particles/rve/radius", -1);
+        attribute(f, "        ", "species", "Scalar", "Node", h, ref, "/particles/rve/species", -1);
+        attribute(f, "        ", "id", "Scalar", "Node", h, ref, "/particles/rve/id", -1);
+        if (with_force)
+            attribute(f, "        ", "contact_force", "Scalar", "Node", h, ref, frc, (long long)k);
         fprintf(f, "      </Grid>\n");
     }
     fprintf(f, "    </Grid>\n");
@@ -271,26 +319,26 @@ static int steps_grid(FILE *f, hid_t h, const char *ref)
 /* An fe2 result's macro mesh over its converged load steps: a temporal
  * collection of the deformed mesh (Quadrilateral, Triangle or Mixed from
  * /observables/fe2/mesh/xdmf_topology) with the displacement per node and
- * the element-averaged von Mises stress per cell, through the per-step
- * views /observables/fe2/views/<name>/<k>. */
+ * the element-averaged von Mises stress per cell: row k of each series'
+ * value. */
 static int fe2_grid(FILE *f, hid_t h, const char *ref)
 {
     const char *top = "/observables/fe2/mesh/xdmf_topology", *el = "/observables/fe2/mesh/elements",
-               *tim = "/observables/fe2/load_steps/time";
+               *tim = "/observables/fe2/load_steps/time", *pos = "/observables/fe2/position/value";
     hsize_t dt[3], de[3], dk[3], dn[3];
     if (dims_of(h, top, dt) != 1 || dims_of(h, el, de) != 2 || dims_of(h, tim, dk) != 1 || !dk[0] ||
-        dims_of(h, "/observables/fe2/views/position/0", dn) != 2)
+        dims_of(h, pos, dn) != 3 || dn[0] != dk[0])
         return 0;
+    int readable = has_offset(h, pos);
     /* the flat topology's length tells the kind: 4 or 3 per element, else Mixed */
     const char *kind = dt[0] == 4 * de[0] ? "Quadrilateral"
         : dt[0] == 3 * de[0]              ? "Triangle"
                                           : "Mixed";
-    double *t = read_doubles(h, tim, dk[0]);
+    double *t = readable ? read_doubles(h, tim, dk[0]) : NULL;
     if (!t)
         return 0;
-    const unsigned long long ne = de[0], nn = dn[0];
+    const unsigned long long ne = de[0];
     int npe = !strcmp(kind, "Triangle") ? 3 : !strcmp(kind, "Quadrilateral") ? 4 : 0;
-    char s[64], view[96];
     fprintf(f,
             "    <Grid Name=\"load steps\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
     for (hsize_t k = 0; k < dk[0]; k++) {
@@ -305,20 +353,14 @@ static int fe2_grid(FILE *f, hid_t h, const char *ref)
                     kind, ne, npe);
         else
             fprintf(f, "        <Topology TopologyType=\"Mixed\" NumberOfElements=\"%llu\">\n", ne);
-        snprintf(s, sizeof s, "%llu", (unsigned long long)dt[0]);
-        item(f, "          ", s, "Int", 8, ref, top);
+        item(f, "          ", h, ref, top);
         fprintf(f, "        </Topology>\n        <Geometry GeometryType=\"XY\">\n");
-        snprintf(view, sizeof view, "/observables/fe2/views/position/%llu", (unsigned long long)k);
-        snprintf(s, sizeof s, "%llu 2", nn);
-        item(f, "          ", s, "Float", 8, ref, view);
+        row_item(f, "          ", h, ref, pos, k);
         fprintf(f, "        </Geometry>\n");
-        snprintf(view, sizeof view, "/observables/fe2/views/displacement/%llu",
-                 (unsigned long long)k);
-        attribute(f, "        ", "displacement", "Vector", "Node", s, "Float", 8, ref, view);
-        snprintf(view, sizeof view, "/observables/fe2/views/von_mises_element/%llu",
-                 (unsigned long long)k);
-        snprintf(s, sizeof s, "%llu", ne);
-        attribute(f, "        ", "von_mises", "Scalar", "Cell", s, "Float", 8, ref, view);
+        attribute(f, "        ", "displacement", "Vector", "Node", h, ref,
+                  "/observables/fe2/displacement/value", (long long)k);
+        attribute(f, "        ", "von_mises", "Scalar", "Cell", h, ref,
+                  "/observables/fe2/von_mises_element/value", (long long)k);
         fprintf(f, "      </Grid>\n");
     }
     fprintf(f, "    </Grid>\n");
@@ -351,8 +393,12 @@ int pk_xdmf_write(const char *h5_path, const char *h5_ref, const char *xdmf_path
     char ref[1024], tmp[1100];
     xml_escape(h5_ref, ref, sizeof ref);
     snprintf(tmp, sizeof tmp, "%s.tmp.%ld", xdmf_path, (long)getpid());
-    FILE *f = fopen(tmp, "w");
+    /* the mode of the result file it describes */
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, PK_RESULT_FILE_MODE);
+    FILE *f = fd < 0 ? NULL : fdopen(fd, "w");
     if (!f) {
+        if (fd >= 0)
+            close(fd);
         H5Fclose(h);
         snprintf(err, errlen, "cannot write %s", tmp);
         return -1;

@@ -42,3 +42,26 @@ int pk_edmd_run_shell_in_walls(const pk_box *b, double w, pk_particles *p,
         st->hist_phi[k] *= f;
     return rc;
 }
+
+double pk_edmd_pull_inside(const pk_box *b, pk_particles *p)
+{
+    double smin = 1;
+    for (int k = 0; k < b->dim; k++) {
+        if (b->periodic[k])
+            continue;
+        const double c = 0.5 * b->L[k];
+        double s = 1;
+        for (size_t i = 0; i < p->n; i++) { /* |x − c| + r <= c after scaling by s */
+            const double off = fabs(p->x[3 * i + k] - c), room = c - p->r[i];
+            if (off > room)
+                s = fmin(s, fmax(room, 0) / off);
+        }
+        if (s < 1)
+            for (size_t i = 0; i < p->n; i++) {
+                double x = c + s * (p->x[3 * i + k] - c);
+                p->x[3 * i + k] = fmin(fmax(x, p->r[i]), b->L[k] - p->r[i]); /* round-off */
+            }
+        smin = fmin(smin, s);
+    }
+    return smin;
+}

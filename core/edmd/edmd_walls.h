@@ -25,4 +25,13 @@
 int pk_edmd_run_shell_in_walls(const pk_box *b, double w, pk_particles *p,
                                const pk_edmd_params *prm, pk_monitor *mon, pk_edmd_stats *st);
 
+/* A run whose shell h stopped short of w leaves grains up to w − h through
+ * the walls of b.  Scales the walled coordinates of p about the box centre,
+ * axis by axis, by the largest factor s_k <= 1 that brings every true
+ * surface inside b (clearance >= 0); pair distances shrink by at most that
+ * factor, so a gap g becomes >= g − (1 − s)(r_i + r_j + g): the caller
+ * measures the gap that holds afterwards.  Returns the smallest factor (1 when
+ * every grain was inside). */
+double pk_edmd_pull_inside(const pk_box *b, pk_particles *p);
+
 #endif

@@ -22,7 +22,7 @@
 
 #define PK_PSD_MAX_CLASSES 256
 
-    typedef struct pk_size_class {
+typedef struct pk_size_class {
     double d_lo, d_hi;    /* class bounds, d_lo < d_hi (continuous mode) */
     double d_rep;         /* representative diameter (discrete mode): Meier's lower sieve */
     double mass_fraction; /* share of the *whole* curve's mass, 0..1 */

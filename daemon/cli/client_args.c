@@ -95,11 +95,11 @@ void pk_client_help(const char *cmd, FILE *f)
         fputc('\n', f);
     }
     if (c->bit & (SUBMIT | FETCH))
-        fprintf(
-            f,
-            "\nexit status: 0 done, 1 rejected (the problem's errors on stderr), 2 transport\n"
-            "or integrity error (no answer, 5xx, SHA-256 mismatch), 3 the job failed or was\n"
-            "dismissed (a failed job's partial result is still downloaded with -o), 64 usage.\n");
+        fprintf(f,
+                "\nexit status: 0 done, 1 rejected (the problem's errors on stderr), 2 transport\n"
+                "or integrity error (no answer, 5xx, SHA-256 mismatch), 3 the job failed or was\n"
+                "dismissed (with -o OUT, a failed job's partial result is downloaded to\n"
+                "OUT.partial: OUT is written only for a successful job), 64 usage.\n");
 }
 
 int pk_client_parse(int argc, char **argv, pk_client_args *a)

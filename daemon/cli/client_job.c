@@ -287,14 +287,18 @@ int pk_client_fetch(const pk_client *c, const char *id, const char *out, json_t 
             rc = check_result_digest(out, json_string_value(json_object_get(v, "result_digest")),
                                      info);
     } else if (r.status == 422 && type && strstr(type, "job-failed")) {
-        /* the job failed: say why; its partial file is still worth keeping */
+        /* the job failed: say why; its partial file is still worth keeping, at
+         * OUT.partial, so that OUT exists only for a job that succeeded */
         pk_client_report("fetch", &r);
         json_t *part = json_object_get(doc, "partial_result");
         const char *href = json_string_value(json_object_get(part, "href"));
+        char partial[4200];
+        snprintf(partial, sizeof partial, "%s.partial", out);
         if (href &&
-            download_verified(c, href, out, json_string_value(json_object_get(part, "sha256")),
+            download_verified(c, href, partial, json_string_value(json_object_get(part, "sha256")),
                               info) == 0)
-            fprintf(stderr, "packd fetch: partial result of the failed job in %s\n", out);
+            fprintf(stderr, "packd fetch: partial result of the failed job in %s (not %s)\n",
+                    partial, out);
         if (json_object_get(doc, "summary"))
             json_object_set(info, "summary", json_object_get(doc, "summary"));
         rc = 3;

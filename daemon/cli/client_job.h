@@ -25,7 +25,7 @@ json_t *pk_client_wait(const pk_client *c, const char *id, int quiet);
 
 /* Download the job's result to out and verify its SHA-256 against the
  * results document and the X-Content-SHA256 header (a failed job's partial
- * file too, then 3), and its content hash against the summary's
+ * file too, to "<out>.partial", then 3: out is written only on success), and its content hash against the summary's
  * result_digest when the server states one (api/results/result_digest.h).
  * On success *info (if given) gets {"output", "sha256", "size", "summary",
  * "result_digest"}. */

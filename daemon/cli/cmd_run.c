@@ -67,7 +67,8 @@ static void run_help(FILE *f)
           "  --threads N                threads of the parallel sections (1..64, default 1)\n"
           "  --checkpoint FILE          save/resume the run's state in FILE\n"
           "  --checkpoint-interval S    seconds between checkpoints (default 30)\n"
-          "  --author NAME              the result's /h5md/author (default $USER)\n\n"
+          "  --author NAME              the result's /h5md/author, the person responsible\n"
+          "                             (default $USER; \"\" or no $USER: \"unknown\")\n\n"
           "Under mpirun -np R (or srun --ntasks=R --mpi=pmix) an fe2 job spreads its\n"
           "Gauss points over the R ranks, rank 0 alone writing and printing (docs/fe2.md);\n"
           "other processes run on rank 0 alone.\n\n"
@@ -208,9 +209,8 @@ static int run_job(int argc, char **argv)
     pk_schema_errors errs = {0};
     json_t *summary = NULL;
     char err[1024] = "";
-    /* the file's author: the service's job owner, else who runs packd */
-    pk_run_ctx run = {
-        .threads = threads, .mon = &mon, .author = author && *author ? author : "packd run"};
+    /* the file's author: the service's job owner, else who runs packd (NULL: unknown) */
+    pk_run_ctx run = {.threads = threads, .mon = &mon, .author = author};
     /* a checkpoint resumes only the job (and packd version) that wrote it */
     char digest[65];
     if (ckpt_path && !other_rank) {

@@ -45,13 +45,13 @@ int pk_results_opts_save(pk_req *r, const char *id, const pk_exec_opts *o)
     return rc;
 }
 
-/* The row of job id if visible, successful (or, with partial_ok, failed
- * with its partial result file), else NULL after replying with the problem. */
-static json_t *finished_job(pk_req *r, json_t *row, int partial_ok, enum MHD_Result *rc)
+/* The row of job id if visible, successful (or, with failed_ok, failed),
+ * else NULL after replying with the problem. */
+static json_t *finished_job(pk_req *r, json_t *row, int failed_ok, enum MHD_Result *rc)
 {
     const char *id = json_string_value(json_object_get(row, "id"));
     const char *st = json_string_value(json_object_get(row, "status"));
-    if (partial_ok && pk_has_partial_result(row))
+    if (failed_ok && !strcmp(st, "failed"))
         return row;
     if (!strcmp(st, "failed")) {
         *rc = pk_send_problem_doc(r, 422, pk_failed_results_problem(row), 0);
@@ -196,8 +196,10 @@ enum MHD_Result route_result_file(pk_req *r)
     if (!row)
         return pk_reply_problem(r, PK_P_NO_SUCH_JOB, r->seg[1]);
     enum MHD_Result rc;
-    /* a failed job's partial result file stays downloadable */
-    if (!(row = finished_job(r, row, !strcmp(out->id, "result") || !strcmp(out->id, "xdmf"), &rc)))
+    /* a failed job's summary (why it stopped) and partial result file stay readable */
+    int file = !strcmp(out->id, "result") || !strcmp(out->id, "xdmf");
+    int failed_ok = !strcmp(out->id, "summary") || (file && pk_has_partial_result(row));
+    if (!(row = finished_job(r, row, failed_ok, &rc)))
         return rc;
     return send_output(r, row, out);
 }

@@ -3,8 +3,14 @@
 // job's bar reach 100 %, open the job page, see the picture load, download
 // the HDF5 file; then submit the EDMD example with its inputs edited to grow
 // slower (about 5 s) and see its bar stand strictly between 0 and 100 %
-// while it runs (the live progress), then at 100 %.  Prints PASS/FAIL lines (tests/integration/check.inc) and
-// saves screenshots and the download in OUT_DIR.
+// while it runs (the live progress), then at 100 %.  Then, on job pages: a
+// running job keeps its status word through its progress events; a job that
+// runs out of wall time shows `failed`, its reason, summary and partial-file
+// download; a running job cancelled by its button shows `dismissed`.  Times
+// are shown in the browser's zone (Asia/Kolkata, GMT+5:30) and say so.  At a
+// 390 px viewport the list and a job page are no wider than the viewport.
+// Prints PASS/FAIL lines (tests/integration/check.inc) and saves screenshots
+// and the downloads (result.h5, partial.h5) in OUT_DIR.
 // Env: PLAYWRIGHT_CORE (the installed module), CHROMIUM, SLOW (wait factor),
 // TOKEN (auth on: typed into the token field first; the names of the PASS
 // lines then end in _auth).
@@ -21,6 +27,34 @@ const pass = (n) => console.log('PASS ' + n + tag);
 const fail = (n, why) => { failed++; console.log('FAIL ' + n + tag + (why ? ': ' + String(why).split('\n')[0] : '')); };
 const shot = (name) => path.join(out, 'dashboard-' + name + tag + '.png');
 
+// RSA in a box too small for φ = 0.8: it places grains until wall_time_s.
+const rsaUntilWallTime = (s) => ({
+  dim: 2, domain: { box: { size: [40, 40], periodic: false } },
+  grading: { type: 'fuller', q: 0.5, d_max: 4 }, d_min: 2,
+  phi: { value: 0.8, refers_to: 'resolved' }, delta_d: 0.1,
+  rsa: { max_failed_draws: 1e10 }, limits: { wall_time_s: s }, seed: 3,
+});
+
+// Submit the example `label` with its inputs changed by edit (the JSON
+// textarea, as a person would); the new job's id.
+async function submitEdited(page, label, edit, previous) {
+  await page.goto(page.url().replace(/#.*$/, '') + '#/');
+  await page.selectOption('#example', { label });
+  if (!(await page.isVisible('#inputs'))) await page.click('#submit-form details summary');
+  const inputs = edit(JSON.parse(await page.inputValue('#inputs')));
+  await page.fill('#inputs', JSON.stringify(inputs));
+  await page.click('#submit');
+  const a = await page.waitForSelector(`#submitted a:not(:has-text("${previous}"))`);
+  return (await a.textContent()).trim();
+}
+
+async function openJob(page, id) {
+  await page.goto(page.url().replace(/#.*$/, '') + '#/jobs/' + encodeURIComponent(id));
+  await page.waitForFunction((i) => document.getElementById('job-id').textContent === i, id);
+}
+
+const width = (page) => page.evaluate(() => document.documentElement.scrollWidth);
+
 async function step(name, fn) {
   try { await fn(); pass(name); return true; } catch (e) { fail(name, e.message); return false; }
 }
@@ -30,7 +64,10 @@ async function step(name, fn) {
     executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
     args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'],
   });
-  const page = await browser.newPage({ viewport: { width: 1200, height: 900 }, acceptDownloads: true });
+  const page = await browser.newPage({
+    viewport: { width: 1200, height: 900 }, acceptDownloads: true,
+    timezoneId: 'Asia/Kolkata', locale: 'en-US', // UTC+5:30: a zone no server runs in by accident
+  });
   page.setDefaultTimeout(30000 * slow);
   const problems = []; // script errors and CSP violations
   page.on('pageerror', (e) => problems.push(e.message));
@@ -65,6 +102,10 @@ async function step(name, fn) {
       }, row, { timeout: 60000 * slow });
       await page.screenshot({ path: shot('list'), fullPage: true });
     });
+    await step('dashboard_list_time_local_with_zone', async () => {
+      const t = await page.textContent(`${row} td.created`);
+      if (!t.includes('GMT+5:30')) throw new Error('created shows ' + t);
+    });
     await step('dashboard_job_page_picture', async () => {
       await page.click(`${row} a`);
       await page.waitForFunction(() => {
@@ -73,6 +114,10 @@ async function step(name, fn) {
       });
       await page.waitForSelector('#summary tr');
       await page.screenshot({ path: shot('job'), fullPage: true });
+    });
+    await step('dashboard_job_times_local_with_zone', async () => {
+      const t = await page.textContent('#job-times');
+      if (!/created .*GMT\+5:30/.test(t) || !/finished .*GMT\+5:30/.test(t)) throw new Error('times: ' + t);
     });
     await step('dashboard_downloads_result', async () => {
       const [dl] = await Promise.all([
@@ -113,6 +158,61 @@ async function step(name, fn) {
       }, sel, { timeout: 60000 * slow });
       const seen = await page.evaluate(() => [...new Set(window.seenValues)]);
       console.log('BAR ' + seen.join(' '));
+    });
+    let last = id;
+    await step('dashboard_job_page_keeps_status', async () => {
+      last = await submitEdited(page, 'edmd-quartz-2d (pack)', (i) => { i.edmd.growth_rate = 0.002; return i; }, last); // ~10 s
+      await openJob(page, last);
+      // the status word and the bar, sampled every 20 ms until the job ends
+      await page.evaluate(() => {
+        window.seenStatus = [];
+        window.seenBar = [];
+        const t = setInterval(() => {
+          const st = document.getElementById('job-status').textContent;
+          window.seenStatus.push(st);
+          window.seenBar.push(document.getElementById('job-progress').value);
+          if (st === 'successful' || st === 'failed') clearInterval(t);
+        }, 20);
+      });
+      await page.waitForFunction(() => window.seenStatus.includes('successful'), null, { timeout: 60000 * slow });
+      const [st, bar] = await page.evaluate(() => [window.seenStatus, window.seenBar]);
+      if (!bar.some((v) => v > 0 && v < 100)) throw new Error('no progress seen: ' + [...new Set(bar)].join(' '));
+      const blank = st.filter((x) => !x).length;
+      if (blank) throw new Error(blank + ' of ' + st.length + ' samples without a status word');
+    });
+    await step('dashboard_failed_job_page', async () => {
+      last = await submitEdited(page, 'meier-quartz-2d (pack)', () => rsaUntilWallTime(1), last);
+      await openJob(page, last);
+      await page.waitForSelector('#job-status:text-is("failed")', { timeout: 60000 * slow });
+      await page.waitForSelector('#job-reason:has-text("wall time")');
+      await page.waitForSelector('#summary tr');
+      const [dl] = await Promise.all([
+        page.waitForEvent('download'),
+        page.click('a[data-output="result"]:has-text("partial")'),
+      ]);
+      await dl.saveAs(path.join(out, 'partial' + tag + '.h5'));
+      await page.screenshot({ path: shot('failed'), fullPage: true });
+    });
+    await step('dashboard_cancel_button', async () => {
+      last = await submitEdited(page, 'meier-quartz-2d (pack)', () => rsaUntilWallTime(300), last);
+      await openJob(page, last);
+      await page.click('#cancel');
+      await page.waitForSelector('#job-status:text-is("dismissed")');
+      if (await page.isVisible('#cancel')) throw new Error('the button stays after the job is dismissed');
+      await page.screenshot({ path: shot('dismissed'), fullPage: true });
+    });
+    await step('dashboard_fits_390px', async () => {
+      await page.setViewportSize({ width: 390, height: 844 });
+      await page.goto(base + '/#/');
+      await page.waitForSelector(row);
+      const list = await width(page);
+      await page.screenshot({ path: shot('list-390'), fullPage: true });
+      await openJob(page, id);
+      await page.waitForSelector('#summary tr');
+      await page.waitForFunction(() => [...document.images].every((i) => i.complete));
+      const job = await width(page);
+      await page.screenshot({ path: shot('job-390'), fullPage: true });
+      if (list > 390 || job > 390) throw new Error(`scrollWidth at 390 px: list ${list}, job page ${job}`);
     });
     if (problems.length) fail('dashboard_no_script_errors', problems.join(' | '));
     else pass('dashboard_no_script_errors');

@@ -4,7 +4,8 @@
 # invalid job exits 1 with its pointers, jobs lists, fetch re-downloads,
 # cancel dismisses a running job; against a stand-in service
 # (fake_service.py): a tampered or cut download is refused (exit 2), a failed
-# job exits 3 with its partial file, the token is sent as a bearer token.
+# job exits 3 with its partial file at OUT.partial (OUT itself not written),
+# the token is sent as a bearer token.
 # Every subcommand answers --help.
 . "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
 
@@ -34,6 +35,15 @@ check submit_result_matches_server_sha sh -c "[ -n '$server_sha' ] && [ \"\$(sha
 check submit_result_opens sh -c "'$PACKD' inspect '$T/out.h5' | grep -q '\"count\": 1000' || h5dump -H '$T/out.h5' >/dev/null"
 check submit_progress_line_on_stderr grep -q "job ${ID%%-*} successful" "$T/submit.err"
 check no_part_file_left test ! -e "$T/out.h5.part"
+
+# 1b. a job that fails (its wall time): exit 3; -o's file is not written, the
+# partial result is at OUT.partial and the message says so
+slow_body 1 | python3 -c "import json,sys; d=json.load(sys.stdin); d['process']='pack'; print(json.dumps(d))" >"$T/fails.json"
+"$PACKD" submit "$T/fails.json" --server "$B" -q -o "$T/fails.h5" >"$T/fails.out" 2>"$T/fails.err"
+check submit_failed_exit_3 test $? = 3
+check submit_failed_output_not_written test ! -e "$T/fails.h5"
+check submit_failed_partial_at_dot_partial sh -c "h5dump -d /observables/verdict/status '$T/fails.h5.partial' | grep -q failed"
+check submit_failed_message_names_partial grep -q "partial result of the failed job in $T/fails.h5.partial" "$T/fails.err"
 
 # 2. an invalid job: exit 1, each error's pointer and message on stderr
 printf '{"process": "pack", "inputs": {"dim": 5}}\n' >"$T/bad.json"
@@ -79,7 +89,10 @@ check digest_says_stated grep -q 'result_digest .*the server states 0000' "$T/di
 "$PACKD" fetch failed -o "$T/partial.bin" --server "$F" >/dev/null 2>"$T/failed.err"
 check failed_job_exit_3 test $? = 3
 check failed_job_reason_printed grep -q 'ran out of wall time' "$T/failed.err"
-check failed_job_partial_kept test -s "$T/partial.bin"
+check failed_job_partial_kept test -s "$T/partial.bin.partial"
+# -o names the file of a successful job only: a pipeline that tests its existence stops here
+check failed_job_output_not_written test ! -e "$T/partial.bin"
+check failed_job_names_partial_file grep -q "partial result of the failed job in $T/partial.bin.partial" "$T/failed.err"
 
 # 7. a service with auth on: the token from $PACKD_TOKEN opens it, none gets 401 (exit 1)
 tok=$("$PACKD" token add alice --data "$T/authd" 2>/dev/null)

@@ -6,7 +6,11 @@
 # example, watches its bar reach 100 %, sees the picture and downloads the
 # result, which h5ls reads; then submits the EDMD example edited to run ~5 s
 # and sees its bar strictly between 0 and 100 % while it runs (the values the
-# bar showed are printed as a BAR line).  Screenshots: $PACKD_BUILD/screenshots/.
+# bar showed are printed as a BAR line); then job pages: the status word kept
+# through progress events, a failed job's reason, summary and partial file
+# (h5ls reads it), a cancel button that dismisses, times in the browser's
+# zone, and the list and a job page no wider than a 390 px viewport
+# (dashboard_driver.js).  Screenshots: $PACKD_BUILD/screenshots/.
 . "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
 BUILD=${PACKD_BUILD:-$(dirname "$PACKD")}
 
@@ -51,13 +55,14 @@ if [ ! -f "$PW/package.json" ]; then # installed by make test's dependency step
 fi
 SHOTS="$BUILD/screenshots"
 mkdir -p "$SHOTS"
-rm -f "$SHOTS"/dashboard-*.png "$SHOTS"/result*.h5
+rm -f "$SHOTS"/dashboard-*.png "$SHOTS"/result*.h5 "$SHOTS"/partial*.h5
 browse() { # TAG [TOKEN]: the driver's PASS/FAIL lines, then the download checked
-    PLAYWRIGHT_CORE="$PW" CHROMIUM="$CHROMIUM" SLOW=$SLOW HOME="$T" TOKEN="${2:-}" timeout $((180 * SLOW)) \
+    PLAYWRIGHT_CORE="$PW" CHROMIUM="$CHROMIUM" SLOW=$SLOW HOME="$T" TOKEN="${2:-}" timeout $((300 * SLOW)) \
         node "$SRC/tests/integration/dashboard_driver.js" "$B" "$SHOTS" meier-quartz-2d.json >"$T/drv.txt" 2>&1
     grep -E '^(PASS|FAIL|SKIP|BAR) ' "$T/drv.txt"
     grep -qE '^(PASS|FAIL) ' "$T/drv.txt" || fail "dashboard_driver$1" "$(tail -3 "$T/drv.txt")"
     check "dashboard_download_is_hdf5$1" sh -c "h5ls '$SHOTS/result$1.h5' | grep -q '^particles'"
+    check "dashboard_partial_download_is_hdf5$1" sh -c "h5ls '$SHOTS/partial$1.h5' | grep -q '^particles'"
     id=$(sed -n 's/^JOB //p' "$T/drv.txt")
     c ${2:+-H "Authorization: Bearer $2"} -o "$T/api.h5" "$B/jobs/$id/results/result"
     check "dashboard_download_is_the_result$1" cmp -s "$SHOTS/result$1.h5" "$T/api.h5"

@@ -4,8 +4,9 @@
 # tet filling; homogenize) has time-dependent elements with step, time and
 # value of one length, a scalar ASCII unit string on every dimensional
 # dataset, the units module, connectivity [n][2] with its particles group;
-# /h5md/author names who ran it: $USER for `packd run`, the job's owner (the
-# token's name) for a service job.
+# /h5md/author names who ran it: $USER or --author for `packd run`, the job's
+# owner (the token's name) for a service job, "unknown" when no person is
+# known (no $USER; a service job without auth, whose owner is an address).
 . "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
 EX="$SRC/examples"
 CHECK="$SRC/tests/tools/h5md_check.py"
@@ -30,8 +31,20 @@ check h5md_homogenize_units sh -c "h5dump -a /particles/grains/position/unit hom
 check h5md_homogenize_shapes sh -c "h5dump -H -d /observables/homogenize/P/value hom.h5 | grep -q '( 20, 2, 2 )' &&
     h5dump -H -d /connectivity/contacts hom.h5 | grep -q ', 2 ) /' &&
     h5dump -H -d /observables/homogenize/final_state/position hom.h5 | grep -q '( 150, 2 )'"
+# without $USER nor --author nobody is known: the name says "unknown", not the program
 USER= "$PACKD" run "$EX/homogenize/rve-rsa-2d.json" -o anon.h5 >/dev/null 2>&1
-check h5md_author_without_user python3 "$CHECK" anon.h5 --author "packd run"
+check h5md_author_without_user python3 "$CHECK" anon.h5 --author unknown
+USER=carol "$PACKD" run "$EX/homogenize/rve-rsa-2d.json" -o named.h5 --author "Carol Meier" >/dev/null 2>&1
+check h5md_author_option python3 "$CHECK" named.h5 --author "Carol Meier"
+
+# a service job without auth: its owner is only the client's address, no person
+start_daemon open || { fail open_serve_starts; exit 1; }
+ID=$(submit "$T/fast.json")
+st() { c -o "$T/st.json" "$B/jobs/$ID" && member "$T/st.json" status; }
+ok() { [ "$(st)" = successful ]; }
+check open_job_successful wait_for 60 ok
+c -o "$T/open.h5" "$B/jobs/$ID/results/result"
+check h5md_service_without_owner_unknown python3 "$CHECK" "$T/open.h5" --author unknown
 
 # a service job: its owner (the token's name) is the author
 D="$T/auth"

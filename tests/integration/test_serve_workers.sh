@@ -95,6 +95,10 @@ check accepted_jobs_survive_kill9 test $ok = 1
 
 c "$B/jobs/$R" >"$T/rr.json"
 check restarted_job_result sh -c "grep -q 'wall time' '$T/rr.json'"
+# a failed job's summary stays readable: why it stopped (the dashboard's failed-job page)
+code=$(c -o "$T/rs.json" -w '%{http_code}' "$B/jobs/$R/results/summary")
+check failed_job_summary_served sh -c "[ $code = 200 ] &&
+    python3 -c \"import json; assert 'wall time' in json.load(open('$T/rs.json'))['failure']\""
 
 # 6. SIGTERM: running job gets grace_s (1 s here), then is re-queued; the
 #    daemon exits 0; after a restart the job runs to its wall-time limit

@@ -1,10 +1,13 @@
 #!/bin/sh
-# test_xdmf.sh — the XDMF sidecars of a tetfill and a homogenize result, as
-# ParaView would read them: every DataItem names a dataset of the stated
-# shape and type (tests/tools/xdmf_check.py); the tetfill sidecar has a
-# Tetrahedron grid, the homogenize one a temporal collection with one grid
-# per load step.  Where pvpython is installed, ParaView's Xdmf3 reader opens
-# each headless and makes points, cells, tet cells and the time steps.
+# test_xdmf.sh — the XDMF sidecars of every kind of result (2D and 3D
+# packings, tetfill, homogenize load steps, fe2), as ParaView reads them:
+# every DataItem's Dimensions and type are its HDF5 dataset's (h5dump), a
+# load step's row of an H5MD element its row's shape and byte offset
+# (tests/tools/xdmf_check.py); the tetfill sidecar has a Tetrahedron grid,
+# the load paths a temporal collection with one grid per step.  Where pvbatch
+# is installed (Debian's paraview and python3-paraview), ParaView's Xdmf3 and
+# legacy readers open each headless without a complaint and make the points,
+# cells, tet cells, named grains/mesh blocks, id and species, the time steps.
 set -u
 PACKD=${PACKD:-build/packd}
 SRC=${PACKD_SRC:-$PWD}
@@ -13,11 +16,22 @@ trap 'rm -rf "$T"' EXIT
 . "$SRC/tests/integration/check.inc"
 X="python3 $SRC/tests/tools/xdmf_check.py"
 PV=
-if command -v pvpython >/dev/null 2>&1 || command -v pvbatch >/dev/null 2>&1; then
+if command -v pvbatch >/dev/null 2>&1; then
     PV=--paraview
 else
-    skip xdmf_paraview "pvpython not installed (Debian's paraview): the sidecars are checked against the HDF5 files only"
+    skip xdmf_paraview "pvbatch not installed (Debian's paraview, python3-paraview): the sidecars are checked against the HDF5 files only"
 fi
+
+# packings, 2D and 3D: one vertex cell per grain
+for j in meier-quartz-2d:1000 din-a16-3d-walled:; do
+    n=${j%%:*}
+    if (cd "$SRC" && "$PACKD" run "examples/$n.json" -o "$T/$n.h5" --xdmf "$T/$n.xdmf") >"$T/$n.out" 2>&1; then
+        pts=${j#*:}
+        check "xdmf_${n}_datasets" $X "$T/$n.xdmf" ${pts:+--points $pts} $PV
+    else
+        fail "xdmf_${n}_runs" "$(tail -c 300 "$T/$n.out")"
+    fi
+done
 
 # tetfill: the mesh as a Tetrahedron grid beside the grains
 mkdir -p "$T/h5" "$T/x"
@@ -40,5 +54,12 @@ if (cd "$T" && "$PACKD" run "$SRC/examples/homogenize/rve-rsa-2d.json" -o rve-2d
     check xdmf_homogenize_datasets $X "$T/hom.xdmf" --steps "$steps" $PV
 else
     fail xdmf_homogenize_runs "$(tail -c 300 "$T/hom.out")"
+fi
+# fe2: the deformed macro mesh per converged step (3 steps, 4 Q1 elements)
+if (cd "$T" && "$PACKD" run "$SRC/tests/data/fe2/block-small.json" -o fe2.h5 --xdmf fe2.xdmf) \
+    >"$T/fe2.out" 2>&1; then
+    check xdmf_fe2_datasets $X "$T/fe2.xdmf" --steps 3 --mesh2d 4 $PV
+else
+    fail xdmf_fe2_runs "$(tail -c 300 "$T/fe2.out")"
 fi
 exit 0

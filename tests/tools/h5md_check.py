@@ -3,10 +3,14 @@
 rules of H5MD 1.1 as docs/result-format.md states them, from h5dump's header
 (no h5py needed):
 
-- /h5md: version [1, 1], author with a name (equal to NAME when given),
+- /h5md: version [1, 1], author with a name (equal to NAME when given; a
+  person or "unknown", never the program or a client's address),
   creator, modules/units with its version and system;
 - every time-dependent element (a group holding `value`) has `step` and `time`
-  whose first dimension equals value's (shared ones through hard links);
+  whose first dimension equals value's (shared ones through hard links), and
+  its `time` a unit ("1" when it is a number, the units module's numeric factor);
+- a particles group holds H5MD elements and its box, no other groups; no
+  group is a set of per-step copies named 0, 1, …;
 - every `unit` attribute is a scalar ASCII string of the units module's
   syntax ("mm", "N mm-2", "s-1"); every dimensional dataset packd writes
   (the DIMENSIONAL list) carries one;
@@ -35,7 +39,9 @@ DIMENSIONAL = [
     r"|newton/solves/abs_residual_0|micro/gauss_point_\d+)",
     r"/connectivity/contact_(overlap|normal_force|branch)",
 ]
-UNIT = re.compile(r"^(\d+(\.\d+)? )?[A-Za-z]+([+-]\d+)?( [A-Za-z]+([+-]\d+)?)*$")
+UNIT = re.compile(r"^(\d+(\.\d+)?|(\d+(\.\d+)? )?[A-Za-z]+([+-]\d+)?( [A-Za-z]+([+-]\d+)?)*)$")
+# who an author is not: a program, a machine's address
+NOT_A_PERSON = re.compile(r"^(packd( run)?|\d+\.\d+\.\d+\.\d+|[0-9a-fA-F:]*:[0-9a-fA-F:.]*)$")
 
 
 def parse(path):
@@ -119,6 +125,8 @@ def main():
         bad.append("/h5md/author has no name")
     elif author is not None and name != author:
         bad.append("/h5md/author name is %r, not %r" % (name, author))
+    elif NOT_A_PERSON.match(name):
+        bad.append("/h5md/author name %r is no person (\"unknown\" when none is known)" % name)
     elements = 0
     for p, o in objs.items():
         if o["kind"] != "GROUP" or p + "/value" not in objs:
@@ -131,6 +139,19 @@ def main():
                 bad.append("%s: time-dependent element without %s" % (p, c))
             elif not v["dims"] or d["dims"] != v["dims"][:1]:
                 bad.append("%s/%s: shape %s, value %s" % (p, c, d["dims"], v["dims"]))
+        t = resolved(objs, p + "/time")
+        if t is not None and "unit" not in t["attrs"]:
+            bad.append("%s/time: without a unit (\"1\" for a number)" % p)
+    # a particles group holds H5MD elements (and its box), not groups of per-step copies
+    for p, o in objs.items():
+        parts = p.split("/")
+        if o["kind"] == "GROUP" and len(parts) == 4 and parts[1] == "particles" and \
+                parts[3] != "box" and p + "/value" not in objs:
+            bad.append("%s: a group in a particles group that is no H5MD element" % p)
+        kids = [q for q in objs if q.rsplit("/", 1)[0] == p and q != p]
+        if o["kind"] == "GROUP" and kids and all(re.fullmatch(r"\d+", q.rsplit("/", 1)[1])
+                                                 for q in kids):
+            bad.append("%s: per-step copies %s, not one time-dependent element" % (p, kids[0]))
     units = 0
     for p, o in objs.items():
         u = o["attrs"].get("unit")

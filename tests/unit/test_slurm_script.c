@@ -86,7 +86,7 @@ static void test_one_task(void)
     c.slurm_mem_mb = 1000;
     pk_slurm_job j = {.id = "one",
                       .dir = dir,
-                      .owner = "lab",
+                      .author = "lab",
                       .packd = "/opt/packd",
                       .threads = 2,
                       .ranks = 1,
@@ -117,7 +117,7 @@ static void test_ranks(void)
     c.slurm_mem_mb = 1001;
     pk_slurm_job j = {.id = "ranks",
                       .dir = dir,
-                      .owner = "lab",
+                      .author = "lab",
                       .packd = "/opt/packd",
                       .threads = 2,
                       .ranks = 3,
