@@ -48,6 +48,8 @@ static const struct key {
      "concurrent worker processes (0 = accept but run nothing)"},
     {"job_threads", K_INT, F(job_threads), 1, 64,
      "threads of each job's parallel sections (the results are the same for any)"},
+    {"worker_nice", K_INT, F(worker_nice), 0, 19,
+     "niceness of local worker processes: the HTTP loops get a core before busy workers"},
     {"max_body_bytes", K_LONG, F(max_body_bytes), 1024, 1e12, "largest request body"},
     {"max_particles", K_LONG, F(max_particles), 1, 1e12, "cap on a job's limits.max_particles"},
     {"max_wall_time_s", K_DOUBLE, F(max_wall_time_s), 1, 1e9, "cap on a job's limits.wall_time_s"},

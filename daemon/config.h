@@ -25,6 +25,7 @@ typedef struct pk_config {
     long input_max_bytes;       /* largest file a request may name in input_dir */
     int workers;                /* concurrent worker processes */
     int job_threads;            /* threads of each job's parallel sections (same results for any) */
+    int worker_nice;            /* niceness of local workers: the HTTP loops get a core first */
     long max_body_bytes;        /* largest request body (POST /files, /execution) */
     long max_particles;         /* cap on limits.max_particles of each job */
     double max_wall_time_s;     /* cap on limits.wall_time_s; the worker is killed 30 s after */

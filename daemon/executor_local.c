@@ -28,6 +28,7 @@
 #include <string.h>
 #include <sys/file.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -68,6 +69,7 @@ typedef struct local_exec {
     int workers;
     double max_wall_time_s;
     int job_threads; /* --threads of each worker */
+    int worker_nice; /* setpriority of each worker */
     double checkpoint_interval_s;
     int stopping;
     double grace_deadline;
@@ -154,6 +156,7 @@ static int launch(local_exec *s, slot *sl, json_t *job)
     snprintf(owner, sizeof owner, "%s", pk_worker_author(job));
     pthread_mutex_lock(&s->mu);
     snprintf(threads, sizeof threads, "%d", s->job_threads);
+    int niceness = s->worker_nice;
     snprintf(interval, sizeof interval, "%g",
              s->checkpoint_interval_s > 0 ? s->checkpoint_interval_s : 30);
     pthread_mutex_unlock(&s->mu);
@@ -172,6 +175,8 @@ static int launch(local_exec *s, slot *sl, json_t *job)
         sigemptyset(&none);
         sigprocmask(SIG_SETMASK, &none, NULL);
         signal(SIGPIPE, SIG_DFL);
+        if (niceness > 0 && setpriority(PRIO_PROCESS, 0, niceness) != 0)
+            _exit(125);
         int lk = open(lock_path, O_RDWR | O_CREAT, 0640);
         if (lk < 0 || flock(lk, LOCK_EX) != 0) /* inherited by the exec'd worker */
             _exit(125);
@@ -418,6 +423,7 @@ static void configure(pk_executor *e, const pk_config *c)
     s->workers = c->workers > MAX_SLOTS ? MAX_SLOTS : c->workers;
     s->max_wall_time_s = c->max_wall_time_s;
     s->job_threads = c->job_threads;
+    s->worker_nice = c->worker_nice;
     s->checkpoint_interval_s = c->checkpoint_interval_s;
     s->local_below_s = c->slurm_local_below_s;
     pthread_mutex_unlock(&s->mu);

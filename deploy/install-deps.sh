@@ -18,11 +18,12 @@ RUN_PKGS="build-essential pkg-config hdf5-tools libmicrohttpd-dev libcurl4-opens
 # fe2 run over ranks); 48 packages, 141 MB, so not in `run`: `install-deps.sh mpi`, then make
 MPI_PKGS="openmpi-bin libopenmpi-dev"
 # libomp-14-dev: clang's <omp.h> for the fuzz build; libopenblas0-pthread: the digest
-# guard runs the solver against the threaded OpenBLAS too; clang-format: the format check
+# guard runs the solver against the threaded OpenBLAS too; clang-format: the format check;
+# prometheus: promtool checks the /metrics exposition (test_metrics.sh)
 # paraview, python3-paraview: pvbatch, ParaView's XDMF readers that test_xdmf opens every
 # sidecar with (131 packages: 140 MB to download, 0.8 GB installed, 6.5 min on a busy 2-core machine)
 PARAVIEW_PKGS="paraview python3-paraview"
-TEST_PKGS="$MPI_PKGS $PARAVIEW_PKGS python3 python3-jsonschema python3-matplotlib python3-owslib procps clang libclang-rt-14-dev libomp-14-dev clang-format chromium nodejs libopenblas0-pthread slurm-wlm munge"
+TEST_PKGS="$MPI_PKGS $PARAVIEW_PKGS python3 python3-jsonschema python3-matplotlib python3-owslib procps clang libclang-rt-14-dev libomp-14-dev clang-format chromium nodejs libopenblas0-pthread slurm-wlm munge prometheus"
 BENCH_PKGS="wrk sqlite3"
 # The dashboard's browser test drives chromium with playwright-core from npm; a node
 # from elsewhere (NodeSource) brings its own npm, which Debian's npm would conflict with.

@@ -31,8 +31,9 @@ typedef struct pk_req {
     char owner[128]; /* who asks (auth.c): token name, proxy's X-Packd-Owner or address */
     int admin;       /* sees every owner's jobs and uploads */
     int answered;    /* answered from the headers alone (413, 415): the body is not read */
-    const struct pk_route *route; /* the route matched and authorised from the headers */
-    double started;               /* when the headers were complete (pk_queue_now clock) */
+    const struct pk_route *route;   /* the route matched and authorised from the headers */
+    const struct pk_route *matched; /* the route matched, authorised or not (metrics) */
+    double started;                 /* when the headers were complete (pk_queue_now clock) */
     /* A request that waits without a thread (http_park.h): once its
      * connection resumes, resume is called instead of the route; wait is
      * its state, freed by wait_free when the request ends. */

@@ -9,6 +9,7 @@
 
 #include "cors.h"
 #include "http.h"
+#include "http_durations.h"
 #include "daemon/data_paths.h"
 #include "daemon/log.h"
 #include "api/digest.h"
@@ -121,6 +122,7 @@ enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp)
         __atomic_add_fetch(&r->svc->responses[status], 1, __ATOMIC_RELAXED);
     pk_config cfg = pk_service_config(r->svc);
     pk_cors_response_headers(&cfg, pk_header(r, "Origin"), resp);
+    pk_http_duration_observe(r->matched, status, pk_queue_now() - r->started);
     MHD_add_response_header(resp, "Server", "packd/" PACKD_VERSION);
     MHD_add_response_header(resp, "X-Content-Type-Options", "nosniff");
     enum MHD_Result rc = MHD_queue_response(r->conn, status, resp);

@@ -212,6 +212,7 @@ static enum MHD_Result on_headers(pk_req *r)
     pk_config cfg = pk_service_config(r->svc);
     const pk_route *rt = find_route(r);
     enum MHD_Result refused;
+    r->matched = rt;
     r->answered = 1;
     if (!pk_host_allowed(&cfg, pk_header(r, "Host")))
         return pk_send_problem(r, 421, PK_PROBLEM_GENERIC, "Misdirected Request",

@@ -183,3 +183,15 @@ sqlite3 *pk_db_open(const char *path, char *err, size_t errlen)
     }
     return db;
 }
+
+sqlite3 *pk_db_open_reader(const char *path, char *err, size_t errlen)
+{
+    sqlite3 *db = NULL;
+    if (sqlite3_open_v2(path, &db, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX, NULL) != SQLITE_OK) {
+        snprintf(err, errlen, "%s: reader: %s", path, db ? sqlite3_errmsg(db) : "cannot open");
+        sqlite3_close(db);
+        return NULL;
+    }
+    sqlite3_busy_timeout(db, 5000); /* only a WAL recovery or restart makes a reader wait */
+    return db;
+}

@@ -23,4 +23,9 @@ int pk_db_file_private(const char *path);
  * connection to DATA/queue.db goes through here.  NULL with err. */
 sqlite3 *pk_db_open(const char *path, char *err, size_t errlen);
 
+/* A read-only connection (SQLITE_OPEN_READONLY) to a database pk_db_open
+ * made: in WAL mode its reads see the last commit and never wait on the
+ * writer's lock or fsync.  NULL with err. */
+sqlite3 *pk_db_open_reader(const char *path, char *err, size_t errlen);
+
 #endif

@@ -16,9 +16,9 @@
 #include "migrations.h"
 #include "uuid.h"
 
-/* Connections that only read (query_only), one per HTTP event-loop thread
- * at most: in WAL mode a read never waits on the writer's fsync, so status
- * polls stay fast while workers report progress. */
+/* Read-only connections (SQLITE_OPEN_READONLY), one per HTTP event-loop
+ * thread at most: in WAL mode a read never waits on the writer's fsync, so
+ * status polls stay fast while workers report progress. */
 #define READERS 8
 
 typedef struct reader {
@@ -27,15 +27,17 @@ typedef struct reader {
 } reader;
 
 struct pk_queue {
-    sqlite3 *db; /* the one writer */
-    pthread_mutex_t mu;
+    sqlite3 *db;        /* the one writer */
+    pthread_mutex_t mu; /* the writer's: held across a commit and its fsync */
     reader rd[READERS];
     unsigned rd_next;
     pthread_mutex_t ev_mu;
     pthread_cond_t ev_cond;
     long long ev_seq; /* bumped on every inserted event / state change */
     /* The last failed write (disk or database full, I/O error) until a
-     * commit succeeds again: /healthz is not ready meanwhile. */
+     * commit succeeds again: /healthz is not ready meanwhile.  Under
+     * state_mu, never held across a write: /healthz never waits on one. */
+    pthread_mutex_t state_mu;
     double write_failed_at, probed_at;
     char write_error[160];
     long long commits; /* transactions the writer committed (atomic) */
@@ -216,12 +218,14 @@ static int begin(pk_queue *q) { return sqlite3_exec(q->db, "BEGIN IMMEDIATE", NU
 /* Remember whether the database takes writes (under q->mu). */
 static void note_write(pk_queue *q, int ok)
 {
+    pthread_mutex_lock(&q->state_mu);
     if (ok) {
         q->write_failed_at = 0;
-        return;
+    } else {
+        snprintf(q->write_error, sizeof q->write_error, "%s", sqlite3_errmsg(q->db));
+        q->write_failed_at = pk_queue_now();
     }
-    snprintf(q->write_error, sizeof q->write_error, "%s", sqlite3_errmsg(q->db));
-    q->write_failed_at = pk_queue_now();
+    pthread_mutex_unlock(&q->state_mu);
 }
 
 /* 0 when committed; -1 (rolled back, remembered) otherwise. */
@@ -262,21 +266,18 @@ pk_queue *pk_queue_open(const char *path, char *err, size_t errlen)
     }
     sqlite3_commit_hook(q->db, count_commit, q);
     pthread_mutex_init(&q->mu, NULL);
+    pthread_mutex_init(&q->state_mu, NULL);
     pthread_mutex_init(&q->ev_mu, NULL);
     pthread_cond_init(&q->ev_cond, NULL);
     for (int i = 0; i < READERS; i++)
         pthread_mutex_init(&q->rd[i].mu, NULL);
     for (int i = 0; i < READERS; i++) {
         /* after the writer: the file exists, is in WAL mode and migrated */
-        if (sqlite3_open_v2(path, &q->rd[i].db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX,
-                            NULL) != SQLITE_OK ||
-            sqlite3_exec(q->rd[i].db, "PRAGMA query_only=1", NULL, NULL, NULL) != SQLITE_OK) {
-            snprintf(err, errlen, "%s: reader: %s", path,
-                     q->rd[i].db ? sqlite3_errmsg(q->rd[i].db) : "cannot open");
+        q->rd[i].db = pk_db_open_reader(path, err, errlen);
+        if (!q->rd[i].db) {
             pk_queue_close(q);
             return NULL;
         }
-        sqlite3_busy_timeout(q->rd[i].db, 5000);
     }
     return q;
 }
@@ -291,6 +292,7 @@ void pk_queue_close(pk_queue *q)
     }
     sqlite3_close(q->db);
     pthread_mutex_destroy(&q->mu);
+    pthread_mutex_destroy(&q->state_mu);
     pthread_mutex_destroy(&q->ev_mu);
     pthread_cond_destroy(&q->ev_cond);
     free(q);
@@ -753,17 +755,23 @@ static void probe_write(pk_queue *q)
 
 int pk_queue_writable(pk_queue *q, char *why, size_t n)
 {
-    pthread_mutex_lock(&q->mu);
     double now = pk_queue_now();
-    if (q->write_failed_at > 0 && now - q->probed_at >= 1.0) {
+    pthread_mutex_lock(&q->state_mu);
+    int probe = q->write_failed_at > 0 && now - q->probed_at >= 1.0;
+    if (probe)
         q->probed_at = now;
+    pthread_mutex_unlock(&q->state_mu);
+    /* a writer busy now reports its own outcome: no waiting for it */
+    if (probe && pthread_mutex_trylock(&q->mu) == 0) {
         probe_write(q);
+        pthread_mutex_unlock(&q->mu);
     }
+    pthread_mutex_lock(&q->state_mu);
     int ok = q->write_failed_at == 0;
     if (!ok)
         snprintf(why, n, "%s; last failed write %.0f s ago", q->write_error,
                  fmax(now - q->write_failed_at, 0));
-    pthread_mutex_unlock(&q->mu);
+    pthread_mutex_unlock(&q->state_mu);
     return ok;
 }
 

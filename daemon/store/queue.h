@@ -3,9 +3,10 @@
  * idempotency keys, uploads and the events SSE listeners resume from.
  *
  * One writer connection per pk_queue, serialised by a mutex, and a few
- * query-only reader connections for the lookups (get, list, events, files,
- * stats), so a read never waits on a commit's fsync: every function is one
- * short transaction and safe to call from any thread.  Job rows come back as
+ * read-only connections (SQLITE_OPEN_READONLY) for the lookups (get, list,
+ * events, files, stats) and pk_queue_writable, so a read never waits on a
+ * commit's fsync: every function is one short transaction and safe to call
+ * from any thread.  Job rows come back as
  * JSON objects with the column names as keys (inputs/summary parsed). */
 #ifndef PK_QUEUE_H
 #define PK_QUEUE_H
@@ -118,7 +119,9 @@ long long pk_queue_transactions(pk_queue *q);
 
 /* 1 when the last write committed; 0 while writes fail (why: the error and
  * how long).  Meanwhile a probe as large as a job's end is written at most
- * once a second, so the state clears by itself once space returns. */
+ * once a second (skipped while the writer is busy: it reports its own
+ * outcome), so the state clears by itself once space returns.  Never waits
+ * on a write in progress. */
 int pk_queue_writable(pk_queue *q, char *why, size_t n);
 
 /* For a back end that runs jobs outside this process (daemon/executor.h):

@@ -16,8 +16,10 @@
 #define LAST_USED_EVERY_S 60.0 /* last_used is a write: not on every request */
 
 struct pk_tokens {
-    sqlite3 *db;
+    sqlite3 *db; /* writes (add, revoke, last_used) */
     pthread_mutex_t mu;
+    sqlite3 *rd; /* read-only (migrations.h): a check never waits on a write */
+    pthread_mutex_t rd_mu;
 };
 
 static double now_s(void)
@@ -39,7 +41,14 @@ pk_tokens *pk_tokens_open(const char *db_path, char *err, size_t errlen)
         free(t);
         return NULL;
     }
+    t->rd = pk_db_open_reader(db_path, err, errlen);
+    if (!t->rd) {
+        sqlite3_close(t->db);
+        free(t);
+        return NULL;
+    }
     pthread_mutex_init(&t->mu, NULL);
+    pthread_mutex_init(&t->rd_mu, NULL);
     return t;
 }
 
@@ -47,8 +56,10 @@ void pk_tokens_close(pk_tokens *t)
 {
     if (!t)
         return;
+    sqlite3_close(t->rd);
     sqlite3_close(t->db);
     pthread_mutex_destroy(&t->mu);
+    pthread_mutex_destroy(&t->rd_mu);
     free(t);
 }
 
@@ -159,6 +170,26 @@ int pk_tokens_revoke(pk_tokens *t, const char *name)
 
 /* The lookup is by the token's hash: its timing says nothing about the
  * token's characters (an attacker cannot choose the hash's prefix). */
+/* Record a token's use: best effort and never waiting (a request that
+ * finds the store or the database's write lock busy leaves it to a later
+ * one), so a check never waits on another connection's commit. */
+static void note_used(pk_tokens *t, const char *hex, double now)
+{
+    if (pthread_mutex_trylock(&t->mu) != 0)
+        return;
+    sqlite3_stmt *st = NULL;
+    sqlite3_busy_timeout(t->db, 0);
+    if (sqlite3_prepare_v2(t->db, "UPDATE tokens SET last_used=? WHERE sha256=?", -1, &st, NULL) ==
+        SQLITE_OK) {
+        sqlite3_bind_double(st, 1, now);
+        sqlite3_bind_text(st, 2, hex, -1, SQLITE_TRANSIENT);
+        sqlite3_step(st);
+    }
+    sqlite3_finalize(st);
+    sqlite3_busy_timeout(t->db, 5000);
+    pthread_mutex_unlock(&t->mu);
+}
+
 int pk_tokens_verify(pk_tokens *t, const char *token, char name[PK_TOKEN_NAME_MAX], int *admin)
 {
     if (strncmp(token, PK_TOKEN_PREFIX, strlen(PK_TOKEN_PREFIX)) != 0 ||
@@ -167,10 +198,10 @@ int pk_tokens_verify(pk_tokens *t, const char *token, char name[PK_TOKEN_NAME_MA
     char hex[65];
     pk_token_hash(token, hex);
     double now = now_s();
-    int rc = -1;
-    pthread_mutex_lock(&t->mu);
+    int rc = -1, stale = 0;
+    pthread_mutex_lock(&t->rd_mu);
     sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(t->db,
+    if (sqlite3_prepare_v2(t->rd,
                            "SELECT name, admin, coalesce(last_used, 0) FROM tokens WHERE sha256=?",
                            -1, &st, NULL) == SQLITE_OK) {
         sqlite3_bind_text(st, 1, hex, -1, SQLITE_TRANSIENT);
@@ -179,21 +210,13 @@ int pk_tokens_verify(pk_tokens *t, const char *token, char name[PK_TOKEN_NAME_MA
         if (rc == 1) {
             snprintf(name, PK_TOKEN_NAME_MAX, "%s", (const char *)sqlite3_column_text(st, 0));
             *admin = sqlite3_column_int(st, 1);
-        }
-        int stale = rc == 1 && now - sqlite3_column_double(st, 2) >= LAST_USED_EVERY_S;
-        sqlite3_finalize(st);
-        st = NULL;
-        /* Best effort: a failed write (busy, disk full) does not refuse the request. */
-        if (stale &&
-            sqlite3_prepare_v2(t->db, "UPDATE tokens SET last_used=? WHERE sha256=?", -1, &st,
-                               NULL) == SQLITE_OK) {
-            sqlite3_bind_double(st, 1, now);
-            sqlite3_bind_text(st, 2, hex, -1, SQLITE_TRANSIENT);
-            sqlite3_step(st);
+            stale = now - sqlite3_column_double(st, 2) >= LAST_USED_EVERY_S;
         }
     }
     sqlite3_finalize(st);
-    pthread_mutex_unlock(&t->mu);
+    pthread_mutex_unlock(&t->rd_mu);
+    if (stale)
+        note_used(t, hex, now);
     return rc;
 }
 

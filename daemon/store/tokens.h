@@ -44,7 +44,8 @@ json_t *pk_tokens_list(pk_tokens *t);
 int pk_tokens_revoke(pk_tokens *t, const char *name);
 
 /* The name and admin flag of a presented token: 1 valid, 0 unknown, -1 the
- * database did not answer.  Records last_used (at most once a minute). */
+ * database did not answer.  Records last_used (at most once a minute, best
+ * effort: never waiting on another write). */
 int pk_tokens_verify(pk_tokens *t, const char *token, char name[PK_TOKEN_NAME_MAX], int *admin);
 
 /* Tokens stored (-1 on error). */

@@ -3,12 +3,19 @@
 # the packd_job_duration_seconds histogram count a finished job once and
 # keep it after the job is dismissed (DELETE) and across a restart; a
 # database from before the counters gets them filled from its jobs; the
-# exposition passes promtool check metrics where Debian's prometheus package
-# is installed, else check_metrics.py (the same rules a scraper applies).
+# process_* metrics describe this daemon (start time, RSS, CPU, open and
+# maximum fds); packd_http_request_duration_seconds counts a request under
+# its route template and status, never its raw path; the exposition passes
+# promtool check metrics (Debian's prometheus package, in install-deps.sh's
+# test list) where installed, and check_metrics.py (the same rules a scraper
+# applies).
 . "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
 
 metric() { # FILE 'name{labels}' -> value
     grep -F "$2 " "$1" | head -1 | cut -d' ' -f2
+}
+sample() { # FILE name (no labels) -> value
+    awk -v n="$2" '$1 == n { print $2; exit }' "$1"
 }
 stop_daemon() { # the daemon of start_daemon: SIGTERM, wait until gone
     kill -TERM "$DPID"
@@ -32,6 +39,37 @@ else
     echo "(promtool not installed: the exposition is checked by check_metrics.py only)"
 fi
 check exposition_well_formed python3 "$SRC/tests/integration/check_metrics.py" "$T/m1.txt"
+
+# process_*: this daemon as the kernel sees it
+now=$(date +%s)
+check process_start_time sh -c "awk -v s='$(sample "$T/m1.txt" process_start_time_seconds)' -v now=$now \
+    'BEGIN { exit !(s > now - 600 * $SLOW && s <= now + 1) }'"
+check process_rss test "$(sample "$T/m1.txt" process_resident_memory_bytes)" -gt 1000000
+check process_cpu awk -v c="$(sample "$T/m1.txt" process_cpu_seconds_total)" 'BEGIN { exit !(c > 0) }'
+check process_fds sh -c "[ '$(sample "$T/m1.txt" process_open_fds)' -ge 3 ] &&
+    [ '$(sample "$T/m1.txt" process_open_fds)' -le '$(sample "$T/m1.txt" process_max_fds)' ]"
+check process_fds_match_proc test "$(sample "$T/m1.txt" process_max_fds)" = \
+    "$(awk '/^Max open files/ { print $4 }' "/proc/$DPID/limits")"
+
+# the request-duration histogram counts a request under its route template
+H='packd_http_request_duration_seconds'
+JOB404="$H"'_count{method="GET",route="/jobs/{jobId}",code="404"}'
+NOROUTE="$H"'_count{method="other",route="unmatched",code="404"}'
+n0=$(metric "$T/m1.txt" "$JOB404")
+u0=$(metric "$T/m1.txt" "$NOROUTE")
+c -o /dev/null "$B/jobs/0badc0de-feed-4bee-8eef-000000000404"
+c -o /dev/null "$B/no-such-route-7f3a9/x"
+c "$B/metrics" >"$T/h1.txt"
+check histogram_counts_request test "$(metric "$T/h1.txt" "$JOB404")" = $((${n0:-0} + 1))
+check histogram_inf_bucket_is_count test "$(metric "$T/h1.txt" "$H"'_bucket{method="GET",route="/jobs/{jobId}",code="404",le="+Inf"}')" = \
+    "$(metric "$T/h1.txt" "$JOB404")"
+check histogram_unmatched_counted test "$(metric "$T/h1.txt" "$NOROUTE")" = $((${u0:-0} + 1))
+check histogram_no_raw_paths sh -c "! grep -q -e 0badc0de -e no-such-route '$T/h1.txt'"
+check histogram_has_status_poll grep -q "^$H"'_bucket{method="GET",route="/jobs/{jobId}",code="200",le="0.0005"} ' "$T/h1.txt"
+if command -v promtool >/dev/null 2>&1; then
+    check promtool_check_new_series sh -c "promtool check metrics <'$T/h1.txt'"
+fi
+check new_series_well_formed python3 "$SRC/tests/integration/check_metrics.py" "$T/h1.txt"
 
 # DELETE a finished job: the job gauge moves, the counters do not
 c -X DELETE -o /dev/null "$B/jobs/$ID"
