@@ -15,10 +15,6 @@ PACKD=${PACKD:-build/packd}
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 
-field() { # FILE KEY: the first value of "KEY" in a packd run summary
-    grep -o "\"$2\": [^,]*" "$1" | head -1 | sed 's/^[^:]*: //'
-}
-
 cat >"$T/fines.json" <<'JOB'
 {"process": "pack", "inputs": {"dim": 2, "domain": {"box": {"size": [60, 60], "periodic": true}},
  "grading": {"type": "classes", "classes": [{"d": 10, "volume_percent": 99.99}, {"d": 0.01, "volume_percent": 0.01}]},

@@ -14,10 +14,6 @@ PACKD=${PACKD:-build/packd}
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 
-field() { # FILE KEY: the first value of "KEY" in a packd run summary
-    grep -o "\"$2\": [^,]*" "$1" | head -1 | sed 's/^[^:]*: //'
-}
-
 # audit FILE.h5 DD: the smallest pair gap >= DD and every grain inside the
 # walls, to 1e-9 mm, from the file's positions, radii and box edges
 audit() {

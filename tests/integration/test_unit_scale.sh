@@ -12,10 +12,6 @@ PACKD=${PACKD:-build/packd}
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 
-field() { # FILE KEY: the first value of "KEY" in a packd run summary
-    grep -o "\"$2\": [^,]*" "$1" | head -1 | sed 's/^[^:]*: //'
-}
-
 # scaled NAME TEMPLATE: runs TEMPLATE with @L@ = 20·s, @a@ = 0.5·s, @b@ = 1.5·s
 # … at s = 1e-6, 1, 1e6; prints "count phi" per scale
 scaled() {
