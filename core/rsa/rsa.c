@@ -107,7 +107,8 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
         return -1;
 
     const double gap = prm->delta_d;
-    /* the clearance kept at walls: Δd/2 (spec §2.1 step 2), or none */
+    /* the clearance kept at walls: Δd/2 (Titscher & Unger §6.3: the diameters
+     * are enlarged by Δd), or none */
     const double wall = prm->wall_gap == PK_RSA_WALL_GAP_NONE ? 0 : 0.5 * gap;
     pk_grid grid;
     if (pk_grid_init(&grid, b, 0.5 * diameters[n - 1], 0.5 * diameters[0], gap, out->n + n) != 0)
@@ -138,7 +139,7 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
                                   .ctx = &sg};
     for (size_t i = 0; i < n; i++) {
         double r = 0.5 * diameters[i];
-        /* Draw range per axis: walls keep the grain `wall` away (spec §2.1). */
+        /* Draw range per axis: walls keep the grain `wall` away (Titscher & Unger §4). */
         double lo[PK_MAXDIM] = {0, 0, 0}, span[PK_MAXDIM] = {0, 0, 0};
         int fits = 1;
         for (int k = 0; k < b->dim; k++) {

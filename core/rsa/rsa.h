@@ -1,9 +1,9 @@
-/* rsa.h — random sequential addition (Titscher & Unger §4; spec §2).
+/* rsa.h — random sequential addition (Titscher & Unger §4).
  *
  * Grains are placed largest first at uniformly drawn positions; a draw is
  * rejected if the grain comes closer than Δd to a placed grain (surface to
  * surface) or, on a walled axis, closer than Δd/2 to a wall (the draw range
- * is shrunk so this never needs a test: spec §2.1 step 2; `wall_gap` NONE
+ * is shrunk so this never needs a test: Titscher & Unger §4; `wall_gap` NONE
  * keeps Δd between grains only and lets grains touch the walls).  After
  * `max_failed_draws` consecutive rejections of one grain the run stops with
  * what it has placed (Titscher's N^F failure criterion).  When the draws come
@@ -38,8 +38,9 @@ typedef enum pk_rsa_draws {
 
 /* The clearance kept at walls. */
 typedef enum pk_rsa_wall_gap {
-    PK_RSA_WALL_GAP_HALF = 0, /* "half" (default): every wall clearance >= Δd/2 (spec §2.1) */
-    PK_RSA_WALL_GAP_NONE      /* "none": Δd between grains only, grains may touch the walls
+    PK_RSA_WALL_GAP_HALF =
+        0, /* "half" (default): every wall clearance >= Δd/2 (Titscher & Unger §6.3) */
+    PK_RSA_WALL_GAP_NONE /* "none": Δd between grains only, grains may touch the walls
                                  (Titscher §3/§6.3; EDMD's wall_gap none) */
 } pk_rsa_wall_gap;
 
