@@ -38,9 +38,8 @@ typedef enum pk_rsa_draws {
 
 /* The clearance kept at walls. */
 typedef enum pk_rsa_wall_gap {
-    PK_RSA_WALL_GAP_HALF =
-        0, /* "half" (default): every wall clearance >= Δd/2 (Titscher & Unger §6.3) */
-    PK_RSA_WALL_GAP_NONE /* "none": Δd between grains only, grains may touch the walls
+    PK_RSA_WALL_GAP_HALF = 0, /* "half" (default): wall clearances >= Δd/2 (Titscher §6.3) */
+    PK_RSA_WALL_GAP_NONE      /* "none": Δd between grains only, grains may touch the walls
                                  (Titscher §3/§6.3; EDMD's wall_gap none) */
 } pk_rsa_wall_gap;
 
