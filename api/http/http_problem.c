@@ -7,6 +7,7 @@ static const struct {
     const char *type, *title;
 } problems[PK_P_COUNT] = {
     [PK_P_BAD_REQUEST] = {400, PK_PROBLEM_GENERIC, "Bad Request"},
+    [PK_P_MISDIRECTED] = {421, PK_PROBLEM_GENERIC, "Misdirected Request"},
     [PK_P_NOT_FOUND] = {404, PK_PROBLEM_GENERIC, "Not Found"},
     [PK_P_NO_SUCH_JOB] = {404, PK_PROBLEM_NO_SUCH_JOB, "No such job"},
     [PK_P_NO_SUCH_PROCESS] = {404, PK_PROBLEM_NO_SUCH_PROCESS, "No such process"},

@@ -24,6 +24,7 @@
  * the code and the detail only (the pattern of TALER_MHD_reply_with_ec). */
 typedef enum pk_problem_code {
     PK_P_BAD_REQUEST,
+    PK_P_MISDIRECTED,
     PK_P_NOT_FOUND,
     PK_P_NO_SUCH_JOB,
     PK_P_NO_SUCH_PROCESS,

@@ -117,9 +117,8 @@ int pk_authorize(pk_req *r, pk_access access, enum MHD_Result *reply)
     if (named && !*named)
         named = NULL;
     if (named && !owner_ok(named)) {
-        *reply =
-            pk_send_problem(r, 400, PK_PROBLEM_GENERIC, "Bad Request",
-                            "X-Packd-Owner: 1 to 127 printable characters without spaces", NULL, 0);
+        *reply = pk_reply_problem(r, PK_P_BAD_REQUEST,
+                                  "X-Packd-Owner: 1 to 127 printable characters without spaces");
         return 0;
     }
     snprintf(r->owner, sizeof r->owner, "%s", named ? named : peer);

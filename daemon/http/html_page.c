@@ -164,8 +164,7 @@ enum MHD_Result pk_send_doc(pk_req *r, json_t *doc, const char *title, pk_html_r
     json_decref(doc);
     if (h.oom) {
         free(h.buf);
-        return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error",
-                               "out of memory writing the page", NULL, 0);
+        return pk_reply_problem(r, PK_P_INTERNAL, "out of memory writing the page");
     }
     struct MHD_Response *resp =
         MHD_create_response_from_buffer(h.len, h.buf, MHD_RESPMEM_MUST_FREE);

@@ -253,8 +253,7 @@ enum MHD_Result pk_send_file(pk_req *r, const char *path, const char *ctype, con
     if (fd < 0 || fstat(fd, &st) != 0) {
         if (fd >= 0)
             close(fd);
-        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "the file is gone", NULL,
-                               0);
+        return pk_reply_problem(r, PK_P_NOT_FOUND, "the file is gone");
     }
     char etag[80];
     snprintf(etag, sizeof etag, "\"%s\"", sha256_hex);

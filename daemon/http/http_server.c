@@ -127,8 +127,7 @@ static enum MHD_Result no_route(pk_req *r)
     char allow[128];
     allowed_methods(r, allow, sizeof allow);
     if (!allow[0])
-        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such resource", NULL,
-                               0);
+        return pk_reply_problem(r, PK_P_NOT_FOUND, "no such resource");
     if (!strcmp(r->method, "OPTIONS") && !has_body(r))
         return options(r, allow);
     char detail[200];
@@ -215,31 +214,28 @@ static enum MHD_Result on_headers(pk_req *r)
     r->matched = rt;
     r->answered = 1;
     if (!pk_host_allowed(&cfg, pk_header(r, "Host")))
-        return pk_send_problem(r, 421, PK_PROBLEM_GENERIC, "Misdirected Request",
-                               "this service does not answer to that Host name (allowed_hosts)",
-                               NULL, 0);
+        return pk_reply_problem(r, PK_P_MISDIRECTED,
+                                "this service does not answer to that Host name (allowed_hosts)");
     if (!rt)
         return no_route(r);
     if (!pk_authorize(r, rt->access, &refused))
         return refused;
     if (strcmp(rt->method, "POST") != 0 && has_body(r))
-        return pk_send_problem(r, 413, PK_PROBLEM_GENERIC, "Content Too Large",
-                               "this route takes no request body", NULL, 0);
+        return pk_reply_problem(r, PK_P_CONTENT_TOO_LARGE, "this route takes no request body");
     if (wants_json_body(r) && !is_json_media_type(pk_header(r, "Content-Type")))
-        return pk_send_problem(r, 415, PK_PROBLEM_GENERIC, "Unsupported Media Type",
-                               "this route takes a JSON body: Content-Type must be application/json"
-                               " (a charset parameter is allowed)",
-                               NULL, 0);
+        return pk_reply_problem(
+            r, PK_P_UNSUPPORTED_MEDIA_TYPE,
+            "this route takes a JSON body: Content-Type must be application/json"
+            " (a charset parameter is allowed)");
     const char *bad_type =
         strcmp(rt->pattern, "/files") ? NULL : upload_type_refused(pk_header(r, "Content-Type"));
     if (bad_type)
-        return pk_send_problem(r, 415, PK_PROBLEM_GENERIC, "Unsupported Media Type", bad_type, NULL,
-                               0);
+        return pk_reply_problem(r, PK_P_UNSUPPORTED_MEDIA_TYPE, bad_type);
     const char *cl = pk_header(r, "Content-Length");
     if (cl && strtoll(cl, NULL, 10) > cfg.max_body_bytes) {
         char d[128];
         snprintf(d, sizeof d, "the body exceeds max_body_bytes = %ld", cfg.max_body_bytes);
-        return pk_send_problem(r, 413, PK_PROBLEM_GENERIC, "Content Too Large", d, NULL, 0);
+        return pk_reply_problem(r, PK_P_CONTENT_TOO_LARGE, d);
     }
     r->answered = 0;
     r->route = rt;
@@ -321,7 +317,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
         pk_config cfg = pk_service_config(svc);
         char d[128];
         snprintf(d, sizeof d, "the body exceeds max_body_bytes = %ld", cfg.max_body_bytes);
-        return pk_send_problem(r, 413, PK_PROBLEM_GENERIC, "Content Too Large", d, NULL, 0);
+        return pk_reply_problem(r, PK_P_CONTENT_TOO_LARGE, d);
     }
     return r->route->handler(r);
 }

@@ -112,8 +112,7 @@ static enum MHD_Result send_page(pk_req *r, const char *name, const char *csp)
 {
     const pk_web_asset *a = asset(name);
     if (!a)
-        return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error",
-                               "the page is not compiled in", NULL, 0);
+        return pk_reply_problem(r, PK_P_INTERNAL, "the page is not compiled in");
     return send_asset_csp(r, a, csp);
 }
 
@@ -128,8 +127,7 @@ enum MHD_Result route_dashboard_asset(pk_req *r)
     const char *dot = strrchr(r->seg[1], '.');
     const pk_web_asset *a = dot && !strcmp(dot, ".html") ? NULL : asset(r->seg[1]);
     if (!a)
-        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found", "no such dashboard file",
-                               NULL, 0);
+        return pk_reply_problem(r, PK_P_NOT_FOUND, "no such dashboard file");
     return send_asset(r, a);
 }
 
@@ -155,7 +153,7 @@ enum MHD_Result route_dashboard_inputs(pk_req *r)
 {
     json_t *row = pk_job_visible(r, r->seg[2]);
     if (!row)
-        return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[2], NULL, 0);
+        return pk_reply_problem(r, PK_P_NO_SUCH_JOB, r->seg[2]);
     json_decref(row);
     pk_config cfg = pk_service_config(r->svc);
     char dir[1200], path[1300];
@@ -164,8 +162,7 @@ enum MHD_Result route_dashboard_inputs(pk_req *r)
     json_t *job = access(path, R_OK) == 0 ? json_load_file(path, 0, NULL) : NULL;
     if (!json_is_object(job)) {
         json_decref(job);
-        return pk_send_problem(r, 404, PK_PROBLEM_GENERIC, "Not Found",
-                               "the job's inputs are not kept", NULL, 0);
+        return pk_reply_problem(r, PK_P_NOT_FOUND, "the job's inputs are not kept");
     }
     return pk_send_json(r, 200, job, NULL);
 }

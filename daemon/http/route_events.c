@@ -178,7 +178,7 @@ enum MHD_Result route_events(pk_req *r)
 {
     json_t *row = pk_job_visible(r, r->seg[1]);
     if (!row)
-        return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
+        return pk_reply_problem(r, PK_P_NO_SUCH_JOB, r->seg[1]);
     json_decref(row);
     sse *s = calloc(1, sizeof *s);
     s->svc = r->svc;

@@ -137,8 +137,7 @@ static enum MHD_Result reply_job(pk_req *r, const char *id, int replayed)
 {
     json_t *row = pk_queue_get(r->svc->q, id);
     if (!row)
-        return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error", "job vanished",
-                               NULL, 0);
+        return pk_reply_problem(r, PK_P_INTERNAL, "job vanished");
     json_t *info = pk_status_info(row);
     pk_absolute_links(r, info);
     struct MHD_Response *resp = pk_json_response(info, "application/json");
@@ -160,8 +159,7 @@ enum MHD_Result route_execute(pk_req *r)
     pk_service *svc = r->svc;
     const pk_process *p = pk_process_find(r->seg[1]);
     if (!p)
-        return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_PROCESS, "No such process", r->seg[1],
-                               NULL, 0);
+        return pk_reply_problem(r, PK_P_NO_SUCH_PROCESS, r->seg[1]);
     if (__atomic_load_n(&svc->draining, __ATOMIC_RELAXED))
         return pk_send_problem(r, 503, PK_PROBLEM_PACKD "shutting-down", "Service Unavailable",
                                "the daemon is stopping; submit again shortly", NULL, 10);
@@ -174,14 +172,14 @@ enum MHD_Result route_execute(pk_req *r)
                      jerr.line, jerr.column);
         else
             snprintf(d, sizeof d, "the body is empty; expected {\"inputs\": {...}}");
-        return pk_send_problem(r, 400, PK_PROBLEM_GENERIC, "Bad Request", d, NULL, 0);
+        return pk_reply_problem(r, PK_P_BAD_REQUEST, d);
     }
     if (!pk_json_depth_within(body, PK_JSON_MAX_DEPTH)) {
         json_decref(body);
         char d[120];
         snprintf(d, sizeof d, "the body nests objects and arrays deeper than %d levels (limit)",
                  PK_JSON_MAX_DEPTH);
-        return pk_send_problem(r, 400, PK_PROBLEM_GENERIC, "Bad Request", d, NULL, 0);
+        return pk_reply_problem(r, PK_P_BAD_REQUEST, d);
     }
     json_t *inputs = json_object_get(body, "inputs");
     pk_exec_opts opts = {0};

@@ -43,7 +43,7 @@ static int write_all(const char *path, const char *data, size_t n)
 enum MHD_Result route_files_post(pk_req *r)
 {
     if (r->body_len == 0)
-        return pk_send_problem(r, 400, PK_PROBLEM_GENERIC, "Bad Request", "empty upload", NULL, 0);
+        return pk_reply_problem(r, PK_P_BAD_REQUEST, "empty upload");
     pk_config cfg = pk_service_config(r->svc);
     char hex[65], dir[1100], path[1200], owner[128], href[80];
     pk_sha256_hex(r->body, r->body_len, hex);
@@ -54,8 +54,7 @@ enum MHD_Result route_files_post(pk_req *r)
     pk_owner(r, owner, sizeof owner);
     if (write_all(path, r->body, r->body_len) != 0 ||
         pk_queue_add_file(r->svc->q, hex, hex, (long long)r->body_len, ct, owner) != 0)
-        return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error",
-                               "cannot store the file", NULL, 0);
+        return pk_reply_problem(r, PK_P_INTERNAL, "cannot store the file");
     snprintf(href, sizeof href, "/files/%s", hex);
     json_t *doc = json_pack("{s:s,s:s,s:s,s:I,s:s}", "id", hex, "href", href, "sha256", hex, "size",
                             (json_int_t)r->body_len, "type", ct);
@@ -69,8 +68,7 @@ enum MHD_Result route_file_get(pk_req *r)
 {
     json_t *f = pk_queue_get_file(r->svc->q, r->seg[1], pk_scope(r));
     if (!f)
-        return pk_send_problem(r, 404, PK_PROBLEM_PACKD "no-such-file", "No such file", r->seg[1],
-                               NULL, 0);
+        return pk_reply_problem(r, PK_P_NO_SUCH_FILE, r->seg[1]);
     pk_config cfg = pk_service_config(r->svc);
     char path[1200];
     snprintf(path, sizeof path, "%s/files/%s", cfg.data, r->seg[1]);

@@ -16,7 +16,7 @@ enum MHD_Result route_job(pk_req *r)
 {
     json_t *row = pk_job_visible(r, r->seg[1]);
     if (!row)
-        return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
+        return pk_reply_problem(r, PK_P_NO_SUCH_JOB, r->seg[1]);
     char etag[200];
     snprintf(etag, sizeof etag, "\"%s-%lld\"", r->seg[1],
              (long long)json_integer_value(json_object_get(row, "rev")));
@@ -56,7 +56,7 @@ enum MHD_Result route_job_delete(pk_req *r)
     json_t *mine = pk_job_visible(r, r->seg[1]);
     json_decref(mine);
     if (!mine || pk_queue_dismiss(r->svc->q, r->seg[1], was) != 0)
-        return pk_send_problem(r, 404, PK_PROBLEM_NO_SUCH_JOB, "No such job", r->seg[1], NULL, 0);
+        return pk_reply_problem(r, PK_P_NO_SUCH_JOB, r->seg[1]);
     if (!strcmp(was, "running")) {
         pk_executor_wake(r->svc->exec); /* SIGTERM to the worker (scancel) now */
     } else if (!strcmp(was, "successful") || !strcmp(was, "failed")) {

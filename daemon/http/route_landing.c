@@ -67,7 +67,6 @@ enum MHD_Result route_api(pk_req *r)
         return pk_send_api_page(r);
     const char *doc = pk_schema_text("openapi.json"); /* schemas/openapi.json, served as is */
     if (!doc)
-        return pk_send_problem(r, 500, PK_PROBLEM_GENERIC, "Internal Server Error",
-                               "openapi.json is not compiled in", NULL, 0);
+        return pk_reply_problem(r, PK_P_INTERNAL, "openapi.json is not compiled in");
     return pk_send_text(r, 200, "application/vnd.oai.openapi+json;version=3.0", doc);
 }

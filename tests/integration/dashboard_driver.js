@@ -36,16 +36,22 @@ const rsaUntilWallTime = (s) => ({
 });
 
 // Submit the example `label` with its inputs changed by edit (the JSON
-// textarea, as a person would); the new job's id.
-async function submitEdited(page, label, edit, previous) {
+// textarea, as a person would); the new job's id, once the page shows it in
+// place of the link it showed before (whichever job that was).
+async function submitEdited(page, label, edit) {
   await page.goto(page.url().replace(/#.*$/, '') + '#/');
   await page.selectOption('#example', { label });
   if (!(await page.isVisible('#inputs'))) await page.click('#submit-form details summary');
   const inputs = edit(JSON.parse(await page.inputValue('#inputs')));
   await page.fill('#inputs', JSON.stringify(inputs));
+  const shown = () => { const a = document.querySelector('#submitted a'); return a ? a.textContent.trim() : ''; };
+  const before = await page.evaluate(shown);
   await page.click('#submit');
-  const a = await page.waitForSelector(`#submitted a:not(:has-text("${previous}"))`);
-  return (await a.textContent()).trim();
+  await page.waitForFunction((b) => {
+    const a = document.querySelector('#submitted a');
+    return a && a.textContent.trim() !== b;
+  }, before);
+  return page.evaluate(shown);
 }
 
 async function openJob(page, id) {
@@ -161,7 +167,7 @@ async function step(name, fn) {
     });
     let last = id;
     await step('dashboard_job_page_keeps_status', async () => {
-      last = await submitEdited(page, 'edmd-quartz-2d (pack)', (i) => { i.edmd.growth_rate = 0.002; return i; }, last); // ~10 s
+      last = await submitEdited(page, 'edmd-quartz-2d (pack)', (i) => { i.edmd.growth_rate = 0.0002; return i; }); // ~7 s
       await openJob(page, last);
       // the status word and the bar, sampled every 20 ms until the job ends
       await page.evaluate(() => {
@@ -174,14 +180,14 @@ async function step(name, fn) {
           if (st === 'successful' || st === 'failed') clearInterval(t);
         }, 20);
       });
-      await page.waitForFunction(() => window.seenStatus.includes('successful'), null, { timeout: 60000 * slow });
+      await page.waitForFunction(() => window.seenStatus.includes('successful'), null, { timeout: 180000 * slow });
       const [st, bar] = await page.evaluate(() => [window.seenStatus, window.seenBar]);
       if (!bar.some((v) => v > 0 && v < 100)) throw new Error('no progress seen: ' + [...new Set(bar)].join(' '));
       const blank = st.filter((x) => !x).length;
       if (blank) throw new Error(blank + ' of ' + st.length + ' samples without a status word');
     });
     await step('dashboard_failed_job_page', async () => {
-      last = await submitEdited(page, 'meier-quartz-2d (pack)', () => rsaUntilWallTime(1), last);
+      last = await submitEdited(page, 'meier-quartz-2d (pack)', () => rsaUntilWallTime(1));
       await openJob(page, last);
       await page.waitForSelector('#job-status:text-is("failed")', { timeout: 60000 * slow });
       await page.waitForSelector('#job-reason:has-text("wall time")');
@@ -194,7 +200,7 @@ async function step(name, fn) {
       await page.screenshot({ path: shot('failed'), fullPage: true });
     });
     await step('dashboard_cancel_button', async () => {
-      last = await submitEdited(page, 'meier-quartz-2d (pack)', () => rsaUntilWallTime(300), last);
+      last = await submitEdited(page, 'meier-quartz-2d (pack)', () => rsaUntilWallTime(300));
       await openJob(page, last);
       await page.click('#cancel');
       await page.waitForSelector('#job-status:text-is("dismissed")');
