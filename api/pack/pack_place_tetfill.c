@@ -316,7 +316,7 @@ static void check_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, void
     }
     if (setup(job, S, &ptr, &rule, err, sizeof err) != 0) {
         pk_schema_errors_add(errs, ptr, rule, "%s", err);
-        free(S);
+        free_setup(S); /* a box meshed before its check failed */
     } else if (prepared && !job->service)
         *prepared = S;
     else
@@ -337,7 +337,7 @@ static int place_tetfill(const pk_pack_job *job, const pk_pack_plan *plan, const
         return -1;
     }
     if (own && setup(job, S, &ptr, &rule, err, errlen) != 0) {
-        free(S);
+        free_setup(S);
         return -1;
     }
     pk_tetfill_stats ts;
