@@ -58,11 +58,15 @@ function el(tag, text, cls) {
 // --- live progress: the job's event stream (text/event-stream over fetch, so
 // the token goes in a header; EventSource cannot send one)
 const streams = new Map(); // jobID -> AbortController
+let view = 0; // moves on every route(): work begun for an earlier view drops its results
 
-function stream(id, onEvent) {
+// Stream a job's events to onEvent; onEnd(final) once the stream is over,
+// final saying whether a final status came through it.
+function stream(id, onEvent, onEnd) {
   if (streams.has(id) || streams.size >= MAX_STREAMS) return;
   const ctl = new AbortController();
   streams.set(id, ctl);
+  let final = false;
   (async () => {
     try {
       const r = await fetch('jobs/' + encodeURIComponent(id) + '/events',
@@ -83,13 +87,18 @@ function stream(id, onEvent) {
             if (line.startsWith('event:')) kind = line.slice(6).trim();
             else if (line.startsWith('data:')) data += line.slice(5).trim();
           }
-          if (data) {
-            try { onEvent(kind, JSON.parse(data)); } catch (e) { /* not JSON: ignore */ }
-          }
+          if (!data) continue;
+          let d;
+          try { d = JSON.parse(data); } catch (e) { continue; /* not JSON: ignore */ }
+          final = final || FINAL.includes(d.status);
+          onEvent(kind, d);
         }
       }
-    } catch (e) { /* aborted or the connection dropped: the list poll goes on */ }
-    finally { streams.delete(id); }
+    } catch (e) { /* aborted or the connection dropped */ }
+    finally {
+      if (streams.get(id) === ctl) streams.delete(id);
+      if (!ctl.signal.aborted && onEnd) onEnd(final);
+    }
   })();
 }
 
@@ -158,8 +167,10 @@ function jobRow(j) {
 let packResults = []; // successful pack jobs: the RVEs a homogenize example can take
 
 async function refreshList() {
+  const v = view;
   try {
     const doc = await api('jobs?limit=50');
+    if (v !== view) return; // the page moved on while the list was asked for
     packResults = (doc.jobs || []).filter((j) => j.processID === 'pack' && j.status === 'successful');
     fillRVE();
     const tbody = $('jobs').tBodies[0];
@@ -338,6 +349,7 @@ async function showFailed(id, s) {
 }
 
 async function showJob(id) {
+  const v = view;
   pageJob = id;
   $('job-id').textContent = id;
   for (const k of ['pictures', 'downloads', 'job-message', 'job-percent', 'job-inputs', 'job-times', 'job-reason']) $(k).replaceChildren();
@@ -346,15 +358,22 @@ async function showJob(id) {
   $('summary').tBodies[0].replaceChildren();
   let s;
   try { s = await api('jobs/' + encodeURIComponent(id)); } catch (e) { showError('Job: ' + e.message); return; }
+  if (v !== view) return;
   showJobStatus(s);
-  api('dashboard/jobs/' + encodeURIComponent(id) + '/inputs').then(
-    (j) => { $('job-inputs').textContent = JSON.stringify(j.inputs, null, 2); },
-    () => { $('job-inputs').textContent = '(not available)'; });
+  if (s.status === 'dismissed') $('job-inputs').textContent = '(removed with the job)';
+  else {
+    api('dashboard/jobs/' + encodeURIComponent(id) + '/inputs').then(
+      (j) => { $('job-inputs').textContent = JSON.stringify(j.inputs, null, 2); },
+      () => { $('job-inputs').textContent = '(not available)'; });
+  }
   if (!FINAL.includes(s.status)) {
+    const here = () => v === view && pageJob === id;
     stream(id, (kind, d) => {
-      if (pageJob !== id) return;
+      if (!here()) return;
       showJobStatus(d, kind);
       if (d.status && FINAL.includes(d.status)) showJob(id);
+    }, (final) => { // a stream that broke off: ask again shortly
+      if (!final && here()) setTimeout(() => { if (here()) showJob(id); }, 2000);
     });
     return;
   }
@@ -382,6 +401,7 @@ async function showJob(id) {
 let listTimer = null;
 
 function route() {
+  view++;
   stopStreams();
   rows.clear();
   $('jobs').tBodies[0].replaceChildren();

@@ -238,10 +238,11 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
         }
         st->placed++;
         solid += pk_ball_measure(b->dim, r);
+        /* kept current: the draw loop's ticks report it too */
+        pg.done = st->placed;
+        pg.fraction = (double)st->placed / (double)n;
+        pg.phi = solid / box_measure;
         if ((i & 0x3ff) == 0) {
-            pg.done = st->placed;
-            pg.fraction = (double)st->placed / (double)n;
-            pg.phi = solid / box_measure;
             int c = pk_monitor_tick(mon, &pg, 0);
             if (c) {
                 st->reason = c == 2 ? PK_STOP_WALL_TIME : PK_STOP_CANCELLED;

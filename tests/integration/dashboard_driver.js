@@ -167,28 +167,38 @@ async function step(name, fn) {
     });
     let last = id;
     await step('dashboard_job_page_keeps_status', async () => {
-      last = await submitEdited(page, 'edmd-quartz-2d (pack)', (i) => { i.edmd.growth_rate = 0.0002; return i; }); // ~7 s
+      last = await submitEdited(page, 'meier-quartz-2d (pack)', () => rsaUntilWallTime(300));
       await openJob(page, last);
-      // the status word and the bar, sampled every 20 ms until the job ends
+      await page.waitForSelector('#job-status:text-is("running")', { timeout: 60000 * slow });
+      // the status word and the bar, sampled every 20 ms through its progress events
       await page.evaluate(() => {
         window.seenStatus = [];
         window.seenBar = [];
-        const t = setInterval(() => {
-          const st = document.getElementById('job-status').textContent;
-          window.seenStatus.push(st);
+        window.sampler = setInterval(() => {
+          window.seenStatus.push(document.getElementById('job-status').textContent);
           window.seenBar.push(document.getElementById('job-progress').value);
-          if (st === 'successful' || st === 'failed') clearInterval(t);
         }, 20);
       });
-      await page.waitForFunction(() => window.seenStatus.includes('successful'), null, { timeout: 180000 * slow });
-      const [st, bar] = await page.evaluate(() => [window.seenStatus, window.seenBar]);
-      if (!bar.some((v) => v > 0 && v < 100)) throw new Error('no progress seen: ' + [...new Set(bar)].join(' '));
-      const blank = st.filter((x) => !x).length;
-      if (blank) throw new Error(blank + ' of ' + st.length + ' samples without a status word');
+      await page.waitForFunction(() => window.seenStatus.length >= 100 &&
+        window.seenBar.some((v) => v > 0 && v < 100), null, { timeout: 60000 * slow });
+      const [st, bar] = await page.evaluate(() => { clearInterval(window.sampler); return [window.seenStatus, window.seenBar]; });
+      const other = st.filter((x) => x !== 'running').length;
+      if (other) throw new Error(other + ' of ' + st.length + ' samples without the status word: ' + [...new Set(st)].join(' '));
+      await page.click('#cancel');
+      await page.waitForSelector('#job-status:text-is("dismissed")');
+      console.log('BAR ' + [...new Set(bar)].join(' '));
     });
     await step('dashboard_failed_job_page', async () => {
+      // the list refresh of the submission lands while the job page, opened
+      // meanwhile, waits for the job's status: the page must still follow the job
+      const after = (ms) => (r) => setTimeout(() => r.continue().catch(() => {}), ms);
+      const list = after(500), status = after(1500);
+      await page.route(/\/jobs\?limit=/, list);
+      await page.route(/\/jobs\/[0-9a-f-]+$/, status);
       last = await submitEdited(page, 'meier-quartz-2d (pack)', () => rsaUntilWallTime(1));
       await openJob(page, last);
+      await page.unroute(/\/jobs\?limit=/, list);
+      await page.unroute(/\/jobs\/[0-9a-f-]+$/, status);
       await page.waitForSelector('#job-status:text-is("failed")', { timeout: 60000 * slow });
       await page.waitForSelector('#job-reason:has-text("wall time")');
       await page.waitForSelector('#summary tr');
