@@ -26,7 +26,8 @@ seconds() {
 below() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a + 0 < b + 0) }'; }
 answered_at_once() { # SECONDS: a 200 well under the bar (else says what came)
     [ "$(cat "$T/code")" = 200 ] && below "$1" $BAR && return 0
-    echo "# answered $(cat "$T/code") after $1 s"
+    echo "# answered $(cat "$T/code") after $1 s; the daemon's last lines:"
+    tail -5 "$LOG" | sed 's/^/# /'
     return 1
 }
 # the bar: well under the 5 s busy timeout a waiting read would sit out
