@@ -70,6 +70,9 @@ static const struct key {
      "close a connection silent this long (restart to change)"},
     {"sync_wait_s", K_DOUBLE, F(sync_wait_s), 0, 300,
      "Prefer: respond-sync: seconds an execute request waits for its job (then 201 async)"},
+    {"result_cache_max_age_s", K_DOUBLE, F(result_cache_max_age_s), 0, 1e10,
+     "answer a request from the owner's successful job with equal inputs (and seed) that "
+     "finished at most this long ago (0 = never; the request's Cache-Control: no-cache runs it)"},
     {"head_timeout_s", K_DOUBLE, F(head_timeout_s), 0.5, 3600,
      "seconds a request head may take, from the connection or the previous response (beyond: "
      "closed)"},

@@ -41,7 +41,8 @@ typedef struct pk_config {
     double body_timeout_s; /* a request body must arrive within this time after its headers */
     double
         body_min_rate; /* bytes/s: a body of n bytes gets head_timeout_s + n / this (≤ body_timeout_s) */
-    double sync_wait_s; /* Prefer: respond-sync waits this long for the job, then 201 */
+    double sync_wait_s;            /* Prefer: respond-sync waits this long for the job, then 201 */
+    double result_cache_max_age_s; /* reuse an equal successful job this young (0: never) */
     double
         checkpoint_interval_s; /* between two checkpoints of a long job (job dir checkpoint.h5) */
     pk_log_level log_level;

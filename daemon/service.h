@@ -19,7 +19,8 @@ typedef struct pk_service {
     int draining;      /* SIGTERM received: refuse new jobs (atomic) */
     int stopping;      /* streams must end now (atomic) */
     double started;
-    unsigned long long responses[600]; /* by HTTP status (atomic) */
+    unsigned long long responses[600];           /* by HTTP status (atomic) */
+    unsigned long long cache_hits, cache_misses; /* execute requests (atomic), result_cache.h */
 } pk_service;
 
 /* A copy of the current configuration. */

@@ -23,6 +23,9 @@
 #include "api/inputs/input_confine.h"
 #include "api/inputs/json_depth.h"
 #include "daemon/log.h"
+#include "daemon/result_cache.h"
+#include "daemon/store/job_files.h"
+#include "daemon/store/uuid.h"
 #include "api/digest.h"
 
 /* A synchronous execute waiting for its job. */
@@ -154,6 +157,45 @@ static enum MHD_Result reply_job(pk_req *r, const char *id, int replayed)
     return pk_send(r, 201, resp);
 }
 
+/* "Cache-Control: no-cache" (RFC 9111 5.2.1.4): the client wants a fresh run. */
+static int wants_fresh(pk_req *r)
+{
+    const char *cc = pk_header(r, "Cache-Control");
+    for (; cc && *cc; cc++)
+        if (!strncasecmp(cc, "no-cache", 8))
+            return 1;
+    return 0;
+}
+
+/* Queue the job, or answer it from an equal successful job of the same
+ * owner that finished within max_age_s (result_cache.h): a new job, already
+ * successful, whose files are hard links to the old one's.  A PK_Q_* code. */
+static int submit(pk_req *r, const pk_submit *s, const char *data, double max_age_s, char id[37])
+{
+    pk_service *svc = r->svc;
+    char src[37], fresh[37];
+    if (s->cache_key && max_age_s > 0 && !wants_fresh(r)) {
+        int rc = PK_Q_GONE;
+        if (pk_queue_find_reusable(svc->q, s->cache_key, s->owner, pk_queue_now() - max_age_s,
+                                   src) &&
+            pk_uuid4(fresh) == 0 && pk_result_cache_link(data, src, fresh) == 0) {
+            snprintf(id, 37, "%s", fresh);
+            rc = pk_queue_submit_reused(svc->q, s, src, id); /* EXISTING: id is the earlier job */
+            if (rc != PK_Q_OK)
+                pk_job_dir_remove(data, fresh);
+        }
+        if (rc == PK_Q_OK) {
+            __atomic_add_fetch(&svc->cache_hits, 1, __ATOMIC_RELAXED);
+            pk_log(PK_LOG_INFO, "job answered from an equal one", "{s:s,s:s,s:s}", "job", id,
+                   "from", src, "owner", s->owner);
+        }
+        if (rc == PK_Q_OK || rc == PK_Q_EXISTING || rc == PK_Q_KEY_CONFLICT)
+            return rc;
+        __atomic_add_fetch(&svc->cache_misses, 1, __ATOMIC_RELAXED);
+    }
+    return pk_queue_submit(svc->q, s, id);
+}
+
 enum MHD_Result route_execute(pk_req *r)
 {
     pk_service *svc = r->svc;
@@ -237,7 +279,6 @@ enum MHD_Result route_execute(pk_req *r)
         return rc;
     }
     char *text = json_dumps(inputs, JSON_COMPACT | JSON_SORT_KEYS);
-    json_decref(body);
     char fp_src_hash[65], owner[128], id[37];
     size_t plen = strlen(p->id), tlen = strlen(text);
     char *fp_src = malloc(plen + tlen + 2);
@@ -248,14 +289,18 @@ enum MHD_Result route_execute(pk_req *r)
     free(fp_src);
     pk_owner(r, owner, sizeof owner);
     const char *key = pk_header(r, "Idempotency-Key");
+    char cache_key[65];
     pk_submit s = {.process = p->id,
                    .inputs_json = text,
                    .owner = owner,
                    .idempotency_key = key && *key ? key : NULL,
                    .request_sha256 = fp_src_hash,
+                   .cache_key =
+                       pk_result_cache_key(p->id, inputs, cache_key) == 0 ? cache_key : NULL,
                    .max_queued = cfg.max_queued,
                    .max_queued_per_owner = cfg.max_queued_per_owner};
-    int rc = pk_queue_submit(svc->q, &s, id);
+    int rc = submit(r, &s, data, cfg.result_cache_max_age_s, id);
+    json_decref(body);
     free(text);
     if (rc == PK_Q_OK && pk_results_opts_save(r, id, &opts) != 0)
         pk_log(PK_LOG_WARN, "cannot store the execute options; results answer as a document",

@@ -1,10 +1,8 @@
 /* GET /jobs/{id} (ETag/If-None-Match), DELETE /jobs/{id}; the list GET /jobs
  * is route_job_list.c. */
-#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "auth.h"
 #include "http.h"
@@ -32,24 +30,6 @@ enum MHD_Result route_job(pk_req *r)
     return pk_send_json(r, 200, info, etag);
 }
 
-/* A dismissed finished job's files go; the row stays (status "dismissed"). */
-static void remove_job_files(const char *data, const char *id)
-{
-    char dir[1200];
-    pk_job_dir(data, id, dir, sizeof dir);
-    DIR *d = opendir(dir);
-    if (!d)
-        return;
-    struct dirent *e;
-    while ((e = readdir(d))) {
-        char p[1500];
-        if (e->d_name[0] != '.' && snprintf(p, sizeof p, "%s/%s", dir, e->d_name) < (int)sizeof p)
-            unlink(p);
-    }
-    closedir(d);
-    rmdir(dir);
-}
-
 enum MHD_Result route_job_delete(pk_req *r)
 {
     char was[16];
@@ -61,7 +41,7 @@ enum MHD_Result route_job_delete(pk_req *r)
         pk_executor_wake(r->svc->exec); /* SIGTERM to the worker (scancel) now */
     } else if (!strcmp(was, "successful") || !strcmp(was, "failed")) {
         pk_config cfg = pk_service_config(r->svc);
-        remove_job_files(cfg.data, r->seg[1]);
+        pk_job_dir_remove(cfg.data, r->seg[1]); /* the row stays */
     }
     pk_log(PK_LOG_INFO, "job dismissed", "{s:s,s:s}", "job", r->seg[1], "was", was);
     json_t *row = pk_queue_get(r->svc->q, r->seg[1]);

@@ -164,6 +164,14 @@ enum MHD_Result route_metrics(pk_req *r)
             "packd_executor_poll_seconds_total %.6f\n",
             cycles, cycle_s);
     pk_text_put(&b,
+                "# HELP packd_result_cache_requests_total Execute requests that could be answered"
+                " from an equal successful job (result_cache_max_age_s), by outcome: hit (answered"
+                " from it) or miss (run).\n# TYPE packd_result_cache_requests_total counter\n"
+                "packd_result_cache_requests_total{outcome=\"hit\"} %llu\n"
+                "packd_result_cache_requests_total{outcome=\"miss\"} %llu\n",
+                __atomic_load_n(&svc->cache_hits, __ATOMIC_RELAXED),
+                __atomic_load_n(&svc->cache_misses, __ATOMIC_RELAXED));
+    pk_text_put(&b,
                 "# HELP packd_http_responses_total HTTP responses by status code.\n"
                 "# TYPE packd_http_responses_total counter\n");
     for (int c = 100; c < 600; c++) {

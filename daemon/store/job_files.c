@@ -1,7 +1,9 @@
 /* job_files.c — names and paths of a job directory's files; contract in job_files.h. */
 #include "job_files.h"
 
+#include <dirent.h>
 #include <stdio.h>
+#include <unistd.h>
 
 const char *pk_job_file_name(pk_job_file f)
 {
@@ -32,4 +34,22 @@ int pk_job_dir(const char *data, const char *id, char *out, size_t n)
 int pk_job_file_path(const char *dir, pk_job_file f, char *out, size_t n)
 {
     return fits(snprintf(out, n, "%s/%s", dir, pk_job_file_name(f)), n);
+}
+
+void pk_job_dir_remove(const char *data, const char *id)
+{
+    char dir[1200];
+    if (pk_job_dir(data, id, dir, sizeof dir) != 0)
+        return;
+    DIR *d = opendir(dir);
+    if (!d)
+        return;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        char p[1500];
+        if (e->d_name[0] != '.' && snprintf(p, sizeof p, "%s/%s", dir, e->d_name) < (int)sizeof p)
+            unlink(p);
+    }
+    closedir(d);
+    rmdir(dir);
 }

@@ -32,4 +32,7 @@ int pk_job_dir(const char *data, const char *id, char *out, size_t n);
 /* dir/<name of f>.  0, or -1 if it does not fit in n bytes. */
 int pk_job_file_path(const char *dir, pk_job_file f, char *out, size_t n);
 
+/* Remove DATA/jobs/<id> and the files in it (a dismissed job's). */
+void pk_job_dir_remove(const char *data, const char *id);
+
 #endif

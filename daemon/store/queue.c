@@ -298,29 +298,72 @@ void pk_queue_close(pk_queue *q)
     free(q);
 }
 
+/* Inside an open transaction: PK_Q_EXISTING (id filled) or PK_Q_KEY_CONFLICT
+ * when s's idempotency key was seen, rolled back; PK_Q_OK otherwise. */
+static int seen_key(pk_queue *q, const pk_submit *s, char id[37])
+{
+    if (!s->idempotency_key)
+        return PK_Q_OK;
+    json_t *k =
+        one_row(prep(q, "SELECT request_sha256, job_id FROM idempotency WHERE owner=? AND key=?",
+                     "ss", s->owner, s->idempotency_key));
+    if (!k)
+        return PK_Q_OK;
+    int same = !strcmp(json_string_value(json_object_get(k, "request_sha256")),
+                       s->request_sha256 ? s->request_sha256 : "");
+    snprintf(id, 37, "%s", json_string_value(json_object_get(k, "job_id")));
+    json_decref(k);
+    rollback(q);
+    return same ? PK_Q_EXISTING : PK_Q_KEY_CONFLICT;
+}
+
+/* Inside an open transaction: the idempotency row of the new job id (if s
+ * has a key), its status event, the commit.  A PK_Q_* code. */
+static int submit_end(pk_queue *q, const pk_submit *s, const char *id, double now)
+{
+    if (s->idempotency_key &&
+        run(q,
+            prep(q,
+                 "INSERT INTO idempotency(owner, key, request_sha256, job_id, created) VALUES "
+                 "(?,?,?,?,?)",
+                 "ssssd", s->owner, s->idempotency_key, s->request_sha256 ? s->request_sha256 : "",
+                 id, now)) != 1) {
+        int code = sqlite3_errcode(q->db);
+        rollback(q);
+        if (code == SQLITE_FULL || code == SQLITE_IOERR || code == SQLITE_READONLY) {
+            note_write(q, 0);
+            return PK_Q_UNWRITABLE;
+        }
+        return PK_Q_ERROR;
+    }
+    add_status_event(q, id);
+    /* only a committed job is answered 201 */
+    return commit(q) == 0 ? PK_Q_OK : PK_Q_UNWRITABLE;
+}
+
+/* The code of a failed INSERT of a job row (rolled back). */
+static int insert_failed(pk_queue *q)
+{
+    int code = sqlite3_errcode(q->db);
+    rollback(q);
+    if (code == SQLITE_FULL || code == SQLITE_IOERR || code == SQLITE_READONLY) {
+        note_write(q, 0);
+        return PK_Q_UNWRITABLE;
+    }
+    return PK_Q_ERROR;
+}
+
 int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37])
 {
-    int rc = PK_Q_ERROR;
+    int rc;
     pthread_mutex_lock(&q->mu);
     if (begin(q) != SQLITE_OK) {
         note_write(q, 0);
         rc = PK_Q_UNWRITABLE;
         goto out;
     }
-    if (s->idempotency_key) {
-        json_t *k = one_row(
-            prep(q, "SELECT request_sha256, job_id FROM idempotency WHERE owner=? AND key=?", "ss",
-                 s->owner, s->idempotency_key));
-        if (k) {
-            int same = !strcmp(json_string_value(json_object_get(k, "request_sha256")),
-                               s->request_sha256 ? s->request_sha256 : "");
-            snprintf(id, 37, "%s", json_string_value(json_object_get(k, "job_id")));
-            json_decref(k);
-            rollback(q);
-            rc = same ? PK_Q_EXISTING : PK_Q_KEY_CONFLICT;
-            goto out;
-        }
-    }
+    if ((rc = seen_key(q, s, id)) != PK_Q_OK)
+        goto out;
     if (scalar(q, prep(q, "SELECT count(*) FROM jobs WHERE status='accepted'", NULL)) >=
         s->max_queued) {
         rollback(q);
@@ -336,32 +379,81 @@ int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37])
     }
     if (pk_uuid4(id) != 0) {
         rollback(q);
+        rc = PK_Q_ERROR;
         goto out;
     }
     double now = pk_queue_now();
     if (run(q,
             prep(q,
-                 "INSERT INTO jobs(id, process, inputs, owner, status, message, created, updated)"
-                 " VALUES (?,?,?,?,'accepted','queued',?,?)",
-                 "ssssdd", id, s->process, s->inputs_json, s->owner, now, now)) != 1 ||
-        (s->idempotency_key &&
-         run(q,
-             prep(q,
-                  "INSERT INTO idempotency(owner, key, request_sha256, job_id, created) VALUES "
-                  "(?,?,?,?,?)",
-                  "ssssd", s->owner, s->idempotency_key, s->request_sha256 ? s->request_sha256 : "",
-                  id, now)) != 1)) {
-        int code = sqlite3_errcode(q->db);
-        if (code == SQLITE_FULL || code == SQLITE_IOERR || code == SQLITE_READONLY) {
-            note_write(q, 0);
-            rc = PK_Q_UNWRITABLE;
-        }
-        rollback(q);
+                 "INSERT INTO jobs(id, process, inputs, owner, status, message, created, updated,"
+                 " cache_key) VALUES (?,?,?,?,'accepted','queued',?,?,?)",
+                 "ssssdds", id, s->process, s->inputs_json, s->owner, now, now, s->cache_key)) !=
+        1) {
+        rc = insert_failed(q);
         goto out;
     }
-    add_status_event(q, id);
-    /* only a committed job is answered 201 */
-    rc = commit(q) == 0 ? PK_Q_OK : PK_Q_UNWRITABLE;
+    rc = submit_end(q, s, id, now);
+out:
+    pthread_mutex_unlock(&q->mu);
+    if (rc == PK_Q_OK)
+        notify(q);
+    return rc;
+}
+
+int pk_queue_find_reusable(pk_queue *q, const char *key, const char *owner, double not_before,
+                           char src[37])
+{
+    reader *rd = reader_take(q);
+    json_t *r = one_row(rprep(rd,
+                              "SELECT id FROM jobs WHERE cache_key=? AND owner=? AND"
+                              " status='successful' AND finished >= ? AND"
+                              " coalesce(json_extract(summary, '$.complete'), 1) != 0"
+                              " ORDER BY finished DESC LIMIT 1",
+                              "ssd", key, owner, not_before));
+    reader_give(rd);
+    const char *id = json_string_value(json_object_get(r, "id"));
+    int found = id && strlen(id) < 37;
+    if (found)
+        snprintf(src, 37, "%s", id);
+    json_decref(r);
+    return found;
+}
+
+int pk_queue_submit_reused(pk_queue *q, const pk_submit *s, const char *src, char id[37])
+{
+    int rc;
+    pthread_mutex_lock(&q->mu);
+    if (begin(q) != SQLITE_OK) {
+        note_write(q, 0);
+        rc = PK_Q_UNWRITABLE;
+        goto out;
+    }
+    if ((rc = seen_key(q, s, id)) != PK_Q_OK)
+        goto out;
+    double now = pk_queue_now();
+    char msg[120];
+    snprintf(msg, sizeof msg, "the result of job %s (the same inputs and seed, run by this packd)",
+             src);
+    int n =
+        run(q,
+            prep(q,
+                 "INSERT INTO jobs(id, process, inputs, owner, status, progress, message,"
+                 " created, finished, updated, summary, result_sha256, result_size,"
+                 " cache_key) SELECT ?, ?, ?, ?, 'successful', 100, ?, ?, ?, ?, summary,"
+                 " result_sha256, result_size, cache_key FROM jobs"
+                 " WHERE id=? AND status='successful'",
+                 "sssssddds", id, s->process, s->inputs_json, s->owner, msg, now, now, now, src));
+    if (n == 0) {
+        rollback(q);
+        rc = PK_Q_GONE;
+        goto out;
+    }
+    if (n != 1) {
+        rc = insert_failed(q);
+        goto out;
+    }
+    pk_metrics_job_ended(q->db, id, "successful"); /* never started: no run time */
+    rc = submit_end(q, s, id, now);
 out:
     pthread_mutex_unlock(&q->mu);
     if (rc == PK_Q_OK)

@@ -23,6 +23,7 @@ enum {
     PK_Q_OWNER_FULL = -3,   /* max_queued_per_owner waiting jobs of this owner */
     PK_Q_KEY_CONFLICT = -4, /* idempotency key reused with another request */
     PK_Q_UNWRITABLE = -5,   /* the database takes no writes now (disk full, I/O error) */
+    PK_Q_GONE = -6,         /* the job to reuse is no longer successful (dismissed meanwhile) */
     PK_Q_ERROR = -1,
 };
 
@@ -36,11 +37,26 @@ typedef struct pk_submit {
     const char *process, *inputs_json, *owner;
     const char *idempotency_key; /* may be NULL */
     const char *request_sha256;  /* fingerprint of the request (with a key) */
+    const char *cache_key;       /* its result may answer a later equal request; NULL: never */
     int max_queued, max_queued_per_owner;
 } pk_submit;
 
 /* Submit a job; fills id (37 bytes). Returns a PK_Q_* code. */
 int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37]);
+
+/* A successful job of owner whose cache_key is key, finished at or after
+ * not_before, whose summary does not say complete: false (a run that
+ * stopped short may go further when run again): its id in src (37 bytes),
+ * the newest such; 0 when there is none. */
+int pk_queue_find_reusable(pk_queue *q, const char *key, const char *owner, double not_before,
+                           char src[37]);
+
+/* Record s as a job already successful with src's result (its files are in
+ * place under the id the caller chose, in id): its summary, digest and
+ * size, message saying where it came from.  The idempotency key is honoured
+ * as by pk_queue_submit (PK_Q_EXISTING fills id with the earlier job);
+ * PK_Q_GONE when src is no longer successful. */
+int pk_queue_submit_reused(pk_queue *q, const pk_submit *s, const char *src, char id[37]);
 
 /* The job row, or NULL if unknown. */
 json_t *pk_queue_get(pk_queue *q, const char *id);

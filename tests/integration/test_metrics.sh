@@ -93,7 +93,8 @@ import sqlite3, sys
 db = sqlite3.connect(sys.argv[1])
 # version 2: the schema before the counters (daemon/store/migrations.c, step 2 -> 3)
 db.executescript("DROP TABLE job_counts; DROP TABLE job_durations; DROP TABLE duration_buckets;"
-                 "ALTER TABLE jobs DROP COLUMN executor_ref; PRAGMA user_version = 2;")
+                 "ALTER TABLE jobs DROP COLUMN executor_ref; DROP INDEX jobs_by_cache_key;"
+                 "ALTER TABLE jobs DROP COLUMN cache_key; PRAGMA user_version = 2;")
 PY
 start_daemon m1 --workers 1 || { fail upgrade_start; exit 1; }
 c "$B/metrics" >"$T/m4.txt"

@@ -1,6 +1,7 @@
 /* test_queue.c — daemon/store/queue.c on a real SQLite file: submission limits,
  * idempotency keys, atomic claims, events, dismissal, recovery after a daemon
- * death (bounded attempts), concurrent writers through two connections. */
+ * death (bounded attempts), concurrent writers through two connections, a
+ * finished job's result reused for an equal request. */
 #include <math.h>
 #include <pthread.h>
 #include <sqlite3.h>
@@ -242,6 +243,52 @@ static void test_concurrent_connections(void)
     pk_queue_close(q2);
 }
 
+/* A job run to an end with summary sum, under cache key k. */
+static void run_keyed(pk_queue *q, const char *owner, const char *k, const char *sum, char id[37])
+{
+    pk_submit s = {.process = "pack",
+                   .inputs_json = "{\"dim\":2}",
+                   .owner = owner,
+                   .cache_key = k,
+                   .max_queued = 5,
+                   .max_queued_per_owner = 3};
+    CHECK(pk_queue_submit(q, &s, id) == PK_Q_OK);
+    json_decref(pk_queue_claim(q));
+    CHECK(!strcmp(pk_queue_finish(q, id, "successful", "done", sum, "ab", 12), "successful"));
+}
+
+static void test_reuse(void)
+{
+    pk_queue *q = fresh();
+    char a[37], shortrun[37], src[37], r[37] = "00000000-0000-4000-8000-000000000001";
+    run_keyed(q, "ann", "K", "{\"complete\":true}", a);
+    run_keyed(q, "ann", "K2", "{\"complete\":false}", shortrun);
+    CHECK(pk_queue_find_reusable(q, "K", "ann", 0, src) == 1 && !strcmp(src, a));
+    CHECK(pk_queue_find_reusable(q, "K", "bob", 0, src) == 0);  /* another owner's */
+    CHECK(pk_queue_find_reusable(q, "K2", "ann", 0, src) == 0); /* stopped short */
+    CHECK(pk_queue_find_reusable(q, "K", "ann", pk_queue_now() + 1, src) == 0); /* too old */
+    pk_submit s = {.process = "pack",
+                   .inputs_json = "{\"dim\":2}",
+                   .owner = "ann",
+                   .idempotency_key = "k",
+                   .request_sha256 = "fp",
+                   .cache_key = "K"};
+    CHECK(pk_queue_submit_reused(q, &s, a, r) == PK_Q_OK);
+    json_t *row = pk_queue_get(q, r);
+    CHECK(row && !strcmp(str(row, "status"), "successful") && strstr(str(row, "message"), a));
+    CHECK(!strcmp(str(row, "result_sha256"), "ab") &&
+          json_is_null(json_object_get(row, "started")));
+    json_decref(row);
+    char again[37] = "00000000-0000-4000-8000-000000000002";
+    CHECK(pk_queue_submit_reused(q, &s, a, again) == PK_Q_EXISTING && !strcmp(again, r));
+    char was[16];
+    CHECK(pk_queue_dismiss(q, a, was) == 0);
+    s.idempotency_key = NULL;
+    char late[37] = "00000000-0000-4000-8000-000000000003";
+    CHECK(pk_queue_submit_reused(q, &s, a, late) == PK_Q_GONE && !pk_queue_get(q, late));
+    pk_queue_close(q);
+}
+
 int main(void)
 {
     if (!mkdtemp(dir))
@@ -252,6 +299,7 @@ int main(void)
     RUN(test_dismiss_running);
     RUN(test_recover_bounded);
     RUN(test_concurrent_connections);
+    RUN(test_reuse);
     char cmd[300];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     if (system(cmd) != 0)
