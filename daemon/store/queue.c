@@ -377,7 +377,9 @@ int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37])
         rc = PK_Q_OWNER_FULL;
         goto out;
     }
-    if (pk_uuid4(id) != 0) {
+    if (s->id && strlen(s->id) < 37)
+        snprintf(id, 37, "%s", s->id);
+    else if (pk_uuid4(id) != 0) {
         rollback(q);
         rc = PK_Q_ERROR;
         goto out;
@@ -762,6 +764,19 @@ json_t *pk_queue_events(pk_queue *q, const char *id, long long after, int limit)
                            "SELECT id, kind, data FROM events WHERE job_id=? AND id>? ORDER BY id"
                            " LIMIT ?",
                            "sIi", id, after, limit));
+    reader_give(rd);
+    return r;
+}
+
+json_t *pk_queue_status_events(pk_queue *q, long long after, int limit)
+{
+    reader *rd = reader_take(q);
+    json_t *r = after < 0
+        ? one_row(rprep(rd, "SELECT coalesce(max(id), 0) AS id FROM events", NULL))
+        : rows(rprep(rd,
+                     "SELECT id, job_id, data FROM events WHERE kind='status'"
+                     " AND id>? ORDER BY id LIMIT ?",
+                     "Ii", after, limit));
     reader_give(rd);
     return r;
 }
