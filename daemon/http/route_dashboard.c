@@ -1,6 +1,6 @@
 /* route_dashboard.c — the browser dashboard: the files of web/ and the examples compiled
  * in (web_assets.h), the page at / for a browser, and the job's inputs the
- * job page shows.  The page runs only its own script (Content-Security-Policy);
+ * job page shows, and the queue's counts above the list.  The page runs only its own script (Content-Security-Policy);
  * it reads the API as any client does, with the user's bearer token. */
 #include "route_dashboard.h"
 
@@ -146,6 +146,22 @@ enum MHD_Result route_dashboard_examples(pk_req *r)
         json_decref(ex);
     }
     return pk_send_json(r, 200, json_pack("{s:o}", "examples", list), NULL);
+}
+
+/* The queue and the workers, counted over every owner: no job ids, no owners
+ * (the figures of /metrics, which is for admins only). */
+enum MHD_Result route_dashboard_queue(pk_req *r)
+{
+    json_t *st = pk_queue_stats(r->svc->q);
+    json_t *jobs = json_object_get(st, "jobs");
+    json_t *doc = json_pack("{s:I,s:I,s:i,s:i,s:s}", "accepted",
+                            json_integer_value(json_object_get(jobs, "accepted")), "running",
+                            json_integer_value(json_object_get(jobs, "running")), "workers_busy",
+                            pk_executor_busy(r->svc->exec), "workers_max",
+                            pk_executor_capacity(r->svc->exec), "executor",
+                            pk_executor_name(r->svc->exec));
+    json_decref(st);
+    return pk_send_json(r, 200, doc, NULL);
 }
 
 /* {process, inputs} as the job was submitted (job.json). */
