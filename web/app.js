@@ -450,6 +450,7 @@ function route() {
   } else {
     pageJob = null;
     showFilters(listParams());
+    $('range').textContent = '';
     refreshList();
     listTimer = setInterval(refreshList, 5000);
   }
