@@ -154,12 +154,11 @@ enum MHD_Result route_dashboard_queue(pk_req *r)
 {
     json_t *st = pk_queue_stats(r->svc->q);
     json_t *jobs = json_object_get(st, "jobs");
-    json_t *doc = json_pack("{s:I,s:I,s:i,s:i,s:s}", "accepted",
-                            json_integer_value(json_object_get(jobs, "accepted")), "running",
-                            json_integer_value(json_object_get(jobs, "running")), "workers_busy",
-                            pk_executor_busy(r->svc->exec), "workers_max",
-                            pk_executor_capacity(r->svc->exec), "executor",
-                            pk_executor_name(r->svc->exec));
+    json_t *doc = json_pack(
+        "{s:I,s:I,s:i,s:i,s:s}", "accepted", json_integer_value(json_object_get(jobs, "accepted")),
+        "running", json_integer_value(json_object_get(jobs, "running")), "workers_busy",
+        pk_executor_busy(r->svc->exec), "workers_max", pk_executor_capacity(r->svc->exec),
+        "executor", pk_executor_name(r->svc->exec));
     json_decref(st);
     return pk_send_json(r, 200, doc, NULL);
 }
