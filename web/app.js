@@ -448,6 +448,7 @@ function route() {
   if (m) {
     showJob(decodeURIComponent(m[1]));
   } else {
+    $('back').href = location.hash || '#/'; // a job page leads back to the list it was opened from
     pageJob = null;
     showFilters(listParams());
     $('range').textContent = '';

@@ -17,7 +17,8 @@ function listParams() {
     const n = Number(q.get(k));
     return Number.isInteger(n) && n >= 1 ? n : def;
   };
-  return { status: values('status'), process: values('process'), page: count('page', 1), limit: count('limit', PAGE_SIZE) };
+  // a limit above the API's maximum (route_job_list.c) would page past what it lists
+  return { status: values('status'), process: values('process'), page: count('page', 1), limit: Math.min(count('limit', PAGE_SIZE), 10000) };
 }
 
 function listHash(p) {

@@ -11,8 +11,8 @@
 // queue line above the list shows what GET /dashboard/queue counts while every
 // worker is busy and a job waits, and the list filtered to those running jobs
 // drops them once cancelled; a status filter in the URL hash lists exactly
-// the API's jobs of that status, also after a reload, and the checkboxes
-// change it; pages of a small limit (a hash parameter) list the API's pages,
+// the API's jobs of that status, also after a reload, the checkboxes change
+// it, and a job page leads back to it; pages of a small limit (a hash parameter) list the API's pages,
 // newer/older and "jobs N–M of TOTAL" as the API counts.  At a 390 px
 // viewport the list and a job page are no wider than the viewport.
 // Prints PASS/FAIL lines (tests/integration/check.inc) and saves screenshots
@@ -249,6 +249,9 @@ async function step(name, fn) {
     await step('dashboard_cancel_button', async () => {
       last = await submitEdited(page, 'meier-quartz-2d (pack)', () => rsaUntilWallTime(300));
       await openJob(page, last);
+      // its inputs shown first: a dismissal removes them, and a request still on
+      // its way would get a 404
+      await page.waitForFunction(() => document.getElementById('job-inputs').textContent !== '');
       await page.click('#cancel');
       await page.waitForSelector('#job-status:text-is("dismissed")');
       if (await page.isVisible('#cancel')) throw new Error('the button stays after the job is dismissed');
@@ -305,6 +308,11 @@ async function step(name, fn) {
       await page.waitForFunction(() => location.hash === '#/?status=failed');
       await shows('failed');
       await page.screenshot({ path: shot('filtered'), fullPage: true });
+      // a job page leads back to the filtered list
+      await page.click(`tr[data-job="${of('failed')[0]}"] a`);
+      await page.waitForFunction((i) => document.getElementById('job-id').textContent === i, of('failed')[0]);
+      await page.click('#back');
+      await shows('failed');
     });
     await step('dashboard_pages', async () => {
       const limit = 3;
