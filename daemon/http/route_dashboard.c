@@ -7,11 +7,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <unistd.h>
 
 #include "auth.h"
 #include "web_assets.h"
-#include "daemon/store/job_files.h"
 
 /* Pictures and downloads of an auth'd page are fetched with the token and
  * shown from blob: URLs. */
@@ -163,21 +161,17 @@ enum MHD_Result route_dashboard_queue(pk_req *r)
     return pk_send_json(r, 200, doc, NULL);
 }
 
-/* {process, inputs} as the job was submitted (job.json). */
+/* {process, inputs} as the job was submitted: the queue's row, from which the
+ * job file its worker reads is written when it starts (so also while it waits). */
 enum MHD_Result route_dashboard_inputs(pk_req *r)
 {
     json_t *row = pk_job_visible(r, r->seg[2]);
     if (!row)
         return pk_reply_problem(r, PK_P_NO_SUCH_JOB, r->seg[2]);
+    json_t *job = json_pack("{s:O,s:O}", "process", json_object_get(row, "process"), "inputs",
+                            json_object_get(row, "inputs"));
     json_decref(row);
-    pk_config cfg = pk_service_config(r->svc);
-    char dir[1200], path[1300];
-    pk_job_dir(cfg.data, r->seg[2], dir, sizeof dir);
-    pk_job_file_path(dir, PK_JOB_INPUT, path, sizeof path);
-    json_t *job = access(path, R_OK) == 0 ? json_load_file(path, 0, NULL) : NULL;
-    if (!json_is_object(job)) {
-        json_decref(job);
+    if (!job)
         return pk_reply_problem(r, PK_P_NOT_FOUND, "the job's inputs are not kept");
-    }
     return pk_send_json(r, 200, job, NULL);
 }

@@ -9,12 +9,13 @@
 // download; a running job cancelled by its button shows `dismissed`.  Times
 // are shown in the browser's zone (Asia/Kolkata, GMT+5:30) and say so.  The
 // queue line above the list shows what GET /dashboard/queue counts while every
-// worker is busy and a job waits, and the list filtered to those running jobs
-// drops them once cancelled; a status filter in the URL hash lists exactly
-// the API's jobs of that status, also after a reload, the checkboxes change
-// it, and a job page leads back to it; pages of a small limit (a hash parameter) list the API's pages,
-// newer/older and "jobs N–M of TOTAL" as the API counts.  At a 390 px
-// viewport the list and a job page are no wider than the viewport.
+// worker is busy and a job waits, and the list filtered to those jobs drops
+// them once cancelled; the waiting job's page shows its inputs (no 404).  A status filter in the URL hash
+// lists exactly the API's jobs of that status, also after a reload; the
+// checkboxes change it, and a job page leads back to it.  Pages of a small
+// limit (a hash parameter) list the API's pages, newer/older and "jobs N–M of
+// TOTAL" as the API counts.  At a 390 px viewport the list and a job page are
+// no wider than the viewport.
 // Prints PASS/FAIL lines (tests/integration/check.inc) and saves screenshots
 // and the downloads (result.h5, partial.h5) in OUT_DIR.
 // Env: PLAYWRIGHT_CORE (the installed module), CHROMIUM, SLOW (wait factor),
@@ -249,9 +250,6 @@ async function step(name, fn) {
     await step('dashboard_cancel_button', async () => {
       last = await submitEdited(page, 'meier-quartz-2d (pack)', () => rsaUntilWallTime(300));
       await openJob(page, last);
-      // its inputs shown first: a dismissal removes them, and a request still on
-      // its way would get a 404
-      await page.waitForFunction(() => document.getElementById('job-inputs').textContent !== '');
       await page.click('#cancel');
       await page.waitForSelector('#job-status:text-is("dismissed")');
       if (await page.isVisible('#cancel')) throw new Error('the button stays after the job is dismissed');
@@ -279,7 +277,13 @@ async function step(name, fn) {
         if (listed.slice().sort().join(' ') !== held.slice().sort().join(' ')) throw new Error('the API lists other jobs: ' + listed);
         await listShows(page, listed, `jobs 1–${held.length} of ${held.length}`);
         await page.screenshot({ path: shot('queue'), fullPage: true });
-        for (const j of held) await apiCall('jobs/' + j, { method: 'DELETE' });
+        // the waiting job's page shows its inputs (no worker has its job file yet)
+        const waitingId = (await apiCall('jobs?status=accepted&limit=1')).jobs[0].jobID;
+        await openJob(page, waitingId);
+        await page.waitForSelector('#job-status:text-is("accepted")');
+        await page.waitForSelector('#job-inputs:has-text("wall_time_s")');
+        await page.goto(base + '/#/?status=running,accepted&process=pack');
+        for (const j of held) await apiCall('jobs/' + j, { method: 'DELETE' }).catch(() => {});
         held.length = 0;
         // the refresh under the filter drops them, and the line counts no job
         await listShows(page, [], 'no jobs match the filters');
