@@ -88,6 +88,9 @@ static const struct key {
     {"allowed_hosts", K_STR, F(allowed_hosts), 0, 0,
      "Host names requests may carry, comma-separated, * = any (unset: bind address, localhost, "
      "this machine's names and addresses, public_url's host); others get 421"},
+    {"callback_allow", K_STR, F(callback_allow), 0, 0,
+     "addresses a subscriber callback may reach though private or loopback, comma-separated "
+     "(\"\" = public addresses only)"},
     {"cors_origins", K_STR, F(cors_origins), 0, 0,
      "origins whose pages may call the API from a browser (CORS), comma-separated "
      "scheme://host[:port], * = any (unset: none)"},

@@ -49,16 +49,17 @@ typedef struct pk_config {
     pk_auth_mode auth;       /* bearer tokens required (daemon/http/auth.c) */
     char trusted_proxy[64];  /* peer whose X-Packd-Owner is honoured; "" = none */
     char allowed_hosts[512]; /* Host header names accepted, comma-separated ("" = this machine's) */
-    char cors_origins[512];  /* origins browsers may call from, comma-separated ("" = CORS off) */
-    pk_executor_kind executor;  /* local workers or a Slurm cluster */
-    char slurm_partition[64];   /* sbatch --partition; "" = the cluster's default */
-    char slurm_account[64];     /* sbatch --account; "" = the user's default */
-    char slurm_qos[64];         /* sbatch --qos; "" = the default */
-    char slurm_options[512];    /* more sbatch options, split at blanks */
-    char slurm_packd[1024];     /* packd on the nodes; "" = this binary's path */
-    int slurm_mem_mb;           /* MB per job (per rank of an MPI job); 0 = the default */
-    char slurm_mpi[32];         /* srun --mpi of a job of several ranks (pmix) */
-    int slurm_max_jobs;         /* jobs on Slurm at once (submitted, not ended) */
+    char callback_allow[512];  /* private/loopback addresses callbacks may reach, comma-separated */
+    char cors_origins[512];    /* origins browsers may call from, comma-separated ("" = CORS off) */
+    pk_executor_kind executor; /* local workers or a Slurm cluster */
+    char slurm_partition[64];  /* sbatch --partition; "" = the cluster's default */
+    char slurm_account[64];    /* sbatch --account; "" = the user's default */
+    char slurm_qos[64];        /* sbatch --qos; "" = the default */
+    char slurm_options[512];   /* more sbatch options, split at blanks */
+    char slurm_packd[1024];    /* packd on the nodes; "" = this binary's path */
+    int slurm_mem_mb;          /* MB per job (per rank of an MPI job); 0 = the default */
+    char slurm_mpi[32];        /* srun --mpi of a job of several ranks (pmix) */
+    int slurm_max_jobs;        /* jobs on Slurm at once (submitted, not ended) */
     double slurm_local_below_s; /* limits.wall_time_s at most this: run locally (0 = never) */
     char config_file[1024];     /* the file read, "" if none (kept for SIGHUP) */
 } pk_config;

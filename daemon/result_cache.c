@@ -60,19 +60,34 @@ int pk_result_cache_key(const char *process, json_t *inputs, char key[65])
     return rc;
 }
 
+static const pk_job_file linked[] = {PK_JOB_INPUT, PK_JOB_RESULT, PK_JOB_XDMF, PK_JOB_SUMMARY};
+
+void pk_result_cache_unlink(const char *data, const char *dst)
+{
+    char dir[1200], path[1300];
+    if (pk_job_dir(data, dst, dir, sizeof dir) != 0)
+        return;
+    for (size_t i = 0; i < sizeof linked / sizeof *linked; i++)
+        if (pk_job_file_path(dir, linked[i], path, sizeof path) == 0)
+            unlink(path);
+}
+
 int pk_result_cache_link(const char *data, const char *src, const char *dst)
 {
-    static const pk_job_file files[] = {PK_JOB_INPUT, PK_JOB_RESULT, PK_JOB_XDMF, PK_JOB_SUMMARY};
-    char from_dir[1200], to_dir[1200], from[1300], to[1300];
+    char from_dir[1200], to_dir[1200], jobs[1300], from[1300], to[1300];
     if (pk_job_dir(data, src, from_dir, sizeof from_dir) != 0 ||
-        pk_job_dir(data, dst, to_dir, sizeof to_dir) != 0 || mkdir(to_dir, 0750) != 0)
+        pk_job_dir(data, dst, to_dir, sizeof to_dir) != 0)
         return -1;
-    for (size_t i = 0; i < sizeof files / sizeof *files; i++) {
-        pk_job_file_path(from_dir, files[i], from, sizeof from);
-        pk_job_file_path(to_dir, files[i], to, sizeof to);
+    snprintf(jobs, sizeof jobs, "%s/jobs", data);
+    mkdir(jobs, 0750);
+    if (mkdir(to_dir, 0750) != 0 && errno != EEXIST)
+        return -1;
+    for (size_t i = 0; i < sizeof linked / sizeof *linked; i++) {
+        pk_job_file_path(from_dir, linked[i], from, sizeof from);
+        pk_job_file_path(to_dir, linked[i], to, sizeof to);
         /* a job without an XDMF sidecar has none to give; the rest must be there */
-        if (link(from, to) != 0 && !(errno == ENOENT && files[i] == PK_JOB_XDMF)) {
-            pk_job_dir_remove(data, dst);
+        if (link(from, to) != 0 && !(errno == ENOENT && linked[i] == PK_JOB_XDMF)) {
+            pk_result_cache_unlink(data, dst);
             return -1;
         }
     }

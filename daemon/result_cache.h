@@ -15,8 +15,12 @@
 int pk_result_cache_key(const char *process, json_t *inputs, char key[65]);
 
 /* The result files of job src (its inputs, result, XDMF and summary) as
- * hard links in the new job directory of dst under data: either job's
- * dismissal leaves the other's files.  0, or -1 with dst's directory gone. */
+ * hard links in the job directory of dst under data (made if need be):
+ * either job's dismissal leaves the other's files.  0, or -1 with none of
+ * them left in dst. */
 int pk_result_cache_link(const char *data, const char *src, const char *dst);
+
+/* Remove those links from dst again (its other files stay). */
+void pk_result_cache_unlink(const char *data, const char *dst);
 
 #endif

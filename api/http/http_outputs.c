@@ -5,6 +5,7 @@
 #include <pthread.h>
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 
 #include "api/picture/picture.h"
 #include "http_status_info.h"
@@ -83,18 +84,59 @@ size_t pk_outputs_list(char *buf, size_t n)
     return k < n ? k : n - 1;
 }
 
+/* OGC API - Processes 1.0, "subscriber": where the job's events are POSTed. */
+static int parse_subscriber(json_t *sub, pk_exec_opts *o, char *detail, size_t n)
+{
+    static const char *const uris[] = {"successUri", "inProgressUri", "failedUri"};
+    if (!sub)
+        return 0;
+    if (!json_is_object(sub)) {
+        snprintf(detail, n, "/subscriber: an object with successUri, inProgressUri, failedUri");
+        return -1;
+    }
+    const char *key;
+    json_t *v;
+    json_object_foreach (sub, key, v) {
+        size_t k = 0;
+        while (k < 3 && strcmp(key, uris[k]))
+            k++;
+        const char *u = json_string_value(v);
+        if (k == 3) {
+            snprintf(detail, n, "/subscriber/%.60s: unknown (successUri, inProgressUri, failedUri)",
+                     key);
+            return -1;
+        }
+        size_t len = u ? strlen(u) : 0;
+        int ok = len > 0 && len < 2048 &&
+            (!strncasecmp(u, "http://", 7) || !strncasecmp(u, "https://", 8));
+        for (size_t i = 0; ok && i < len; i++)
+            ok = (unsigned char)u[i] > ' ' && (unsigned char)u[i] < 0x7f;
+        if (!ok) {
+            snprintf(detail, n, "/subscriber/%s: an absolute http or https URL (< 2048 bytes)",
+                     key);
+            return -1;
+        }
+    }
+    o->subscriber = json_object_size(sub) ? json_incref(sub) : NULL;
+    return 0;
+}
+
 int pk_exec_opts_parse(json_t *body, pk_exec_opts *o, char *detail, size_t n)
 {
     memset(o, 0, sizeof *o);
+    if (parse_subscriber(json_object_get(body, "subscriber"), o, detail, n) != 0)
+        return -1;
     json_t *resp = json_object_get(body, "response");
     const char *mode = resp ? json_string_value(resp) : "document";
     if (!mode || (strcmp(mode, "raw") && strcmp(mode, "document"))) {
         snprintf(detail, n, "/response: \"raw\" or \"document\"");
+        pk_exec_opts_free(o);
         return -1;
     }
     json_t *outs = json_object_get(body, "outputs");
     if (outs && !json_is_object(outs)) {
         snprintf(detail, n, "/outputs: an object whose keys are output ids");
+        pk_exec_opts_free(o);
         return -1;
     }
     const char *key, *value_one = NULL;
@@ -105,12 +147,14 @@ int pk_exec_opts_parse(json_t *body, pk_exec_opts *o, char *detail, size_t n)
             char all[600];
             pk_outputs_list(all, sizeof all);
             snprintf(detail, n, "/outputs/%.60s: no such output (%s)", key, all);
+            pk_exec_opts_free(o);
             return -1;
         }
         json_t *tm = json_object_get(v, "transmissionMode");
         const char *t = tm ? json_string_value(tm) : "reference";
         if (!json_is_object(v) || !t || (strcmp(t, "value") && strcmp(t, "reference"))) {
             snprintf(detail, n, "/outputs/%.60s/transmissionMode: \"value\" or \"reference\"", key);
+            pk_exec_opts_free(o);
             return -1;
         }
         if (!strcmp(t, "value")) {
@@ -137,13 +181,17 @@ int pk_exec_opts_parse(json_t *body, pk_exec_opts *o, char *detail, size_t n)
 
 json_t *pk_exec_opts_json(const pk_exec_opts *o)
 {
-    if (!o->serve[0] && !o->select)
+    if (!o->serve[0] && !o->select && !o->subscriber)
         return NULL;
     json_t *j = json_object();
     if (o->serve[0])
         json_object_set_new(j, "serve", json_string(o->serve));
     if (o->select)
         json_object_set(j, "select", o->select);
+    if (o->subscriber) {
+        json_object_set(j, "subscriber", o->subscriber);
+        json_object_set_new(j, "base", json_string(o->base));
+    }
     return j;
 }
 
@@ -156,10 +204,16 @@ void pk_exec_opts_from_json(json_t *j, pk_exec_opts *o)
     json_t *sel = json_object_get(j, "select");
     if (json_is_array(sel))
         o->select = json_incref(sel);
+    json_t *sub = json_object_get(j, "subscriber");
+    if (json_is_object(sub))
+        o->subscriber = json_incref(sub);
+    const char *base = json_string_value(json_object_get(j, "base"));
+    snprintf(o->base, sizeof o->base, "%s", base ? base : "");
 }
 
 void pk_exec_opts_free(pk_exec_opts *o)
 {
     json_decref(o->select);
-    o->select = NULL;
+    json_decref(o->subscriber);
+    o->select = o->subscriber = NULL;
 }

@@ -36,13 +36,16 @@ size_t pk_outputs_list(char *buf, size_t n);
  * results document), select the outputs a document lists (NULL: all). */
 typedef struct pk_exec_opts {
     char serve[32];
-    json_t *select; /* array of output ids, or NULL */
+    json_t *select;     /* array of output ids, or NULL */
+    json_t *subscriber; /* {successUri, inProgressUri, failedUri} (OGC callbacks), or NULL */
+    char base[256];     /* the service's URL as the client named it (links in callbacks) */
 } pk_exec_opts;
 
 /* From an execute request body: 0, or -1 with detail (pointer and rule) for
  * a 400.  response "raw" serves "result" (or the one output selected);
  * response "document" with exactly one output whose transmissionMode is
- * "value" serves that output's bytes. */
+ * "value" serves that output's bytes.  subscriber: each URI given is an
+ * absolute http or https URL. */
 int pk_exec_opts_parse(json_t *body, pk_exec_opts *o, char *detail, size_t n);
 /* As stored beside the job (NULL when the defaults: a full document). */
 json_t *pk_exec_opts_json(const pk_exec_opts *o);

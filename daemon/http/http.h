@@ -70,6 +70,10 @@ enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp);
  * configured public_url, else the request's Host.  pk_send_json and the
  * problem senders do it; pk_send makes a path Location header absolute. */
 void pk_absolute_links(pk_req *r, json_t *doc);
+/* This service's URL as the client reaches it: public_url, else http://<Host>. */
+void pk_base_url(pk_req *r, char *out, size_t n);
+/* Links of doc made absolute under base (a URL pk_base_url gave). */
+void pk_absolute_links_at(json_t *doc, const char *base);
 /* The inverse for a request's inputs: links into this service given as
  * absolute URLs (as its documents give them) become paths again. */
 void pk_own_links_as_paths(pk_req *r, json_t *inputs);

@@ -16,7 +16,7 @@
 
 /* The base of absolute links: public_url, else http://<Host> when the Host
  * header is a plain host[:port], else http://localhost. */
-static void base_url(pk_req *r, char *out, size_t n)
+void pk_base_url(pk_req *r, char *out, size_t n)
 {
     pk_config cfg = pk_service_config(r->svc);
     const char *host = pk_header(r, "Host");
@@ -79,16 +79,18 @@ static void relative_hrefs(json_t *node, const char *base, size_t bl)
 void pk_own_links_as_paths(pk_req *r, json_t *inputs)
 {
     char base[300];
-    base_url(r, base, sizeof base);
+    pk_base_url(r, base, sizeof base);
     relative_hrefs(inputs, base, strlen(base));
 }
 
 void pk_absolute_links(pk_req *r, json_t *doc)
 {
     char base[300];
-    base_url(r, base, sizeof base);
+    pk_base_url(r, base, sizeof base);
     absolute_hrefs(doc, base);
 }
+
+void pk_absolute_links_at(json_t *doc, const char *base) { absolute_hrefs(doc, base); }
 
 /* A document as a client sees it: no path of the data directory, links absolute. */
 void pk_client_view(pk_req *r, json_t *doc)
@@ -105,7 +107,7 @@ enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp)
     const char *loc = MHD_get_response_header(resp, "Location");
     if (loc && loc[0] == '/') { /* RFC 9110 allows relative; OGC clients need absolute */
         char base[300], abs[800], rel[500];
-        base_url(r, base, sizeof base);
+        pk_base_url(r, base, sizeof base);
         snprintf(rel, sizeof rel, "%s", loc);
         snprintf(abs, sizeof abs, "%s%s", base, rel);
         MHD_del_response_header(resp, "Location", loc);
@@ -113,7 +115,7 @@ enum MHD_Result pk_send(pk_req *r, unsigned status, struct MHD_Response *resp)
     }
     if (r->sync_job[0]) { /* OGC /req/core/job-results-success-sync: a monitor link to the job */
         char base[300], link[500];
-        base_url(r, base, sizeof base);
+        pk_base_url(r, base, sizeof base);
         snprintf(link, sizeof link, "<%s/jobs/%s>; rel=\"monitor\"", base, r->sync_job);
         MHD_add_response_header(resp, "Link", link);
         MHD_add_response_header(resp, "Preference-Applied", "respond-sync");

@@ -24,6 +24,7 @@
 #include "host_check.h"
 #include "http.h"
 #include "http_park.h"
+#include "callbacks.h"
 #include "daemon/log.h"
 
 pk_config pk_service_config(pk_service *s)
@@ -385,8 +386,14 @@ struct MHD_Daemon *pk_http_start(pk_service *svc, int *port, char *err, size_t e
         snprintf(err, errlen, "cannot start the stream waker thread");
         return NULL;
     }
+    if (pk_callbacks_start(svc) != 0) {
+        pk_park_stop();
+        snprintf(err, errlen, "cannot start the callback thread");
+        return NULL;
+    }
     unsigned limit = connection_limit(&cfg);
     if (pk_conn_guard_start(svc, limit) != 0) {
+        pk_callbacks_stop();
         pk_park_stop();
         snprintf(err, errlen, "cannot start the connection deadline thread");
         return NULL;
@@ -401,6 +408,7 @@ struct MHD_Daemon *pk_http_start(pk_service *svc, int *port, char *err, size_t e
         pk_conn_guard_notify, NULL, MHD_OPTION_END);
     if (!d) {
         pk_conn_guard_stop();
+        pk_callbacks_stop();
         pk_park_stop();
         snprintf(err, errlen, "cannot listen on %s:%d (in use or not permitted)", cfg.bind,
                  cfg.port);
@@ -419,6 +427,7 @@ struct MHD_Daemon *pk_http_start(pk_service *svc, int *port, char *err, size_t e
 void pk_http_stop(struct MHD_Daemon *d)
 {
     pk_park_stop(); /* resumes every parked stream: MHD must not stop with suspended ones */
+    pk_callbacks_stop();
     pk_conn_guard_stop();
     MHD_stop_daemon(d);
 }

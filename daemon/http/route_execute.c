@@ -167,22 +167,23 @@ static int wants_fresh(pk_req *r)
     return 0;
 }
 
-/* Queue the job, or answer it from an equal successful job of the same
- * owner that finished within max_age_s (result_cache.h): a new job, already
- * successful, whose files are hard links to the old one's.  A PK_Q_* code. */
+/* Queue the job s->id, or answer it from an equal successful job of the
+ * same owner that finished within max_age_s (result_cache.h): the job is
+ * then made already successful, its files hard links to the old one's.
+ * A PK_Q_* code; id is the job answered. */
 static int submit(pk_req *r, const pk_submit *s, const char *data, double max_age_s, char id[37])
 {
     pk_service *svc = r->svc;
-    char src[37], fresh[37];
+    char src[37];
     if (s->cache_key && max_age_s > 0 && !wants_fresh(r)) {
         int rc = PK_Q_GONE;
         if (pk_queue_find_reusable(svc->q, s->cache_key, s->owner, pk_queue_now() - max_age_s,
                                    src) &&
-            pk_uuid4(fresh) == 0 && pk_result_cache_link(data, src, fresh) == 0) {
-            snprintf(id, 37, "%s", fresh);
+            pk_result_cache_link(data, src, s->id) == 0) {
+            snprintf(id, 37, "%s", s->id);
             rc = pk_queue_submit_reused(svc->q, s, src, id); /* EXISTING: id is the earlier job */
             if (rc != PK_Q_OK)
-                pk_job_dir_remove(data, fresh);
+                pk_result_cache_unlink(data, s->id);
         }
         if (rc == PK_Q_OK) {
             __atomic_add_fetch(&svc->cache_hits, 1, __ATOMIC_RELAXED);
@@ -289,8 +290,21 @@ enum MHD_Result route_execute(pk_req *r)
     free(fp_src);
     pk_owner(r, owner, sizeof owner);
     const char *key = pk_header(r, "Idempotency-Key");
-    char cache_key[65];
-    pk_submit s = {.process = p->id,
+    char cache_key[65], new_id[37];
+    if (pk_uuid4(new_id) != 0) {
+        json_decref(body);
+        free(text);
+        pk_exec_opts_free(&opts);
+        return pk_reply_problem(r, PK_P_INTERNAL, "no job id");
+    }
+    /* the options are in place before the job exists: its first event may
+     * go to a subscriber (callbacks.h) */
+    pk_base_url(r, opts.base, sizeof opts.base);
+    if (pk_results_opts_save(r, new_id, &opts) != 0)
+        pk_log(PK_LOG_WARN, "cannot store the execute options; results answer as a document",
+               "{s:s}", "job", new_id);
+    pk_submit s = {.id = new_id,
+                   .process = p->id,
                    .inputs_json = text,
                    .owner = owner,
                    .idempotency_key = key && *key ? key : NULL,
@@ -302,9 +316,8 @@ enum MHD_Result route_execute(pk_req *r)
     int rc = submit(r, &s, data, cfg.result_cache_max_age_s, id);
     json_decref(body);
     free(text);
-    if (rc == PK_Q_OK && pk_results_opts_save(r, id, &opts) != 0)
-        pk_log(PK_LOG_WARN, "cannot store the execute options; results answer as a document",
-               "{s:s}", "job", id);
+    if (rc != PK_Q_OK) /* no job of that id: its options go */
+        pk_job_dir_remove(data, new_id);
     if (rc != PK_Q_OK && rc != PK_Q_EXISTING)
         pk_exec_opts_free(&opts);
     switch (rc) {

@@ -47,8 +47,8 @@ enum MHD_Result route_landing(pk_req *r)
 enum MHD_Result route_conformance(pk_req *r)
 {
     const char *base = "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/";
-    const char *classes[] = {"core",     "json",    "oas30",
-                             "job-list", "dismiss", "ogc-process-description"};
+    const char *classes[] = {
+        "core", "json", "oas30", "job-list", "dismiss", "callback", "ogc-process-description"};
     json_t *a = json_array();
     for (size_t i = 0; i < sizeof classes / sizeof *classes; i++) {
         char uri[160];

@@ -19,8 +19,13 @@
 void pk_results_opts_load(pk_req *r, const char *id, pk_exec_opts *o)
 {
     pk_config cfg = pk_service_config(r->svc);
+    pk_results_opts_read(cfg.data, id, o);
+}
+
+void pk_results_opts_read(const char *data, const char *id, pk_exec_opts *o)
+{
     char dir[1200], path[1300];
-    pk_job_dir(cfg.data, id, dir, sizeof dir);
+    pk_job_dir(data, id, dir, sizeof dir);
     pk_job_file_path(dir, PK_JOB_EXEC_OPTS, path, sizeof path);
     json_t *j = access(path, R_OK) == 0 ? json_load_file(path, 0, NULL) : NULL;
     pk_exec_opts_from_json(j, o);
@@ -90,15 +95,16 @@ static void job_file(pk_req *r, const char *id, const char *name, char *path, si
     snprintf(path, n, "%s/%s", dir, name);
 }
 
-/* The results document: summary, result, xdmf and the pictures drawn. */
-static json_t *results_document(pk_req *r, json_t *row, const pk_exec_opts *o)
+json_t *pk_results_document_of(const char *data, json_t *row, const pk_exec_opts *o)
 {
     const char *id = json_string_value(json_object_get(row, "id"));
     json_t *doc = pk_results_document(row);
     const pk_output *out;
+    char dir[1200];
+    pk_job_dir(data, id, dir, sizeof dir);
     for (size_t i = 0; (out = pk_output_at(i)); i++) {
         char path[1300], href[200];
-        job_file(r, id, out->id, path, sizeof path);
+        snprintf(path, sizeof path, "%s/%s", dir, out->id);
         if (out->optional && access(path, R_OK) == 0) {
             snprintf(href, sizeof href, "/jobs/%s/results/%s", id, out->id);
             json_object_set_new(
@@ -162,7 +168,8 @@ enum MHD_Result pk_send_results(pk_req *r, json_t *row, const pk_exec_opts *o)
         return rc;
     if (o->serve[0])
         return send_output(r, row, pk_output_find(o->serve));
-    json_t *doc = results_document(r, row, o);
+    pk_config cfg = pk_service_config(r->svc);
+    json_t *doc = pk_results_document_of(cfg.data, row, o);
     json_decref(row);
     return pk_send_json(r, 200, doc, NULL);
 }

@@ -34,6 +34,7 @@ void pk_queue_close(pk_queue *q);
 double pk_queue_now(void);
 
 typedef struct pk_submit {
+    const char *id; /* the new job's id (pk_uuid4), or NULL: one is made */
     const char *process, *inputs_json, *owner;
     const char *idempotency_key; /* may be NULL */
     const char *request_sha256;  /* fingerprint of the request (with a key) */
@@ -113,6 +114,10 @@ int pk_queue_recover(pk_queue *q, int max_attempts, int *failed);
 
 /* SIGTERM past the grace period: give the start back and re-queue. */
 void pk_queue_requeue(pk_queue *q, const char *id, const char *why);
+
+/* The status events of every job after event id `after` (at most limit):
+ * [{id, job_id, data}]; with after < 0, {id} of the last event of all. */
+json_t *pk_queue_status_events(pk_queue *q, long long after, int limit);
 
 /* Events of a job after event id `after` (oldest first, at most limit):
  * [{"id", "kind", "data"}]. */
