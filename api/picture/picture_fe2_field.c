@@ -27,7 +27,8 @@ static double *read_doubles(hid_t f, const char *path, int last, hsize_t dims[3]
     int r = s >= 0 ? H5Sget_simple_extent_ndims(s) : -1;
     double *v = NULL;
     if (r >= 1 && r <= 3 && H5Sget_simple_extent_dims(s, dims, NULL) == r && dims[0] > 0) {
-        hsize_t start[3] = {0, 0, 0}, count[3] = {dims[0], r > 1 ? dims[1] : 1, r > 2 ? dims[2] : 1};
+        hsize_t start[3] = {0, 0, 0},
+                count[3] = {dims[0], r > 1 ? dims[1] : 1, r > 2 ? dims[2] : 1};
         if (last)
             start[0] = dims[0] - 1, count[0] = 1;
         size_t n = (size_t)(count[0] * count[1] * count[2]);
@@ -125,7 +126,8 @@ static void trace(cairo_t *cr, const field *fd, hsize_t e, const double *u, doub
         long a = (long)fd->el[e * fd->nv + k];
         if (a < 0 || (hsize_t)a >= fd->nn)
             continue;
-        double px = fd->x[2 * a] + (u ? u[2 * a] : 0), py = fd->x[2 * a + 1] + (u ? u[2 * a + 1] : 0);
+        double px = fd->x[2 * a] + (u ? u[2 * a] : 0),
+               py = fd->x[2 * a + 1] + (u ? u[2 * a + 1] : 0);
         (k ? cairo_line_to : cairo_move_to)(cr, x0 + px * s, y0 + (ymax - py) * s);
     }
     cairo_close_path(cr);
