@@ -49,10 +49,12 @@ function duration(s) {
   return t < 60 ? t + ' s' : Math.floor(t / 60) + ' min ' + String(t % 60).padStart(2, '0') + ' s';
 }
 
-// The line of a progress event: its stage, φ, the time elapsed and left
+// The line of a progress event: its stage, φ (Δd while a shell grows), the
+// time elapsed and left
 // (the stage's own estimate, else a linear one from its fraction)
 function progressLine(d) {
-  let line = d.stage + (d.phi ? ', φ = ' + Number(d.phi).toFixed(4) : '');
+  let line = d.stage + (d.delta_d > 0 ? ', Δd = ' + Number(d.delta_d).toPrecision(4) // shell growth
+    : d.phi > 0 ? ', φ = ' + Number(d.phi).toFixed(4) : '');
   if (typeof d.elapsed_s === 'number') {
     line += ', ' + duration(d.elapsed_s) + ' elapsed';
     const eta = typeof d.eta_s === 'number' && d.eta_s >= 0 ? d.eta_s

@@ -363,7 +363,10 @@ static int place_edmd_unit(const pk_pack_job *job, const pk_pack_job *user, doub
     }
     pk_edmd_stats es;
     /* the monitor's wall limit counts from the job's start (pk_monitor_start),
-     * so it covers the RSA start too */
+     * so it covers the RSA start too; its Δd in the job's unit */
+    double unit_was = mon ? mon->length_unit : 0;
+    if (mon)
+        mon->length_unit = ell;
     int run_rc = pk_edmd_run_shell_in_walls(&job->box, w, p, &prm, mon, &es);
     if (run_rc != 0 && ck.resume &&
         !ck.resumed) { /* a snapshot that does not fit: from the start */
@@ -373,6 +376,8 @@ static int place_edmd_unit(const pk_pack_job *job, const pk_pack_job *user, doub
         ck.resume = NULL;
         run_rc = pk_edmd_run_shell_in_walls(&job->box, w, p, &prm, mon, &es);
     }
+    if (mon)
+        mon->length_unit = unit_was;
     pk_edmd_snapshot_free(&snap);
     if (run_rc != 0) {
         snprintf(err, errlen,

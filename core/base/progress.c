@@ -61,7 +61,11 @@ int pk_monitor_tick(pk_monitor *m, pk_progress *p, int force)
         return 0;
     m->t_last = now;
     p->elapsed_s = now - m->t_start;
-    if (m->fn && m->fn(p, m->ctx))
+    if (!m->fn)
+        return 0;
+    pk_progress shown = *p; /* lengths in the caller's unit */
+    shown.delta_d *= m->length_unit > 0 ? m->length_unit : 1;
+    if (m->fn(&shown, m->ctx))
         return m->cancelled = 1;
     return 0;
 }

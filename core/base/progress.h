@@ -20,6 +20,7 @@ typedef struct pk_progress {
     size_t total;        /* items planned, 0 if unknown */
     double elapsed_s;    /* wall time since the stage began */
     double eta_s;        /* estimated seconds left, <0 if unknown */
+    double delta_d;      /* shell growth: the gap Δd grown so far (φ stays); 0 otherwise */
     const char *message; /* optional short text, may be NULL */
 } pk_progress;
 
@@ -33,6 +34,7 @@ typedef struct pk_monitor {
     double interval_s;             /* min wall time between callbacks (default 0.5) */
     double wall_limit_s;           /* 0 = none; exceeded => stop with reason.  Set it
                                         * with pk_monitor_start: it counts from there */
+    double length_unit;            /* a loop in scaled lengths reports x·length_unit (0 = 1) */
     /* private */
     double t_start, t_last, t_job;
     int cancelled, begun;

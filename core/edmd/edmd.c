@@ -396,6 +396,7 @@ typedef struct run_loop {
     uint64_t rebase_win, last_rebase;
     uint64_t resort_win, next_resort;
     pk_progress pr;
+    double eta_w, eta_f, rate; /* the last rate sample (wall s, fraction); fraction per s */
     char msg[160];
 } run_loop;
 
@@ -493,14 +494,25 @@ static pk_edmd_criterion progress(const edmd_state *s, run_loop *L)
     pr->done = (size_t)st->events;
     if (isfinite(L->t_stop)) {
         pr->fraction = fmin(1, (L->t_base + s->t) / L->t_stop);
-        pr->eta_s =
-            pr->fraction > 0 ? (pk_wall_seconds() - L->w0) * (1 - pr->fraction) / pr->fraction : -1;
+        /* from the rate of the last second or more, not the average: a run
+         * slows as the grains crowd (collisions per unit of growth rise) */
+        double w = pk_wall_seconds() - L->w0;
+        if (w - L->eta_w >= 1.0) {
+            double r = (pr->fraction - L->eta_f) / (w - L->eta_w);
+            L->rate = L->eta_w > 0 && r > 0 ? r : L->rate;
+            L->eta_w = w;
+            L->eta_f = pr->fraction;
+        }
+        pr->eta_s = L->rate > 0 ? (1 - pr->fraction) / L->rate
+            : pr->fraction > 0  ? w * (1 - pr->fraction) / pr->fraction
+                                : -1;
     } else { /* until jammed: the reduced pressure on its way to p_max, on a log scale */
         double f = L->pressure > 1 && prm->p_max > 1 ? log(L->pressure) / log(prm->p_max) : 0;
         if (prm->max_events)
             f = fmax(f, (double)st->events / (double)prm->max_events);
         pr->fraction = fmax(pr->fraction, fmin(f, 0.99));
     }
+    pr->delta_d = s->h1 > 0 ? 2 * (s->h0 + s->h1 * s->t) : 0;
     snprintf(L->msg, sizeof L->msg, "events=%llu collisions=%llu reduced_pressure=%.4g",
              (unsigned long long)st->events, (unsigned long long)st->pair, L->pressure);
     pr->message = L->msg;

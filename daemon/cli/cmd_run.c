@@ -44,6 +44,8 @@ static int print_progress(const pk_progress *p, void *ctx)
                           "total", (json_int_t)p->total, "elapsed_s", p->elapsed_s);
     if (p->eta_s >= 0)
         json_object_set_new(j, "eta_s", json_real(p->eta_s));
+    if (p->delta_d > 0)
+        json_object_set_new(j, "delta_d", json_real(p->delta_d));
     if (p->message)
         json_object_set_new(j, "message", json_string(p->message));
     json_dumpf(j, s->out, JSON_COMPACT);

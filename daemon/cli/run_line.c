@@ -30,6 +30,7 @@ void pk_run_line_init(pk_run_line *l, FILE *tty)
     struct winsize ws;
     l->cols = ioctl(fileno(tty), TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0 ? ws.ws_col : 80;
     l->fraction = l->phi = l->eta_s = -1;
+    l->delta_d = 0;
 }
 
 void pk_run_line_duration(double s, char *out, size_t n)
@@ -74,13 +75,17 @@ void pk_run_line_draw(pk_run_line *l, const pk_progress *p)
         l->done = p->done;
         l->total = p->total;
         l->eta_s = p->eta_s;
+        l->delta_d = p->delta_d;
     } else if (strcmp(stage, l->outer) != 0)
         inner = stage;
     char line[256], t[32];
     int k = snprintf(line, sizeof line, "%s", l->outer);
     if (l->fraction >= 0)
         k += snprintf(line + k, sizeof line - (size_t)k, " %3.0f%%", 100 * l->fraction);
-    if (l->phi >= 0)
+    if (l->delta_d > 0) /* shell growth: the gap grows, φ stays */
+        k += snprintf(line + k, sizeof line - (size_t)k, "  %s %.4g", l->utf8 ? "Δd" : "delta_d",
+                      l->delta_d);
+    else if (l->phi >= 0)
         k +=
             snprintf(line + k, sizeof line - (size_t)k, "  %s %.4f", l->utf8 ? "φ" : "phi", l->phi);
     else if (l->total > 0)

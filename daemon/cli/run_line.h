@@ -17,7 +17,7 @@ typedef struct pk_run_line {
     /* the last stage that knew its fraction: an inner stage without one
      * (a relaxation inside a homogenization step) is shown beside it */
     char outer[24];
-    double fraction, phi, eta_s, t_outer;
+    double fraction, phi, eta_s, delta_d, t_outer;
     size_t done, total;
 } pk_run_line;
 

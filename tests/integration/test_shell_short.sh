@@ -40,9 +40,19 @@ cat >"$T/short.json" <<'JOB'
  "delta_d": 2, "algorithm": "edmd", "edmd": {"growth": "shell", "growth_rate": 0.01, "wall_gap": "none"},
  "seed": 1}}
 JOB
-"$PACKD" run "$T/short.json" -o "$T/short.h5" >"$T/short.out" 2>"$T/short.err"
+"$PACKD" run "$T/short.json" -o "$T/short.h5" --progress-file "$T/short.prog" >"$T/short.out" 2>"$T/short.err"
 rc=$?
 dd=$(field "$T/short.out" delta_d_reached)
+# the progress lines of the shell growth give the gap grown so far in mm (the
+# job's unit, not the engine's scaled one): the shell grows linearly in time
+# from 0 to the asked 2 mm, so Δd = fraction × 2 mm, and never past what was kept
+check shell_progress_reports_delta_d python3 - "$T/short.prog" "${dd:-0}" <<'PY'
+import json, sys
+ev = [json.loads(l) for l in open(sys.argv[1]) if '"stage":"edmd"' in l]
+assert ev and all(e["delta_d"] > 0 for e in ev), ev
+assert all(abs(e["delta_d"] - 2 * e["fraction"]) <= 1e-9 * 2 for e in ev), ev
+assert max(e["delta_d"] for e in ev) <= float(sys.argv[2]) + 1e-9, ev
+PY
 check shell_short_kept sh -c "[ $rc -eq 0 ] && grep -q '\"complete\": false' '$T/short.out' &&
     ! grep -q '\"failure\"' '$T/short.out' &&
     grep -q 'short of the job.s delta_d = 2: every gap of the result is >= ' '$T/short.out' &&
