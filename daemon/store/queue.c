@@ -317,6 +317,18 @@ static int seen_key(pk_queue *q, const pk_submit *s, char id[37])
     return same ? PK_Q_EXISTING : PK_Q_KEY_CONFLICT;
 }
 
+/* The code of a failed INSERT of a submission (rolled back). */
+static int insert_failed(pk_queue *q)
+{
+    int code = sqlite3_errcode(q->db);
+    rollback(q);
+    if (code == SQLITE_FULL || code == SQLITE_IOERR || code == SQLITE_READONLY) {
+        note_write(q, 0);
+        return PK_Q_UNWRITABLE;
+    }
+    return PK_Q_ERROR;
+}
+
 /* Inside an open transaction: the idempotency row of the new job id (if s
  * has a key), its status event, the commit.  A PK_Q_* code. */
 static int submit_end(pk_queue *q, const pk_submit *s, const char *id, double now)
@@ -327,30 +339,11 @@ static int submit_end(pk_queue *q, const pk_submit *s, const char *id, double no
                  "INSERT INTO idempotency(owner, key, request_sha256, job_id, created) VALUES "
                  "(?,?,?,?,?)",
                  "ssssd", s->owner, s->idempotency_key, s->request_sha256 ? s->request_sha256 : "",
-                 id, now)) != 1) {
-        int code = sqlite3_errcode(q->db);
-        rollback(q);
-        if (code == SQLITE_FULL || code == SQLITE_IOERR || code == SQLITE_READONLY) {
-            note_write(q, 0);
-            return PK_Q_UNWRITABLE;
-        }
-        return PK_Q_ERROR;
-    }
+                 id, now)) != 1)
+        return insert_failed(q);
     add_status_event(q, id);
     /* only a committed job is answered 201 */
     return commit(q) == 0 ? PK_Q_OK : PK_Q_UNWRITABLE;
-}
-
-/* The code of a failed INSERT of a job row (rolled back). */
-static int insert_failed(pk_queue *q)
-{
-    int code = sqlite3_errcode(q->db);
-    rollback(q);
-    if (code == SQLITE_FULL || code == SQLITE_IOERR || code == SQLITE_READONLY) {
-        note_write(q, 0);
-        return PK_Q_UNWRITABLE;
-    }
-    return PK_Q_ERROR;
 }
 
 /* Take the writer and open a submission's transaction: PK_Q_OK, or the
