@@ -1,5 +1,6 @@
-// packd dashboard: the job list with live progress, a job page, and a form
-// that submits the examples.  It reads the API as any client does; job data
+// packd dashboard: the job list with live progress (its filters and pages:
+// list-filters.js) and the queue's state, a job page, and a form that submits
+// the examples.  It reads the API as any client does; job data
 // enters the page only as text (textContent), never as markup.
 'use strict';
 
@@ -165,26 +166,60 @@ function jobRow(j) {
 }
 
 let packResults = []; // successful pack jobs: the RVEs a homogenize example can take
+let listAsked = 0, listShown = 0; // list refreshes begun, and the newest one shown
+let processesListed = false;
 
 async function refreshList() {
-  const v = view;
+  const v = view, n = ++listAsked, p = listParams();
   try {
-    const doc = await api('jobs?limit=50');
-    if (v !== view) return; // the page moved on while the list was asked for
-    packResults = (doc.jobs || []).filter((j) => j.processID === 'pack' && j.status === 'successful');
-    fillRVE();
+    const doc = await api(listQuery(p));
+    // the page moved on while the list was asked for, or a newer answer is shown
+    if (v !== view || n < listShown) return;
+    listShown = n;
     const tbody = $('jobs').tBodies[0];
     const seen = new Set();
     for (const j of doc.jobs || []) {
       seen.add(j.jobID);
       tbody.appendChild(jobRow(j).tr); // in the list's order (newest first)
     }
-    for (const [id, row] of rows)
-      if (!seen.has(id)) { row.tr.remove(); rows.delete(id); }
+    for (const [id, row] of rows) {
+      if (seen.has(id)) continue;
+      row.tr.remove();
+      rows.delete(id);
+      const ctl = streams.get(id); // a row gone from the list (filtered out) needs no stream
+      if (ctl) { ctl.abort(); streams.delete(id); }
+    }
+    showPaging(p, doc);
     showError('');
   } catch (e) {
     showError('Job list: ' + e.message + (token() ? '' : ' (auth on? enter a token above)'));
+    return;
   }
+  // asked once the list answered: with auth on they need the token too
+  refreshQueue(v);
+  refreshRVEs(v);
+  if (!processesListed) api('processes').then((d) => { processesListed = true; fillProcesses(d); }, () => {});
+}
+
+// Jobs waiting and running, workers busy of the maximum, and where they run.
+async function refreshQueue(v) {
+  try {
+    const q = await api('dashboard/queue');
+    if (v !== view) return;
+    for (const k of ['accepted', 'running', 'workers_busy', 'workers_max', 'executor']) $('q-' + k).textContent = q[k];
+  } catch (e) { showError('Queue: ' + e.message); }
+}
+
+// The RVEs a homogenize example can take, asked only while one is picked.
+async function refreshRVEs(v) {
+  const ex = examples[Number($('example').value)];
+  if (!ex || !ex.inputs.rve) return;
+  try {
+    const doc = await api('jobs?processID=pack&status=successful&limit=50');
+    if (v !== view) return;
+    packResults = doc.jobs || [];
+    fillRVE();
+  } catch (e) { /* the list shows the API's error */ }
 }
 
 // --- the examples form
@@ -211,6 +246,7 @@ function pickExample() {
   $('example-comment').textContent = ex.comment || '';
   $('inputs').value = JSON.stringify(ex.inputs, null, 2);
   fillRVE();
+  if (ex.inputs.rve && listShown) refreshRVEs(view); // once the API has answered (a token)
 }
 
 // A homogenize example names an RVE file of its own folder; here it takes
@@ -397,7 +433,7 @@ async function showJob(id) {
   } catch (e) { showError('Summary: ' + e.message); }
 }
 
-// --- routing: #/ the list, #/jobs/ID a job
+// --- routing: #/ the list (#/?status=…&process=…&page=…: list-filters.js), #/jobs/ID a job
 let listTimer = null;
 
 function route() {
@@ -412,7 +448,10 @@ function route() {
   if (m) {
     showJob(decodeURIComponent(m[1]));
   } else {
+    $('back').href = location.hash || '#/'; // a job page leads back to the list it was opened from
     pageJob = null;
+    showFilters(listParams());
+    $('range').textContent = '';
     refreshList();
     listTimer = setInterval(refreshList, 5000);
   }

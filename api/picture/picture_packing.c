@@ -11,6 +11,8 @@
 
 #define PANEL 720.0 /* the longer box side, in pt/px */
 #define MARGIN 36.0
+#define LEGEND 170.0   /* the size-class legend's column */
+#define LEGEND_ROWS 16 /* classes beyond: every k-th shown */
 
 typedef struct frame {
     double x0, y0, s, Lx, Ly; /* panel origin (top-left), scale, box extent */
@@ -138,6 +140,75 @@ static int draw_projection(cairo_t *cr, const frame *f, const pk_box *b, const p
     return 0;
 }
 
+/* The smallest and largest diameter of each size class (species). */
+static void class_sizes(const pk_particles *p, int classes, double *dlo, double *dhi)
+{
+    for (int k = 0; k < classes; k++)
+        dlo[k] = INFINITY, dhi[k] = 0;
+    for (size_t i = 0; i < p->n; i++) {
+        int k = p->species[i];
+        dlo[k] = fmin(dlo[k], 2 * p->r[i]);
+        dhi[k] = fmax(dhi[k], 2 * p->r[i]);
+    }
+}
+
+/* A swatch and the diameters of each size class, top to bottom from (x, y). */
+static void draw_legend(cairo_t *cr, const pk_particles *p, int classes, const char *unit, double x,
+                        double y)
+{
+    double *dlo = malloc(2 * (size_t)classes * sizeof *dlo);
+    if (!dlo)
+        return;
+    double *dhi = dlo + classes;
+    class_sizes(p, classes, dlo, dhi);
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    pk_canvas_text(cr, x, y, 0, 0.5, 12, "size classes (d)");
+    int step = (classes + LEGEND_ROWS - 1) / LEGEND_ROWS;
+    for (int k = 0, row = 1; k < classes; k += step, row++) {
+        double yr = y + 20 * row;
+        cairo_new_path(cr);
+        cairo_arc(cr, x + 7, yr, 6, 0, 2 * M_PI);
+        pk_canvas_class_colour(cr, k, classes, 1.0);
+        cairo_fill_preserve(cr);
+        cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
+        cairo_set_line_width(cr, 0.4);
+        cairo_stroke(cr);
+        char label[96];
+        if (dhi[k] == 0)
+            snprintf(label, sizeof label, "none placed");
+        else if (dhi[k] - dlo[k] <= 1e-9 * dhi[k])
+            snprintf(label, sizeof label, "%.3g %s", dhi[k], unit);
+        else
+            snprintf(label, sizeof label, "%.3g–%.3g %s", dlo[k], dhi[k], unit);
+        pk_canvas_text(cr, x + 20, yr, 0, 0.5, 11, label);
+    }
+    free(dlo);
+}
+
+/* A bar of a round length (1, 2 or 5 × 10^k) near a fifth of the box
+ * width, left-aligned at (x, y), labelled with it. */
+static void draw_scale_bar(cairo_t *cr, const frame *f, const char *unit, double x, double y)
+{
+    double want = f->Lx / 5, e = pow(10, floor(log10(want))), len = e;
+    if (2 * e <= want)
+        len = 5 * e <= want ? 5 * e : 2 * e;
+    double w = len * f->s;
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    cairo_set_line_width(cr, 2.5);
+    cairo_move_to(cr, x, y);
+    cairo_line_to(cr, x + w, y);
+    cairo_stroke(cr);
+    cairo_set_line_width(cr, 1);
+    for (int k = 0; k < 2; k++) {
+        cairo_move_to(cr, x + k * w, y - 5);
+        cairo_line_to(cr, x + k * w, y + 5);
+    }
+    cairo_stroke(cr);
+    char label[64];
+    snprintf(label, sizeof label, "%g %s", len, unit);
+    pk_canvas_text(cr, x + w + 8, y, 0, 0.5, 12, label);
+}
+
 int pk_picture_packing(const char *h5_path, const char *out_path, char *err, size_t errlen)
 {
     pk_box b;
@@ -155,18 +226,20 @@ int pk_picture_packing(const char *h5_path, const char *out_path, char *err, siz
     int panels = b.dim == 3 ? 2 : 1;
     double pw = f.Lx * f.s, ph = f.Ly * f.s;
     pk_canvas c;
-    if (pk_canvas_open(&c, out_path, panels * (pw + MARGIN) + MARGIN, ph + 2.5 * MARGIN, err,
-                       errlen) != 0) {
+    if (pk_canvas_open(&c, out_path, panels * (pw + MARGIN) + MARGIN + LEGEND, ph + 3.5 * MARGIN,
+                       err, errlen) != 0) {
         pk_particles_free(&p);
         return -1;
     }
-    char dims[96], title[256];
+    char unit[32], dims[128], title[320];
+    if (pk_h5_read_unit(h5_path, unit, sizeof unit) != 0 || !unit[0])
+        snprintf(unit, sizeof unit, "(length unit)");
     if (b.dim == 3)
-        snprintf(dims, sizeof dims, "%g x %g x %g", b.L[0], b.L[1], b.L[2]);
+        snprintf(dims, sizeof dims, "%g × %g × %g %s", b.L[0], b.L[1], b.L[2], unit);
     else
-        snprintf(dims, sizeof dims, "%g x %g", b.L[0], b.L[1]);
-    snprintf(title, sizeof title, "%zu grains, %d size class%s, phi = %.4f, %dD box %s", p.n,
-             classes, classes > 1 ? "es" : "", measure / pk_box_measure(&b), b.dim, dims);
+        snprintf(dims, sizeof dims, "%g × %g %s", b.L[0], b.L[1], unit);
+    snprintf(title, sizeof title, "%zu grains, %d size class%s, φ = %.4f, %dD box %s", p.n, classes,
+             classes > 1 ? "es" : "", measure / pk_box_measure(&b), b.dim, dims);
     cairo_set_source_rgb(c.cr, 0, 0, 0);
     pk_canvas_text(c.cr, MARGIN, MARGIN * 0.6, 0, 0.5, 14, title);
     f.x0 = MARGIN;
@@ -198,6 +271,9 @@ int pk_picture_packing(const char *h5_path, const char *out_path, char *err, siz
         pk_canvas_text(c.cr, f.x0 + pw / 2, f.y0 + ph + 0.5 * MARGIN, 0.5, 0.5, 12,
                        "view along -z (nearer = brighter)");
     }
+    draw_scale_bar(c.cr, &(frame){.s = f.s, .Lx = b.L[0]}, unit, MARGIN,
+                   1.5 * MARGIN + ph + 1.5 * MARGIN);
+    draw_legend(c.cr, &p, classes, unit, panels * (pw + MARGIN) + MARGIN, 1.5 * MARGIN + 8);
     pk_particles_free(&p);
     if (rc != 0) {
         pk_canvas_abort(&c);

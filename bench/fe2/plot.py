@@ -30,8 +30,9 @@ BC_LABEL = {"taylor": "Taylor", "restricted_taylor": "restricted Taylor", "perio
 
 
 def h5(path, name):
-    """Dataset OBS+name of a result file as a nested list (numbers or strings)."""
-    out = subprocess.run(["h5dump", "-y", "-w", "0", "-d", OBS + name, path],
+    """Dataset OBS+name of a result file as a nested list (numbers or strings); its
+    attributes (units) left out."""
+    out = subprocess.run(["h5dump", "-y", "-w", "0", "-A", "0", "-d", OBS + name, path],
                          capture_output=True, text=True, check=True).stdout
     m = re.search(r"DATASPACE\s+(SCALAR|SIMPLE\s*\{\s*\(([^)]*)\))", out)
     shape = [int(x) for x in m.group(2).split(",")] if m.group(2) else []

@@ -14,7 +14,7 @@
 #include "daemon/data_paths.h"
 #include "daemon/log.h"
 
-#define RETRIES 3       /* after the first attempt: 2 s, 8 s, 32 s later */
+#define RETRIES 3        /* after the first attempt: 2 s, 8 s, 32 s later */
 #define PENDING_MAX 1000 /* deliveries waiting; beyond, the oldest is dropped */
 #define BATCH 200
 
@@ -257,11 +257,11 @@ static void hand_on(json_t *ev)
     pk_results_opts_read(cfg.data, job, &o);
     json_t *data = json_object_get(ev, "data"); /* decoded by the queue */
     const char *st = json_string_value(json_object_get(data, "status"));
-    const char *which = !st                         ? NULL
-        : !strcmp(st, "successful")                 ? "successUri"
-        : !strcmp(st, "failed")                     ? "failedUri"
+    const char *which = !st                                 ? NULL
+        : !strcmp(st, "successful")                         ? "successUri"
+        : !strcmp(st, "failed")                             ? "failedUri"
         : !strcmp(st, "accepted") || !strcmp(st, "running") ? "inProgressUri"
-                                                    : NULL;
+                                                            : NULL;
     const char *uri = which ? json_string_value(json_object_get(o.subscriber, which)) : NULL;
     json_t *row = uri ? pk_queue_get(C.svc->q, job) : NULL;
     if (row) {
@@ -341,8 +341,8 @@ void pk_callbacks_stop(void)
     while (C.head) { /* not delivered: said so */
         delivery *d = C.head;
         C.head = d->next;
-        pk_log(PK_LOG_WARN, "callback not delivered: the daemon stops", "{s:s,s:s}", "job",
-               d->job, "uri", d->uri);
+        pk_log(PK_LOG_WARN, "callback not delivered: the daemon stops", "{s:s,s:s}", "job", d->job,
+               "uri", d->uri);
         free(d->uri);
         free(d->body);
         free(d);

@@ -1,17 +1,15 @@
 /* route_dashboard.c — the browser dashboard: the files of web/ and the examples compiled
  * in (web_assets.h), the page at / for a browser, and the job's inputs the
- * job page shows.  The page runs only its own script (Content-Security-Policy);
+ * job page shows, and the queue's counts above the list.  The page runs only its own script (Content-Security-Policy);
  * it reads the API as any client does, with the user's bearer token. */
 #include "route_dashboard.h"
 
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <unistd.h>
 
 #include "auth.h"
 #include "web_assets.h"
-#include "daemon/store/job_files.h"
 
 /* Pictures and downloads of an auth'd page are fetched with the token and
  * shown from blob: URLs. */
@@ -148,21 +146,32 @@ enum MHD_Result route_dashboard_examples(pk_req *r)
     return pk_send_json(r, 200, json_pack("{s:o}", "examples", list), NULL);
 }
 
-/* {process, inputs} as the job was submitted (job.json). */
+/* The queue and the workers, counted over every owner: no job ids, no owners
+ * (the figures of /metrics, which is for admins only). */
+enum MHD_Result route_dashboard_queue(pk_req *r)
+{
+    json_t *st = pk_queue_stats(r->svc->q);
+    json_t *jobs = json_object_get(st, "jobs");
+    json_t *doc = json_pack(
+        "{s:I,s:I,s:i,s:i,s:s}", "accepted", json_integer_value(json_object_get(jobs, "accepted")),
+        "running", json_integer_value(json_object_get(jobs, "running")), "workers_busy",
+        pk_executor_busy(r->svc->exec), "workers_max", pk_executor_capacity(r->svc->exec),
+        "executor", pk_executor_name(r->svc->exec));
+    json_decref(st);
+    return pk_send_json(r, 200, doc, NULL);
+}
+
+/* {process, inputs} as the job was submitted: the queue's row, from which the
+ * job file its worker reads is written when it starts (so also while it waits). */
 enum MHD_Result route_dashboard_inputs(pk_req *r)
 {
     json_t *row = pk_job_visible(r, r->seg[2]);
     if (!row)
         return pk_reply_problem(r, PK_P_NO_SUCH_JOB, r->seg[2]);
+    json_t *job = json_pack("{s:O,s:O}", "process", json_object_get(row, "process"), "inputs",
+                            json_object_get(row, "inputs"));
     json_decref(row);
-    pk_config cfg = pk_service_config(r->svc);
-    char dir[1200], path[1300];
-    pk_job_dir(cfg.data, r->seg[2], dir, sizeof dir);
-    pk_job_file_path(dir, PK_JOB_INPUT, path, sizeof path);
-    json_t *job = access(path, R_OK) == 0 ? json_load_file(path, 0, NULL) : NULL;
-    if (!json_is_object(job)) {
-        json_decref(job);
+    if (!job)
         return pk_reply_problem(r, PK_P_NOT_FOUND, "the job's inputs are not kept");
-    }
     return pk_send_json(r, 200, job, NULL);
 }

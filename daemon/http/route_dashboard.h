@@ -16,5 +16,6 @@ enum MHD_Result pk_send_api_page(pk_req *r);
 enum MHD_Result route_dashboard_asset(pk_req *r);    /* GET /dashboard/{file} */
 enum MHD_Result route_dashboard_examples(pk_req *r); /* GET /dashboard/examples */
 enum MHD_Result route_dashboard_inputs(pk_req *r);   /* GET /dashboard/jobs/{id}/inputs */
+enum MHD_Result route_dashboard_queue(pk_req *r);    /* GET /dashboard/queue */
 
 #endif

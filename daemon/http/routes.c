@@ -25,6 +25,7 @@ const pk_route pk_routes[] = {
     {"GET", "/healthz", route_healthz, PK_PUBLIC},
     /* the browser dashboard: its page is / for a browser (route_landing) */
     {"GET", "/dashboard/examples", route_dashboard_examples, PK_PUBLIC},
+    {"GET", "/dashboard/queue", route_dashboard_queue, PK_USER},
     {"GET", "/dashboard/*", route_dashboard_asset, PK_PUBLIC},
     {"GET", "/dashboard/jobs/*/inputs", route_dashboard_inputs, PK_USER},
     {NULL, NULL, NULL, PK_PUBLIC},

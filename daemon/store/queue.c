@@ -353,16 +353,31 @@ static int insert_failed(pk_queue *q)
     return PK_Q_ERROR;
 }
 
-int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37])
+/* Take the writer and open a submission's transaction: PK_Q_OK, or the
+ * code to answer (no transaction left open; the writer still held). */
+static int submit_begin(pk_queue *q, const pk_submit *s, char id[37])
 {
-    int rc;
     pthread_mutex_lock(&q->mu);
     if (begin(q) != SQLITE_OK) {
         note_write(q, 0);
-        rc = PK_Q_UNWRITABLE;
-        goto out;
+        return PK_Q_UNWRITABLE;
     }
-    if ((rc = seen_key(q, s, id)) != PK_Q_OK)
+    return seen_key(q, s, id);
+}
+
+/* Release the writer after a submission; a new job wakes the listeners. */
+static int submit_done(pk_queue *q, int rc)
+{
+    pthread_mutex_unlock(&q->mu);
+    if (rc == PK_Q_OK)
+        notify(q);
+    return rc;
+}
+
+int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37])
+{
+    int rc = submit_begin(q, s, id);
+    if (rc != PK_Q_OK)
         goto out;
     if (scalar(q, prep(q, "SELECT count(*) FROM jobs WHERE status='accepted'", NULL)) >=
         s->max_queued) {
@@ -396,10 +411,7 @@ int pk_queue_submit(pk_queue *q, const pk_submit *s, char id[37])
     }
     rc = submit_end(q, s, id, now);
 out:
-    pthread_mutex_unlock(&q->mu);
-    if (rc == PK_Q_OK)
-        notify(q);
-    return rc;
+    return submit_done(q, rc);
 }
 
 int pk_queue_find_reusable(pk_queue *q, const char *key, const char *owner, double not_before,
@@ -423,14 +435,8 @@ int pk_queue_find_reusable(pk_queue *q, const char *key, const char *owner, doub
 
 int pk_queue_submit_reused(pk_queue *q, const pk_submit *s, const char *src, char id[37])
 {
-    int rc;
-    pthread_mutex_lock(&q->mu);
-    if (begin(q) != SQLITE_OK) {
-        note_write(q, 0);
-        rc = PK_Q_UNWRITABLE;
-        goto out;
-    }
-    if ((rc = seen_key(q, s, id)) != PK_Q_OK)
+    int rc = submit_begin(q, s, id);
+    if (rc != PK_Q_OK)
         goto out;
     double now = pk_queue_now();
     char msg[120];
@@ -457,10 +463,7 @@ int pk_queue_submit_reused(pk_queue *q, const pk_submit *s, const char *src, cha
     pk_metrics_job_ended(q->db, id, "successful"); /* never started: no run time */
     rc = submit_end(q, s, id, now);
 out:
-    pthread_mutex_unlock(&q->mu);
-    if (rc == PK_Q_OK)
-        notify(q);
-    return rc;
+    return submit_done(q, rc);
 }
 
 #define JOB_COLUMNS                                                                                \

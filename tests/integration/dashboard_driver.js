@@ -7,8 +7,15 @@
 // running job keeps its status word through its progress events; a job that
 // runs out of wall time shows `failed`, its reason, summary and partial-file
 // download; a running job cancelled by its button shows `dismissed`.  Times
-// are shown in the browser's zone (Asia/Kolkata, GMT+5:30) and say so.  At a
-// 390 px viewport the list and a job page are no wider than the viewport.
+// are shown in the browser's zone (Asia/Kolkata, GMT+5:30) and say so.  The
+// queue line above the list shows what GET /dashboard/queue counts while every
+// worker is busy and a job waits, and the list filtered to those jobs drops
+// them once cancelled; the waiting job's page shows its inputs (no 404).  A status filter in the URL hash
+// lists exactly the API's jobs of that status, also after a reload; the
+// checkboxes change it, and a job page leads back to it.  Pages of a small
+// limit (a hash parameter) list the API's pages, newer/older and "jobs N–M of
+// TOTAL" as the API counts.  At a 390 px viewport the list and a job page are
+// no wider than the viewport.
 // Prints PASS/FAIL lines (tests/integration/check.inc) and saves screenshots
 // and the downloads (result.h5, partial.h5) in OUT_DIR.
 // Env: PLAYWRIGHT_CORE (the installed module), CHROMIUM, SLOW (wait factor),
@@ -57,6 +64,37 @@ async function submitEdited(page, label, edit) {
 async function openJob(page, id) {
   await page.goto(page.url().replace(/#.*$/, '') + '#/jobs/' + encodeURIComponent(id));
   await page.waitForFunction((i) => document.getElementById('job-id').textContent === i, id);
+}
+
+// The API as the page's user, from the driver (not through the page).
+async function apiCall(p, opts) {
+  const o = Object.assign({}, opts || {});
+  o.headers = Object.assign({ Accept: 'application/json' }, token ? { Authorization: 'Bearer ' + token } : {}, o.headers || {});
+  const r = await fetch(base + '/' + p, o);
+  if (!r.ok) throw new Error(p + ': ' + r.status + ' ' + (await r.text()).slice(0, 200));
+  return r.json();
+}
+const submitJob = async (process, inputs) => (await apiCall('processes/' + process + '/execution', {
+  method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify({ inputs }),
+})).jobID;
+
+// Poll fn (the API, from the driver) until it gives a truthy value.
+async function until(what, fn, seconds) {
+  const end = Date.now() + seconds * 1000 * slow;
+  for (;;) {
+    const v = await fn();
+    if (v) return v;
+    if (Date.now() > end) throw new Error('waited ' + seconds * slow + ' s for ' + what);
+    await new Promise((r) => setTimeout(r, 200));
+  }
+}
+
+// The list shows exactly these job ids in this order, and its range line says text.
+async function listShows(page, ids, text) {
+  await page.waitForFunction(([want, t]) => {
+    const got = [...document.querySelectorAll('#jobs tbody tr')].map((tr) => tr.dataset.job);
+    return got.join(' ') === want.join(' ') && document.getElementById('range').textContent === t;
+  }, [ids, text]);
 }
 
 const width = (page) => page.evaluate(() => document.documentElement.scrollWidth);
@@ -216,6 +254,108 @@ async function step(name, fn) {
       await page.waitForSelector('#job-status:text-is("dismissed")');
       if (await page.isVisible('#cancel')) throw new Error('the button stays after the job is dismissed');
       await page.screenshot({ path: shot('dismissed'), fullPage: true });
+    });
+    await step('dashboard_queue_line', async () => {
+      // every worker busy with a job that runs until cancelled, and one job waiting
+      const max = (await apiCall('dashboard/queue')).workers_max;
+      const held = [];
+      try {
+        for (let i = 0; i <= max; i++) held.push(await submitJob('pack', rsaUntilWallTime(300)));
+        const q = await until('all workers busy and a job waiting', async () => {
+          const d = await apiCall('dashboard/queue');
+          return d.running === max && d.workers_busy === max && d.accepted === 1 ? d : null;
+        }, 60);
+        const running = (await apiCall('jobs?status=running&limit=1')).numberMatched;
+        if (running !== q.running) throw new Error(`the job list counts ${running} running, the queue ${q.running}`);
+        // the list filtered to them: the rows are the held jobs, the line the API's counts
+        await page.goto(base + '/#/?status=running,accepted&process=pack');
+        await page.waitForFunction((want) => Object.keys(want).every((k) => {
+          const e = document.getElementById('q-' + k);
+          return e && e.textContent === String(want[k]);
+        }), q);
+        const listed = (await apiCall('jobs?status=running,accepted&processID=pack&limit=50')).jobs.map((j) => j.jobID);
+        if (listed.slice().sort().join(' ') !== held.slice().sort().join(' ')) throw new Error('the API lists other jobs: ' + listed);
+        await listShows(page, listed, `jobs 1–${held.length} of ${held.length}`);
+        await page.screenshot({ path: shot('queue'), fullPage: true });
+        // the waiting job's page shows its inputs (no worker has its job file yet)
+        const waitingId = (await apiCall('jobs?status=accepted&limit=1')).jobs[0].jobID;
+        await openJob(page, waitingId);
+        await page.waitForSelector('#job-status:text-is("accepted")');
+        await page.waitForSelector('#job-inputs:has-text("wall_time_s")');
+        await page.goto(base + '/#/?status=running,accepted&process=pack');
+        for (const j of held) await apiCall('jobs/' + j, { method: 'DELETE' }).catch(() => {});
+        held.length = 0;
+        // the refresh under the filter drops them, and the line counts no job
+        await listShows(page, [], 'no jobs match the filters');
+        await page.waitForFunction(() => ['q-accepted', 'q-running', 'q-workers_busy'].every((k) => document.getElementById(k).textContent === '0'),
+          null, { timeout: 60000 * slow });
+      } finally {
+        for (const j of held) await apiCall('jobs/' + j, { method: 'DELETE' }).catch(() => {});
+      }
+    });
+    await step('dashboard_filter_status', async () => {
+      const all = (await apiCall('jobs?limit=1000')).jobs;
+      const of = (st) => all.filter((j) => j.status === st).map((j) => j.jobID);
+      if (!of('successful').length || !of('failed').length) throw new Error('needs successful and failed jobs');
+      const shows = async (st) => {
+        await listShows(page, of(st), `jobs 1–${of(st).length} of ${of(st).length}`);
+        const boxes = await page.$$eval('#filters input[name="status"]', (bs) => bs.filter((b) => b.checked).map((b) => b.value));
+        if (boxes.join() !== st) throw new Error(`the boxes checked: ${boxes} (the filter is ${st})`);
+      };
+      await page.goto(base + '/#/?status=successful');
+      await shows('successful');
+      await page.reload();
+      await shows('successful');
+      if (!page.url().endsWith('#/?status=successful')) throw new Error('the reload lost the filter: ' + page.url());
+      await page.check('#filters input[value="failed"]');
+      await page.uncheck('#filters input[value="successful"]');
+      await page.waitForFunction(() => location.hash === '#/?status=failed');
+      await shows('failed');
+      await page.screenshot({ path: shot('filtered'), fullPage: true });
+      // a job page leads back to the filtered list
+      await page.click(`tr[data-job="${of('failed')[0]}"] a`);
+      await page.waitForFunction((i) => document.getElementById('job-id').textContent === i, of('failed')[0]);
+      await page.click('#back');
+      await shows('failed');
+    });
+    await step('dashboard_pages', async () => {
+      const limit = 3;
+      let total = (await apiCall('jobs?limit=1')).numberMatched;
+      if (total <= 2 * limit) { // three pages, the last one short
+        const ex = (await apiCall('dashboard/examples')).examples.find((e) => e.name === example);
+        while (total <= 2 * limit) { await submitJob(ex.process, ex.inputs); total++; }
+      }
+      // every job ended: the lists by status below hold still
+      await until('every job ended', async () => (await apiCall('jobs?status=accepted,running&limit=1')).numberMatched === 0, 60);
+      const pageOf = async (n, q) => (await apiCall(`jobs?limit=${limit}&offset=${(n - 1) * limit}${q || ''}`)).jobs.map((j) => j.jobID);
+      const range = (n, len) => `jobs ${(n - 1) * limit + 1}–${(n - 1) * limit + len} of ${total}`;
+      const buttons = async (prev, next) => {
+        const got = [await page.isEnabled('#prev'), await page.isEnabled('#next')];
+        if (got[0] !== prev || got[1] !== next) throw new Error(`newer/older enabled: ${got} (want ${prev},${next})`);
+      };
+      await page.goto(base + `/#/?limit=${limit}`);
+      const p1 = await pageOf(1), p2 = await pageOf(2);
+      await listShows(page, p1, range(1, limit));
+      await buttons(false, true);
+      await page.click('#next');
+      await listShows(page, p2, range(2, limit));
+      if (!/page=2/.test(page.url())) throw new Error('the page is not in the hash: ' + page.url());
+      await page.reload();
+      await listShows(page, p2, range(2, limit));
+      await buttons(true, true);
+      const last = Math.ceil(total / limit), pl = await pageOf(last);
+      await page.goto(base + `/#/?page=${last}&limit=${limit}`);
+      await listShows(page, pl, range(last, pl.length));
+      await buttons(true, false);
+      await page.screenshot({ path: shot('pages'), fullPage: true });
+      await page.click('#prev');
+      await listShows(page, await pageOf(last - 1), range(last - 1, limit));
+      // filters and pages together: the second page of the ended jobs
+      const q = '&status=successful,failed,dismissed';
+      const ended = (await apiCall(`jobs?limit=1${q}`)).numberMatched;
+      const e2 = await pageOf(2, q);
+      await page.goto(base + `/#/?status=successful,failed,dismissed&page=2&limit=${limit}`);
+      await listShows(page, e2, `jobs ${limit + 1}–${limit + e2.length} of ${ended}`);
     });
     await step('dashboard_fits_390px', async () => {
       await page.setViewportSize({ width: 390, height: 844 });

@@ -9,7 +9,10 @@
 # bar showed are printed as a BAR line); then job pages: the status word kept
 # through progress events, a failed job's reason, summary and partial file
 # (h5ls reads it), a cancel button that dismisses, times in the browser's
-# zone, and the list and a job page no wider than a 390 px viewport
+# zone; the queue line (GET /dashboard/queue, which answers the counts only,
+# to a token when auth is on) as the API counts, the list filtered by status
+# and process through the URL hash (kept across a reload) and paged as the API
+# pages it; and the list and a job page no wider than a 390 px viewport
 # (dashboard_driver.js).  Screenshots: $PACKD_BUILD/screenshots/.
 . "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
 BUILD=${PACKD_BUILD:-$(dirname "$PACKD")}
@@ -35,6 +38,26 @@ check dashboard_examples_listed python3 -c "
 import json; d = json.load(open('$T/ex.json'))['examples']
 assert any(e['name'] == 'meier-quartz-2d.json' and e['inputs']['dim'] == 2 for e in d), d"
 check dashboard_asset_404 test "$(c -o /dev/null -w '%{http_code}' "$B/dashboard/nope.js")" = 404
+
+# GET /dashboard/queue: counts only (no job ids, no owners); with auth on a token is needed
+queue_doc() { # NAME FILE: the document has exactly the counts and the local executor
+    check "$1" python3 -c "
+import json; d = json.load(open('$2'))
+assert set(d) == {'accepted', 'running', 'workers_busy', 'workers_max', 'executor'}, d
+assert all(isinstance(d[k], int) and d[k] >= 0 for k in d if k != 'executor'), d
+assert d['workers_max'] >= 1 and d['executor'] == 'local', d"
+}
+c -o "$T/queue.json" "$B/dashboard/queue"
+queue_doc dashboard_queue_counts "$T/queue.json"
+B_OPEN=$B
+tok=$("$PACKD" token add alice --data "$T/auth" 2>/dev/null)
+printf 'auth = on\n' >"$T/auth.conf"
+start_daemon auth --config "$T/auth.conf" || exit 1
+B_AUTH=$B
+check dashboard_queue_needs_token test "$(c -o /dev/null -w '%{http_code}' "$B_AUTH/dashboard/queue")" = 401
+c -H "Authorization: Bearer $tok" -o "$T/queue_auth.json" "$B_AUTH/dashboard/queue"
+queue_doc dashboard_queue_counts_auth "$T/queue_auth.json"
+B=$B_OPEN
 
 # --- the browser
 CHROMIUM=$(command -v chromium || true)
@@ -70,7 +93,5 @@ browse() { # TAG [TOKEN]: the driver's PASS/FAIL lines, then the download checke
 browse ""
 
 # auth on: the token typed into the page; pictures and files come as blobs
-tok=$("$PACKD" token add alice --data "$T/auth" 2>/dev/null)
-printf 'auth = on\n' >"$T/auth.conf"
-start_daemon auth --config "$T/auth.conf" || exit 1
+B=$B_AUTH
 browse _auth "$tok"

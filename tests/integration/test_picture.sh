@@ -17,13 +17,19 @@ trap 'rm -rf "$T"' EXIT
 "$PACKD" picture "$T/q.h5" -o "$T/q.png"
 # box panel: x from 36, y from 54, 720 px wide (api/picture/picture_packing.c); φ = 0.45
 fill=$(python3 "$SRC/tests/tools/png_fill.py" "$T/q.png" 37 55 755 773)
-check picture_2d_png_size test "$(echo "$fill" | cut -d' ' -f1-2)" = "792 810"
+check picture_2d_png_size test "$(echo "$fill" | cut -d' ' -f1-2)" = "962 846"
+# right of the panel a swatch and the diameters of each size class (coloured
+# swatches: 6 of the 7 classes were placed); below it the scale bar
+legend=$(python3 "$SRC/tests/tools/png_fill.py" "$T/q.png" 792 54 962 230 colour)
+check picture_2d_size_legend python3 -c "f = float('$legend'.split()[2]); assert f > 0.005, f"
+bar=$(python3 "$SRC/tests/tools/png_fill.py" "$T/q.png" 36 815 156 835)
+check picture_2d_scale_bar python3 -c "f = float('$bar'.split()[2]); assert f > 0.05, f"
 # outlines (0.4–0.9 px around 3–17 px disks) add up to ~0.07 of ink
 check picture_2d_ink_is_phi python3 -c "f = float('$fill'.split()[2]); assert 0.45 <= f <= 0.55, f"
 "$PACKD" picture "$T/q.h5" -o "$T/q.svg"
 check picture_2d_svg python3 -c "
 import xml.etree.ElementTree as E
-r = E.parse('$T/q.svg').getroot(); assert r.tag.endswith('svg') and r.get('width').startswith('792'), r.attrib"
+r = E.parse('$T/q.svg').getroot(); assert r.tag.endswith('svg') and r.get('width').startswith('962'), r.attrib"
 "$PACKD" picture "$T/q.h5" --kind grading -o "$T/g.svg"
 check picture_grading_svg python3 -c "
 import xml.etree.ElementTree as E; E.parse('$T/g.svg')"
@@ -32,7 +38,7 @@ import xml.etree.ElementTree as E; E.parse('$T/g.svg')"
 "$PACKD" run "$SRC/examples/din-a16-3d-walled.json" -o "$T/a.h5" >/dev/null 2>&1
 "$PACKD" picture "$T/a.h5" -o "$T/a.png"
 fill3=$(python3 "$SRC/tests/tools/png_fill.py" "$T/a.png" 37 55 755 773)
-check picture_3d_two_panels test "$(echo "$fill3" | cut -d' ' -f1)" = 1548
+check picture_3d_two_panels test "$(echo "$fill3" | cut -d' ' -f1)" = 1718
 # a section through grains at φ_eff = 0.316 inks about φ of the plane (area fraction = volume fraction)
 check picture_3d_section_ink python3 -c "f = float('$fill3'.split()[2]); assert 0.25 <= f <= 0.42, f"
 # a tetfill result: its tet mesh where the section cuts it, outlined in dark red (one

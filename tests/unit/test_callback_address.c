@@ -8,10 +8,22 @@ static void test_public_and_private(void)
 {
     CHECK(pk_callback_address_ok("93.184.216.34", ""));
     CHECK(pk_callback_address_ok("2606:2800:220:1::248", ""));
-    const char *closed[] = {"127.0.0.1", "10.1.2.3",  "172.16.0.1", "172.31.255.255",
-                            "192.168.1.1", "169.254.169.254", "100.64.0.1", "0.0.0.0",
-                            "224.0.0.1", "::1", "::", "fe80::1", "fd00::1", "::ffff:127.0.0.1",
-                            "::ffff:10.0.0.1", "not an address"};
+    const char *closed[] = {"127.0.0.1",
+                            "10.1.2.3",
+                            "172.16.0.1",
+                            "172.31.255.255",
+                            "192.168.1.1",
+                            "169.254.169.254",
+                            "100.64.0.1",
+                            "0.0.0.0",
+                            "224.0.0.1",
+                            "::1",
+                            "::",
+                            "fe80::1",
+                            "fd00::1",
+                            "::ffff:127.0.0.1",
+                            "::ffff:10.0.0.1",
+                            "not an address"};
     for (size_t i = 0; i < sizeof closed / sizeof *closed; i++)
         CHECK_MSG(!pk_callback_address_ok(closed[i], ""), "%s", closed[i]);
     CHECK(pk_callback_address_ok("172.32.0.1", "")); /* just outside 172.16/12 */
