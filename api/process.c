@@ -41,7 +41,7 @@ static const pk_process homogenize_process = {
     .run = pk_homog_run,
 };
 
-static const char *const fe2_pictures[] = {"packing", "response", NULL};
+static const char *const fe2_pictures[] = {"field", "response", "packing", NULL};
 static const pk_process fe2_process = {
     .id = "fe2",
     .title = "FE²: a plane-strain boundary value problem with a DEM RVE at every Gauss point",

@@ -44,9 +44,22 @@ function localTime(iso) {
   });
 }
 
-// The line of a progress event: its stage and φ (the worker's object)
+function duration(s) {
+  const t = Math.round(s);
+  return t < 60 ? t + ' s' : Math.floor(t / 60) + ' min ' + String(t % 60).padStart(2, '0') + ' s';
+}
+
+// The line of a progress event: its stage, φ, the time elapsed and left
+// (the stage's own estimate, else a linear one from its fraction)
 function progressLine(d) {
-  return d.stage + (d.phi ? ', φ = ' + Number(d.phi).toFixed(4) : '');
+  let line = d.stage + (d.phi ? ', φ = ' + Number(d.phi).toFixed(4) : '');
+  if (typeof d.elapsed_s === 'number') {
+    line += ', ' + duration(d.elapsed_s) + ' elapsed';
+    const eta = typeof d.eta_s === 'number' && d.eta_s >= 0 ? d.eta_s
+      : d.fraction >= 0.02 && d.fraction < 1 ? d.elapsed_s * (1 - d.fraction) / d.fraction : -1;
+    if (eta >= 0) line += ', about ' + duration(eta) + ' left';
+  }
+  return line;
 }
 
 function el(tag, text, cls) {

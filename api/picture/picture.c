@@ -3,6 +3,7 @@
 
 #include <cairo.h>
 #include <fontconfig/fontconfig.h>
+#include <hdf5.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -14,6 +15,10 @@ static const struct {
     pk_picture_kind kind;
     int (*draw)(const char *h5_path, const char *out_path, char *err, size_t errlen);
 } kinds[] = {
+    /* first: an fe2 result's default picture is its macro problem, not its RVE */
+    {"field", "field", "the FE² stress field",
+     "the macro mesh deformed, coloured by the von Mises stress (fe2 results)", PK_PICTURE_FIELD,
+     pk_picture_field},
     {"packing", "picture", "the packing",
      "the grains by size class (3D: mid-plane section and depth-shaded view along -z)",
      PK_PICTURE_PACKING, pk_picture_packing},
@@ -56,6 +61,16 @@ const char *pk_picture_kind_name(int i, const char **file, const char **title, c
     if (help)
         *help = kinds[i].help;
     return kinds[i].name;
+}
+
+pk_picture_kind pk_picture_default(const char *h5_path)
+{
+    hid_t f = H5Fopen(h5_path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    int fe2 = f >= 0 && H5Lexists(f, "/observables/fe2", H5P_DEFAULT) > 0 &&
+        H5Lexists(f, "/observables/fe2/mesh", H5P_DEFAULT) > 0;
+    if (f >= 0)
+        H5Fclose(f);
+    return fe2 ? PK_PICTURE_FIELD : PK_PICTURE_PACKING;
 }
 
 int pk_picture_write(const char *h5_path, pk_picture_kind kind, const char *out_path, char *err,

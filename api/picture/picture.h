@@ -30,7 +30,8 @@ typedef enum {
     PK_PICTURE_HISTORY,
     PK_PICTURE_STRESS,
     PK_PICTURE_RESIDUAL,
-    PK_PICTURE_RESPONSE
+    PK_PICTURE_RESPONSE,
+    PK_PICTURE_FIELD
 } pk_picture_kind;
 
 /* A kind's name ("packing", "grading", ...) → kind; -1 for any other name. */
@@ -42,6 +43,11 @@ int pk_picture_kind_parse(const char *name, pk_picture_kind *kind);
  * one list of the kinds: `packd picture` and the service's outputs
  * (api/http/http_outputs.h) read it. */
 const char *pk_picture_kind_name(int i, const char **file, const char **title, const char **help);
+
+/* The kind `packd picture` draws when none is named: an fe2 result's field
+ * (the macro problem), any other result's packing.  H5 errors silenced by
+ * the caller's quiet mode or printed; a file that does not open: packing. */
+pk_picture_kind pk_picture_default(const char *h5_path);
 
 /* Draw the picture of h5_path into out_path (written under a temporary name,
  * then renamed).  0 on success, -1 with err. */

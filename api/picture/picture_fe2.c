@@ -29,8 +29,9 @@ int pk_picture_response(const char *h5_path, const char *out_path, char *err, si
     double *dil = pk_plot_series(f, FE2 "dilatancy_percent/value", &nd);
     double *comp = pk_plot_series(f, FE2 "reaction/component", &nc);
     char *names = pk_plot_text(f, FE2 "reaction/names");
-    char bc[64];
+    char bc[64], unit[32];
     pk_plot_string(f, FE2 "boundary_condition", bc, sizeof bc);
+    pk_plot_unit(f, FE2 "reaction", unit, sizeof unit);
     double *re[MAXC] = {0};
     char label[MAXC][80];
     int nre = 0;
@@ -79,7 +80,10 @@ int pk_picture_response(const char *h5_path, const char *out_path, char *err, si
         pk_plot_grid_y(c.cr, &q, 1);
         pk_plot_grid_x(c.cr, &p);
         pk_plot_frame(c.cr, &p, "load (stage + fraction of the stage)", NULL);
-        pk_plot_title_y(c.cr, &p, 0, "reaction of the support (per unit thickness)", NULL, NULL);
+        char ytitle[96];
+        snprintf(ytitle, sizeof ytitle, "reaction of the support per unit thickness%s%s%s",
+                 unit[0] ? " [" : "", unit, unit[0] ? "]" : "");
+        pk_plot_title_y(c.cr, &p, 0, ytitle, NULL, NULL);
         pk_plot_title_y(c.cr, &q, 1, "dilatancy \u0394 (%)", NULL, &sd);
         const pk_plot_style *styles[MAXC + 1];
         const char *texts[MAXC + 1];
@@ -91,7 +95,17 @@ int pk_picture_response(const char *h5_path, const char *out_path, char *err, si
         pk_plot_line(c.cr, &q, t, dil, n, &sd);
         styles[nre] = &sd;
         texts[nre] = "dilatancy (right axis)";
-        pk_plot_legend(c.cr, &p, 3, styles, texts, nre + 1);
+        /* the corner the curves leave freest, the dilatancy mapped onto the left axis */
+        double *dil_on_p = malloc(n * sizeof *dil_on_p);
+        const double *ys[MAXC + 1];
+        for (int k = 0; k < nre; k++)
+            ys[k] = re[k];
+        for (size_t i = 0; dil_on_p && i < n; i++)
+            dil_on_p[i] = p.y.lo + (dil[i] - q.y.lo) / (q.y.hi - q.y.lo) * (p.y.hi - p.y.lo);
+        ys[nre] = dil_on_p ? dil_on_p : dil;
+        int corner = pk_plot_free_corner(c.cr, &p, texts, nre + 1, t, ys, nre + 1, n);
+        free(dil_on_p);
+        pk_plot_legend(c.cr, &p, corner, styles, texts, nre + 1);
         char text[200];
         snprintf(text, sizeof text, "FE\u00b2 response: %s boundary condition, %zu load step%s",
                  *bc ? bc : "unknown", n, n == 1 ? "" : "s");

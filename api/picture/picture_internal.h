@@ -10,5 +10,6 @@ int pk_picture_history(const char *h5_path, const char *out_path, char *err, siz
 int pk_picture_stress(const char *h5_path, const char *out_path, char *err, size_t errlen);
 int pk_picture_residual(const char *h5_path, const char *out_path, char *err, size_t errlen);
 int pk_picture_response(const char *h5_path, const char *out_path, char *err, size_t errlen);
+int pk_picture_field(const char *h5_path, const char *out_path, char *err, size_t errlen);
 
 #endif

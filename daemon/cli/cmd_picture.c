@@ -10,7 +10,8 @@ static int usage(FILE *f)
 {
     fprintf(f,
             "usage: packd picture RESULT.h5 -o FILE.svg|FILE.png [--kind KIND]\n"
-            "kinds (default packing; a kind needs its data in the file):\n");
+            "kinds (default: field for an fe2 result, else packing; a kind needs its data in "
+            "the file):\n");
     const char *name, *help;
     for (int i = 0; (name = pk_picture_kind_name(i, NULL, NULL, &help)); i++)
         fprintf(f, "  %-9s %s\n", name, help);
@@ -19,7 +20,7 @@ static int usage(FILE *f)
 
 int cmd_picture(int argc, char **argv)
 {
-    const char *in = NULL, *out = NULL, *kind_name = "packing";
+    const char *in = NULL, *out = NULL, *kind_name = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help"))
             return usage(stdout);
@@ -33,8 +34,10 @@ int cmd_picture(int argc, char **argv)
             return usage(stderr);
     }
     pk_picture_kind kind;
-    if (!in || !out || pk_picture_kind_parse(kind_name, &kind) != 0)
+    if (!in || !out || (kind_name && pk_picture_kind_parse(kind_name, &kind) != 0))
         return usage(stderr);
+    if (!kind_name)
+        kind = pk_picture_default(in);
     char err[1024];
     int rc = pk_picture_write(in, kind, out, err, sizeof err);
     pk_picture_release();

@@ -4,7 +4,8 @@
 // the HDF5 file; then submit the EDMD example with its inputs edited to grow
 // slower (about 5 s) and see its bar stand strictly between 0 and 100 %
 // while it runs (the live progress), then at 100 %.  Then, on job pages: a
-// running job keeps its status word through its progress events; a job that
+// running job keeps its status word through its progress events and shows
+// its stage, φ, time elapsed and left; a job that
 // runs out of wall time shows `failed`, its reason, summary and partial-file
 // download; a running job cancelled by its button shows `dismissed`.  Times
 // are shown in the browser's zone (Asia/Kolkata, GMT+5:30) and say so.  The
@@ -220,6 +221,8 @@ async function step(name, fn) {
       await page.waitForFunction(() => window.seenStatus.length >= 100 &&
         window.seenBar.some((v) => v > 0 && v < 100), null, { timeout: 60000 * slow });
       const [st, bar] = await page.evaluate(() => { clearInterval(window.sampler); return [window.seenStatus, window.seenBar]; });
+      const msg = await page.textContent('#job-message');
+      if (!/^rsa, φ = 0\.\d{4}, \d+ s elapsed, about .* left$/.test(msg)) throw new Error('progress line: ' + msg);
       const other = st.filter((x) => x !== 'running').length;
       if (other) throw new Error(other + ' of ' + st.length + ' samples without the status word: ' + [...new Set(st)].join(' '));
       await page.click('#cancel');

@@ -76,6 +76,14 @@ check xdmf_sidecar sh -c "grep -q 'TopologyType=\"Quadrilateral\"' r.xdmf &&
     test \$(grep -c '<Time ' r.xdmf) -eq 3"
 "$PACKD" picture r.h5 -o resp.svg --kind response >/dev/null 2>&1
 check picture_response test -s resp.svg
+# the default picture of an fe2 result is its macro problem: the deformed
+# mesh coloured by the von Mises stress (coloured ink over the mesh, a bar)
+"$PACKD" picture r.h5 -o field.png >/dev/null 2>&1
+mesh_ink=$(python3 "$SRC/tests/tools/png_fill.py" field.png 50 75 600 550 colour)
+check picture_default_is_field python3 -c "
+w, h, f = '$mesh_ink'.split()[:3]; assert (w, h) == ('760', '600') and float(f) > 0.2, '$mesh_ink'"
+"$PACKD" picture r.h5 --kind packing -o rve.png >/dev/null 2>&1
+check picture_rve_on_request test -s rve.png
 check xdmf_items_match python3 "$SRC/tests/tools/xdmf_check.py" r.xdmf --steps 3 --mesh2d 4
 # H5MD 1.1: the job's unit (mm) on the RVE, the mesh, the fields; plane-strain stress in N mm-2
 check h5md_fe2 python3 "$SRC/tests/tools/h5md_check.py" r.h5
@@ -126,6 +134,9 @@ check daemon_successful wait_status "$ID" successful 60
 c -o d.h5 "$B/jobs/$ID/results/result"
 c -o res.json "$B/jobs/$ID/results"
 check daemon_lists_response_picture grep -q 'response.png' res.json
+check daemon_lists_field_picture_first python3 -c "
+import json; d = json.load(open('res.json')); pics = [k for k in d if k.endswith('.png')]
+assert pics and pics[0] == 'field.png', pics"
 check daemon_result_read_back sh -c "h5dump -d /observables/fe2/displacement/value d.h5 | grep -q '( 3, 9, 2 )'"
 
 # 3b. the served process description: each input's schema usable alone by a third-party

@@ -28,6 +28,7 @@ static void test_declared_per_process(void)
     CHECK(declares("homogenize", "stress.png") && !declares("homogenize", "grading.png"));
     CHECK(!declares("homogenize", "history.png"));
     CHECK(declares("fe2", "response.svg") && !declares("fe2", "stress.png"));
+    CHECK(declares("fe2", "field.png") && !declares("pack", "field.png"));
 }
 
 static void test_pictures_are_outputs(void)
@@ -46,7 +47,8 @@ static void test_pictures_are_outputs(void)
     CHECK(pk_output_find("stress.gif") == NULL && pk_output_find(NULL) == NULL);
     char all[600];
     pk_outputs_list(all, sizeof all);
-    CHECK_MSG(strstr(all, "summary, result, xdmf, picture.png") && strstr(all, "response.svg"),
+    CHECK_MSG(strstr(all, "summary, result, xdmf, field.png") && strstr(all, "picture.png") &&
+                  strstr(all, "response.svg"),
               "%s", all);
     for (size_t i = 0; pk_processes[i]; i++)
         for (size_t j = 0; pk_processes[i]->pictures && pk_processes[i]->pictures[j]; j++) {
