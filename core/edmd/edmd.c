@@ -261,27 +261,18 @@ static void hist_push(pk_edmd_stats *st, uint64_t *stride, uint64_t ev, double t
     st->nhist++;
 }
 
-/* Set rates, masses, velocities, positions (zero start), skins.  Returns the
- * stop time (INFINITY when growing until jammed) or NAN on bad input. */
-static double setup(edmd_state *s, const pk_particles *p, const pk_edmd_params *prm,
-                    pk_edmd_stats *st)
+/* The growth law: radii ρ_i(t) = a_i + g_i·t (k[i].a, k[i].g) and the shell
+ * h0 + h1·t; *t_end: when the law reaches the target sizes.  -1 on bad input. */
+static int set_rates(edmd_state *s, const pk_particles *p, const pk_edmd_params *prm, double dbar,
+                     double *t_end)
 {
     const size_t n = s->n;
-    const int dim = s->dim;
-    double dbar = 0, rmax = 0;
-    for (size_t i = 0; i < n; i++) {
-        dbar += 2 * p->r[i] / (double)n;
-        rmax = fmax(rmax, p->r[i]);
-    }
-    if (!(dbar > 0) || !(prm->growth_rate > 0))
-        return NAN;
     const double gam = prm->growth_rate, h = 0.5 * prm->delta_d;
-    double t_end;
     if (prm->growth == PK_EDMD_GROW_RELATIVE) {
         double s0 = prm->start_zero ? 0 : prm->delta;
         if (!(s0 >= 0 && s0 < 1))
-            return NAN;
-        t_end = (1 - s0) / gam;
+            return -1;
+        *t_end = (1 - s0) / gam;
         for (size_t i = 0; i < n; i++) {
             if (prm->start_zero) { /* ρ = (r + h)·γt: the shell scales with the grain */
                 s->k[i].a = 0;
@@ -293,26 +284,28 @@ static double setup(edmd_state *s, const pk_particles *p, const pk_edmd_params *
         }
         s->h0 = h;
         s->h1 = 0;
-    } else {
-        if (prm->start_zero)
-            return NAN;
-        double ga = 0.5 * gam * dbar;
-        for (size_t i = 0; i < n; i++) {
-            s->k[i].a = p->r[i];
-            s->k[i].g = ga;
-        }
-        s->h0 = 0;
-        s->h1 = ga;
-        t_end = h / ga;
+        return 0;
     }
-    st->t_end = t_end;
-    double t_stop = t_end;
-    if (prm->until == PK_EDMD_UNTIL_JAMMED)
-        t_stop = INFINITY;
-    else if (prm->growth == PK_EDMD_GROW_RELATIVE && prm->phi_target > 0)
-        t_stop = time_of_phi(s, prm->phi_target);
+    if (prm->start_zero)
+        return -1;
+    double ga = 0.5 * gam * dbar;
+    for (size_t i = 0; i < n; i++) {
+        s->k[i].a = p->r[i];
+        s->k[i].g = ga;
+    }
+    s->h0 = 0;
+    s->h1 = ga;
+    *t_end = h / ga;
+    return 0;
+}
 
-    /* masses (normalised to mean 1) and equipartition velocities */
+/* Masses (normalised to mean 1: by volume, or equal) and equipartition
+ * velocities of scale d̄/√m without drift; positions wrapped into [0, L). */
+static void set_motion(edmd_state *s, const pk_particles *p, const pk_edmd_params *prm, double dbar,
+                       double rmax)
+{
+    const size_t n = s->n;
+    const int dim = s->dim;
     double msum = 0;
     for (size_t i = 0; i < n; i++) {
         s->m[i] = prm->equal_masses ? 1.0 : pow(p->r[i] / rmax, dim);
@@ -329,18 +322,25 @@ static double setup(edmd_state *s, const pk_particles *p, const pk_edmd_params *
             s->k[i].v[k] = sc * pk_rng_normal(&rng);
     }
     remove_drift(s);
-    for (size_t i = 0; i < n; i++) { /* wrapped into [0, L) */
+    for (size_t i = 0; i < n; i++) {
         for (int k = 0; k < 3; k++)
             s->k[i].p[k] = k >= dim ? 0 : p->x[3 * i + k];
         pk_box_wrap(&s->box, s->k[i].p); /* t = 0: p is the position */
     }
-    /* skins: a fraction of the radius at the reference time, at most twice
-     * the mean (coarse grains would list hundreds of fines); grains below the
-     * mean get SKIN_FINE·(2ρ̄ − r), up to SKIN_FINE·2ρ̄ for the finest: fines
-     * fly as fast as the coarse and rattle in their pores, so with a small
-     * skin they rebuild all the time (a rebuild is a multi-level cell query),
-     * while their lists (few grains of their size) stay short
-     * (docs/perf/edmd.md, SKIN_FINE) */
+}
+
+/* Skins: a fraction of the radius at the reference time, at most twice
+ * the mean (coarse grains would list hundreds of fines); grains below the
+ * mean get SKIN_FINE·(2ρ̄ − r), up to SKIN_FINE·2ρ̄ for the finest: fines
+ * fly as fast as the coarse and rattle in their pores, so with a small
+ * skin they rebuild all the time (a rebuild is a multi-level cell query),
+ * while their lists (few grains of their size) stay short
+ * (docs/perf/edmd.md, SKIN_FINE).  A skin leaves a pair one periodic image
+ * within reach.  -1 when the periodic box is too small for that. */
+static int set_skins(edmd_state *s, const pk_edmd_params *prm, double t_end)
+{
+    const size_t n = s->n;
+    const int dim = s->dim;
     double t_ref = isfinite(t_end) ? t_end : 0;
     double rho_mean = 0, rho_max = 0;
     for (size_t i = 0; i < n; i++) {
@@ -358,7 +358,7 @@ static double setup(edmd_state *s, const pk_particles *p, const pk_edmd_params *
         grow_max = pow(1 / fmax(phi_sim(s, t_ref), 1e-300), 1.0 / dim);
     double room = 0.25 * Lper - rho_max * grow_max;
     if (!(room > 0))
-        return NAN;
+        return -1;
     for (size_t i = 0; i < n; i++) {
         double r = edmd_rho(s, i, t_ref);
         s->rref[i] = r;
@@ -368,6 +368,34 @@ static double setup(edmd_state *s, const pk_particles *p, const pk_edmd_params *
         if (0.5 * s->skin[i] > room)
             s->skin[i] = 2 * room;
     }
+    return 0;
+}
+
+/* Set rates, masses, velocities, positions (zero start), skins.  Returns the
+ * stop time (INFINITY when growing until jammed) or NAN on bad input. */
+static double setup(edmd_state *s, const pk_particles *p, const pk_edmd_params *prm,
+                    pk_edmd_stats *st)
+{
+    const size_t n = s->n;
+    double dbar = 0, rmax = 0;
+    for (size_t i = 0; i < n; i++) {
+        dbar += 2 * p->r[i] / (double)n;
+        rmax = fmax(rmax, p->r[i]);
+    }
+    if (!(dbar > 0) || !(prm->growth_rate > 0))
+        return NAN;
+    double t_end;
+    if (set_rates(s, p, prm, dbar, &t_end) != 0)
+        return NAN;
+    st->t_end = t_end;
+    double t_stop = t_end;
+    if (prm->until == PK_EDMD_UNTIL_JAMMED)
+        t_stop = INFINITY;
+    else if (prm->growth == PK_EDMD_GROW_RELATIVE && prm->phi_target > 0)
+        t_stop = time_of_phi(s, prm->phi_target);
+    set_motion(s, p, prm, dbar, rmax);
+    if (set_skins(s, prm, t_end) != 0)
+        return NAN;
     double vmax_g = 0;
     for (size_t i = 0; i < n; i++)
         vmax_g = fmax(vmax_g, s->k[i].g);

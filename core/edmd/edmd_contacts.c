@@ -104,6 +104,85 @@ void pk_contact_network_free(pk_contact_network *net)
     memset(net, 0, sizeof *net);
 }
 
+/* The contact graph as CSR: grain i's neighbours adj[off[i] .. off[i+1]-1],
+ * -1 for a wall.  deg[i] is grain i's contact count.  -1 when out of memory
+ * (*off, *adj set to what must be freed). */
+static int build_adjacency(const pk_contact_network *net, size_t n, const int32_t *deg,
+                           size_t **off_out, int32_t **adj_out)
+{
+    size_t *off = malloc((n + 1) * sizeof *off);
+    *off_out = off;
+    *adj_out = NULL;
+    if (!off)
+        return -1;
+    off[0] = 0;
+    for (size_t i = 0; i < n; i++)
+        off[i + 1] = off[i] + (size_t)deg[i];
+    int32_t *adj = malloc((off[n] + 1) * sizeof *adj);
+    *adj_out = adj;
+    size_t *fill = malloc((n + 1) * sizeof *fill);
+    if (!adj || !fill) {
+        free(fill);
+        return -1;
+    }
+    memcpy(fill, off, (n + 1) * sizeof *fill);
+    for (size_t k = 0; k < net->npair; k++) {
+        adj[fill[net->pi[k]]++] = net->pj[k];
+        adj[fill[net->pj[k]]++] = net->pi[k];
+    }
+    for (size_t k = 0; k < net->nwall; k++)
+        adj[fill[net->wi[k]]++] = -1; /* a wall: never peeled */
+    free(fill);
+    return 0;
+}
+
+/* Peel: a grain with fewer than dim+1 contacts to the remaining grains and
+ * the walls cannot be locally jammed; removing it may leave a neighbour
+ * short too.  Sets gone[i] for the rattlers, lowers deg to the contacts
+ * within the backbone, and returns the rattler count.  stack: n entries. */
+static size_t peel_rattlers(size_t n, int dim, const size_t *off, const int32_t *adj, int32_t *deg,
+                            uint8_t *gone, int32_t *stack)
+{
+    size_t top = 0, rattlers = 0;
+    for (size_t i = 0; i < n; i++)
+        if (deg[i] < dim + 1) {
+            gone[i] = 1;
+            stack[top++] = (int32_t)i;
+        }
+    while (top) {
+        size_t i = (size_t)stack[--top];
+        rattlers++;
+        for (size_t q = off[i]; q < off[i + 1]; q++) {
+            if (adj[q] < 0)
+                continue;
+            size_t j = (size_t)adj[q];
+            if (gone[j])
+                continue;
+            if (--deg[j] < dim + 1) {
+                gone[j] = 1;
+                stack[top++] = (int32_t)j;
+            }
+        }
+    }
+    return rattlers;
+}
+
+/* The backbone's contact counts (pairs once, wall contacts once) and mean
+ * coordination, from deg after the peel. */
+static void backbone_stats(const pk_contact_network *net, size_t n, const int32_t *deg,
+                           const uint8_t *gone, pk_contact_stats *cs)
+{
+    size_t z = 0;
+    for (size_t i = 0; i < n; i++)
+        if (!gone[i])
+            z += (size_t)deg[i];
+    size_t walls = 0; /* each pair counted twice in z, each wall contact once */
+    for (size_t k = 0; k < net->nwall; k++)
+        walls += !gone[net->wi[k]];
+    cs->backbone_contacts = (z - walls) / 2 + walls;
+    cs->mean_contacts = (double)z / (double)cs->backbone;
+}
+
 int pk_contact_network_compute(const pk_box *b, const pk_particles *p, double delta_d,
                                double wall_gap, double tol, pk_contact_network *out,
                                pk_contact_stats *cs)
@@ -148,65 +227,16 @@ int pk_contact_network_compute(const pk_box *b, const pk_particles *p, double de
     }
     for (size_t k = 0; k < net->nwall; k++)
         deg[net->wi[k]]++;
-    /* adjacency (CSR), then peel: a grain with fewer than dim+1 contacts to
-     * the remaining grains and the walls cannot be locally jammed */
-    off = malloc((p->n + 1) * sizeof *off);
     stack = malloc(p->n * sizeof *stack);
-    if (!off || !stack)
+    if (build_adjacency(net, p->n, deg, &off, &adj) != 0 || !stack)
         goto out;
-    off[0] = 0;
-    for (size_t i = 0; i < p->n; i++)
-        off[i + 1] = off[i] + (size_t)deg[i];
-    adj = malloc((off[p->n] + 1) * sizeof *adj);
-    size_t *fill = malloc((p->n + 1) * sizeof *fill);
-    if (!adj || !fill) {
-        free(fill);
-        goto out;
-    }
-    memcpy(fill, off, (p->n + 1) * sizeof *fill);
-    for (size_t k = 0; k < net->npair; k++) {
-        adj[fill[net->pi[k]]++] = net->pj[k];
-        adj[fill[net->pj[k]]++] = net->pi[k];
-    }
-    for (size_t k = 0; k < net->nwall; k++)
-        adj[fill[net->wi[k]]++] = -1; /* a wall: never peeled */
-    free(fill);
-    size_t top = 0;
-    for (size_t i = 0; i < p->n; i++)
-        if (deg[i] < p->dim + 1) {
-            gone[i] = 1;
-            stack[top++] = (int32_t)i;
-        }
-    while (top) {
-        size_t i = (size_t)stack[--top];
-        cs->rattlers++;
-        for (size_t q = off[i]; q < off[i + 1]; q++) {
-            if (adj[q] < 0)
-                continue;
-            size_t j = (size_t)adj[q];
-            if (gone[j])
-                continue;
-            if (--deg[j] < p->dim + 1) {
-                gone[j] = 1;
-                stack[top++] = (int32_t)j;
-            }
-        }
-    }
+    cs->rattlers = peel_rattlers(p->n, p->dim, off, adj, deg, gone, stack);
     cs->contacts = net->npair;
     cs->wall_contacts = net->nwall;
     cs->rattler_fraction = (double)cs->rattlers / (double)p->n;
     cs->backbone = p->n - cs->rattlers;
-    if (cs->backbone) {
-        size_t z = 0;
-        for (size_t i = 0; i < p->n; i++)
-            if (!gone[i])
-                z += (size_t)deg[i];
-        size_t walls = 0; /* each pair counted twice in z, each wall contact once */
-        for (size_t k = 0; k < net->nwall; k++)
-            walls += !gone[net->wi[k]];
-        cs->backbone_contacts = (z - walls) / 2 + walls;
-        cs->mean_contacts = (double)z / (double)cs->backbone;
-    }
+    if (cs->backbone)
+        backbone_stats(net, p->n, deg, gone, cs);
     rc = 0;
     if (out) {
         net->rattler = gone;

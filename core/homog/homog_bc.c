@@ -135,6 +135,128 @@ static void diff_keys(const pk_homog_state *a, const pk_homog_state *b, size_t *
     *broken = a->ncontact - common;
 }
 
+/* F̄ as the 3×3 the RVE is deformed by: the 2D embedding
+ * [[F11 F12 0] [F21 F22 0] [0 0 1]] in 2D.  -3 unless finite. */
+static int embed_F(const double F[9], int dim, double Fm[9])
+{
+    memcpy(Fm, F, 9 * sizeof *Fm);
+    if (dim == 2) {
+        Fm[2] = Fm[5] = Fm[6] = Fm[7] = 0;
+        Fm[8] = 1;
+    }
+    for (int k = 0; k < 9; k++)
+        if (!isfinite(Fm[k]))
+            return -3;
+    return 0;
+}
+
+/* The trial's starting positions: prescribed grains at F̄X ((4.24), (4.27)₁,
+ * corners (4.33)₂); free ones where the committed state left them, moved by
+ * F̄ F̄ₙ⁻¹ with the affine predictor.  -3 if F̄ₙ is singular. */
+static int prescribe(const pk_homog_rve *rve, const pk_homog_opts *o,
+                     const pk_homog_state *committed, const double Fm[9], pk_homog_state *trial)
+{
+    double Fold_inv[9], Q[9];
+    if (pk_m3_inv(committed->F, Fold_inv) == 0)
+        return -3;
+    pk_m3_mul(Fm, Fold_inv, Q);
+    for (size_t i = 0; i < rve->n; i++) {
+        double *x = &trial->x[3 * i];
+        if (rve->fixed[i])
+            pk_m3_vec(Fm, &rve->X[3 * i], x);
+        else if (o->affine_predictor) {
+            double y[3];
+            pk_m3_vec(Q, x, y);
+            memcpy(x, y, sizeof y);
+        }
+        if (rve->dim == 2)
+            x[2] = 0;
+    }
+    return 0;
+}
+
+/* Relax the free grains of the trial: with friction (history from the
+ * committed state), by the Newton hybrid when asked, else by DR. */
+static int relax_trial(const pk_dem_system *sys, const pk_homog_rve *rve, const pk_homog_opts *o,
+                       const pk_homog_state *committed, pk_fric_ctx *fc, pk_homog_state *trial,
+                       pk_monitor *mon, pk_homog_step *out, pk_fric_totals *ftot)
+{
+    size_t nfree = 0;
+    for (size_t i = 0; i < sys->np; i++)
+        nfree += sys->is_free[i];
+    if (o->friction) {
+        geom_of(rve, &fc->g_n);
+        pk_dem_geom_set_F(&fc->g_n, committed->F);
+        return pk_homog_relax_fric(sys, trial->x, &o->dr, fc, trial->u, mon, &out->dr, ftot);
+    }
+    if (o->newton && nfree) {
+        out->used_newton = 1;
+        const pk_newton_opts no = {o->newton, o->newton_ctx, o->newton_max_iter};
+        return pk_homog_newton_speculative(sys, trial->x, &o->dr, &no, mon, &out->dr, &out->newton);
+    }
+    return pk_homog_relax(sys, trial->x, &o->dr, mon, &out->dr);
+}
+
+/* The averaged stresses from S = Σ f ⊗ l over the RVE's volume V:
+ * P = (Σ f ⊗ l) F̄⁻ᵗ / V, σ = S / (J V), and σ's skew part. */
+static void average_stresses(const double S[9], const double Finv[9], double J, double V,
+                             pk_homog_step *out)
+{
+    double FinvT[9];
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            FinvT[3 * a + b] = Finv[3 * b + a];
+    pk_m3_mul(S, FinvT, out->P); /* Σ f ⊗ F̄⁻¹l = (Σ f ⊗ l) F̄⁻ᵗ */
+    for (int k = 0; k < 9; k++) {
+        out->P[k] /= V;
+        out->sigma[k] = S[k] / (J * V);
+    }
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            out->sigma_skew[3 * a + b] = 0.5 * (out->sigma[3 * a + b] - out->sigma[3 * b + a]);
+}
+
+/* Balance checks of the relaxed state from the forces f: |Σ f|, the free
+ * grains' residual, the stress from the prescribed grains' reactions (walled
+ * RVEs; periodic: P itself) and its relative defect against P. */
+static void force_balance(const pk_homog_rve *rve, const double *f, const uint8_t *is_free,
+                          pk_homog_step *out)
+{
+    const int dim = rve->dim;
+    double sf[3] = {0, 0, 0}, ff = 0;
+    memset(out->P_reaction, 0, sizeof out->P_reaction);
+    for (size_t i = 0; i < rve->n; i++) {
+        for (int a = 0; a < dim; a++) {
+            sf[a] += f[3 * i + a];
+            ff += is_free[i] ? f[3 * i + a] * f[3 * i + a] : 0;
+        }
+        if (rve->fixed[i] && !rve->periodic)
+            for (int a = 0; a < dim; a++)
+                for (int b = 0; b < dim; b++)
+                    out->P_reaction[3 * a + b] -= f[3 * i + a] * rve->X[3 * i + b] / rve->V;
+    }
+    if (rve->periodic)
+        memcpy(out->P_reaction, out->P, sizeof out->P);
+    out->sum_force = sqrt(sf[0] * sf[0] + sf[1] * sf[1] + sf[2] * sf[2]);
+    out->free_force = sqrt(ff);
+    double dP = 0, nP = 0;
+    for (int k = 0; k < 9; k++) {
+        dP += (out->P_reaction[k] - out->P[k]) * (out->P_reaction[k] - out->P[k]);
+        nP += out->P[k] * out->P[k];
+    }
+    out->reaction_defect = sqrt(dP) / fmax(sqrt(nP), 1e-300);
+}
+
+/* Largest overlap of a contact over the smaller radius of its pair. */
+static double max_overlap_ratio(const pk_dem_pairs *c, const double *r)
+{
+    double m = 0;
+    for (size_t p = 0; p < c->n; p++)
+        if (c->eps[p] >= 0 && c->len[p] > 0)
+            m = fmax(m, c->eps[p] / fmin(r[c->i[p]], r[c->j[p]]));
+    return m;
+}
+
 int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homog_state *committed,
                   const double F[9], pk_homog_state *trial, pk_homog_step *out, pk_monitor *mon)
 {
@@ -142,14 +264,8 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     const size_t n = rve->n;
     memset(out, 0, sizeof *out);
     double Fm[9];
-    memcpy(Fm, F, sizeof Fm);
-    if (dim == 2) { /* the 2D embedding: F = [[F11 F12 0] [F21 F22 0] [0 0 1]] */
-        Fm[2] = Fm[5] = Fm[6] = Fm[7] = 0;
-        Fm[8] = 1;
-    }
-    for (int k = 0; k < 9; k++)
-        if (!isfinite(Fm[k]))
-            return -3;
+    if (embed_F(F, dim, Fm) != 0)
+        return -3;
     pk_dem_geom g;
     geom_of(rve, &g);
     double J = pk_dem_geom_set_F(&g, Fm);
@@ -160,23 +276,8 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     if (pk_homog_state_copy(trial, committed) != 0)
         return -1;
     memcpy(trial->F, Fm, sizeof Fm);
-    /* prescribed positions; free ones from the committed history (+ predictor) */
-    double Fold_inv[9], Q[9];
-    if (pk_m3_inv(committed->F, Fold_inv) == 0)
+    if (prescribe(rve, o, committed, Fm, trial) != 0)
         return -3;
-    pk_m3_mul(Fm, Fold_inv, Q);
-    for (size_t i = 0; i < n; i++) {
-        double *x = &trial->x[3 * i];
-        if (rve->fixed[i])
-            pk_m3_vec(Fm, &rve->X[3 * i], x); /* (4.24), (4.27)₁, corners (4.33)₂ */
-        else if (o->affine_predictor) {
-            double y[3];
-            pk_m3_vec(Q, x, y);
-            memcpy(x, y, sizeof y);
-        }
-        if (dim == 2)
-            x[2] = 0;
-    }
     uint8_t *is_free = malloc(n ? n : 1);
     double *f = malloc(3 * (n ? n : 1) * sizeof *f);
     uint8_t *rat = malloc(n ? n : 1);
@@ -192,21 +293,8 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     }
     for (size_t i = 0; i < n; i++)
         is_free[i] = !rve->fixed[i];
-    size_t nfree = 0;
-    for (size_t i = 0; i < n; i++)
-        nfree += is_free[i];
     const pk_dem_system sys = {&c, &g, rve->r, n, o->E_n, is_free};
-    if (o->friction) {
-        geom_of(rve, &fc.g_n);
-        pk_dem_geom_set_F(&fc.g_n, committed->F);
-        rc = pk_homog_relax_fric(&sys, trial->x, &o->dr, &fc, trial->u, mon, &out->dr, &ftot);
-    } else if (o->newton && nfree) {
-        out->used_newton = 1;
-        const pk_newton_opts no = {o->newton, o->newton_ctx, o->newton_max_iter};
-        rc = pk_homog_newton_speculative(&sys, trial->x, &o->dr, &no, mon, &out->dr, &out->newton);
-    } else {
-        rc = pk_homog_relax(&sys, trial->x, &o->dr, mon, &out->dr);
-    }
+    rc = relax_trial(&sys, rve, o, committed, &fc, trial, mon, out, &ftot);
     if (rc != 0)
         goto done;
 
@@ -229,45 +317,9 @@ int pk_homog_eval(const pk_homog_rve *rve, const pk_homog_opts *o, const pk_homo
     out->J = J;
     out->energy = phi;
     out->energy_density = phi / rve->V;
-    double FinvT[9];
-    for (int a = 0; a < 3; a++)
-        for (int b = 0; b < 3; b++)
-            FinvT[3 * a + b] = g.Finv[3 * b + a];
-    pk_m3_mul(S, FinvT, out->P); /* Σ f ⊗ F̄⁻¹l = (Σ f ⊗ l) F̄⁻ᵗ */
-    for (int k = 0; k < 9; k++) {
-        out->P[k] /= rve->V;
-        out->sigma[k] = S[k] / (J * rve->V);
-    }
-    for (int a = 0; a < 3; a++)
-        for (int b = 0; b < 3; b++)
-            out->sigma_skew[3 * a + b] = 0.5 * (out->sigma[3 * a + b] - out->sigma[3 * b + a]);
-    double sf[3] = {0, 0, 0}, ff = 0;
-    memset(out->P_reaction, 0, sizeof out->P_reaction);
-    for (size_t i = 0; i < n; i++) {
-        for (int a = 0; a < dim; a++) {
-            sf[a] += f[3 * i + a];
-            ff += is_free[i] ? f[3 * i + a] * f[3 * i + a] : 0;
-        }
-        if (rve->fixed[i] && !rve->periodic)
-            for (int a = 0; a < dim; a++)
-                for (int b = 0; b < dim; b++)
-                    out->P_reaction[3 * a + b] -= f[3 * i + a] * rve->X[3 * i + b] / rve->V;
-    }
-    if (rve->periodic)
-        memcpy(out->P_reaction, out->P, sizeof out->P);
-    out->sum_force = sqrt(sf[0] * sf[0] + sf[1] * sf[1] + sf[2] * sf[2]);
-    out->free_force = sqrt(ff);
-    double dP = 0, nP = 0;
-    for (int k = 0; k < 9; k++) {
-        dP += (out->P_reaction[k] - out->P[k]) * (out->P_reaction[k] - out->P[k]);
-        nP += out->P[k] * out->P[k];
-    }
-    out->reaction_defect = sqrt(dP) / fmax(sqrt(nP), 1e-300);
-    for (size_t p = 0; p < c.n; p++)
-        if (c.eps[p] >= 0 && c.len[p] > 0) {
-            double rmin = fmin(rve->r[c.i[p]], rve->r[c.j[p]]);
-            out->max_overlap_ratio = fmax(out->max_overlap_ratio, c.eps[p] / rmin);
-        }
+    average_stresses(S, g.Finv, J, rve->V, out);
+    force_balance(rve, f, is_free, out);
+    out->max_overlap_ratio = max_overlap_ratio(&c, rve->r);
     size_t nr = pk_dem_rattlers(&c, dim, n, is_free, rat);
     if (nr == (size_t)-1) {
         rc = -1;

@@ -238,6 +238,210 @@ static pk_sparse_factor *factor_block(const newton_run *sy, newton_work *w, doub
     return F;
 }
 
+/* Trust region in the max norm: no grain moves more than MAX_MOVE Verlet
+ * skins per step — along a soft mode the step is cut to the region where
+ * contacts are known (trial points keep their candidate list, no rebuild per
+ * line-search cut).  Scales d (nd entries, dim per grain) and *gd with it. */
+static void trust_region(double *d, size_t nd, int dim, double skin, double *gd)
+{
+    double dmax2 = 0;
+    for (size_t e = 0; e < nd; e += (size_t)dim) {
+        double q = 0;
+        for (int a = 0; a < dim; a++)
+            q += d[e + a] * d[e + a];
+        dmax2 = fmax(dmax2, q);
+    }
+    double reach = MAX_MOVE * skin;
+    if (dmax2 > reach * reach) {
+        double shrink = reach / sqrt(dmax2);
+        for (size_t e = 0; e < nd; e++)
+            d[e] *= shrink;
+        *gd *= shrink;
+    }
+}
+
+/* A line-search outcome: step s to the trial point w->xt (forces w->ft),
+ * its energy and residual, and whether it was accepted. */
+typedef struct trial {
+    double s, phi, fn;
+    int ok;
+} trial;
+
+/* Backtracking line search from x along w->d (slope gd < 0): accept by
+ * Armijo's rule, or by a lower residual where the energy change is lost in
+ * round-off; each cut takes the minimiser of the quadratic through Φ(0),
+ * Φ'(0), Φ(s) (Nocedal & Wright §3.5) within [CUT_MIN, CUT_MAX]·s.  Returns
+ * the force evaluation's error, else 0 with *t. */
+static int line_search(const newton_run *sy, newton_work *w, const double *x, double phi, double fn,
+                       double gd, pk_newton_stats *ns, trial *t)
+{
+    const int dim = sy->s.g->dim;
+    const size_t np = sy->s.np;
+    double s = 1, phit = phi, ftn = fn, cut_by = CUT_MAX;
+    int ok = 0, rc = 0;
+    for (int cut = 0; cut < MAX_CUTS; cut++, s *= cut_by) {
+        memcpy(w->xt, x, 3 * np * sizeof *x);
+        for (size_t i = 0; i < np; i++)
+            if (w->dof[i] >= 0)
+                for (int a = 0; a < dim; a++)
+                    w->xt[3 * i + a] += s * w->d[w->dof[i] + a];
+        rc = eval_at(sy->s.c, sy->s.g, w->xt, sy->s.r, np, sy->s.E, sy->prm, w->ft, &phit);
+        if (rc != 0)
+            break;
+        ftn = sqrt(pk_homog_dot_mask(w->ft, w->ft, sy->s.is_free, np, dim));
+        double lin = -s * gd; /* predicted decrease to first order */
+        if (lin <= ENERGY_ROUNDOFF * fabs(phi))
+            ok = ftn < fn; /* energy change lost in round-off */
+        else
+            ok = phit <= phi - ARMIJO * lin;
+        if (ok)
+            break;
+        ns->cuts++;
+        /* Φ(t) ≈ Φ + t·gd + c t² through Φ(s): its minimiser over s */
+        cut_by = lin > ENERGY_ROUNDOFF * fabs(phi)
+            ? fmax(CUT_MIN, fmin(CUT_MAX, 0.5 * lin / (phit - phi + lin)))
+            : CUT_MAX;
+    }
+    *t = (trial){.s = s, .phi = phit, .fn = ftn, .ok = ok};
+    return rc;
+}
+
+/* Move to the accepted trial point: the L-BFGS pair (s·d, Δg) joins the
+ * memory, the point, its forces, energy and residual become current. */
+static void take_step(const newton_run *sy, newton_work *w, const trial *t, double *x, double *phi,
+                      double *fn)
+{
+    const int dim = sy->s.g->dim;
+    const size_t np = sy->s.np, nd = w->mem.nd;
+    gather_gradient(w->ft, w->dof, np, dim, w->gt);
+    for (size_t e = 0; e < nd; e++) {
+        w->sv[e] = t->s * w->d[e];
+        w->yv[e] = w->gt[e] - w->g[e];
+    }
+    qn_push(&w->mem, w->sv, w->yv);
+    memcpy(w->g, w->gt, nd * sizeof *w->g);
+    memcpy(x, w->xt, 3 * np * sizeof *x);
+    memcpy(w->f, w->ft, 3 * np * sizeof *w->f);
+    *phi = t->phi;
+    *fn = t->fn;
+}
+
+/* The stop checks between steps: 1 when the abort flag is set or the monitor
+ * asks to stop (st->stop set then), else 0. */
+static int newton_tick(const newton_run *sy, const pk_newton_stats *ns, pk_dr_stats *st)
+{
+    if (sy->abort && atomic_load(sy->abort))
+        return 1;
+    if (sy->mon) {
+        pk_progress pr = {
+            .stage = "newton", .fraction = -1, .phi = -1, .eta_s = -1, .done = ns->steps};
+        int t = pk_monitor_tick(sy->mon, &pr, 0);
+        if (t) {
+            st->stop = t == 1 ? PK_DR_CANCELLED : PK_DR_WALL_TIME;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Quasi-Newton steps preconditioned by the factor fac: exact Newton first,
+ * then L-BFGS corrections as contacts open and close, until the residual
+ * stops halving within REFRESH_WINDOW steps (the caller refreshes the
+ * factor), reaches target, or MAX_INNER steps.  *failed_first: the first
+ * step's line search failed.  Returns 0, -1 (memory), -2 (box), 1 (stop). */
+static int qn_steps(const newton_run *sy, newton_work *w, pk_sparse_factor *fac, double *x,
+                    double *phi, double *fn, double target, int *failed_first, pk_newton_stats *ns,
+                    pk_dr_stats *st)
+{
+    const size_t nd = w->mem.nd;
+    w->mem.count = w->mem.head = 0;
+    gather_gradient(w->f, w->dof, sy->s.np, sy->s.g->dim, w->g);
+    double f_window = *fn;
+    size_t window_start = 0;
+    *failed_first = 0;
+    for (size_t inner = 0; inner<MAX_INNER && * fn> target; inner++) {
+        if (qn_direction(&w->mem, sy->solver, fac, w->g, w->qv, w->d) != 0)
+            return -1;
+        double gd = dot(w->g, w->d, nd);
+        if (!(gd < 0)) { /* memory spoilt the direction: plain preconditioned step */
+            w->mem.count = w->mem.head = 0;
+            if (qn_direction(&w->mem, sy->solver, fac, w->g, w->qv, w->d) != 0)
+                return -1;
+            gd = dot(w->g, w->d, nd);
+            if (!(gd < 0))
+                return 0;
+        }
+        trust_region(w->d, nd, sy->s.g->dim, sy->prm->skin, &gd);
+        trial t;
+        int rc = line_search(sy, w, x, *phi, *fn, gd, ns, &t);
+        if (rc != 0)
+            return rc;
+        if (!t.ok) {
+            *failed_first = inner == 0;
+            return 0;
+        }
+        take_step(sy, w, &t, x, phi, fn);
+        ns->steps++;
+        if (*fn < 0.5 * f_window) {
+            f_window = *fn;
+            window_start = inner;
+        } else if (inner >= window_start + REFRESH_WINDOW) {
+            return 0;
+        }
+        if (newton_tick(sy, ns, st))
+            return 1;
+    }
+    return 0;
+}
+
+/* A point reached with a Levenberg–Marquardt shift is a minimum only if the
+ * unshifted block is positive definite there: ns->exit says which. */
+static int confirm_minimum(const newton_run *sy, newton_work *w, size_t *budget,
+                           pk_newton_stats *ns)
+{
+    pk_sparse_info info;
+    pk_sparse_factor *fac = factor_block(sy, w, 0, budget, ns, &info);
+    sy->solver->release(fac);
+    if (info.status == PK_SPARSE_FAILED)
+        return -1;
+    ns->exit = info.status == PK_SPARSE_OK ? PK_NEWTON_CONVERGED : PK_NEWTON_BLOCK_NOT_PD;
+    return 0;
+}
+
+/* The Levenberg–Marquardt shift of an attempt (see pk_hybrid_newton_phase). */
+typedef struct lm_shift {
+    double mu, mu_used;
+    int stable_start; /* the block was positive definite at the entry point */
+    int raises, hold; /* hold: keep μ at the next positive definite factorisation */
+} lm_shift;
+
+/* After an indefinite block: 1 if μ is raised (×10, or SHIFT_FIRST·E) for
+ * another factorisation, 0 if the phase ends. */
+static int lm_raise(lm_shift *m, double E, int shift, double fn, double f_entry,
+                    pk_newton_stats *ns)
+{
+    if (!(shift && m->stable_start && m->raises < SHIFT_RAISES && m->mu < SHIFT_MAX * E &&
+          fn <= f_entry))
+        return 0;
+    m->mu = m->mu > 0 ? 10 * m->mu : SHIFT_FIRST * E;
+    ns->shifts++;
+    m->raises++;
+    m->hold = 1;
+    return 1;
+}
+
+/* After a positive definite factorisation with μ: μ ÷ 10 for the next one
+ * (held once after a raise), 0 below SHIFT_MIN·E. */
+static void lm_factored(lm_shift *m, double E)
+{
+    m->mu_used = m->mu;
+    if (m->hold)
+        m->hold = 0;
+    else
+        m->mu = m->mu > 10 * SHIFT_MIN * E ? 0.1 * m->mu : 0;
+    m->stable_start = 1;
+}
+
 /* One Newton phase from x (w->f, *phi, *fn describe x on entry and on exit):
  * factorisations of the stiffness at the current point, each followed by
  * L-BFGS steps it preconditions, until |f| <= target.  It hands back
@@ -263,17 +467,12 @@ int pk_hybrid_newton_phase(const newton_run *sy, newton_work *w, double *x, doub
                            double target, size_t stall, int shift, size_t *budget,
                            pk_newton_stats *ns, pk_dr_stats *st)
 {
-    pk_dem_pairs *c = sy->s.c;
-    const pk_dem_geom *g = sy->s.g;
-    const int dim = g->dim;
-    const size_t np = sy->s.np, nd = w->mem.nd;
     const double E = sy->s.E;
-    double best = *fn, mu = 0, mu_used = 0;
     const double f_entry = *fn; /* no shift once the residual rose above it */
+    double best = *fn;
     size_t since_best = 0;
-    int stable_start = 0;     /* the block was positive definite at the entry point */
-    int raises = 0, hold = 0; /* hold: keep μ at the next positive definite factorisation */
-    int rises = 0;            /* of the residual between factorisation points (attempts) */
+    int rises = 0; /* of the residual between factorisation points (attempts) */
+    lm_shift m = {0};
     ns->exit = PK_NEWTON_CAP;
     while (*fn > target) {
         if (*budget == 0)
@@ -285,141 +484,24 @@ int pk_hybrid_newton_phase(const newton_run *sy, newton_work *w, double *x, doub
             return 0;
         }
         pk_sparse_info info;
-        pk_sparse_factor *fac = factor_block(sy, w, mu, budget, ns, &info);
-        if (info.status == PK_SPARSE_FAILED) {
-            sy->solver->release(fac);
-            return -1;
-        }
+        pk_sparse_factor *fac = factor_block(sy, w, m.mu, budget, ns, &info);
         if (info.status != PK_SPARSE_OK) {
             sy->solver->release(fac);
-            if (shift && stable_start && raises < SHIFT_RAISES && mu < SHIFT_MAX * E &&
-                *fn <= f_entry) {
-                mu = mu > 0 ? 10 * mu : SHIFT_FIRST * E;
-                ns->shifts++;
-                raises++;
-                hold = 1;
+            if (info.status == PK_SPARSE_FAILED)
+                return -1;
+            if (lm_raise(&m, E, shift, *fn, f_entry, ns))
                 continue;
-            }
             ns->exit = PK_NEWTON_BLOCK_NOT_PD;
             return 0;
         }
-        mu_used = mu;
-        if (hold)
-            hold = 0;
-        else
-            mu = mu > 10 * SHIFT_MIN * E ? 0.1 * mu : 0;
-        stable_start = 1;
-        /* Quasi-Newton steps preconditioned by this factor: exact Newton first,
-         * then L-BFGS corrections as contacts open and close, until the
-         * residual stops halving within the window (refresh the factor). */
-        w->mem.count = w->mem.head = 0;
-        gather_gradient(w->f, w->dof, np, dim, w->g);
+        lm_factored(&m, E);
         const double f_factor = *fn;
-        double f_window = *fn;
-        size_t window_start = 0;
-        int failed_first = 0, rc = 0;
-        for (size_t inner = 0; inner<MAX_INNER && * fn> target; inner++) {
-            if (qn_direction(&w->mem, sy->solver, fac, w->g, w->qv, w->d) != 0) {
-                rc = -1;
-                break;
-            }
-            double gd = dot(w->g, w->d, nd);
-            if (!(gd < 0)) { /* memory spoilt the direction: plain preconditioned step */
-                w->mem.count = w->mem.head = 0;
-                if (qn_direction(&w->mem, sy->solver, fac, w->g, w->qv, w->d) != 0) {
-                    rc = -1;
-                    break;
-                }
-                gd = dot(w->g, w->d, nd);
-                if (!(gd < 0))
-                    break;
-            }
-            /* Trust region in the max norm: no grain moves more than half the
-             * Verlet skin per step — along a soft mode the step is cut to the
-             * region where contacts are known (trial points keep their
-             * candidate list, no rebuild per line-search cut). */
-            double dmax2 = 0;
-            for (size_t e = 0; e < nd; e += (size_t)dim) {
-                double q = 0;
-                for (int a = 0; a < dim; a++)
-                    q += w->d[e + a] * w->d[e + a];
-                dmax2 = fmax(dmax2, q);
-            }
-            double reach = MAX_MOVE * sy->prm->skin;
-            if (dmax2 > reach * reach) {
-                double shrink = reach / sqrt(dmax2);
-                for (size_t e = 0; e < nd; e++)
-                    w->d[e] *= shrink;
-                gd *= shrink;
-            }
-            double s = 1, phit = *phi, ftn = *fn, cut_by = CUT_MAX;
-            int ok = 0;
-            for (int cut = 0; cut < MAX_CUTS; cut++, s *= cut_by) {
-                memcpy(w->xt, x, 3 * np * sizeof *x);
-                for (size_t i = 0; i < np; i++)
-                    if (w->dof[i] >= 0)
-                        for (int a = 0; a < dim; a++)
-                            w->xt[3 * i + a] += s * w->d[w->dof[i] + a];
-                rc = eval_at(c, g, w->xt, sy->s.r, np, E, sy->prm, w->ft, &phit);
-                if (rc != 0)
-                    break;
-                ftn = sqrt(pk_homog_dot_mask(w->ft, w->ft, sy->s.is_free, np, dim));
-                double lin = -s * gd; /* predicted decrease to first order */
-                if (lin <= ENERGY_ROUNDOFF * fabs(*phi))
-                    ok = ftn < *fn; /* energy change lost in round-off */
-                else
-                    ok = phit <= *phi - ARMIJO * lin;
-                if (ok)
-                    break;
-                ns->cuts++;
-                /* Φ(t) ≈ Φ + t·gd + c t² through Φ(s): its minimiser over s */
-                cut_by = lin > ENERGY_ROUNDOFF * fabs(*phi)
-                    ? fmax(CUT_MIN, fmin(CUT_MAX, 0.5 * lin / (phit - *phi + lin)))
-                    : CUT_MAX;
-            }
-            if (rc != 0)
-                break;
-            if (!ok) {
-                failed_first = inner == 0;
-                break;
-            }
-            gather_gradient(w->ft, w->dof, np, dim, w->gt);
-            for (size_t e = 0; e < nd; e++) {
-                w->sv[e] = s * w->d[e];
-                w->yv[e] = w->gt[e] - w->g[e];
-            }
-            qn_push(&w->mem, w->sv, w->yv);
-            memcpy(w->g, w->gt, nd * sizeof *w->g);
-            memcpy(x, w->xt, 3 * np * sizeof *x);
-            memcpy(w->f, w->ft, 3 * np * sizeof *w->f);
-            *phi = phit;
-            *fn = ftn;
-            ns->steps++;
-            if (*fn < 0.5 * f_window) {
-                f_window = *fn;
-                window_start = inner;
-            } else if (inner >= window_start + REFRESH_WINDOW) {
-                break;
-            }
-            if (sy->abort && atomic_load(sy->abort)) {
-                rc = 1;
-                break;
-            }
-            if (sy->mon) {
-                pk_progress pr = {
-                    .stage = "newton", .fraction = -1, .phi = -1, .eta_s = -1, .done = ns->steps};
-                int t = pk_monitor_tick(sy->mon, &pr, 0);
-                if (t) {
-                    st->stop = t == 1 ? PK_DR_CANCELLED : PK_DR_WALL_TIME;
-                    rc = 1;
-                    break;
-                }
-            }
-        }
+        int failed_first;
+        int rc = qn_steps(sy, w, fac, x, phi, fn, target, &failed_first, ns, st);
         sy->solver->release(fac);
         if (rc != 0)
             return rc;
-        rc = eval_at(c, g, x, sy->s.r, np, E, sy->prm, w->f,
+        rc = eval_at(sy->s.c, sy->s.g, x, sy->s.r, sy->s.np, E, sy->prm, w->f,
                      phi); /* contacts of the current point */
         if (rc != 0)
             return rc;
@@ -438,17 +520,8 @@ int pk_hybrid_newton_phase(const newton_run *sy, newton_work *w, double *x, doub
             return 0;
         }
     }
-    if (mu_used > 0) { /* converged on a shifted model: a minimum only if K itself is PD */
-        pk_sparse_info info;
-        pk_sparse_factor *fac = factor_block(sy, w, 0, budget, ns, &info);
-        sy->solver->release(fac);
-        if (info.status == PK_SPARSE_FAILED)
-            return -1;
-        if (info.status != PK_SPARSE_OK) {
-            ns->exit = PK_NEWTON_BLOCK_NOT_PD;
-            return 0;
-        }
-    }
+    if (m.mu_used > 0) /* converged on a shifted model: a minimum only if K itself is PD */
+        return confirm_minimum(sy, w, budget, ns);
     ns->exit = PK_NEWTON_CONVERGED;
     return 0;
 }

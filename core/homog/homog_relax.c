@@ -368,6 +368,26 @@ int pk_relax_settled(pk_dr_stats *st, const pk_dr_params *prm, int nothing_moves
     return 1;
 }
 
+/* Σ −Δx·Δf and Σ Δx·Δx over the iterations since the last estimate
+ * (frictionless: the increments of x alone), Δx = Δt v: their quotient is
+ * the Rayleigh quotient of DR's own increments (estimate). */
+typedef struct increments {
+    double df, dd;
+} increments;
+
+/* Fresh estimates at x (geometry refreshed first), seeded by the increments'
+ * Rayleigh quotient; the increments start again.  -1 when out of memory. */
+static int re_estimate(const relax_run *sys, pk_relax_geom *geo, const double *f, double *x,
+                       double *u, const double *gu, increments *inc, pk_dr_stats *st)
+{
+    pk_relax_geom_refresh(geo, x);
+    if (estimate(sys, f, x, u, gu, inc->dd > 0 ? inc->df / inc->dd : 0, st) != 0)
+        return -1;
+    st->refreshes++;
+    inc->df = inc->dd = 0;
+    return 0;
+}
+
 static int relax(const pk_dem_system *sy, double *x, const pk_dr_params *prm, pk_fric_ctx *fc,
                  double *u, pk_dr_hook *hook, pk_monitor *mon, pk_dr_stats *st, pk_fric_totals *tot)
 {
@@ -403,12 +423,7 @@ static int relax(const pk_dem_system *sy, double *x, const pk_dr_params *prm, pk
     pk_progress pr = {.stage = "relax", .fraction = -1, .phi = -1, .eta_s = -1};
     double fbest = st->f0;
     pk_relax_geom geo = {sy, 1}; /* pk_dem_eval_forces */
-    /* Σ −Δx·Δf and Σ Δx·Δx over the iterations since the last estimate
-     * (frictionless: the increments of x alone), Δx = Δt v: the Rayleigh
-     * quotient of DR's own increments (estimate) */
-    struct {
-        double df, dd;
-    } inc = {0, 0};
+    increments inc = {0, 0};
     for (size_t k = 0;; k++) {
         double dt = st->dt, gm = st->gamma;
         /* one step of (4.39)–(4.41): cv = (2 − γΔt)/(2 + γΔt), cf = 2Δt/(2 + γΔt),
@@ -450,27 +465,20 @@ static int relax(const pk_dem_system *sy, double *x, const pk_dr_params *prm, pk
             break;
         if (!isfinite(st->f) || st->f > 1e3 * fbest) {
             /* diverging: the spectrum moved (new contacts) — fresh estimates, restart at rest */
-            pk_relax_geom_refresh(&geo, x);
-            if (estimate(&sys, f, x, u, gu, inc.dd > 0 ? inc.df / inc.dd : 0, st) != 0) {
+            if (re_estimate(&sys, &geo, f, x, u, gu, &inc, st) != 0) {
                 rc = -1;
                 goto out;
             }
             memset(v, 0, 3 * np * sizeof *v);
             memset(vu, 0, np * sizeof *vu);
             fbest = st->f;
-            st->refreshes++;
-            inc.df = inc.dd = 0;
             continue;
         }
         fbest = fmin(fbest, st->f);
-        if (prm->refresh && st->iterations % prm->refresh == 0) {
-            pk_relax_geom_refresh(&geo, x);
-            if (estimate(&sys, f, x, u, gu, inc.dd > 0 ? inc.df / inc.dd : 0, st) != 0) {
-                rc = -1;
-                goto out;
-            }
-            st->refreshes++;
-            inc.df = inc.dd = 0;
+        if (prm->refresh && st->iterations % prm->refresh == 0 &&
+            re_estimate(&sys, &geo, f, x, u, gu, &inc, st) != 0) {
+            rc = -1;
+            goto out;
         }
     }
     pk_relax_geom_refresh(&geo, x);

@@ -439,199 +439,270 @@ static inline size_t draw_of(const scratch *w, int region, size_t a)
     return region ? w->ord[a] : a;
 }
 
+/* One run of run_batches: the cell store, the batch scratch, the occupancy
+ * map of the batch's placements and the open region, with the counters
+ * carried from one batch to the next. */
+typedef struct batch_run {
+    const pk_rsa_batch_env *e;
+    double r;
+    const int32_t *species;
+    size_t m;
+    const double *lo, *span;
+    pk_rsa_cells C;
+    scratch w;
+    uint8_t *map;     /* cells holding a grain accepted in this batch (bit per cell) */
+    int shift;        /* bucket of a cell: its index >> shift */
+    uint32_t nbucket; /* buckets of the counting sort */
+    int grid_empty;   /* no grain in the grid: its overlap test is skipped */
+    double ball;      /* measure of one grain */
+    size_t first;     /* grains before the run (obstacles) */
+    pk_rsa_region reg;
+    int region, region_allowed; /* draws from the open region; may still switch to it */
+    uint64_t stale_since;       /* draws in fully covered cells since the last compaction */
+    size_t placed;
+    uint64_t failed;      /* draws failed in a row */
+    double p_surv, p_acc; /* running estimates from the last batch */
+} batch_run;
+
+/* Set up the run's store, scratch and map.  -1 when out of memory (nothing
+ * left to free). */
+static int open_run(batch_run *u, const pk_rsa_batch_env *e, double r, const int32_t *species,
+                    size_t m, const double *lo, const double *span)
+{
+    *u = (batch_run){.e = e, .r = r, .species = species, .m = m, .lo = lo, .span = span};
+    if (pk_rsa_cells_init(&u->C, e->b, r, e->prm->delta_d, lo, span) != 0)
+        return -1;
+    u->map = calloc(u->C.ncell / 8 + 16, 1);
+    if (!u->map) {
+        pk_rsa_cells_free(&u->C);
+        return -1;
+    }
+    while (((u->C.ncell - 1) >> u->shift) >= MAX_BUCKETS)
+        u->shift++;
+    u->nbucket = (uint32_t)((u->C.ncell - 1) >> u->shift) + 1;
+    u->grid_empty = 1;
+    for (int l = 0; l < e->grid->nlevel; l++)
+        u->grid_empty &= e->grid->lv[l].count == 0;
+    u->ball = pk_ball_measure(e->b->dim, r);
+    u->first = e->out->n;
+    u->region_allowed = e->prm->draws == PK_RSA_DRAWS_OPEN;
+    u->p_surv = u->p_acc = 1;
+    return 0;
+}
+
+static void close_run(batch_run *u)
+{
+    pk_rsa_region_free(&u->reg);
+    scratch_free(&u->w);
+    free(u->map);
+    pk_rsa_cells_free(&u->C);
+}
+
+/* Attempts of the next batch: enough draws for SURVIVORS survivors, at most
+ * twice what the grains left need at the last acceptance rate. */
+static size_t batch_size(const batch_run *u)
+{
+    size_t B = u->e->prm->test.batch_attempts;
+    if (!B) {
+        double want = SURVIVORS / u->p_surv, finish = 2.0 * (double)(u->m - u->placed) / u->p_acc;
+        want = want < finish ? want : finish;
+        B = want < B_MIN ? B_MIN : (want > (double)B_MAX ? B_MAX : (size_t)want);
+    }
+    return B;
+}
+
+/* Report progress; the stop a cancel or the wall time asks for, else
+ * PK_STOP_COMPLETE. */
+static pk_stop_reason progress_tick(const batch_run *u)
+{
+    const pk_rsa_batch_env *e = u->e;
+    pk_progress *pg = e->pg;
+    pg->done = e->st->placed;
+    pg->fraction = (double)e->st->placed / (double)(e->st->requested ? e->st->requested : 1);
+    pg->phi = *e->solid / e->box_measure;
+    int cc = pk_monitor_tick(e->mon, pg, 0);
+    return cc == 0 ? PK_STOP_COMPLETE : cc == 2 ? PK_STOP_WALL_TIME : PK_STOP_CANCELLED;
+}
+
+/* Step 3: walk the A attempts of a batch of B draws in attempt order, accept
+ * each survivor that hits neither the batch's earlier acceptances nor the
+ * grid.  Sets *used (draws of the batch consumed) and *acc (accepted). */
+static pk_stop_reason walk_attempts(batch_run *u, size_t S, size_t A, size_t B, size_t *used,
+                                    size_t *acc)
+{
+    const pk_rsa_batch_env *e = u->e;
+    const pk_grid *grid = e->grid;
+    pk_particles *out = e->out;
+    scratch *w = &u->w;
+    uint8_t *map = u->map;
+    const double r = u->r;
+    uint64_t hmask = 63;
+    while (hmask + 1 < 2 * (uint64_t)S)
+        hmask = 2 * hmask + 1;
+    memset(w->head, 0xff, (hmask + 1) * sizeof *w->head);
+    memset(w->taken, 0, S);
+    const uint64_t max_failed = e->prm->max_failed_draws;
+    const size_t nword = (A + 63) / 64;
+    uint64_t failed = u->failed;
+    size_t placed = u->placed;
+    pk_stop_reason reason = PK_STOP_COMPLETE;
+    *used = B;
+    *acc = 0;
+    size_t a = 0;      /* next attempt of the walk */
+    size_t next_d = 0; /* its first draw not yet counted */
+    for (;;) {
+        /* draws rejected at once or in step 2 count as failures: jump to the next survivor */
+        size_t wd = a >> 6;
+        uint64_t bits = wd < nword ? w->sbit[wd] & (~(uint64_t)0 << (a & 63)) : 0;
+        while (!bits && ++wd < nword)
+            bits = w->sbit[wd];
+        a = bits ? 64 * wd + (size_t)__builtin_ctzll(bits) : A;
+        size_t d = a < A ? draw_of(w, u->region, a) : B;
+        if ((uint64_t)(d - next_d) >= max_failed - failed) {
+            *used = next_d + (size_t)(max_failed - failed);
+            failed = max_failed;
+            reason = PK_STOP_MAX_FAILED_DRAWS;
+            break;
+        }
+        failed += d - next_d;
+        if (a == A)
+            break;
+        size_t cur = a++;
+        next_d = d + 1;
+        int32_t j = w->slot[cur];
+        const double *x = &w->surv[3 * (size_t)j];
+        const uint32_t key = w->vkey[j];
+        int ok = !batch_hits(&u->C, w, map, hmask, x, key) &&
+            (u->grid_empty || !pk_grid_overlaps(grid, out, x, r));
+        if (!ok) {
+            if (++failed >= max_failed) {
+                *used = next_d;
+                reason = PK_STOP_MAX_FAILED_DRAWS;
+                break;
+            }
+            continue;
+        }
+        size_t idx = pk_particles_push(out, x, r, u->species[placed]);
+        if (idx == (size_t)-1 || idx >= PK_RSA_CELLS_MORE) {
+            *used = next_d;
+            reason = PK_STOP_ERROR;
+            break;
+        }
+        /* accepted: in the batch's hash and occupancy map until step 4 */
+        w->pid[j] = (uint32_t)idx;
+        failed = 0;
+        placed++;
+        ++*acc;
+        *e->solid += u->ball;
+        w->taken[j] = 1;
+        uint64_t lin = pk_rsa_cells_index(key), h = hash_cell(lin, hmask);
+        w->hcell[j] = lin;
+        map[lin >> 3] |= (uint8_t)(1u << (lin & 7));
+        w->hnext[j] = w->head[h];
+        w->head[h] = j;
+        if (placed == u->m) {
+            *used = next_d;
+            break;
+        }
+    }
+    u->failed = failed;
+    u->placed = placed;
+    return reason;
+}
+
+/* Step 4: the batch's S survivors that were taken join the store (between
+ * batches only: sorted order, streaming), the map is cleared, and the region
+ * marks their exclusion balls and is compacted once its stale draws cost
+ * about one pass over its list (STALE_PER_PASS). */
+static pk_stop_reason grow_store(batch_run *u, size_t S)
+{
+    scratch *w = &u->w;
+    pk_rsa_region *reg = &u->reg;
+    const int region = u->region;
+    size_t ntaken = 0;
+    for (size_t j = 0; j < S; j++)
+        if (w->taken[j])
+            w->kept[ntaken++] = (uint32_t)j; /* (free again after step 2) */
+    pk_rsa_region_spot ring[MARK_RING];
+    for (size_t q = 0; region && q < ntaken && q < MARK_AHEAD; q++)
+        mark_ahead(reg, ring, q, &w->surv[3 * (size_t)w->kept[q]]);
+    for (size_t q = 0; q < ntaken; q++) {
+        const size_t j = w->kept[q];
+        if (q + INSERT_AHEAD < ntaken) {
+            const uint32_t key = w->vkey[w->kept[q + INSERT_AHEAD]];
+            __builtin_prefetch(&u->C.cell[pk_rsa_cells_index(key)], 1);
+        }
+        u->map[w->hcell[j] >> 3] = 0; /* the occupancy map is empty again */
+        if (pk_rsa_cells_insert(&u->C, &w->surv[3 * j], w->pid[j]) != 0)
+            return PK_STOP_ERROR;
+        if (!region)
+            continue;
+        if (q + MARK_AHEAD < ntaken)
+            mark_ahead(reg, ring, q + MARK_AHEAD, &w->surv[3 * (size_t)w->kept[q + MARK_AHEAD]]);
+        pk_rsa_region_mark_at(reg, ring[q % MARK_RING]);
+    }
+    if (region && (u->stale_since += w->stale) * STALE_PER_PASS >= reg->nlist) {
+        pk_rsa_region_compact(reg);
+        u->stale_since = 0;
+    }
+    return PK_STOP_COMPLETE;
+}
+
+/* One batch (README.md, steps 1-4): switch to region draws once acceptance
+ * is low, draw and filter, walk, rewind the stream past the draws used, grow
+ * the store.  PK_STOP_COMPLETE: go on (or the run is full). */
+static pk_stop_reason one_batch(batch_run *u)
+{
+    const pk_rsa_batch_env *e = u->e;
+    pk_rng *rng = e->rng;
+    const int dim = e->b->dim;
+    if (!u->region && u->region_allowed && u->p_acc < REGION_SWITCH_ACC &&
+        u->m - u->placed >= REGION_MIN_LEFT) {
+        u->region_allowed = 0;
+        u->region = region_start(&u->reg, &u->C, e->b, u->r, e->prm->delta_d, u->lo, u->span,
+                                 e->out, u->first, u->m, e->mon, e->pg) == 0;
+    }
+    if (u->region && u->reg.nlist == 0)
+        return PK_STOP_SATURATED; /* every fine voxel lies in an exclusion ball */
+    size_t B = batch_size(u);
+    pk_stop_reason reason = progress_tick(u);
+    if (reason != PK_STOP_COMPLETE)
+        return reason;
+    pk_rng start = *rng;
+    size_t A;
+    size_t S = draw_and_filter(&u->C, e->out->x, &u->w, B, dim, u->lo, u->span, rng, u->shift,
+                               u->nbucket, u->region ? &u->reg : NULL, &A);
+    if (S == SIZE_MAX)
+        return PK_STOP_ERROR;
+    size_t used, acc;
+    reason = walk_attempts(u, S, A, B, &used, &acc);
+    e->st->draws += used;
+    e->st->placed += acc;
+    if (used < B && !u->region) { /* rewind the stream to just after the last attempt used */
+        *rng = start;
+        for (size_t q = 0; q < used * (size_t)dim; q++)
+            pk_rng_next(rng);
+    }
+    /* (region draws use a varying number of outputs: the stream stays
+     * where the batch left it — deterministic, not rewound) */
+    u->p_surv = fmax((double)S / (double)B, 1e-6);
+    u->p_acc = fmax((double)acc / (double)used, 1e-6);
+    if (reason != PK_STOP_COMPLETE || u->placed == u->m)
+        return reason;
+    return grow_store(u, S);
+}
+
 /* The run in batches of attempts (README.md, steps 1-4). */
 static pk_stop_reason run_batches(const pk_rsa_batch_env *e, double r, const int32_t *species,
                                   size_t m, const double *lo, const double *span)
 {
-    const pk_box *b = e->b;
-    const pk_rsa_params *prm = e->prm;
-    const pk_grid *grid = e->grid;
-    pk_rng *rng = e->rng;
-    pk_monitor *mon = e->mon;
-    pk_progress *pg = e->pg;
-    const double box_measure = e->box_measure;
-    double *solid = e->solid;
-    pk_particles *out = e->out;
-    pk_rsa_stats *st = e->st;
-    pk_rsa_cells C;
-    if (pk_rsa_cells_init(&C, b, r, prm->delta_d, lo, span) != 0)
+    batch_run u;
+    if (open_run(&u, e, r, species, m, lo, span) != 0)
         return PK_STOP_ERROR;
-    scratch w;
-    memset(&w, 0, sizeof w);
-    uint8_t *map = calloc(C.ncell / 8 + 16, 1);
-    if (!map) {
-        pk_rsa_cells_free(&C);
-        return PK_STOP_ERROR;
-    }
-    int shift = 0;
-    while (((C.ncell - 1) >> shift) >= MAX_BUCKETS)
-        shift++;
-    const uint32_t nbucket = (uint32_t)((C.ncell - 1) >> shift) + 1;
-    int grid_empty = 1;
-    for (int l = 0; l < grid->nlevel; l++)
-        grid_empty &= grid->lv[l].count == 0;
-    const double ball = pk_ball_measure(b->dim, r);
-    const size_t first = out->n;
-    pk_rsa_region reg;
-    memset(&reg, 0, sizeof reg);
-    int region = 0, region_allowed = prm->draws == PK_RSA_DRAWS_OPEN;
-    uint64_t stale_since = 0; /* draws in fully covered cells since the last compaction */
-
     pk_stop_reason reason = PK_STOP_COMPLETE;
-    size_t placed = 0;
-    uint64_t failed = 0;
-    double p_surv = 1, p_acc = 1; /* running estimates from the last batch */
-    while (placed < m) {
-        if (!region && region_allowed && p_acc < REGION_SWITCH_ACC &&
-            m - placed >= REGION_MIN_LEFT) {
-            region_allowed = 0;
-            region =
-                region_start(&reg, &C, b, r, prm->delta_d, lo, span, out, first, m, mon, pg) == 0;
-        }
-        if (region && reg.nlist == 0) {
-            reason = PK_STOP_SATURATED; /* every fine voxel lies in an exclusion ball */
-            break;
-        }
-        size_t B = prm->test.batch_attempts;
-        if (!B) {
-            double want = SURVIVORS / p_surv, finish = 2.0 * (double)(m - placed) / p_acc;
-            want = want < finish ? want : finish;
-            B = want < B_MIN ? B_MIN : (want > (double)B_MAX ? B_MAX : (size_t)want);
-        }
-        pg->done = st->placed;
-        pg->fraction = (double)st->placed / (double)(st->requested ? st->requested : 1);
-        pg->phi = *solid / box_measure;
-        int cc = pk_monitor_tick(mon, pg, 0);
-        if (cc) {
-            reason = cc == 2 ? PK_STOP_WALL_TIME : PK_STOP_CANCELLED;
-            break;
-        }
-        pk_rng start = *rng;
-        size_t A;
-        size_t S = draw_and_filter(&C, out->x, &w, B, b->dim, lo, span, rng, shift, nbucket,
-                                   region ? &reg : NULL, &A);
-        if (S == SIZE_MAX) {
-            reason = PK_STOP_ERROR;
-            break;
-        }
-
-        /* step 3: attempt order */
-        uint64_t hmask = 63;
-        while (hmask + 1 < 2 * (uint64_t)S)
-            hmask = 2 * hmask + 1;
-        memset(w.head, 0xff, (hmask + 1) * sizeof *w.head);
-        memset(w.taken, 0, S);
-        size_t used = B, acc = 0;
-        const uint64_t max_failed = prm->max_failed_draws;
-        const size_t nword = (A + 63) / 64;
-        size_t a = 0;      /* next attempt of the walk */
-        size_t next_d = 0; /* its first draw not yet counted */
-        for (;;) {
-            /* draws rejected at once or in step 2 count as failures: jump to the next survivor */
-            size_t wd = a >> 6;
-            uint64_t bits = wd < nword ? w.sbit[wd] & (~(uint64_t)0 << (a & 63)) : 0;
-            while (!bits && ++wd < nword)
-                bits = w.sbit[wd];
-            a = bits ? 64 * wd + (size_t)__builtin_ctzll(bits) : A;
-            size_t d = a < A ? draw_of(&w, region, a) : B;
-            if ((uint64_t)(d - next_d) >= max_failed - failed) {
-                used = next_d + (size_t)(max_failed - failed);
-                failed = max_failed;
-                reason = PK_STOP_MAX_FAILED_DRAWS;
-                break;
-            }
-            failed += d - next_d;
-            if (a == A)
-                break;
-            size_t cur = a++;
-            next_d = d + 1;
-            int32_t j = w.slot[cur];
-            const double *x = &w.surv[3 * (size_t)j];
-            const uint32_t key = w.vkey[j];
-            int ok = !batch_hits(&C, &w, map, hmask, x, key) &&
-                (grid_empty || !pk_grid_overlaps(grid, out, x, r));
-            if (!ok) {
-                if (++failed >= max_failed) {
-                    used = next_d;
-                    reason = PK_STOP_MAX_FAILED_DRAWS;
-                    break;
-                }
-                continue;
-            }
-            size_t idx = pk_particles_push(out, x, r, species[placed]);
-            if (idx == (size_t)-1 || idx >= PK_RSA_CELLS_MORE) {
-                used = next_d;
-                reason = PK_STOP_ERROR;
-                break;
-            }
-            w.pid[j] = (uint32_t)idx;
-            failed = 0;
-            placed++;
-            acc++;
-            *solid += ball;
-            w.taken[j] = 1;
-            uint64_t lin = pk_rsa_cells_index(key), h = hash_cell(lin, hmask);
-            w.hcell[j] = lin;
-            map[lin >> 3] |= (uint8_t)(1u << (lin & 7));
-            w.hnext[j] = w.head[h];
-            w.head[h] = j;
-            if (placed == m) {
-                used = next_d;
-                break;
-            }
-        }
-        st->draws += used;
-        st->placed += acc;
-        if (used < B && !region) { /* rewind the stream to just after the last attempt used */
-            *rng = start;
-            for (size_t q = 0; q < used * (size_t)b->dim; q++)
-                pk_rng_next(rng);
-        }
-        /* (region draws use a varying number of outputs: the stream stays
-         * where the batch left it — deterministic, not rewound) */
-        p_surv = fmax((double)S / (double)B, 1e-6);
-        p_acc = fmax((double)acc / (double)used, 1e-6);
-        if (reason != PK_STOP_COMPLETE || placed == m)
-            break;
-        /* step 4: the store grows between batches only (sorted order: streaming);
-         * the region marks the new grains' exclusion balls */
-        size_t ntaken = 0;
-        for (size_t j = 0; j < S; j++)
-            if (w.taken[j])
-                w.kept[ntaken++] = (uint32_t)j; /* (free again after step 2) */
-        pk_rsa_region_spot ring[MARK_RING];
-        for (size_t q = 0; region && q < ntaken && q < MARK_AHEAD; q++)
-            mark_ahead(&reg, ring, q, &w.surv[3 * (size_t)w.kept[q]]);
-        for (size_t q = 0; q < ntaken; q++) {
-            const size_t j = w.kept[q];
-            if (q + INSERT_AHEAD < ntaken) {
-                const uint32_t key = w.vkey[w.kept[q + INSERT_AHEAD]];
-                __builtin_prefetch(&C.cell[pk_rsa_cells_index(key)], 1);
-            }
-            map[w.hcell[j] >> 3] = 0; /* the occupancy map is empty again */
-            if (pk_rsa_cells_insert(&C, &w.surv[3 * j], w.pid[j]) != 0) {
-                reason = PK_STOP_ERROR;
-                break;
-            }
-            if (!region)
-                continue;
-            if (q + MARK_AHEAD < ntaken)
-                mark_ahead(&reg, ring, q + MARK_AHEAD, &w.surv[3 * (size_t)w.kept[q + MARK_AHEAD]]);
-            pk_rsa_region_mark_at(&reg, ring[q % MARK_RING]);
-        }
-        if (reason != PK_STOP_COMPLETE)
-            break;
-        /* compaction: one pass over the list ends the draws into fully
-         * covered cells (STALE_PER_PASS) */
-        if (region && (stale_since += w.stale) * STALE_PER_PASS >= reg.nlist) {
-            pk_rsa_region_compact(&reg);
-            stale_since = 0;
-        }
-    }
-    pk_rsa_region_free(&reg);
-    scratch_free(&w);
-    free(map);
-    pk_rsa_cells_free(&C);
+    while (reason == PK_STOP_COMPLETE && u.placed < m)
+        reason = one_batch(&u);
+    close_run(&u);
     return reason;
 }
 
