@@ -77,8 +77,8 @@ static const char *const steps[] = {
     "ALTER TABLE jobs ADD COLUMN executor_ref TEXT;",
     /* 4 -> 5: the key under which a job's result may answer a later equal
      * request (daemon/result_cache.h); NULL for a job never to be reused. */
-    "ALTER TABLE jobs ADD COLUMN cache_key TEXT;"
-    "CREATE INDEX jobs_by_cache_key ON jobs(cache_key, owner) WHERE cache_key IS NOT NULL;",
+    ("ALTER TABLE jobs ADD COLUMN cache_key TEXT;"
+     "CREATE INDEX jobs_by_cache_key ON jobs(cache_key, owner) WHERE cache_key IS NOT NULL;"),
 };
 
 int pk_schema_version(void) { return (int)(sizeof steps / sizeof *steps); }
