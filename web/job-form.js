@@ -15,11 +15,15 @@ const lengthUnit = () => {
   return u || 'mm';
 };
 
-// The fields of process id, built once its description is read.
-async function buildForm(id) {
-  if (form && form.process === id) return;
+const processDocs = new Map(); // GET /processes/{id}, read once
+
+// The fields of process id (afresh: even when they are shown), built at
+// once when its description has been read before.
+async function buildForm(id, afresh) {
+  if (form && form.process === id && !afresh) return;
   const n = ++formAsked;
-  const doc = await api('processes/' + encodeURIComponent(id));
+  const doc = processDocs.get(id) || await api('processes/' + encodeURIComponent(id));
+  processDocs.set(id, doc);
   if (n !== formAsked) return;
   const inputs = doc.inputs || {};
   const props = {}, roots = {}, required = [];
@@ -38,10 +42,22 @@ async function buildForm(id) {
   formChanged();
 }
 
+// The examples (public) and, once the API answers (with auth on: a token),
+// the processes and the first one's fields.
 async function loadForm() {
   try {
-    const [procs, ex] = await Promise.all([api('processes'), api('dashboard/examples')]);
-    examples = ex.examples || [];
+    examples = (await api('dashboard/examples')).examples || [];
+  } catch (e) { showError('Examples: ' + e.message); }
+  const exs = $('example');
+  exs.replaceChildren(el('option', '(none: the schema\'s defaults)'));
+  exs.options[0].value = '';
+  examples.forEach((e, i) => {
+    const o = el('option', e.name.replace(/\.json$/, '') + ' (' + e.process + ')');
+    o.value = String(i);
+    exs.appendChild(o);
+  });
+  try {
+    const procs = await api('processes');
     const sel = $('process');
     sel.replaceChildren();
     for (const p of procs.processes || []) {
@@ -49,22 +65,18 @@ async function loadForm() {
       o.value = p.id;
       sel.appendChild(o);
     }
-    const exs = $('example');
-    exs.replaceChildren(el('option', '(none: the schema\'s defaults)'));
-    exs.options[0].value = '';
-    examples.forEach((e, i) => {
-      const o = el('option', e.name.replace(/\.json$/, '') + ' (' + e.process + ')');
-      o.value = String(i);
-      exs.appendChild(o);
-    });
-    await buildForm(sel.value);
+    await buildForm(form ? form.process : sel.value);
+    if (form) sel.value = form.process;
   } catch (e) { showError('Job form: ' + e.message + (token() ? '' : ' (auth on? enter a token above)')); }
 }
 
 async function pickExample() {
-  const ex = examples[Number($('example').value)];
+  const ex = $('example').value === '' ? null : examples[Number($('example').value)];
   $('example-comment').textContent = ex ? ex.comment || '' : '';
-  if (!ex) return;
+  if (!ex) { // none: the process's fields as the schema leaves them
+    try { await buildForm(form ? form.process : $('process').value, true); } catch (e) { showError('Job form: ' + e.message); }
+    return;
+  }
   try { await buildForm(ex.process); } catch (e) { showError('Job form: ' + e.message); return; }
   form.field.set(ex.inputs);
   formChanged();

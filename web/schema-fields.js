@@ -60,16 +60,17 @@ function labelled(name, s, raw, opts, control) {
   wrap.append(label);
   const help = [s.description, rangeText(s), s.default !== undefined ? 'default ' + JSON.stringify(s.default) : '']
     .filter(Boolean).join(' · ');
-  if (help) wrap.append(node('small', help, 'help'));
+  if (help && !opts.item) wrap.append(node('small', help, 'help')); // an array's items share its help
   return wrap;
 }
 
 function enumField(s, name, raw, opts) {
   const sel = node('select');
   const values = s.enum.slice();
-  if (!opts.required) sel.append(node('option', s.default !== undefined ? '(default: ' + s.default + ')' : '(not set)'));
+  // the first option sends nothing: the schema's default, or a choice still to make
+  sel.append(node('option', s.default !== undefined ? '(default: ' + s.default + ')' : opts.required ? '(choose)' : '(not set)'));
   for (const v of values) sel.append(node('option', v));
-  const skip = opts.required ? 0 : 1;
+  const skip = 1;
   return {
     el: labelled(name, s, raw, opts, sel),
     get: () => (sel.selectedIndex < skip ? undefined : values[sel.selectedIndex - skip]),
@@ -130,7 +131,7 @@ function arrayField(s, name, raw, opts, root) {
   const itemRaw = s.items || {};
   const addItem = (v) => {
     const i = items.length;
-    const f = schemaField(itemRaw, root, opts.pointer + '/' + i, { name: name + '[' + i + ']', required: true, lengthUnit: opts.lengthUnit, unitName: name });
+    const f = schemaField(itemRaw, root, opts.pointer + '/' + i, { name: name + '[' + i + ']', required: true, lengthUnit: opts.lengthUnit, item: true });
     const row = node('div', null, 'item');
     const del = node('button', '×', 'remove');
     del.type = 'button';

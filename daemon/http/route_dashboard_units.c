@@ -33,7 +33,8 @@ static void pack_units(json_t *into, json_t *inputs, json_t *summary)
     const char *length = json_string_value(json_object_get(inputs, "unit"));
     json_t *dim = json_object_get(inputs, "dim");
     pk_units u;
-    pk_units_init(&u, length ? length : "mm", json_is_integer(dim) ? (int)json_integer_value(dim) : 3);
+    pk_units_init(&u, length ? length : "mm",
+                  json_is_integer(dim) ? (int)json_integer_value(dim) : 3);
     add_rows(into, "", pk_pack_observables(), &u);
     const char *algorithm = json_string_value(json_object_get(summary, "algorithm"));
     const pk_placer *placer = algorithm ? pk_placer_find(algorithm) : NULL;
