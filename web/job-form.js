@@ -128,7 +128,9 @@ function fillRVE() {
 }
 
 function clearFieldErrors() {
-  for (const e of document.querySelectorAll('#form-fields .field-error')) e.remove();
+  const shown = document.querySelectorAll('#form-fields .field-error');
+  if (shown.length) showError(''); // the 4xx they came with
+  for (const e of shown) e.remove();
   $('form-errors').hidden = true;
 }
 

@@ -4,12 +4,14 @@
 // process's members are grouped by their key's first part.
 'use strict';
 
+// [id, title, has(key)]: the first group whose test a key passes holds it
 const PACK_GROUPS = [
   ['asked', 'What was asked', (k) => /^(process|count_requested|phi_target_\w+|d_min|delta_d|algorithm)$/.test(k) || /\.max_failed_draws$/.test(k)],
   ['audit', 'The audit', (k) => /^(smallest_gap|smallest_wall_gap|pairs_below_delta_d|grains_below_wall_gap|result_digest)$/.test(k) || k.startsWith('timing.')],
   ['model', 'The model', (k) => k.startsWith('model.')],
   ['achieved', 'What was achieved', () => true],
 ];
+const PACK_ORDER = ['asked', 'achieved', 'audit', 'model'];
 
 // [key, value] of every member, nested objects flattened with '.'.
 function flatten(obj, prefix, out) {
@@ -58,7 +60,7 @@ function summaryGroups(summary) {
   if (summary.process === 'pack') {
     const groups = PACK_GROUPS.map(([id, title]) => [id, title, []]);
     for (const m of members) groups[PACK_GROUPS.findIndex(([, , has]) => has(m[0]))][2].push(m);
-    return groups.filter((g) => g[2].length);
+    return PACK_ORDER.map((id) => groups.find((g) => g[0] === id)).filter((g) => g[2].length);
   }
   const byPart = new Map();
   for (const m of members) {
