@@ -6,6 +6,7 @@
 // that shows the chosen alternative's fields, arrays have add/remove
 // buttons; each field's element names its JSON pointer (data-pointer) so an
 // API error about that pointer can be shown beside it (job-form.js).
+// Elements are made with app.js's el().
 'use strict';
 
 const HUGE = 1e9; // a bound this large is a guard against overflow, not a range worth showing
@@ -22,13 +23,6 @@ function deref(s, root) {
   return s || {};
 }
 
-function node(tag, text, cls) {
-  const e = document.createElement(tag);
-  if (text !== undefined && text !== null) e.textContent = String(text);
-  if (cls) e.className = cls;
-  return e;
-}
-
 // The unit of a field as a label's span: lengths (a $ref to the schema's
 // length, or a name that is one by the job format) follow the job's `unit`
 // (class len-unit, which job-form.js keeps up to date), *_s is seconds, *_deg
@@ -36,9 +30,9 @@ function node(tag, text, cls) {
 function unitSpan(name, raw, opts) {
   const ref = raw.$ref || (raw.items && raw.items.$ref) || '';
   if (/\/length$/.test(ref) || /^(d_min|delta_d|d_max)$/.test(name))
-    return node('span', ' [' + (opts.lengthUnit ? opts.lengthUnit() : 'length') + ']', 'unit len-unit');
-  if (/_s$/.test(name)) return node('span', ' [s]', 'unit');
-  if (/_deg$/.test(name)) return node('span', ' [°]', 'unit');
+    return el('span', ' [' + (opts.lengthUnit ? opts.lengthUnit() : 'length') + ']', 'unit len-unit');
+  if (/_s$/.test(name)) return el('span', ' [s]', 'unit');
+  if (/_deg$/.test(name)) return el('span', ' [°]', 'unit');
   return null;
 }
 
@@ -51,25 +45,25 @@ function rangeText(s) {
 
 // The label line of a field: name, unit, and (small) its help and range.
 function labelled(name, s, raw, opts, control) {
-  const wrap = node('div', null, 'field');
-  const label = node('label');
-  label.append(node('span', name, 'fname'));
+  const wrap = el('div', null, 'field');
+  const label = el('label');
+  label.append(el('span', name, 'fname'));
   const unit = unitSpan(name, raw, opts);
   if (unit) label.append(unit);
   label.append(control);
   wrap.append(label);
   const help = [s.description, rangeText(s), s.default !== undefined ? 'default ' + JSON.stringify(s.default) : '']
     .filter(Boolean).join(' · ');
-  if (help && !opts.item) wrap.append(node('small', help, 'help')); // an array's items share its help
+  if (help && !opts.item) wrap.append(el('small', help, 'help')); // an array's items share its help
   return wrap;
 }
 
 function enumField(s, name, raw, opts) {
-  const sel = node('select');
+  const sel = el('select');
   const values = s.enum.slice();
   // the first option sends nothing: the schema's default, or a choice still to make
-  sel.append(node('option', s.default !== undefined ? '(default: ' + s.default + ')' : opts.required ? '(choose)' : '(not set)'));
-  for (const v of values) sel.append(node('option', v));
+  sel.append(el('option', s.default !== undefined ? '(default: ' + s.default + ')' : opts.required ? '(choose)' : '(not set)'));
+  for (const v of values) sel.append(el('option', v));
   const skip = 1;
   return {
     el: labelled(name, s, raw, opts, sel),
@@ -83,7 +77,7 @@ function booleanField(s, name, raw, opts) {
 }
 
 function inputField(s, name, raw, opts) {
-  const inp = node('input');
+  const inp = el('input');
   const numeric = s.type === 'number' || s.type === 'integer';
   inp.type = numeric ? 'number' : 'text';
   if (numeric) {
@@ -103,7 +97,7 @@ function inputField(s, name, raw, opts) {
 
 // A value with no schema the fields can show: edited as JSON.
 function jsonField(s, name, raw, opts) {
-  const ta = node('textarea');
+  const ta = el('textarea');
   ta.rows = 3;
   ta.spellcheck = false;
   return {
@@ -117,14 +111,14 @@ function jsonField(s, name, raw, opts) {
 }
 
 function arrayField(s, name, raw, opts, root) {
-  const box = node('fieldset', null, 'array');
-  const legend = node('legend', name);
+  const box = el('fieldset', null, 'array');
+  const legend = el('legend', name);
   const unit = unitSpan(name, raw, opts);
   if (unit) legend.append(unit);
   box.append(legend);
-  if (s.description) box.append(node('small', s.description, 'help'));
-  const list = node('div', null, 'items');
-  const add = node('button', '+ add', 'add');
+  if (s.description) box.append(el('small', s.description, 'help'));
+  const list = el('div', null, 'items');
+  const add = el('button', '+ add', 'add');
   add.type = 'button';
   box.append(list, add);
   let items = [];
@@ -132,8 +126,8 @@ function arrayField(s, name, raw, opts, root) {
   const addItem = (v) => {
     const i = items.length;
     const f = schemaField(itemRaw, root, opts.pointer + '/' + i, { name: name + '[' + i + ']', required: true, lengthUnit: opts.lengthUnit, item: true });
-    const row = node('div', null, 'item');
-    const del = node('button', '×', 'remove');
+    const row = el('div', null, 'item');
+    const del = el('button', '×', 'remove');
     del.type = 'button';
     del.title = 'remove';
     row.append(f.el, del);
@@ -203,15 +197,15 @@ function choiceField(s, name, raw, opts, root) {
     delete base.anyOf;
     return base;
   };
-  const box = node('fieldset', null, 'choice');
-  box.append(node('legend', name));
-  const sel = node('select', null, 'alt');
-  if (!opts.required) sel.append(node('option', '(not set)'));
-  alts.forEach((a, i) => sel.append(node('option', altLabel(a, i))));
+  const box = el('fieldset', null, 'choice');
+  box.append(el('legend', name));
+  const sel = el('select', null, 'alt');
+  if (!opts.required) sel.append(el('option', '(not set)'));
+  alts.forEach((a, i) => sel.append(el('option', altLabel(a, i))));
   const skip = opts.required ? 0 : 1;
-  const help = node('small', s.description || '', 'help');
-  const slot = node('div', null, 'alt-fields');
-  const choose = node('label', 'kind ');
+  const help = el('small', s.description || '', 'help');
+  const slot = el('div', null, 'alt-fields');
+  const choose = el('label', 'kind ');
   choose.append(sel);
   box.append(choose, help, slot);
   box.dataset.pointer = opts.pointer;
@@ -254,13 +248,13 @@ function objectField(s, name, raw, opts, root, roots) {
   const props = s.properties || {};
   const required = new Set(s.required || []);
   const fields = {};
-  const box = node(opts.bare || opts.top ? 'div' : 'fieldset', null, opts.top ? 'inputs' : 'object');
-  if (!opts.bare && !opts.top) box.append(node('legend', name));
-  if (!opts.bare && !opts.top && s.description) box.append(node('small', s.description, 'help'));
+  const box = el(opts.bare || opts.top ? 'div' : 'fieldset', null, opts.top ? 'inputs' : 'object');
+  if (!opts.bare && !opts.top) box.append(el('legend', name));
+  if (!opts.bare && !opts.top && s.description) box.append(el('small', s.description, 'help'));
   let inner = box;
   if (!opts.required && !opts.top && !opts.bare) { // optional: folded until opened or filled
-    const det = node('details');
-    det.append(node('summary', 'options'));
+    const det = el('details');
+    det.append(el('summary', 'options'));
     box.append(det);
     inner = det;
   }
