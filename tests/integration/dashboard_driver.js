@@ -280,10 +280,10 @@ async function step(name, fn) {
           window.seenBar.push(document.getElementById('job-progress').value);
         }, 20);
       });
-      await page.screenshot({ path: shot('job-running'), fullPage: true });
       await page.waitForFunction(() => window.seenStatus.length >= 100 &&
         window.seenBar.some((v) => v > 0 && v < 100), null, { timeout: 60000 * slow });
       const [st, bar] = await page.evaluate(() => { clearInterval(window.sampler); return [window.seenStatus, window.seenBar]; });
+      await page.screenshot({ path: shot('job-running'), fullPage: true });
       const msg = await page.textContent('#job-message');
       if (!/^rsa, φ = 0\.\d{4}, \d+ s elapsed, about .* left$/.test(msg)) throw new Error('progress line: ' + msg);
       const other = st.filter((x) => x !== 'running').length;
