@@ -95,7 +95,8 @@ function inputField(s, name, raw, opts) {
   };
 }
 
-// A value with no schema the fields can show: edited as JSON.
+// A value with no schema the fields can show (a map of names, a bare
+// object): edited as JSON.
 function jsonField(s, name, raw, opts) {
   const ta = el('textarea');
   ta.rows = 3;
@@ -302,7 +303,7 @@ function schemaField(raw, root, pointer, opts) {
   else if (s.type === 'boolean') f = booleanField(s, name, raw, o);
   else if (['number', 'integer', 'string'].includes(s.type)) f = inputField(s, name, raw, o);
   else if (s.type === 'array' && s.items) f = arrayField(s, name, raw, o, root);
-  else if (s.type === 'object' || s.properties) f = objectField(s, name, raw, o, root, opts.roots);
+  else if (s.properties || (s.type === 'object' && opts.roots)) f = objectField(s, name, raw, o, root, opts.roots);
   else f = jsonField(s, name, raw, o);
   if (f.el && !f.el.dataset.pointer) f.el.dataset.pointer = pointer;
   return f;

@@ -21,7 +21,8 @@
 // by field (no example): a negative box edge is refused by the API and the
 // message is shown at that edge's field; the job posted is exactly the one
 // composed; it finishes, and its page shows the summary grouped (asked,
-// achieved, audit, model) with units (mm, s).  An admin (auth off) filters
+// achieved, audit, model) with units (mm, s).  Every example, filled into the
+// form and composed back, keeps its inputs.  An admin (auth off) filters
 // the list by owner as GET /jobs?owner= does; a user (auth on) has no such filter.
 // Prints PASS/FAIL lines (tests/integration/check.inc) and saves screenshots
 // and the downloads (result.h5, partial.h5) in OUT_DIR.
@@ -191,6 +192,22 @@ async function step(name, fn) {
       if (!(await cell('model', 'model.dim')).startsWith('2')) throw new Error('the model group lacks dim');
       await page.screenshot({ path: shot('form-job'), fullPage: true });
       await page.goto(base + '/#/');
+    });
+    await step('dashboard_form_holds_every_example', async () => {
+      // each example filled into the form and composed back (as any edit of a
+      // field does) gives its inputs unchanged: the form loses nothing
+      const canon = (v) => JSON.stringify(v, (k, x) => (x && typeof x === 'object' && !Array.isArray(x) ? Object.fromEntries(Object.entries(x).sort()) : x));
+      const all = (await apiCall('dashboard/examples')).examples;
+      const lost = [];
+      for (const ex of all) {
+        await page.selectOption('#example', { label: ex.name.replace(/\.json$/, '') + ' (' + ex.process + ')' });
+        await page.waitForFunction((p) => document.getElementById('process').value === p &&
+          document.querySelector('#form-fields [data-pointer=""]'), ex.process);
+        await page.dispatchEvent('#form-fields', 'change');
+        if (canon(JSON.parse(await page.inputValue('#inputs'))) !== canon(ex.inputs)) lost.push(ex.name);
+      }
+      if (lost.length) throw new Error('the form changes ' + lost.join(', '));
+      await page.selectOption('#example', '');
     });
     await step('dashboard_submits_example', async () => {
       const label = example.replace(/\.json$/, '') + ' (pack)';
