@@ -280,7 +280,7 @@ const pk_obs_row pk_homog_observables[] = {
     S("precompression", PK_U_NONE, "precompression"),
     S("dr_iterations_total", PK_U_NONE, "dr_iterations_total"),
     S("dr_iterations_max", PK_U_NONE, "dr_iterations_max"),
-    S("threads", PK_U_NONE, "threads"), /* the results are the same for any */
+    {"threads", PK_U_NONE, PK_OBS_RUN, NULL},
     S("hull/widest_gap_over_d_min", PK_U_NONE, "hull/widest_gap_over_d_min"),
     S("hull/full", PK_U_NONE, "hull/full"),
     /* the audit over the steps (its series: /observables/audit) */

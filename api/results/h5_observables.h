@@ -26,7 +26,10 @@ typedef enum {
      * group); the summary holds a view of it (its last step, its steps) */
     PK_OBS_RECORD,
     /* in the file only (a series not summarised): the row gives its unit */
-    PK_OBS_FILE
+    PK_OBS_FILE,
+    /* how the job ran (threads, MPI ranks, wall time): the summary's alone,
+     * the file's bits being the same for any */
+    PK_OBS_RUN
 } pk_obs_form;
 
 typedef struct pk_obs_row {

@@ -2,8 +2,9 @@
  * observable list (api/results/h5_observables.h, the process table's
  * `observables`): every process runs here, and every field of its summary
  * must be a row of its list, have its twin under /observables (the row's
- * file path) and, for a row with a unit, carry that unit in the file and in
- * the summary's "units".  A process added to the table without a job here
+ * file path; a PK_OBS_RUN row, how the job ran, is the summary's alone) and,
+ * for a row with a unit, carry that unit in the file and in the summary's
+ * "units".  A process added to the table without a job here
  * fails too. */
 #include <hdf5.h>
 #include <stdio.h>
@@ -109,10 +110,15 @@ static void check_field(hid_t f, const pk_process *p, json_t *units, const char 
     if (!row)
         return;
     char path[400], unit[64];
+    const char *said = json_string_value(json_object_get(units, name));
+    if (row->form == PK_OBS_RUN) { /* how it ran: the summary's alone, its unit there */
+        CHECK_MSG((row->kind == PK_U_NONE) == !said, "%s: %s's unit in the summary: %s", p->id,
+                  name, said ? said : "(none)");
+        return;
+    }
     snprintf(path, sizeof path, "/observables/%s", pk_obs_file(row));
     CHECK_MSG(exists(f, path), "%s: summary field %s has no twin %s in the file", p->id, name,
               path);
-    const char *said = json_string_value(json_object_get(units, name));
     if (row->kind == PK_U_NONE) {
         CHECK_MSG(!said, "%s: %s is a number without unit, the summary says %s", p->id, name, said);
         return;
