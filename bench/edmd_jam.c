@@ -65,6 +65,15 @@ static void set_mode(pk_edmd_params *prm, const char *mode)
         return;
     }
     prm->jam_rate_factor = 1;
+    if (strcmp(mode, "stages") == 0) { /* the first stage: G@P (run_stages) */
+        const char *sp = getenv("PACKD_BENCH_STAGES");
+        const char *at = sp ? strchr(sp, '@') : NULL;
+        if (at) {
+            prm->growth_rate = atof(sp);
+            prm->p_max = atof(at + 1);
+        }
+        return;
+    }
     if (strcmp(mode, "dphi") == 0 || strcmp(mode, "lift_dphi") == 0 || strcmp(mode, "meier") == 0)
         prm->dphi_crit = 1e-9;
     if (strcmp(mode, "stall") == 0)
@@ -75,6 +84,51 @@ static void set_mode(pk_edmd_params *prm, const char *mode)
         prm->rule = PK_EDMD_RULE_MEIER;
         prm->rescale = 0;
     }
+}
+
+/* PACKD_BENCH_STAGES: the protocol after the first stage (grown at γ with
+ * rate factor 1 to p_max = the first entry's pressure), stage by stage from
+ * the grains where the last one left them (new velocities, δ = 1):
+ *   G@P  grow at rate G (rate factor 1) until the reduced pressure P;
+ *   hold@K  no growth (γ = 10^-12) for K·N events: the pressure relaxes to
+ *           that of the packing's basin at its φ.
+ * One line per stage to stderr (φ, p, events, CPU s so far). */
+static void run_stages(const pk_box *b, pk_particles *p, pk_edmd_params *prm0, pk_edmd_stats *st)
+{
+    const char *spec = getenv("PACKD_BENCH_STAGES");
+    char buf[512];
+    snprintf(buf, sizeof buf, "%s", spec ? spec : "");
+    uint64_t events = st->events;
+    char *save = NULL;
+    int first = 1;
+    for (char *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        if (first) { /* the first stage ran already (set_mode) */
+            first = 0;
+            continue;
+        }
+        pk_edmd_params prm = *prm0;
+        prm.start_zero = 0;
+        prm.delta = 1;
+        prm.jam_rate_factor = 1;
+        prm.seed = prm0->seed + events;
+        const char *at = strchr(tok, '@');
+        if (!at)
+            break;
+        if (strncmp(tok, "hold", 4) == 0) {
+            prm.growth_rate = 1e-12;
+            prm.p_max = INFINITY;
+            prm.stall_growth = 0;
+            prm.max_events = (uint64_t)(atof(at + 1) * (double)p->n);
+        } else {
+            prm.growth_rate = atof(tok);
+            prm.p_max = atof(at + 1);
+        }
+        pk_edmd_run(b, p, &prm, NULL, st);
+        events += st->events;
+        fprintf(stderr, "stage %s: phi=%.6f p=%.3g events=%llu cpu_s=%.2f\n", tok, st->phi,
+                st->pressure, (unsigned long long)events, cpu_s());
+    }
+    st->events = events;
 }
 
 /* radii r (n) in a periodic box filled to φ = 0.5 at those radii; from an
@@ -126,6 +180,8 @@ static result run(const char *name, const char *mode, int dim, const double *r, 
     }
     pk_edmd_stats st;
     pk_edmd_run(&b, &p, &prm, NULL, &st);
+    if (strcmp(mode, "stages") == 0)
+        run_stages(&b, &p, &prm, &st);
     double tol = pk_contact_tolerance(dim, st.pressure);
     pk_contact_stats cs = {0};
     pk_rigidity rg = {0};
