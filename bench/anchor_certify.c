@@ -114,8 +114,10 @@ static int read_anchor(const char *dir, pk_box *b, pk_particles *p)
     const double eps0 = conf_value(nfo, "Theoretical Porosity:", 0);
     const double eps = conf_value(nfo, "Final Porosity:", 0);
     if (!(n > 0) || mode != 1 || !(eps0 > 0) || !(eps > 0)) {
-        fprintf(stderr, "anchor_certify: %s: need a periodic (mode 1) generation.conf and a "
-                        "packing.nfo with both porosities\n", dir);
+        fprintf(stderr,
+                "anchor_certify: %s: need a periodic (mode 1) generation.conf and a "
+                "packing.nfo with both porosities\n",
+                dir);
         return -1;
     }
     memset(b, 0, sizeof *b);
