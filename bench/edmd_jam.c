@@ -22,7 +22,9 @@
  *   bench=edmd_jam_ratio case=NAME mode=M n=N jam_cpu_s=T grow060_cpu_s=G
  *         ratio=T/G phi=F z=Z rattlers=R certified=yes|no
  * PACKD_BENCH_N=n (PACKD_BENCH_MODE=m, PACKD_BENCH_RATE=γ, default 0.02): one
- * run of n ≤ 10^4 equal spheres, for protocol trials (docs/perf/edmd.md). */
+ * run of n ≤ 10^4 equal spheres, for protocol trials (docs/perf/edmd.md);
+ * PACKD_BENCH_SEED=s its seed (default 1), PACKD_BENCH_STAGES its stages
+ * (mode `stages`, run_stages), PACKD_BENCH_DUMP=DIR its packing (dump_packing). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -319,6 +321,9 @@ static result run(const char *name, const char *mode, int dim, const double *r, 
     pk_edmd_params_default(&prm);
     prm.growth_rate = rate;
     prm.until = PK_EDMD_UNTIL_JAMMED;
+    const char *seed = getenv("PACKD_BENCH_SEED"); /* start and velocities (default 1) */
+    if (seed && *seed)
+        prm.seed = strtoull(seed, NULL, 10);
     set_mode(&prm, mode);
     double c0 = cpu_s();
     if (rsa_phi > 0) {
