@@ -44,6 +44,8 @@ static const pk_option edmd_rows[] = {
     {"/edmd/jamming/reduced_pressure", PK_OPT_NUMBER, F(prm.p_max), PK_OPT_PRESET,
      PK_OPT_QUALITY(1e4, 1e12)},
     {"/edmd/jamming/rate_factor", PK_OPT_NUMBER, F(prm.jam_rate_factor), PK_OPT_PRESET},
+    {"/edmd/jamming/full_rate_above", PK_OPT_NUMBER, F(prm.jam_full_rate_p), PK_OPT_IMPLICIT,
+     .dflt = INFINITY},
     {"/edmd/jamming/delta_phi", PK_OPT_NUMBER, F(prm.dphi_crit), PK_OPT_PRESET},
     {"/edmd/jamming/events", PK_OPT_INTEGER, F(prm.dphi_events), PK_OPT_IMPLICIT, .lo = 1,
      .hi = MAX_INT},

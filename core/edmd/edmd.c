@@ -597,6 +597,15 @@ static int window(edmd_state *s, run_loop *L, pk_edmd_criterion *crit)
         L->gam_now *= prm->jam_rate_factor;
         L->slowed = 1;
         st->growth_changes++;
+    } else if (L->slowed == 1 && L->pressure > prm->jam_full_rate_p &&
+               prm->until == PK_EDMD_UNTIL_JAMMED && prm->jam_rate_factor > 0 &&
+               prm->jam_rate_factor < 1) {
+        /* the network the certificate counts is closed by then: the last
+         * decades of pressure at the full rate (docs/perf/edmd.md) */
+        scale_growth(s, 1 / prm->jam_rate_factor);
+        L->gam_now /= prm->jam_rate_factor;
+        L->slowed = 2;
+        st->growth_changes++;
     }
     if (edmd_checkpoint_due(L->ckpt)) { /* re-based first: the snapshot starts at t = 0 */
         L->t_base += s->t;
@@ -716,7 +725,9 @@ static int open_run(const pk_box *b, pk_particles *p, pk_particles *q, edmd_stat
     if (L->stall_win < (uint64_t)s->n)
         L->stall_win = (uint64_t)s->n;
     L->gam_now = from ? c.growth_rate : prm->growth_rate;
-    L->slowed = (from && c.slowed) || !(prm->jam_rate_factor > 0 && prm->jam_rate_factor < 1);
+    /* 0 full rate, 1 slowed past JAM_SLOW_P, 2 back at the full rate past jam_full_rate_p */
+    L->slowed =
+        from && c.slowed ? c.slowed : !(prm->jam_rate_factor > 0 && prm->jam_rate_factor < 1);
     L->stall_auto = isnan(prm->stall_growth);
     L->next_check = st->events + L->c_win;
     L->hist_stride = c.hist_stride;

@@ -72,6 +72,7 @@ typedef struct pk_edmd_params {
     double growth_rate; /* γ: d(diameter)/dt of a mean grain over the rms speed per axis */
     double p_max;       /* reduced pressure criterion (e.g. 1e12) */
     double jam_rate_factor; /* until jammed: the growth rate × this once p > 10^3 (1 = constant) */
+    double jam_full_rate_p; /* ... and back to the full rate once p > this (INFINITY: never) */
     double dphi_crit;       /* Meier Eq. 3.11: Δφ over c events below this => jammed (0 = off) */
     uint64_t dphi_events;   /* c (0 = number of grains) */
     double stall_growth;    /* stall: relative size growth γ·Δt over the window below this;
@@ -119,7 +120,7 @@ typedef struct pk_edmd_stats {
     double t_stop, t_end;    /* simulated times (unit d̄/u) */
     double seconds;
     uint64_t events, pair, wall, nlist, invalid, rescales, rebases, overlaps;
-    uint64_t growth_changes; /* growth-rate reductions of the jamming schedule */
+    uint64_t growth_changes; /* growth-rate changes of the jamming schedule */
     uint64_t resorts;        /* renumberings along the Z-order (large N) */
     uint64_t second;         /* invalid events replaced by their runner-up (no prediction) */
     double max_overlap_rel;  /* largest overlap seen by the predictor, relative to R */

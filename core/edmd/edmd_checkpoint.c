@@ -135,7 +135,7 @@ void edmd_checkpoint_restore(edmd_state *s, pk_edmd_stats *st, edmd_ckpt_loop *l
     l->hist_stride = (uint64_t)r->cnt[PK_EDMD_SNAP_HIST_STRIDE];
     l->hist_count = (uint64_t)r->cnt[PK_EDMD_SNAP_HIST_COUNT];
     l->growth_rate = r->scal[PK_EDMD_SNAP_GROWTH_RATE];
-    l->slowed = r->cnt[PK_EDMD_SNAP_SLOWED] != 0;
+    l->slowed = r->cnt[PK_EDMD_SNAP_SLOWED] == 2 ? 2 : r->cnt[PK_EDMD_SNAP_SLOWED] != 0;
     st->growth_changes = (uint64_t)r->cnt[PK_EDMD_SNAP_GROWTH_CHANGES];
     if (l->hist_stride < 1)
         l->hist_stride = 1;

@@ -90,7 +90,7 @@ typedef struct edmd_ckpt_loop {
     double t_base, K0, pressure, fraction;
     uint64_t hist_stride, hist_count;
     double growth_rate; /* the run's current γ (slowed near jamming) */
-    int slowed;         /* the jamming slowdown has been applied */
+    int slowed;         /* 1: the jamming slowdown applied; 2: and lifted (jam_full_rate_p) */
 } edmd_ckpt_loop;
 
 /* 1 when a snapshot is due (its interval has passed since the last one or

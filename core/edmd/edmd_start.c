@@ -18,6 +18,7 @@ void pk_edmd_params_default(pk_edmd_params *prm)
         .growth_rate = 0.01,
         .p_max = 1e12,
         .jam_rate_factor = 0.1,
+        .jam_full_rate_p = INFINITY,
         .dphi_crit = 0,
         .dphi_events = 0,
         .stall_growth = NAN,
