@@ -44,13 +44,13 @@ int edmd_queue_alloc(edmd_state *s, size_t n)
     edmd_queue *q = &s->q;
     memset(q, 0, sizeof *q);
     const uint32_t cap = nb_cap(n);
-    q->head = malloc((cap + 1) * sizeof *q->head);
+    q->head = edmd_big_calloc(cap + 1, sizeof *q->head);
     q->occ = malloc(cap / 64 * sizeof *q->occ);
-    q->nxt = malloc(n * sizeof *q->nxt);
-    q->prv = malloc(n * sizeof *q->prv);
-    q->where = malloc(n * sizeof *q->where);
-    q->slot = malloc(n * sizeof *q->slot);
-    q->hpos = malloc(n * sizeof *q->hpos);
+    q->nxt = edmd_big_calloc(n, sizeof *q->nxt);
+    q->prv = edmd_big_calloc(n, sizeof *q->prv);
+    q->where = edmd_big_calloc(n, sizeof *q->where);
+    q->slot = edmd_big_calloc(n, sizeof *q->slot);
+    q->hpos = edmd_big_calloc(n, sizeof *q->hpos);
     q->sample = malloc(SAMPLE_MAX * sizeof *q->sample);
     /* heap node k at heap_mem[k + 3]: the 4 children 4k+1..4k+4 of a node
      * share one 64-byte line (16-byte nodes); 3 sentinels follow the last */
@@ -286,6 +286,22 @@ size_t edmd_queue_top(edmd_state *s)
     while (s->q.hn == 0)
         advance(s);
     return (size_t)s->q.heap[0].i;
+}
+
+/* The grain most likely next after the top (the least of the root's
+ * children: the next event unless this one's new predictions come first),
+ * or -1 when the current slot holds no other event. */
+int32_t edmd_queue_runner_up(const edmd_state *s)
+{
+    const edmd_queue *q = &s->q;
+    if (q->hn < 2)
+        return -1;
+    const edmd_hnode *ch = &q->heap[1]; /* nodes hn .. hn + 2 are +inf sentinels */
+    size_t m = 0;
+    const size_t last = q->hn - 1 < ARITY ? q->hn - 1 : ARITY;
+    for (size_t c = 1; c < last; c++)
+        m = ch[c].t < ch[m].t ? c : m;
+    return ch[m].i;
 }
 
 static int cmp_double(const void *a, const void *b)

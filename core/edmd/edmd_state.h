@@ -200,11 +200,20 @@ static inline void edmd_sync(edmd_state *s, size_t i)
     edmd_sync_pos(s, i, x);
 }
 
+/* edmd_mem.c: per-grain arrays, zeroed and 64-byte aligned (free()); from
+ * 4 MB on on 2 MB pages where the system offers them. */
+void *edmd_big_calloc(size_t n, size_t size);
+/* The same advice for an array allocated elsewhere, before its first touch. */
+void edmd_big_hint(void *p, size_t bytes);
+
 /* edmd_predict.c */
 void edmd_predict(edmd_state *s, size_t i); /* refresh i's event and heap slot */
 /* Start loading the records of i's neighbours (before a collision: both
  * grains' predictions then find them in cache). */
 void edmd_prefetch_list(const edmd_state *s, size_t i);
+/* Start loading i's own records (flight, event, list slot, sphere, queue
+ * links): one event ahead of its turn. */
+void edmd_prefetch_grain(const edmd_state *s, size_t i);
 /* Test hook: 1 = the neighbour loop runs scalar even where AVX2 lanes are
  * available (the lanes must give bit-identical events). */
 extern int edmd_scalar_only;
@@ -220,10 +229,11 @@ void edmd_collide_wall(edmd_state *s, size_t i, int code);
 /* edmd_queue.c */
 int edmd_queue_alloc(edmd_state *s, size_t n); /* 0 or -1 */
 void edmd_queue_free(edmd_state *s);
-void edmd_queue_init(edmd_state *s);             /* every ev[i] anew (slots sized here) */
-size_t edmd_queue_top(edmd_state *s);            /* the grain of the earliest event */
-void edmd_queue_update(edmd_state *s, size_t i); /* after ev[i].t changed */
-void edmd_queue_shift(edmd_state *s, double dt); /* all times −= dt */
+void edmd_queue_init(edmd_state *s);               /* every ev[i] anew (slots sized here) */
+size_t edmd_queue_top(edmd_state *s);              /* the grain of the earliest event */
+int32_t edmd_queue_runner_up(const edmd_state *s); /* likely next grain after the top, or -1 */
+void edmd_queue_update(edmd_state *s, size_t i);   /* after ev[i].t changed */
+void edmd_queue_shift(edmd_state *s, double dt);   /* all times −= dt */
 
 /* edmd_order.c: perm[k] = index of the k-th grain along a Z-order curve of
  * cells of edge h.  0 or -1 (out of memory). */
