@@ -450,10 +450,7 @@ void edmd_prefetch_grain(const edmd_state *s, size_t i)
     __builtin_prefetch(&s->ncoll[i]);
     __builtin_prefetch(&s->bs.x[3 * i]);
     __builtin_prefetch(&s->bs.r[i]);
-    __builtin_prefetch(&s->q.where[i]);
-    __builtin_prefetch(&s->q.nxt[i]);
-    __builtin_prefetch(&s->q.prv[i]);
-    __builtin_prefetch(&s->q.slot[i]);
+    __builtin_prefetch(&s->q.node[i]);
 }
 
 void edmd_predict(edmd_state *s, size_t i)

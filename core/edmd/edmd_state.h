@@ -53,24 +53,31 @@ typedef struct edmd_hnode {
 } edmd_hnode;
 _Static_assert(sizeof(edmd_hnode) == 16, "four heap nodes per cache line");
 
+/* A grain's place in the event queue, one record (four a cache line: an
+ * event reads one line for the grain, not one per field; a grain's slot is
+ * that of its event time, recomputed where needed). */
+typedef struct edmd_qnode {
+    int32_t nxt, prv; /* bucket list links (-1: none) */
+    int32_t where;    /* bucket, or Q_HEAP / Q_OVER (edmd_queue.c) */
+    int32_t hpos;     /* node in the heap */
+} edmd_qnode;
+_Static_assert(sizeof(edmd_qnode) == 16, "four queue records per cache line");
+
 /* The event queue (edmd_queue.c): a calendar of time slots after Paul
  * (2007, J. Comput. Phys. 221, 615).  Slot of time t: floor((t − T0)/w).
  * The events of the current slot sit in a small 4-ary heap; those of the
  * next slots up to lap_end in unsorted bucket lists (bucket = slot mod nb),
  * later ones in an overflow list, redistributed when a lap starts. */
 typedef struct edmd_queue {
-    double T0, inv_w;   /* slot origin and 1/width */
-    int64_t cur;        /* current slot: its events are in the heap */
-    int64_t lap_end;    /* first slot not in the buckets (<= cur + nb) */
-    uint32_t nb, mask;  /* buckets: a power of two */
-    int32_t *head;      /* [nb + 1] first grain of each bucket's list; [nb]: overflow */
-    uint64_t *occ;      /* [nb / 64] bucket holds a grain */
-    int32_t *nxt, *prv; /* [n] list links (-1: none) */
-    int32_t *where;     /* [n] bucket, or EDMD_Q_HEAP / EDMD_Q_OVER */
-    int64_t *slot;      /* [n] slot at insertion */
-    edmd_hnode *heap;   /* current slot's events (4-ary, heap_mem + 3) */
+    double T0, inv_w;  /* slot origin and 1/width */
+    int64_t cur;       /* current slot: its events are in the heap */
+    int64_t lap_end;   /* first slot not in the buckets (<= cur + nb) */
+    uint32_t nb, mask; /* buckets: a power of two */
+    int32_t *head;     /* [nb + 1] first grain of each bucket's list; [nb]: overflow */
+    uint64_t *occ;     /* [nb / 64] bucket holds a grain */
+    edmd_qnode *node;  /* [n] each grain's links and place */
+    edmd_hnode *heap;  /* current slot's events (4-ary, heap_mem + 3) */
     edmd_hnode *heap_mem;
-    int32_t *hpos; /* [n] node in the heap */
     size_t hn;
     double *sample; /* scratch of the width estimate */
 } edmd_queue;
