@@ -55,8 +55,9 @@ function valueCell(v, unit) {
 }
 
 // [[id, title, [[key, value]…]]…] of the summary, empty groups left out.
+// The summary's own "units" map is shown beside each figure, not as members.
 function summaryGroups(summary) {
-  const members = flatten(summary, '', []);
+  const members = flatten(summary, '', []).filter(([k]) => !k.startsWith('units.'));
   if (summary.process === 'pack') {
     const groups = PACK_GROUPS.map(([id, title]) => [id, title, []]);
     for (const m of members) groups[PACK_GROUPS.findIndex(([, , has]) => has(m[0]))][2].push(m);
