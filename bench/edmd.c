@@ -18,6 +18,7 @@
  * from zero radii and from an RSA start at φ = 0.30 (…_rsa030).  The N = 10^6
  * cases (to φ = 0.55, both starts) take minutes: opt in with PACKD_BENCH_LARGE=1.  peak_rss_mb is the
  * process peak so far (getrusage), so it is monotone over the cases.
+ * PACKD_BENCH_N=n (PACKD_BENCH_PHI=φ) runs only equal spheres to φ (one_n).
  * PACKD_BENCH_CASE=TEXT runs only the cases whose name contains TEXT (one
  * case under valgrind --tool=callgrind: instructions per collision).
  * Titscher's walled A16 (Δd = 1 mm at φ_M = 53.5 %, both wall rules, through
@@ -120,8 +121,14 @@ static void run_core(const char *name, int dim, const double *r, size_t n, doubl
         for (size_t i = 0; i < n; i++)
             pk_particles_push(&p, x, r[i], 0);
     }
+    double c1 = cpu_s();
     pk_edmd_run(&b, &p, &prm, NULL, st);
-    line(name, n, st, cpu_s() - c0);
+    double c2 = cpu_s();
+    line(name, n, st, c2 - c0);
+    if (rsa_phi > 0) /* the engine alone, without the RSA start */
+        printf("bench=edmd case=%s edmd_cpu_s=%.3f collisions_per_edmd_cpu_s=%.3g\n", name, c2 - c1,
+               (double)st->pair / (c2 - c1));
+    fflush(stdout);
     pk_particles_free(&p);
 }
 
@@ -274,8 +281,26 @@ static void jobs(void)
     fflush(stdout);
 }
 
+/* PACKD_BENCH_N=n (PACKD_BENCH_PHI=φ, default 0.60): only equal spheres,
+ * n of them, grown to φ from the RSA start at φ = 0.30 (the rate against N:
+ * 10^4, 10^5, 10^6). */
+static int one_n(void)
+{
+    const char *nn = getenv("PACKD_BENCH_N"), *ph = getenv("PACKD_BENCH_PHI");
+    if (!nn || !*nn)
+        return 0;
+    const size_t n = (size_t)strtod(nn, NULL);
+    const double phi = ph && *ph ? atof(ph) : 0.60;
+    char name[64];
+    snprintf(name, sizeof name, "mono3d_%zu_to_phi%03.0f_rsa030", n, 100 * phi);
+    mono_from(name, n, 0.1, 0, phi, 0.30);
+    return 1;
+}
+
 int main(void)
 {
+    if (one_n())
+        return 0;
     jobs();
     mono("mono3d_1e3_to_phi060", 1000, 0.1, 0, 0.60);
     mono("mono3d_1e4_to_phi060", 10000, 0.1, 0, 0.60);

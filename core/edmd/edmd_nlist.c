@@ -42,6 +42,7 @@ static int pool_reserve(edmd_state *s, size_t extra)
     if (size > UINT32_MAX)
         return -1;
     int32_t *pool = malloc(size * sizeof *pool);
+    edmd_big_hint(pool, size * sizeof *pool); /* (not touched yet) */
     if (!pool)
         return -1;
     size_t used = 0;

@@ -442,6 +442,17 @@ void edmd_prefetch_list(const edmd_state *s, size_t i)
         __builtin_prefetch(&K[nb[q + 2]]);
 }
 
+void edmd_prefetch_grain(const edmd_state *s, size_t i)
+{
+    __builtin_prefetch(&s->k[i]);
+    __builtin_prefetch(&s->ev[i]);
+    __builtin_prefetch(&s->nl[i]);
+    __builtin_prefetch(&s->ncoll[i]);
+    __builtin_prefetch(&s->bs.x[3 * i]);
+    __builtin_prefetch(&s->bs.r[i]);
+    __builtin_prefetch(&s->q.node[i]);
+}
+
 void edmd_predict(edmd_state *s, size_t i)
 {
     const edmd_kin *ki = &s->k[i];

@@ -44,20 +44,15 @@ int edmd_queue_alloc(edmd_state *s, size_t n)
     edmd_queue *q = &s->q;
     memset(q, 0, sizeof *q);
     const uint32_t cap = nb_cap(n);
-    q->head = malloc((cap + 1) * sizeof *q->head);
+    q->head = edmd_big_calloc(cap + 1, sizeof *q->head);
     q->occ = malloc(cap / 64 * sizeof *q->occ);
-    q->nxt = malloc(n * sizeof *q->nxt);
-    q->prv = malloc(n * sizeof *q->prv);
-    q->where = malloc(n * sizeof *q->where);
-    q->slot = malloc(n * sizeof *q->slot);
-    q->hpos = malloc(n * sizeof *q->hpos);
+    q->node = edmd_big_calloc(n, sizeof *q->node);
     q->sample = malloc(SAMPLE_MAX * sizeof *q->sample);
     /* heap node k at heap_mem[k + 3]: the 4 children 4k+1..4k+4 of a node
      * share one 64-byte line (16-byte nodes); 3 sentinels follow the last */
     q->heap_mem = aligned_alloc(64, ((n + 3 + 3 + 3) / 4 + 1) * 64);
     q->heap = q->heap_mem ? q->heap_mem + 3 : NULL;
-    if (!q->head || !q->occ || !q->nxt || !q->prv || !q->where || !q->slot || !q->hpos ||
-        !q->sample || !q->heap)
+    if (!q->head || !q->occ || !q->node || !q->sample || !q->heap)
         return -1;
     return 0;
 }
@@ -67,11 +62,7 @@ void edmd_queue_free(edmd_state *s)
     edmd_queue *q = &s->q;
     free(q->head);
     free(q->occ);
-    free(q->nxt);
-    free(q->prv);
-    free(q->where);
-    free(q->slot);
-    free(q->hpos);
+    free(q->node);
     free(q->sample);
     free(q->heap_mem);
     memset(q, 0, sizeof *q);
@@ -82,7 +73,7 @@ void edmd_queue_free(edmd_state *s)
 static inline void hplace(edmd_queue *q, size_t k, edmd_hnode e)
 {
     q->heap[k] = e;
-    q->hpos[e.i] = (int32_t)k;
+    q->node[e.i].hpos = (int32_t)k;
 }
 
 /* Nodes hn .. hn + 2 are sentinels at +inf: the last parent's child group is
@@ -130,7 +121,7 @@ static void heap_push(edmd_queue *q, size_t i, double t)
     const size_t k = q->hn++;
     sentinels(q);
     q->heap[k] = (edmd_hnode){t, (int32_t)i};
-    q->hpos[i] = (int32_t)k;
+    q->node[i].hpos = (int32_t)k;
     sift_up(q, k);
 }
 
@@ -142,7 +133,7 @@ static void heap_remove(edmd_queue *q, size_t k)
     if (k == q->hn)
         return;
     q->heap[k] = last;
-    q->hpos[last.i] = (int32_t)k;
+    q->node[last.i].hpos = (int32_t)k;
     if (last.t < old)
         sift_up(q, k);
     else
@@ -166,10 +157,10 @@ static inline int64_t slot_of(const edmd_queue *q, double t)
 static inline void list_push(edmd_queue *q, uint32_t b, size_t i)
 {
     const int32_t h = q->head[b];
-    q->nxt[i] = h;
-    q->prv[i] = -1;
+    q->node[i].nxt = h;
+    q->node[i].prv = -1;
     if (h >= 0)
-        q->prv[h] = (int32_t)i;
+        q->node[h].prv = (int32_t)i;
     q->head[b] = (int32_t)i;
     if (b < q->nb)
         q->occ[b >> 6] |= (uint64_t)1 << (b & 63);
@@ -177,15 +168,15 @@ static inline void list_push(edmd_queue *q, uint32_t b, size_t i)
 
 static inline void list_unlink(edmd_queue *q, uint32_t b, size_t i)
 {
-    const int32_t nx = q->nxt[i], pv = q->prv[i];
-    assert(pv < 0 ? q->head[b] == (int32_t)i : q->nxt[pv] == (int32_t)i);
-    assert(nx < 0 || q->prv[nx] == (int32_t)i);
+    const int32_t nx = q->node[i].nxt, pv = q->node[i].prv;
+    assert(pv < 0 ? q->head[b] == (int32_t)i : q->node[pv].nxt == (int32_t)i);
+    assert(nx < 0 || q->node[nx].prv == (int32_t)i);
     if (pv >= 0)
-        q->nxt[pv] = nx;
+        q->node[pv].nxt = nx;
     else
         q->head[b] = nx;
     if (nx >= 0)
-        q->prv[nx] = pv;
+        q->node[nx].prv = pv;
     if (b < q->nb && q->head[b] < 0)
         q->occ[b >> 6] &= ~((uint64_t)1 << (b & 63));
 }
@@ -194,25 +185,24 @@ static inline void list_unlink(edmd_queue *q, uint32_t b, size_t i)
 static void file(edmd_state *s, size_t i, int64_t sl)
 {
     edmd_queue *q = &s->q;
-    q->slot[i] = sl;
     if (sl <= q->cur) {
-        q->where[i] = Q_HEAP;
+        q->node[i].where = Q_HEAP;
         heap_push(q, i, s->ev[i].t);
     } else if (sl < q->lap_end) {
         const uint32_t b = (uint32_t)sl & q->mask;
-        q->where[i] = (int32_t)b;
+        q->node[i].where = (int32_t)b;
         list_push(q, b, i);
     } else {
-        q->where[i] = Q_OVER;
+        q->node[i].where = Q_OVER;
         list_push(q, q->nb, i);
     }
 }
 
 static void unfile(edmd_queue *q, size_t i)
 {
-    const int32_t w = q->where[i];
+    const int32_t w = q->node[i].where;
     if (w == Q_HEAP)
-        heap_remove(q, (size_t)q->hpos[i]);
+        heap_remove(q, (size_t)q->node[i].hpos);
     else
         list_unlink(q, w == Q_OVER ? q->nb : (uint32_t)w, i);
 }
@@ -245,10 +235,11 @@ static void new_lap(edmd_state *s, int64_t start)
     q->cur = start;
     q->lap_end = start + q->nb;
     for (int32_t i = q->head[q->nb], nx; i >= 0; i = nx) {
-        nx = q->nxt[i]; /* (file() puts i in the heap or a bucket, not back here) */
-        if (q->slot[i] < q->lap_end) {
+        nx = q->node[i].nxt; /* (file() puts i in the heap or a bucket, not back here) */
+        const int64_t sl = slot_of(q, s->ev[i].t); /* as when it was filed */
+        if (sl < q->lap_end) {
             list_unlink(q, q->nb, (size_t)i);
-            file(s, (size_t)i, q->slot[i]);
+            file(s, (size_t)i, sl);
         }
     }
 }
@@ -265,8 +256,8 @@ static void advance(edmd_state *s)
         q->head[b] = -1;
         q->occ[b >> 6] &= ~((uint64_t)1 << (b & 63));
         while (i >= 0) {
-            const int32_t nx = q->nxt[i];
-            q->where[i] = Q_HEAP;
+            const int32_t nx = q->node[i].nxt;
+            q->node[i].where = Q_HEAP;
             heap_push(q, (size_t)i, s->ev[i].t);
             i = nx;
         }
@@ -276,8 +267,10 @@ static void advance(edmd_state *s)
     if (q->hn > 0 || next_occupied(q, q->cur + 1, q->lap_end) >= 0)
         return;
     int64_t lo = SLOT_INF; /* nothing in this lap either: jump to the earliest */
-    for (int32_t i = q->head[q->nb]; i >= 0; i = q->nxt[i])
-        lo = q->slot[i] < lo ? q->slot[i] : lo;
+    for (int32_t i = q->head[q->nb]; i >= 0; i = q->node[i].nxt) {
+        const int64_t si = slot_of(q, s->ev[i].t);
+        lo = si < lo ? si : lo;
+    }
     new_lap(s, lo);
 }
 
@@ -286,6 +279,22 @@ size_t edmd_queue_top(edmd_state *s)
     while (s->q.hn == 0)
         advance(s);
     return (size_t)s->q.heap[0].i;
+}
+
+/* The grain most likely next after the top (the least of the root's
+ * children: the next event unless this one's new predictions come first),
+ * or -1 when the current slot holds no other event. */
+int32_t edmd_queue_runner_up(const edmd_state *s)
+{
+    const edmd_queue *q = &s->q;
+    if (q->hn < 2)
+        return -1;
+    const edmd_hnode *ch = &q->heap[1]; /* nodes hn .. hn + 2 are +inf sentinels */
+    size_t m = 0;
+    const size_t last = q->hn - 1 < ARITY ? q->hn - 1 : ARITY;
+    for (size_t c = 1; c < last; c++)
+        m = ch[c].t < ch[m].t ? c : m;
+    return ch[m].i;
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -353,9 +362,9 @@ void edmd_queue_update(edmd_state *s, size_t i)
     const double t = s->ev[i].t;
     int64_t sl = slot_of(q, t);
     if (sl < q->cur)
-        sl = q->cur;                             /* (never: events lie ahead of the clock) */
-    if (q->where[i] == Q_HEAP && sl == q->cur) { /* re-keyed in the heap */
-        const size_t k = (size_t)q->hpos[i];
+        sl = q->cur;                                  /* (never: events lie ahead of the clock) */
+    if (q->node[i].where == Q_HEAP && sl == q->cur) { /* re-keyed in the heap */
+        const size_t k = (size_t)q->node[i].hpos;
         const double old = q->heap[k].t;
         q->heap[k].t = t;
         if (t < old)

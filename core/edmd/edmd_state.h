@@ -53,24 +53,31 @@ typedef struct edmd_hnode {
 } edmd_hnode;
 _Static_assert(sizeof(edmd_hnode) == 16, "four heap nodes per cache line");
 
+/* A grain's place in the event queue, one record (four a cache line: an
+ * event reads one line for the grain, not one per field; a grain's slot is
+ * that of its event time, recomputed where needed). */
+typedef struct edmd_qnode {
+    int32_t nxt, prv; /* bucket list links (-1: none) */
+    int32_t where;    /* bucket, or Q_HEAP / Q_OVER (edmd_queue.c) */
+    int32_t hpos;     /* node in the heap */
+} edmd_qnode;
+_Static_assert(sizeof(edmd_qnode) == 16, "four queue records per cache line");
+
 /* The event queue (edmd_queue.c): a calendar of time slots after Paul
  * (2007, J. Comput. Phys. 221, 615).  Slot of time t: floor((t − T0)/w).
  * The events of the current slot sit in a small 4-ary heap; those of the
  * next slots up to lap_end in unsorted bucket lists (bucket = slot mod nb),
  * later ones in an overflow list, redistributed when a lap starts. */
 typedef struct edmd_queue {
-    double T0, inv_w;   /* slot origin and 1/width */
-    int64_t cur;        /* current slot: its events are in the heap */
-    int64_t lap_end;    /* first slot not in the buckets (<= cur + nb) */
-    uint32_t nb, mask;  /* buckets: a power of two */
-    int32_t *head;      /* [nb + 1] first grain of each bucket's list; [nb]: overflow */
-    uint64_t *occ;      /* [nb / 64] bucket holds a grain */
-    int32_t *nxt, *prv; /* [n] list links (-1: none) */
-    int32_t *where;     /* [n] bucket, or EDMD_Q_HEAP / EDMD_Q_OVER */
-    int64_t *slot;      /* [n] slot at insertion */
-    edmd_hnode *heap;   /* current slot's events (4-ary, heap_mem + 3) */
+    double T0, inv_w;  /* slot origin and 1/width */
+    int64_t cur;       /* current slot: its events are in the heap */
+    int64_t lap_end;   /* first slot not in the buckets (<= cur + nb) */
+    uint32_t nb, mask; /* buckets: a power of two */
+    int32_t *head;     /* [nb + 1] first grain of each bucket's list; [nb]: overflow */
+    uint64_t *occ;     /* [nb / 64] bucket holds a grain */
+    edmd_qnode *node;  /* [n] each grain's links and place */
+    edmd_hnode *heap;  /* current slot's events (4-ary, heap_mem + 3) */
     edmd_hnode *heap_mem;
-    int32_t *hpos; /* [n] node in the heap */
     size_t hn;
     double *sample; /* scratch of the width estimate */
 } edmd_queue;
@@ -200,11 +207,20 @@ static inline void edmd_sync(edmd_state *s, size_t i)
     edmd_sync_pos(s, i, x);
 }
 
+/* edmd_mem.c: per-grain arrays, zeroed and 64-byte aligned (free()); from
+ * 4 MB on on 2 MB pages where the system offers them. */
+void *edmd_big_calloc(size_t n, size_t size);
+/* The same advice for an array allocated elsewhere, before its first touch. */
+void edmd_big_hint(void *p, size_t bytes);
+
 /* edmd_predict.c */
 void edmd_predict(edmd_state *s, size_t i); /* refresh i's event and heap slot */
 /* Start loading the records of i's neighbours (before a collision: both
  * grains' predictions then find them in cache). */
 void edmd_prefetch_list(const edmd_state *s, size_t i);
+/* Start loading i's own records (flight, event, list slot, sphere, queue
+ * links): one event ahead of its turn. */
+void edmd_prefetch_grain(const edmd_state *s, size_t i);
 /* Test hook: 1 = the neighbour loop runs scalar even where AVX2 lanes are
  * available (the lanes must give bit-identical events). */
 extern int edmd_scalar_only;
@@ -220,10 +236,11 @@ void edmd_collide_wall(edmd_state *s, size_t i, int code);
 /* edmd_queue.c */
 int edmd_queue_alloc(edmd_state *s, size_t n); /* 0 or -1 */
 void edmd_queue_free(edmd_state *s);
-void edmd_queue_init(edmd_state *s);             /* every ev[i] anew (slots sized here) */
-size_t edmd_queue_top(edmd_state *s);            /* the grain of the earliest event */
-void edmd_queue_update(edmd_state *s, size_t i); /* after ev[i].t changed */
-void edmd_queue_shift(edmd_state *s, double dt); /* all times −= dt */
+void edmd_queue_init(edmd_state *s);               /* every ev[i] anew (slots sized here) */
+size_t edmd_queue_top(edmd_state *s);              /* the grain of the earliest event */
+int32_t edmd_queue_runner_up(const edmd_state *s); /* likely next grain after the top, or -1 */
+void edmd_queue_update(edmd_state *s, size_t i);   /* after ev[i].t changed */
+void edmd_queue_shift(edmd_state *s, double dt);   /* all times −= dt */
 
 /* edmd_order.c: perm[k] = index of the k-th grain along a Z-order curve of
  * cells of edge h.  0 or -1 (out of memory). */
