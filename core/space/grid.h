@@ -8,7 +8,8 @@
  * O(1) cells per non-empty level (Titscher §4's halving cell size, without
  * the rebuilds).  Cells live in a hash table per level (power-of-two buckets,
  * each grain remembers its cell, so hash collisions never report a grain
- * twice) — memory is O(N), independent of the box/finest-grain ratio.
+ * twice) — memory is O(N), independent of the box/finest-grain ratio — or,
+ * where a level has at most a few cells per grain, in one head per cell.
  *
  * Used by RSA (insert + overlap test), the gap audit's cross-check, EDMD's
  * neighbour lists and DEM contact detection (insert/move/remove + query).
@@ -30,7 +31,8 @@ typedef struct pk_grid_level {
     int64_t ncell[PK_MAXDIM]; /* cells per axis */
     double r_hi;              /* radii in this level are <= r_hi */
     size_t count;             /* grains registered */
-    uint64_t mask;            /* nbucket - 1 (nbucket a power of two) */
+    int dense;                /* one bucket per cell (index = linear cell index) */
+    uint64_t mask;            /* hashed: nbucket - 1 (nbucket a power of two) */
     int32_t *head;            /* [nbucket] first grain of each bucket, -1 = empty */
 } pk_grid_level;
 
