@@ -35,7 +35,8 @@ static int level_of(const pk_grid *g, double r)
     return l;
 }
 
-int pk_grid_init(pk_grid *g, const pk_box *b, double r_min, double r_max, double gap, size_t cap)
+static int grid_init(pk_grid *g, const pk_box *b, double r_min, double r_max, double gap,
+                     size_t cap, int dense_ok)
 {
     memset(g, 0, sizeof *g);
     if (!b || !(r_max > 0) || !(gap >= 0) || !(r_min >= 0) || b->dim < 2 || b->dim > 3)
@@ -72,7 +73,8 @@ int pk_grid_init(pk_grid *g, const pk_box *b, double r_min, double r_max, double
     for (int l = 0; l < g->nlevel; l++) {
         pk_grid_level *lv = &g->lv[l];
         double cells = (double)lv->ncell[0] * (double)lv->ncell[1] * (double)lv->ncell[2];
-        lv->dense = cells <= (double)DENSE_CELLS_PER_GRAIN * (double)g->cap + DENSE_CELLS_FREE;
+        lv->dense =
+            dense_ok && cells <= (double)DENSE_CELLS_PER_GRAIN * (double)g->cap + DENSE_CELLS_FREE;
         uint64_t nb = lv->dense ? (uint64_t)cells : 16;
         lv->mask = nb - 1;
         lv->head = malloc(nb * sizeof *lv->head);
@@ -91,6 +93,17 @@ int pk_grid_init(pk_grid *g, const pk_box *b, double r_min, double r_max, double
     }
     memset(g->level, 0xff, g->cap * sizeof *g->level);
     return 0;
+}
+
+int pk_grid_init(pk_grid *g, const pk_box *b, double r_min, double r_max, double gap, size_t cap)
+{
+    return grid_init(g, b, r_min, r_max, gap, cap, 0);
+}
+
+int pk_grid_init_dense(pk_grid *g, const pk_box *b, double r_min, double r_max, double gap,
+                       size_t cap)
+{
+    return grid_init(g, b, r_min, r_max, gap, cap, 1);
 }
 
 void pk_grid_free(pk_grid *g)
@@ -223,10 +236,10 @@ int pk_grid_update(pk_grid *g, const pk_particles *p, size_t i)
 /* The one cell scan behind both queries.  With fn == NULL it is the RSA
  * overlap test (extra = 0, stop at the first grain closer than contact). */
 static inline int scan(const pk_grid *g, const pk_particles *p, const double *x, double r,
-                       double extra, pk_grid_visit fn, void *ctx)
+                       double extra, pk_grid_visit fn, void *ctx, int from)
 {
     const int dim = g->box.dim;
-    for (int l = 0; l < g->nlevel; l++) {
+    for (int l = from; l < g->nlevel; l++) {
         const pk_grid_level *lv = &g->lv[l];
         if (lv->count == 0)
             continue;
@@ -302,10 +315,18 @@ int pk_grid_query(const pk_grid *g, const pk_particles *p, const double x[PK_MAX
 {
     if (!fn)
         return 0;
-    return scan(g, p, x, r, extra, fn, ctx);
+    return scan(g, p, x, r, extra, fn, ctx, 0);
 }
 
 int pk_grid_overlaps(const pk_grid *g, const pk_particles *p, const double x[PK_MAXDIM], double r)
 {
-    return scan(g, p, x, r, 0.0, NULL, NULL);
+    return scan(g, p, x, r, 0.0, NULL, NULL, 0);
 }
+
+int pk_grid_overlaps_from(const pk_grid *g, const pk_particles *p, const double x[PK_MAXDIM],
+                          double r, int level)
+{
+    return scan(g, p, x, r, 0.0, NULL, NULL, level < 0 ? 0 : level);
+}
+
+int pk_grid_level_of(const pk_grid *g, double r) { return level_of(g, r); }

@@ -8,8 +8,9 @@
  * O(1) cells per non-empty level (Titscher §4's halving cell size, without
  * the rebuilds).  Cells live in a hash table per level (power-of-two buckets,
  * each grain remembers its cell, so hash collisions never report a grain
- * twice) — memory is O(N), independent of the box/finest-grain ratio — or,
- * where a level has at most a few cells per grain, in one head per cell.
+ * twice) — memory is O(N), independent of the box/finest-grain ratio — or
+ * (pk_grid_init_dense), where a level has few cells per grain, in one head
+ * per cell.
  *
  * Used by RSA (insert + overlap test), the gap audit's cross-check, EDMD's
  * neighbour lists and DEM contact detection (insert/move/remove + query).
@@ -52,6 +53,12 @@ typedef struct pk_grid {
  * gap: the extra contact distance (Δd, >= 0); cap: grains indices < cap.
  * Returns 0 or -1 (bad arguments / out of memory). */
 int pk_grid_init(pk_grid *g, const pk_box *b, double r_min, double r_max, double gap, size_t cap);
+/* The same, but levels with at most 4 cells per grain (+4096) get one head
+ * per cell instead of hashed buckets (faster cell visits; RSA).  Queries
+ * find the same grains; the order of the visits within a cell may differ
+ * from pk_grid_init's, whose chains reorder when buckets grow. */
+int pk_grid_init_dense(pk_grid *g, const pk_box *b, double r_min, double r_max, double gap,
+                       size_t cap);
 void pk_grid_free(pk_grid *g);
 
 /* Register grain i of p (its position and radius are read now). */
@@ -71,5 +78,11 @@ int pk_grid_query(const pk_grid *g, const pk_particles *p, const double x[PK_MAX
 
 /* Fast path for RSA: 1 if a registered grain j has |x_j - x| < r + r_j + gap. */
 int pk_grid_overlaps(const pk_grid *g, const pk_particles *p, const double x[PK_MAXDIM], double r);
+/* The same over levels >= level only (the coarser ones checked elsewhere:
+ * core/rsa/rsa_cover.h). */
+int pk_grid_overlaps_from(const pk_grid *g, const pk_particles *p, const double x[PK_MAXDIM],
+                          double r, int level);
+/* The level a grain of radius r is registered in. */
+int pk_grid_level_of(const pk_grid *g, double r);
 
 #endif

@@ -1,7 +1,7 @@
 /* test_grid.c — core/space/grid's queries against brute force over all grains.
  *
- * A level keeps one head per cell when it has few cells per grain and hashed
- * buckets otherwise (grid.h); both must answer as the plainest code does:
+ * Under pk_grid_init_dense a level keeps one head per cell when it has few
+ * cells per grain and hashed buckets otherwise (grid.h); both must answer as the plainest code does:
  * every registered grain within r + r_j + gap + extra of the point (minimum
  * image) visited exactly once, and pk_grid_overlaps true exactly when one is
  * closer than contact.  Checked in 2D and 3D, walled, periodic and mixed
@@ -65,7 +65,7 @@ static void run_case(const pk_box *b, size_t n, size_t cap, int want_dense, uint
         pk_particles_push(&p, x, r, 0);
     }
     pk_grid grid;
-    CHECK(pk_grid_init(&grid, b, r_min, r_max, gap, cap) == 0);
+    CHECK(pk_grid_init_dense(&grid, b, r_min, r_max, gap, cap) == 0);
     CHECK(grid.nlevel == 4);
     CHECK_MSG(grid.lv[grid.nlevel - 1].dense == want_dense, "finest level dense %d, want %d",
               grid.lv[grid.nlevel - 1].dense, want_dense);
