@@ -2,7 +2,8 @@
  * (flat = linear, his Fig. 8a at φ₀ = 0.6), 10⁵ spheres (bar < 10 s), 10⁶
  * spheres with PACKD_BENCH_LARGE=1 (bar < 2 min, < 2 GiB), and the R sweep
  * on the Gmsh cube of 1127 tets (his Fig. 4a/7a: 1112 tets) to saturation,
- * with the default contact rule and with Jerier's ("touching", gap <= 0). */
+ * with the default contact rule and with Jerier's ("touching", gap <= 0), each
+ * also in the paper's order of steps (7a after 4–6, "paper_order"). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -57,7 +58,7 @@ static int box_case(const char *name, double L, double phi0, size_t n0)
 
 /* One R of the sweep with the contact rule of the z_min test (tetfill.h);
  * seed from PACKD_BENCH_SEED (default 0) for the spread over seeds. */
-static int sweep_case(const char *path, double R, pk_tetfill_contact_rule rule)
+static int sweep_case(const char *path, double R, pk_tetfill_contact_rule rule, int trim_last)
 {
     pk_mesh m;
     char err[512];
@@ -71,6 +72,7 @@ static int sweep_case(const char *path, double R, pk_tetfill_contact_rule rule)
     pk_tetfill_params prm;
     pk_tetfill_defaults(&prm);
     prm.contact_rule = rule;
+    prm.trim_after_loci = trim_last;
     const char *seed = getenv("PACKD_BENCH_SEED");
     prm.seed = seed ? strtoull(seed, NULL, 10) : 0;
     double rbar = m.edge_mean / 8; /* ratio alone: Jerier's rule */
@@ -87,14 +89,19 @@ static int sweep_case(const char *path, double R, pk_tetfill_contact_rule rule)
             return -1;
         /* z by the three contact definitions of tetfill_stats.h: gap <= ε r_min,
          * <= 1e-9 r_min (tangent), <= 0 (touching) */
-        printf("bench=tetfill case=sweep%s_R%g seed=%llu stage=%s tets=%zu spheres=%zu "
+        /* with trim_last, "steps1-6" is after 7a and the *_geo figures before it
+         * (the paper's state after steps 1–6) */
+        printf("bench=tetfill case=sweep%s%s_R%g seed=%llu stage=%s tets=%zu spheres=%zu "
                "n_per_tet=%.2f phi=%.4f z=%.3f z_tangent=%.3f z_touching=%.3f F1=%.4f F2=%.4f "
-               "F3=%.4f z_tangent_steps1_6=%.3f passes=%d seconds=%.3f\n",
+               "F3=%.4f n_per_tet_geo=%.2f z_tangent_geo=%.3f z_touching_geo=%.3f passes=%d "
+               "seconds=%.3f\n",
+               trim_last ? "_paper_order" : "",
                rule == PK_TETFILL_CONTACT_TOUCHING ? "_touching" : "", R,
                (unsigned long long)prm.seed, dens ? "saturated" : "steps1-6", m.ntet, p.n,
                (double)p.n / (double)m.ntet, o.phi, o.z_mean, o.z_tangent, o.z_touching,
-               o.fabric_eig[0], o.fabric_eig[1], o.fabric_eig[2], st.geometric.z_tangent, st.passes,
-               st.seconds);
+               o.fabric_eig[0], o.fabric_eig[1], o.fabric_eig[2],
+               (double)st.n_geometric / (double)m.ntet, st.geometric.z_tangent,
+               st.geometric.z_touching, st.passes, st.seconds);
         fflush(stdout);
         pk_tetfill_measures_free(&o);
         pk_particles_free(&p);
@@ -131,11 +138,14 @@ int main(int argc, char **argv)
     const char *src = getenv("PACKD_SRC");
     char path[4096];
     snprintf(path, sizeof path, "%s/tests/data/meshes/cube41.msh", src ? src : ".");
-    /* "sweep": the default contact rule; "sweep_touching": Jerier's (gap <= 0) */
+    /* "sweep": the default contact rule; "sweep_touching": Jerier's (gap <= 0);
+     * "sweep_paper_order[_touching]": the same with 7a after steps 4–6 */
     const double R[4] = {2, 3, 5, 7};
-    for (int i = 0; i < 4 && want("sweep"); i++)
-        rc |= sweep_case(path, R[i], PK_TETFILL_CONTACT_TANGENT);
-    for (int i = 0; i < 4 && want("sweep_touching"); i++)
-        rc |= sweep_case(path, R[i], PK_TETFILL_CONTACT_TOUCHING);
+    for (int last = 0; last <= 1; last++) {
+        for (int i = 0; i < 4 && want(last ? "sweep_paper_order" : "sweep"); i++)
+            rc |= sweep_case(path, R[i], PK_TETFILL_CONTACT_TANGENT, last);
+        for (int i = 0; i < 4 && want(last ? "sweep_paper_order_touching" : "sweep_touching"); i++)
+            rc |= sweep_case(path, R[i], PK_TETFILL_CONTACT_TOUCHING, last);
+    }
     return rc ? 1 : 0;
 }

@@ -45,6 +45,7 @@ static const pk_option tetfill_rows[] = {
      .names = contact_names},
     {"/tetfill/vertex_weight", PK_OPT_NUMBER, F(prm.vertex_weight), PK_OPT_PRESET},
     {"/tetfill/loose", PK_OPT_BOOL, F(prm.skip_tet_loci), PK_OPT_PRESET},
+    {"/tetfill/trim_after_loci", PK_OPT_BOOL, F(prm.trim_after_loci), PK_OPT_PRESET},
     {"/tetfill/densify", PK_OPT_BOOL, F(prm.densify), PK_OPT_PRESET},
     {"/tetfill/neighbours", PK_OPT_INTEGER, F(prm.neighbours), PK_OPT_PRESET, .lo = 4, .hi = 13},
     {"/tetfill/max_combos", PK_OPT_INTEGER, F(prm.max_combos), PK_OPT_PRESET, .lo = 1, .hi = 715},

@@ -52,6 +52,7 @@ typedef struct filler {
     pk_progress prog;
     pk_tetfill_stats *st;
     int stop; /* 0 go, 1 target reached, 2 cancelled/time/limit */
+    int open; /* steps 4–6 before 7a (trim_after_loci): no boundary, bounding box only */
     /* scratch for the acceptance query */
     double *nd, *nr;
     size_t nn, ncap;
@@ -213,6 +214,15 @@ static int keep_inside(filler *F, size_t i)
     return db >= r - F->prm->eps * F->prm->r_min;
 }
 
+/* Step 7a: n_trimmed counts what it removes. */
+static int trim(filler *F)
+{
+    size_t n = F->p->n;
+    int rc = compact(F, keep_inside);
+    F->st->n_trimmed = n - F->p->n;
+    return rc;
+}
+
 static int reduce_overlaps(filler *F)
 {
     shrink_ctx c = {F, 0};
@@ -270,9 +280,10 @@ static int try_candidate(filler *F, const double x[3], double r)
         return -1;
     for (size_t i = 0; i < F->nn; i++)
         rn = fmin(rn, F->nd[i] - F->nr[i] + dmax);
-    if (rn < prm->r_min || pk_mesh_locate(&F->L, x) < 0)
+    if (rn < prm->r_min || (!F->open && pk_mesh_locate(&F->L, x) < 0))
         return 0;
-    double db = pk_mesh_boundary_distance(&F->L, x, r + F->tau, NULL, NULL);
+    /* the boundary faces as virtual spheres, unless 7a comes later */
+    double db = F->open ? INFINITY : pk_mesh_boundary_distance(&F->L, x, r + F->tau, NULL, NULL);
     if (db + dmax < rn)
         rn = db + dmax;
     if (rn < prm->r_min)
@@ -360,7 +371,8 @@ static int try_locus(filler *F, const double q[3], int void_only)
         reach = reach < full ? fmin(2 * reach, full) : 2 * reach;
     }
     double pq[MAX_PLANES][3], pn[MAX_PLANES][3], pd[MAX_PLANES];
-    int np = pk_mesh_boundary_planes(&F->L, q, fmax(reach, full), MAX_PLANES, pq, pn, pd);
+    int np =
+        F->open ? 0 : pk_mesh_boundary_planes(&F->L, q, fmax(reach, full), MAX_PLANES, pq, pn, pd);
     for (int i = 0; i < np; i++) {
         nb_sphere s = {.s = pd[i], .r = F->Rv, .virt = 1};
         for (int k = 0; k < 3; k++)
@@ -605,9 +617,9 @@ int pk_tetfill(const pk_mesh *m, const pk_tetfill_params *prm, pk_monitor *mon, 
     st->n_direct = p->n - F.first;
     if (F.stop == 1)
         F.stop = 0; /* direct spheres do not count against a target */
-    if (compact(&F, keep_inside) != 0)
+    F.open = prm->trim_after_loci;
+    if (!F.open && trim(&F) != 0)
         goto out;
-    st->n_trimmed = st->n_direct - (p->n - F.first);
     check_targets(&F);
     if (!F.stop && geometric_loci(&F) != 0)
         goto out;
@@ -615,6 +627,14 @@ int pk_tetfill(const pk_mesh *m, const pk_tetfill_params *prm, pk_monitor *mon, 
     st->phi_geometric = F.solid / F.V;
     pk_tetfill_coordination(&F.g, p, F.first, prm->r_min, prm->eps, &st->geometric);
     st->seconds_geometric = pk_wall_seconds() - t0;
+    if (F.open) { /* the paper's order: 7a after the state of steps 1–6 */
+        F.open = 0;
+        if (trim(&F) != 0)
+            goto out;
+        if (F.stop == 1)
+            F.stop = 0; /* the target counts inside the mesh */
+        check_targets(&F);
+    }
     if (!F.stop && prm->densify && densify(&F) != 0)
         goto out;
     if (!F.stop && (prm->phi_target > 0 || prm->n_target))

@@ -10,7 +10,10 @@
  *        until every overlap is within ε·r_min; spheres under r_min removed;
  *   7a   spheres crossing the boundary by more than ε·r_min removed (done
  *        here, before 4–6, because every later candidate is tested against
- *        the boundary faces anyway);
+ *        the boundary faces anyway; `trim_after_loci` keeps the paper's
+ *        order: steps 4–6 then see no boundary — candidates need only a
+ *        centre in the bounding box — and the state "after steps 1–6" the
+ *        paper describes, N ≈ 10 N_t, still holds the spheres 7a removes);
  *   4–6  the geometric procedure (tetfill_tangent.h) at loci: face
  *        barycentres, tet barycentres, and the points between barycentre and
  *        nodes (weight `vertex_weight`, paper: midway = 0.5);
@@ -80,6 +83,7 @@ typedef struct pk_tetfill_params {
     uint64_t seed;                        /* loci order and random radii: streams 0, 1 */
     double vertex_weight;                 /* step 6 locus = centroid + w (node − centroid) */
     int skip_tet_loci;                    /* skip steps 5–6 (Jerier's loose packings) */
+    int trim_after_loci;                  /* the paper's order: 7a after 4–6 (see above) */
     int densify;                          /* run step 7b */
     int neighbours;                       /* nearest spheres combined per locus (4..12) */
     int max_combos;                       /* four-sphere sets tried per locus */
@@ -96,7 +100,7 @@ typedef struct pk_tetfill_stats {
     pk_stop_reason reason;
     size_t n_direct;            /* after steps 2–3 and overlap reduction */
     size_t n_trimmed;           /* removed at the boundary (7a) */
-    size_t n_geometric;         /* after steps 4–6 */
+    size_t n_geometric;         /* after steps 4–6 (before 7a with trim_after_loci) */
     double phi_geometric;       /* solid fraction after steps 4–6 */
     pk_tetfill_coord geometric; /* coordination after steps 1–6 (before 7b) */
     size_t n_final;

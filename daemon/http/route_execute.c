@@ -170,8 +170,10 @@ static int wants_fresh(pk_req *r)
 /* Queue the job s->id, or answer it from an equal successful job of the
  * same owner that finished within max_age_s (result_cache.h): the job is
  * then made already successful, its files hard links to the old one's.
- * A PK_Q_* code; id is the job answered. */
-static int submit(pk_req *r, const pk_submit *s, const char *data, double max_age_s, char id[37])
+ * A PK_Q_* code; id is the job answered, *reused 1 when it was answered
+ * from an earlier one (nothing for the executor to run). */
+static int submit(pk_req *r, const pk_submit *s, const char *data, double max_age_s, char id[37],
+                  int *reused)
 {
     pk_service *svc = r->svc;
     char src[37];
@@ -186,6 +188,7 @@ static int submit(pk_req *r, const pk_submit *s, const char *data, double max_ag
                 pk_result_cache_unlink(data, s->id);
         }
         if (rc == PK_Q_OK) {
+            *reused = 1;
             __atomic_add_fetch(&svc->cache_hits, 1, __ATOMIC_RELAXED);
             pk_log(PK_LOG_INFO, "job answered from an equal one", "{s:s,s:s,s:s}", "job", id,
                    "from", src, "owner", s->owner);
@@ -313,7 +316,8 @@ enum MHD_Result route_execute(pk_req *r)
                        pk_result_cache_key(p->id, inputs, cache_key) == 0 ? cache_key : NULL,
                    .max_queued = cfg.max_queued,
                    .max_queued_per_owner = cfg.max_queued_per_owner};
-    int rc = submit(r, &s, data, cfg.result_cache_max_age_s, id);
+    int reused = 0;
+    int rc = submit(r, &s, data, cfg.result_cache_max_age_s, id, &reused);
     json_decref(body);
     free(text);
     if (rc != PK_Q_OK) /* no job of that id: its options go */
@@ -322,9 +326,11 @@ enum MHD_Result route_execute(pk_req *r)
         pk_exec_opts_free(&opts);
     switch (rc) {
     case PK_Q_OK:
-        pk_log(PK_LOG_INFO, "job accepted", "{s:s,s:s,s:s}", "job", id, "process", p->id, "owner",
-               owner);
-        pk_executor_wake(svc->exec);
+        if (!reused) {
+            pk_log(PK_LOG_INFO, "job accepted", "{s:s,s:s,s:s}", "job", id, "process", p->id,
+                   "owner", owner);
+            pk_executor_wake(svc->exec);
+        }
         return answer(r, id, 0, &opts);
     case PK_Q_EXISTING: return answer(r, id, 1, &opts);
     case PK_Q_KEY_CONFLICT:

@@ -42,6 +42,12 @@ check repeat_is_new_job test -n "$R" -a "$R" != "$A"
 check repeat_successful test "$(status_of "$R")" = successful
 from_a() { reused "$R" && grep -q "$A" "$T/j.json"; }
 check repeat_names_source from_a
+# logged once, as an answer: not as a job accepted for a worker
+logged_as_answer() {
+    grep '"msg":"job answered from an equal one"' "$LOG" | grep -q "\"job\":\"$R\"" &&
+        ! grep '"msg":"job accepted"' "$LOG" | grep -q "\"job\":\"$R\""
+}
+check repeat_logged_as_answer logged_as_answer
 c -o "$T/r.h5" "$B/jobs/$R/results/result"
 check repeat_same_bytes cmp -s "$T/a.h5" "$T/r.h5"
 check repeat_fast test "$ms" -lt $((2000 * SLOW))
