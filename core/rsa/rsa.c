@@ -7,7 +7,6 @@
 #include "core/space/grid.h"
 #include "core/base/rng.h"
 #include "core/rsa/batch/rsa_batch.h"
-#include "rsa_cover.h"
 #include "rsa_voxels.h"
 
 /* Draws come from one voxel set (rsa_voxels.h) built for the smallest grain
@@ -25,12 +24,6 @@
 /* Marking covered sub-voxels costs more than it saves while most draws
  * succeed: it starts once a window of WINDOW placements took more than
  * COVER_AFTER draws per grain, or one grain failed COVER_AFTER_FAILS times. */
-/* The coarse grains are listed per fine cell (rsa_cover.h) when their
- * entries stay below this many per grain to place (plus a constant; A16
- * with Δd 1 mm: ~11 by the boxes' count) */
-#define COVER_ENTRIES_PER_GRAIN 32
-#define COVER_ENTRIES_FREE 65536
-
 #define WINDOW 256
 #define COVER_AFTER 6
 #define COVER_AFTER_FAILS 4096
@@ -117,64 +110,11 @@ typedef struct rsa_run {
     double gap;  /* Δd */
     double wall; /* clearance kept at walls */
     pk_grid grid;
-    pk_rsa_cover cover; /* the grains of levels < cover_level per fine cell */
-    int cover_on, cover_level;
     pk_rng rng;
     pk_progress pg;
     double box_measure, solid;
     segment sg;
 } rsa_run;
-
-/* The cover of the levels coarser than the busiest one among the grains to
- * place, if its entries fit the budget; else the grid alone (cover_on 0). */
-static void open_cover(rsa_run *u, const double *diameters, size_t n)
-{
-    const pk_grid *g = &u->grid;
-    size_t count[PK_GRID_MAX_LEVELS] = {0};
-    for (size_t i = 0; i < n; i++)
-        count[pk_grid_level_of(g, 0.5 * diameters[i])]++;
-    int busiest = 0;
-    for (int l = 1; l < g->nlevel; l++)
-        if (count[l] > count[busiest])
-            busiest = l;
-    if (busiest == 0)
-        return; /* nothing coarser */
-    double r_q = g->lv[busiest].r_hi, entries = 0;
-    for (size_t i = 0; i < n; i++)
-        if (0.5 * diameters[i] > r_q)
-            entries += pk_rsa_cover_cells_of(u->b, r_q, u->gap, 0.5 * diameters[i]);
-    for (size_t j = 0; j < u->out->n; j++)
-        if (u->out->r[j] > r_q)
-            entries += pk_rsa_cover_cells_of(u->b, r_q, u->gap, u->out->r[j]);
-    if (!(entries <= (double)COVER_ENTRIES_PER_GRAIN * (double)n + COVER_ENTRIES_FREE))
-        return;
-    if (pk_rsa_cover_init(&u->cover, u->b, r_q, u->gap) != 0)
-        return;
-    u->cover_on = 1;
-    u->cover_level = busiest;
-}
-
-/* Grain j of out registered in the grid and, if coarse, the cover (out of
- * memory for the cover: it is dropped, the grid answers alone). */
-static int file_grain(rsa_run *u, size_t j)
-{
-    if (pk_grid_insert(&u->grid, u->out, j) != 0)
-        return -1;
-    if (u->cover_on && pk_rsa_cover_add(&u->cover, u->out, j) != 0) {
-        pk_rsa_cover_free(&u->cover);
-        u->cover_on = 0;
-    }
-    return 0;
-}
-
-/* 1 if a grain of radius r at x would come closer than Δd to a placed one. */
-static int overlaps(const rsa_run *u, const double *x, double r)
-{
-    if (u->cover_on && r <= u->cover.r_q)
-        return pk_rsa_cover_hits(&u->cover, u->out, x, r) ||
-            pk_grid_overlaps_from(&u->grid, u->out, x, r, u->cover_level);
-    return pk_grid_overlaps(&u->grid, u->out, x, r);
-}
 
 /* Set up the run for n grains after the grains already in out (which stay
  * obstacles).  -1 when out of memory (nothing left to free). */
@@ -191,10 +131,8 @@ static int open_run(rsa_run *u, const pk_box *b, const double *diameters, size_t
     if (pk_grid_init_dense(&u->grid, b, 0.5 * diameters[n - 1], 0.5 * diameters[0], u->gap,
                            out->n + n) != 0)
         return -1;
-    if (prm->draws == PK_RSA_DRAWS_OPEN)
-        open_cover(u, diameters, n);
     for (size_t j = 0; j < out->n; j++)
-        file_grain(u, j);
+        pk_grid_insert(&u->grid, out, j);
     pk_rng_seed(&u->rng, prm->seed, 1);
     pk_monitor_begin(mon);
     u->box_measure = pk_box_measure(b);
@@ -255,12 +193,12 @@ static pk_stop_reason draw_grain(rsa_run *u, double r, const double *lo, const d
             for (int k = 0; ok && k < b->dim; k++)
                 if (!b->periodic[k] && (x[k] < lo[k] || x[k] > lo[k] + span[k]))
                     ok = 0;
-            ok = ok && !overlaps(u, x, r);
+            ok = ok && !pk_grid_overlaps(&u->grid, u->out, x, r);
         } else {
             for (int k = 0; k < b->dim; k++)
                 x[k] = lo[k] + span[k] * pk_rng_uniform(&u->rng);
             u->st->draws++;
-            ok = !overlaps(u, x, r);
+            ok = !pk_grid_overlaps(&u->grid, u->out, x, r);
         }
         if (ok)
             break;
@@ -310,7 +248,7 @@ static pk_stop_reason place_one(rsa_run *u, const double *diameters, int32_t spe
     if (why != PK_STOP_COMPLETE)
         return why;
     size_t j = pk_particles_push(u->out, x, r, species);
-    if (j == (size_t)-1 || file_grain(u, j) != 0)
+    if (j == (size_t)-1 || pk_grid_insert(&u->grid, u->out, j) != 0)
         return PK_STOP_ERROR;
     after_placement(u, failed);
     u->st->placed++;
@@ -329,7 +267,7 @@ static pk_stop_reason place_one(rsa_run *u, const double *diameters, int32_t spe
 static pk_stop_reason grid_take_run(rsa_run *u, size_t first)
 {
     for (size_t j = first; j < u->out->n; j++)
-        if (file_grain(u, j) != 0)
+        if (pk_grid_insert(&u->grid, u->out, j) != 0)
             return PK_STOP_ERROR;
     return PK_STOP_COMPLETE;
 }
@@ -395,8 +333,6 @@ int pk_rsa_place(const pk_box *b, const double *diameters, const int32_t *specie
     if (u.sg.on)
         pk_rsa_vox_free(&u.sg.vox);
     pk_grid_free(&u.grid);
-    if (u.cover_on)
-        pk_rsa_cover_free(&u.cover);
     st->seconds = pk_wall_seconds() - t0;
     return st->reason == PK_STOP_ERROR ? -1 : 0;
 }

@@ -236,10 +236,10 @@ int pk_grid_update(pk_grid *g, const pk_particles *p, size_t i)
 /* The one cell scan behind both queries.  With fn == NULL it is the RSA
  * overlap test (extra = 0, stop at the first grain closer than contact). */
 static inline int scan(const pk_grid *g, const pk_particles *p, const double *x, double r,
-                       double extra, pk_grid_visit fn, void *ctx, int from)
+                       double extra, pk_grid_visit fn, void *ctx)
 {
     const int dim = g->box.dim;
-    for (int l = from; l < g->nlevel; l++) {
+    for (int l = 0; l < g->nlevel; l++) {
         const pk_grid_level *lv = &g->lv[l];
         if (lv->count == 0)
             continue;
@@ -315,18 +315,10 @@ int pk_grid_query(const pk_grid *g, const pk_particles *p, const double x[PK_MAX
 {
     if (!fn)
         return 0;
-    return scan(g, p, x, r, extra, fn, ctx, 0);
+    return scan(g, p, x, r, extra, fn, ctx);
 }
 
 int pk_grid_overlaps(const pk_grid *g, const pk_particles *p, const double x[PK_MAXDIM], double r)
 {
-    return scan(g, p, x, r, 0.0, NULL, NULL, 0);
+    return scan(g, p, x, r, 0.0, NULL, NULL);
 }
-
-int pk_grid_overlaps_from(const pk_grid *g, const pk_particles *p, const double x[PK_MAXDIM],
-                          double r, int level)
-{
-    return scan(g, p, x, r, 0.0, NULL, NULL, level < 0 ? 0 : level);
-}
-
-int pk_grid_level_of(const pk_grid *g, double r) { return level_of(g, r); }

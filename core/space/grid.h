@@ -78,11 +78,5 @@ int pk_grid_query(const pk_grid *g, const pk_particles *p, const double x[PK_MAX
 
 /* Fast path for RSA: 1 if a registered grain j has |x_j - x| < r + r_j + gap. */
 int pk_grid_overlaps(const pk_grid *g, const pk_particles *p, const double x[PK_MAXDIM], double r);
-/* The same over levels >= level only (the coarser ones checked elsewhere:
- * core/rsa/rsa_cover.h). */
-int pk_grid_overlaps_from(const pk_grid *g, const pk_particles *p, const double x[PK_MAXDIM],
-                          double r, int level);
-/* The level a grain of radius r is registered in. */
-int pk_grid_level_of(const pk_grid *g, double r);
 
 #endif
