@@ -8,6 +8,7 @@
 #include <stddef.h>
 
 #include "api/inputs/check_ctx.h"
+#include "api/results/h5_observables.h"
 #include "api/run_ctx.h"
 #include "api/schemas/json_schema.h"
 
@@ -19,6 +20,9 @@ typedef struct pk_process {
     /* The picture kinds (api/picture/picture.h) its results may hold,
      * NULL-terminated: the pictures its description declares as outputs. */
     const char *const *pictures;
+    /* Its observable list (api/results/h5_observables.h): the summary's
+     * members, their datasets under /observables and their units. */
+    const pk_obs_row *observables;
     /* Schema-valid inputs → the parsed job (the process's option table
      * filled, semantic checks beyond the schema: cross-field rules,
      * feasibility), released by free_job; NULL with errors appended (JSON

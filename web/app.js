@@ -1,6 +1,6 @@
 // packd dashboard: the job list with live progress (its filters and pages:
-// list-filters.js) and the queue's state, a job page, and a form that submits
-// the examples.  It reads the API as any client does; job data
+// list-filters.js) and the queue's state, and a job page (its summary:
+// summary-groups.js); the job form is job-form.js.  It reads the API as any client does; job data
 // enters the page only as text (textContent), never as markup.
 'use strict';
 
@@ -28,7 +28,7 @@ async function api(path, opts) {
   const body = await r.json().catch(() => ({}));
   if (!r.ok) {
     const msg = (body.title || r.statusText) + (body.detail ? ': ' + body.detail : '');
-    throw new Error(r.status + ' ' + msg);
+    throw Object.assign(new Error(r.status + ' ' + msg), { status: r.status, body });
   }
   return body;
 }
@@ -180,7 +180,6 @@ function jobRow(j) {
   return row;
 }
 
-let packResults = []; // successful pack jobs: the RVEs a homogenize example can take
 let listAsked = 0, listShown = 0; // list refreshes begun, and the newest one shown
 let processesListed = false;
 
@@ -213,7 +212,10 @@ async function refreshList() {
   // asked once the list answered: with auth on they need the token too
   refreshQueue(v);
   refreshRVEs(v);
-  if (!processesListed) api('processes').then((d) => { processesListed = true; fillProcesses(d); }, () => {});
+  if (!processesListed) {
+    api('processes').then((d) => { processesListed = true; fillProcesses(d); }, () => {});
+    offerOwnerFilter();
+  }
 }
 
 // Jobs waiting and running, workers busy of the maximum, and where they run.
@@ -223,86 +225,6 @@ async function refreshQueue(v) {
     if (v !== view) return;
     for (const k of ['accepted', 'running', 'workers_busy', 'workers_max', 'executor']) $('q-' + k).textContent = q[k];
   } catch (e) { showError('Queue: ' + e.message); }
-}
-
-// The RVEs a homogenize example can take, asked only while one is picked.
-async function refreshRVEs(v) {
-  const ex = examples[Number($('example').value)];
-  if (!ex || !ex.inputs.rve) return;
-  try {
-    const doc = await api('jobs?processID=pack&status=successful&limit=50');
-    if (v !== view) return;
-    packResults = doc.jobs || [];
-    fillRVE();
-  } catch (e) { /* the list shows the API's error */ }
-}
-
-// --- the examples form
-let examples = [];
-
-async function loadExamples() {
-  try {
-    examples = (await api('dashboard/examples')).examples || [];
-  } catch (e) { showError('Examples: ' + e.message); return; }
-  const sel = $('example');
-  sel.replaceChildren();
-  examples.forEach((ex, i) => {
-    const o = el('option', ex.name.replace(/\.json$/, '') + ' (' + ex.process + ')');
-    o.value = String(i);
-    sel.appendChild(o);
-  });
-  sel.addEventListener('change', pickExample);
-  pickExample();
-}
-
-function pickExample() {
-  const ex = examples[Number($('example').value)];
-  if (!ex) return;
-  $('example-comment').textContent = ex.comment || '';
-  $('inputs').value = JSON.stringify(ex.inputs, null, 2);
-  fillRVE();
-  if (ex.inputs.rve && listShown) refreshRVEs(view); // once the API has answered (a token)
-}
-
-// A homogenize example names an RVE file of its own folder; here it takes
-// the result of one of the user's finished pack jobs instead.
-function fillRVE() {
-  const ex = examples[Number($('example').value)];
-  const wants = !!(ex && ex.inputs.rve);
-  $('rve-pick').hidden = !wants;
-  const sel = $('rve');
-  const keep = sel.value;
-  sel.replaceChildren(el('option', wants && !packResults.length ? '(first run a pack example)' : '(as in the example)'));
-  sel.options[0].value = '';
-  for (const j of packResults) {
-    const o = el('option', j.jobID.slice(0, 8) + ' ' + localTime(j.created));
-    o.value = '/jobs/' + j.jobID + '/results/result';
-    sel.appendChild(o);
-  }
-  sel.value = keep;
-  if (sel.value !== keep || !keep) sel.selectedIndex = packResults.length ? 1 : 0;
-}
-
-async function submitExample(ev) {
-  ev.preventDefault();
-  const ex = examples[Number($('example').value)];
-  if (!ex) return;
-  let inputs;
-  try { inputs = JSON.parse($('inputs').value); } catch (e) { showError('Inputs: ' + e.message); return; }
-  if (inputs.rve && $('rve').value) inputs.rve = { href: $('rve').value };
-  try {
-    const doc = await api('processes/' + encodeURIComponent(ex.process) + '/execution', {
-      method: 'POST', headers: { 'Content-Type': 'application/json' },
-      body: JSON.stringify({ inputs }),
-    });
-    const out = $('submitted');
-    out.replaceChildren('submitted ');
-    const a = el('a', doc.jobID);
-    a.href = '#/jobs/' + encodeURIComponent(doc.jobID);
-    out.appendChild(a);
-    showError('');
-    await refreshList();
-  } catch (e) { showError('Submit: ' + e.message); }
 }
 
 // --- the job page
@@ -348,18 +270,13 @@ function download(id, output, name, title) {
   $('downloads').appendChild(li);
 }
 
-function summaryRows(obj, prefix, tbody, depth) {
-  for (const [k, v] of Object.entries(obj || {})) {
-    const key = prefix ? prefix + '.' + k : k;
-    if (v !== null && typeof v === 'object' && !Array.isArray(v)) {
-      if (depth < 2) summaryRows(v, key, tbody, depth + 1);
-    } else if (!Array.isArray(v) || (v.length <= 8 && v.every((x) => typeof x !== 'object'))) {
-      const tr = el('tr');
-      const shown = typeof v === 'number' && !Number.isInteger(v) ? Number(v.toPrecision(6)) : v;
-      tr.append(el('th', key), el('td', Array.isArray(v) ? JSON.stringify(v) : shown));
-      tbody.appendChild(tr);
-    }
-  }
+// The summary grouped, with the units of its figures (summary-groups.js).
+async function loadSummary(id) {
+  try {
+    const [sum, u] = await Promise.all([api(fileURL(id, 'summary')),
+      api('dashboard/jobs/' + encodeURIComponent(id) + '/units').catch(() => ({ units: {} }))]);
+    if (pageJob === id) showSummary($('summary'), sum, u.units || {});
+  } catch (e) { showError('Summary: ' + e.message); }
 }
 
 // A statusInfo document or an event of the job's stream: progress events
@@ -394,9 +311,7 @@ async function showFailed(id, s) {
   $('job-reason').hidden = false;
   if ((s.links || []).some((l) => l.rel === 'partial-result'))
     download(id, 'result', id + '.partial.h5', 'partial HDF5 result (as far as the job got)');
-  try {
-    summaryRows(await api(fileURL(id, 'summary')), '', $('summary').tBodies[0], 0);
-  } catch (e) { showError('Summary: ' + e.message); }
+  await loadSummary(id);
 }
 
 async function showJob(id) {
@@ -406,7 +321,7 @@ async function showJob(id) {
   for (const k of ['pictures', 'downloads', 'job-message', 'job-percent', 'job-inputs', 'job-times', 'job-reason']) $(k).replaceChildren();
   $('job-reason').hidden = true;
   $('cancel').hidden = true;
-  $('summary').tBodies[0].replaceChildren();
+  $('summary').replaceChildren();
   let s;
   try { s = await api('jobs/' + encodeURIComponent(id)); } catch (e) { showError('Job: ' + e.message); return; }
   if (v !== view) return;
@@ -443,9 +358,7 @@ async function showJob(id) {
     else if (k === 'xdmf') download(id, k, id + '.xdmf', 'XDMF for ParaView (save it next to the .h5 file)');
     else download(id, k, id + '-' + k, (res[k].title || k) + ' (' + k.split('.').pop().toUpperCase() + ')');
   }
-  try {
-    summaryRows(await api(fileURL(id, 'summary')), '', $('summary').tBodies[0], 0);
-  } catch (e) { showError('Summary: ' + e.message); }
+  await loadSummary(id);
 }
 
 // --- routing: #/ the list (#/?status=…&process=…&page=…: list-filters.js), #/jobs/ID a job
@@ -477,11 +390,11 @@ document.addEventListener('DOMContentLoaded', () => {
   $('token-form').addEventListener('submit', (ev) => {
     ev.preventDefault();
     localStorage.setItem('packd.token', $('token').value.trim());
+    processesListed = false; // the owner filter is an admin's
+    loadForm();
     route();
   });
-  $('submit-form').addEventListener('submit', submitExample);
   $('cancel').addEventListener('click', cancelJob);
   window.addEventListener('hashchange', route);
-  loadExamples();
   route();
 });

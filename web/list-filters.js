@@ -1,8 +1,9 @@
 // packd dashboard: the job list's filters and pages.  They live in the URL's
-// hash (#/?status=running,accepted&process=pack&page=2&limit=50), so a reload
+// hash (#/?status=running,accepted&process=pack&owner=alice&page=2&limit=50), so a reload
 // or a shared link shows the same list; the API does the filtering and the
-// paging (GET /jobs: status, processID, limit, offset, numberMatched and the
-// next/prev links).  app.js reads them on every route().
+// paging (GET /jobs: status, processID, owner, limit, offset, numberMatched
+// and the next/prev links).  The owner filter is an admin's (GET
+// /dashboard/me says who is one).  app.js reads them on every route().
 'use strict';
 
 const PAGE_SIZE = 50;
@@ -18,7 +19,7 @@ function listParams() {
     return Number.isInteger(n) && n >= 1 ? n : def;
   };
   // a limit above the API's maximum (route_job_list.c) would page past what it lists
-  return { status: values('status'), process: values('process'), page: count('page', 1), limit: Math.min(count('limit', PAGE_SIZE), 10000) };
+  return { status: values('status'), process: values('process'), owner: (q.get('owner') || '').trim(), page: count('page', 1), limit: Math.min(count('limit', PAGE_SIZE), 10000) };
 }
 
 function listHash(p) {
@@ -26,6 +27,7 @@ function listHash(p) {
   const add = (k, v) => parts.push(k + '=' + v);
   if (p.status.length) add('status', p.status.map(encodeURIComponent).join(','));
   if (p.process.length) add('process', p.process.map(encodeURIComponent).join(','));
+  if (p.owner) add('owner', encodeURIComponent(p.owner));
   if (p.page > 1) add('page', p.page);
   if (p.limit !== PAGE_SIZE) add('limit', p.limit);
   return '#/' + (parts.length ? '?' + parts.join('&') : '');
@@ -36,6 +38,7 @@ function listQuery(p) {
   let q = 'jobs?limit=' + p.limit + '&offset=' + (p.page - 1) * p.limit;
   if (p.status.length) q += '&status=' + p.status.map(encodeURIComponent).join(',');
   if (p.process.length) q += '&processID=' + p.process.map(encodeURIComponent).join(',');
+  if (p.owner) q += '&owner=' + encodeURIComponent(p.owner);
   return q;
 }
 
@@ -52,6 +55,22 @@ function showFilters(p) {
     sel.appendChild(o);
   }
   sel.value = want;
+  $('f-owner').value = p.owner;
+  if (p.owner) $('f-owner-pick').hidden = false; // a shared link's filter stays visible
+}
+
+// The owner filter for an admin, its list offering the admin's own name.
+async function offerOwnerFilter() {
+  try {
+    const me = await api('dashboard/me');
+    $('f-owner-pick').hidden = !me.admin && !listParams().owner;
+    const list = $('f-owners');
+    if (![...list.options].some((o) => o.value === me.owner)) {
+      const o = document.createElement('option');
+      o.value = me.owner;
+      list.appendChild(o);
+    }
+  } catch (e) { /* the list shows the API's error */ }
 }
 
 function fillProcesses(doc) {
@@ -68,7 +87,7 @@ function fillProcesses(doc) {
 // "jobs 51–100 of 137" and the buttons the API's next/prev links allow.
 function showPaging(p, doc) {
   const n = (doc.jobs || []).length, first = (p.page - 1) * p.limit + 1;
-  const filtered = p.status.length || p.process.length;
+  const filtered = p.status.length || p.process.length || p.owner;
   let text;
   if (n) text = 'jobs ' + first + '–' + (first + n - 1) + (typeof doc.numberMatched === 'number' ? ' of ' + doc.numberMatched : '');
   else if (p.page > 1) text = 'no jobs on page ' + p.page;
@@ -94,12 +113,14 @@ document.addEventListener('DOMContentLoaded', () => {
     label.append(box, ' ' + st);
     boxes.appendChild(label);
   }
-  document.getElementById('filters').addEventListener('change', () => {
+  const apply = () => {
     const status = [...document.querySelectorAll('#filters input[name="status"]:checked')].map((b) => b.value);
     const process = document.getElementById('f-process').value;
-    goToList({ status, process: process ? process.split(',') : [], page: 1 });
-  });
-  document.getElementById('filters').addEventListener('submit', (ev) => ev.preventDefault());
+    const owner = document.getElementById('f-owner').value.trim();
+    goToList({ status, process: process ? process.split(',') : [], owner, page: 1 });
+  };
+  document.getElementById('filters').addEventListener('change', apply);
+  document.getElementById('filters').addEventListener('submit', (ev) => { ev.preventDefault(); apply(); });
   document.getElementById('prev').addEventListener('click', () => goToList({ page: Math.max(1, listParams().page - 1) }));
   document.getElementById('next').addEventListener('click', () => goToList({ page: listParams().page + 1 }));
 });

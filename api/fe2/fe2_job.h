@@ -50,6 +50,9 @@ typedef struct pk_fe2_job {
 
 /* The options of the process (fe2_job.c). */
 extern const pk_option_table pk_fe2_options;
+/* The process's observable list (api/results/h5_observables.h; in
+ * fe2_record.c). */
+extern const pk_obs_row pk_fe2_observables[];
 
 /* The macro problem set up from a job (fe2_setup.c): the mesh and its
  * sets, the conditions resolved to degrees of freedom, and each stage's

@@ -42,30 +42,64 @@ static double mesh_area(const pk_fe2_mesh *m, const double *x)
     return a;
 }
 
-/* fe2's observables with a unit (h5_units.h), per unit thickness. */
-static const pk_unit_row fe2_units[] = {
-    {"fe2/mesh/nodes", PK_U_LENGTH},
-    {"fe2/mesh/gauss_position", PK_U_LENGTH},
-    {"fe2/mesh/gauss_weight", PK_U_AREA},
-    {"fe2/displacement", PK_U_LENGTH},
-    {"fe2/position", PK_U_LENGTH},
-    {"fe2/piola_stress", PK_U_PLANE_STRESS},
-    {"fe2/cauchy_stress", PK_U_PLANE_STRESS},
-    {"fe2/von_mises", PK_U_PLANE_STRESS},
-    {"fe2/von_mises_element", PK_U_PLANE_STRESS},
-    {"fe2/rve/energy_density", PK_U_PLANE_STRESS},
-    {"fe2/reaction", PK_U_FORCE_PER_THICKNESS},
-    {"fe2/area", PK_U_AREA},
-    {"fe2/reference_area", PK_U_AREA},
-    {"fe2/micro", PK_U_LENGTH}, /* the RVE centres micro/gauss_point_<g> */
-    {"fe2/newton/solves/abs_residual_0", PK_U_FORCE_PER_THICKNESS},
-    {"fe2/E_n", PK_U_STIFFNESS},
-    {NULL, PK_U_NONE},
+/* The fe2 process's observables (h5_observables.h), per unit thickness:
+ * the summary's members, their datasets under /observables/fe2 and their
+ * units.  Scalars are written from the run's values (pk_h5_obs_rows), the
+ * record's series and arrays here. */
+#define S(name, kind)                                                                              \
+    {                                                                                              \
+        name, kind, PK_OBS_SCALAR, "fe2/" name                                                     \
+    }
+#define FILE_ONLY(file, kind)                                                                      \
+    {                                                                                              \
+        "fe2/" file, kind, PK_OBS_FILE, NULL                                                       \
+    }
+const pk_obs_row pk_fe2_observables[] = {
+    S("termination_reason", PK_U_NONE),
+    S("steps", PK_U_NONE),
+    S("steps_requested", PK_U_NONE),
+    S("nodes", PK_U_NONE),
+    S("elements", PK_U_NONE),
+    S("gauss_points", PK_U_NONE),
+    S("rve_particles", PK_U_NONE),
+    S("boundary_condition", PK_U_NONE),
+    S("E_n", PK_U_STIFFNESS),
+    S("newton_iterations_total", PK_U_NONE),
+    S("step_cuts_total", PK_U_NONE),
+    /* how the run went (docs/perf/fe2-mpi.md), in the summary alone */
+    {"threads", PK_U_NONE, PK_OBS_RUN, NULL},
+    {"mpi_ranks", PK_U_NONE, PK_OBS_RUN, NULL},
+    {"evaluation_rounds", PK_U_NONE, PK_OBS_RUN, NULL},
+    {"steps_wall_s", PK_U_SECONDS, PK_OBS_RUN, NULL},
+    {"mpi_bytes_sent", PK_U_NONE, PK_OBS_RUN, NULL},
+    {"mpi_bytes_received", PK_U_NONE, PK_OBS_RUN, NULL},
+    /* per converged step: reactions of the displacement conditions (by
+     * name, their component), the dilatancy, the load time */
+    {"reaction_per_step", PK_U_FORCE_PER_THICKNESS, PK_OBS_RECORD, "fe2/reaction"},
+    {"dilatancy_percent_per_step", PK_U_NONE, PK_OBS_RECORD, "fe2/dilatancy_percent"},
+    {"time_per_step", PK_U_NONE, PK_OBS_RECORD, "fe2/load_steps/time"},
+    FILE_ONLY("mesh/nodes", PK_U_LENGTH),
+    FILE_ONLY("mesh/gauss_position", PK_U_LENGTH),
+    FILE_ONLY("mesh/gauss_weight", PK_U_AREA),
+    FILE_ONLY("displacement", PK_U_LENGTH),
+    FILE_ONLY("position", PK_U_LENGTH),
+    FILE_ONLY("piola_stress", PK_U_PLANE_STRESS),
+    FILE_ONLY("cauchy_stress", PK_U_PLANE_STRESS),
+    FILE_ONLY("von_mises", PK_U_PLANE_STRESS),
+    FILE_ONLY("von_mises_element", PK_U_PLANE_STRESS),
+    FILE_ONLY("rve/energy_density", PK_U_PLANE_STRESS),
+    FILE_ONLY("area", PK_U_AREA),
+    FILE_ONLY("reference_area", PK_U_AREA),
+    FILE_ONLY("micro", PK_U_LENGTH), /* the RVE centres micro/gauss_point_<g> */
+    FILE_ONLY("newton/solves/abs_residual_0", PK_U_FORCE_PER_THICKNESS),
+    {NULL, PK_U_NONE, PK_OBS_SCALAR, NULL},
 };
+#undef S
+#undef FILE_ONLY
 
 const char *pk_fe2_unit_of(const char *name, const pk_units *u)
 {
-    return pk_unit_in(fe2_units, name, u);
+    return pk_obs_unit_at(pk_fe2_observables, name, u);
 }
 
 int pk_fe2_record_init(pk_fe2_record *r, const pk_fe2_setup *s, const size_t *micro_gp,

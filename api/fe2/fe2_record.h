@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "api/results/h5_observables.h"
 #include "api/results/h5_result.h"
 #include "api/results/h5_units.h"
 #include "core/fe2/fe2_fields.h"

@@ -122,7 +122,7 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
     pk_fe2_state st = {0};
     pk_fe2_record rec = {0};
     pk_par *pool = NULL;
-    json_t *sum = NULL;
+    json_t *sum = NULL, *obs = NULL;
     double *uD = NULL, *fext = NULL, *f0 = NULL;
     const double **micro = NULL;
     double *micro_x = NULL; /* [n_micro_gp][ngrain][3] the output RVEs (rank 0, MPI) */
@@ -307,29 +307,33 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
         }
     }
 
-    sum = json_object();
-    json_object_set_new(sum, "process", json_string("fe2"));
-    json_object_set_new(sum, "termination_reason", json_string(reason));
-    json_object_set_new(sum, "complete", json_boolean(done == nstep));
-    json_object_set_new(sum, "steps", json_integer((json_int_t)done));
-    json_object_set_new(sum, "steps_requested", json_integer((json_int_t)nstep));
-    json_object_set_new(sum, "nodes", json_integer((json_int_t)s.mesh.nnode));
-    json_object_set_new(sum, "elements", json_integer((json_int_t)s.mesh.nelem));
-    json_object_set_new(sum, "gauss_points", json_integer((json_int_t)ngp));
-    json_object_set_new(sum, "rve_particles", json_integer((json_int_t)rve.n));
-    json_object_set_new(sum, "boundary_condition", json_string(pk_homog_bc_name(job->micro.bc)));
-    json_object_set_new(sum, "newton_iterations_total", json_integer((json_int_t)iters_total));
-    json_object_set_new(sum, "step_cuts_total", json_integer((json_int_t)cuts_total));
-    json_object_set_new(sum, "threads", json_integer(pk_par_threads(pool)));
-    json_object_set_new(sum, "mpi_ranks", json_integer(pk_mpi_size()));
+    /* the observables (pk_fe2_observables): the summary's and the file's */
+    obs = json_object();
+    pk_obs_set(obs, "termination_reason", json_string(reason));
+    pk_obs_set(obs, "steps", json_integer((json_int_t)done));
+    pk_obs_set(obs, "steps_requested", json_integer((json_int_t)nstep));
+    pk_obs_set(obs, "nodes", json_integer((json_int_t)s.mesh.nnode));
+    pk_obs_set(obs, "elements", json_integer((json_int_t)s.mesh.nelem));
+    pk_obs_set(obs, "gauss_points", json_integer((json_int_t)ngp));
+    pk_obs_set(obs, "rve_particles", json_integer((json_int_t)rve.n));
+    pk_obs_set(obs, "boundary_condition", json_string(pk_homog_bc_name(job->micro.bc)));
+    pk_obs_set(obs, "E_n", json_real(job->micro.E_n));
+    pk_obs_set(obs, "newton_iterations_total", json_integer((json_int_t)iters_total));
+    pk_obs_set(obs, "step_cuts_total", json_integer((json_int_t)cuts_total));
+    pk_obs_set(obs, "threads", json_integer(pk_par_threads(pool)));
+    pk_obs_set(obs, "mpi_ranks", json_integer(pk_mpi_size()));
     /* what a round costs (docs/perf/fe2-mpi.md): wall time of the load steps
      * (rounds, macro solves, commits) and, over ranks, the bytes rank 0 moved */
-    json_object_set_new(sum, "evaluation_rounds", json_integer((json_int_t)rounds_total));
-    json_object_set_new(sum, "steps_wall_s", json_real(pk_wall_seconds() - solve_t0));
+    pk_obs_set(obs, "evaluation_rounds", json_integer((json_int_t)rounds_total));
+    pk_obs_set(obs, "steps_wall_s", json_real(pk_wall_seconds() - solve_t0));
     if (have_mpi) {
-        json_object_set_new(sum, "mpi_bytes_sent", json_integer((json_int_t)mpi.bytes_out));
-        json_object_set_new(sum, "mpi_bytes_received", json_integer((json_int_t)mpi.bytes_in));
+        pk_obs_set(obs, "mpi_bytes_sent", json_integer((json_int_t)mpi.bytes_out));
+        pk_obs_set(obs, "mpi_bytes_received", json_integer((json_int_t)mpi.bytes_in));
     }
+    sum = json_object();
+    json_object_set_new(sum, "process", json_string("fe2"));
+    json_object_set_new(sum, "complete", json_boolean(done == nstep));
+    json_object_update(sum, obs);
     /* the figures per converged step: reactions of the displacement
      * conditions and the dilatancy Δ = (v/V − 1)·100 % of the specimen */
     json_t *reac = json_object();
@@ -342,6 +346,9 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
     json_object_set_new(sum, "dilatancy_percent_per_step",
                         series_json(rec.dilatancy.v, done, 1, 0));
     json_object_set_new(sum, "time_per_step", series_json(rec.time.v, done, 1, 0));
+    pk_units units; /* lengths in the job's unit, forces in N, per unit thickness */
+    pk_units_init(&units, job->unit, 2);
+    json_object_set_new(sum, "units", pk_obs_units_json(pk_fe2_observables, sum, &units));
     if (failure[0])
         pk_verdict_fail(sum, "%s (the result file holds the %zu converged load steps before it)",
                         failure, done);
@@ -349,15 +356,10 @@ int pk_fe2_run(const void *parsed, const pk_run_ctx *run, const char *job_json,
     pk_h5 *h = pk_h5_create(out_path, run->author, err, errlen);
     if (!h)
         goto out;
-    pk_units units; /* lengths in the job's unit, forces in N, per unit thickness */
-    pk_units_init(&units, job->unit, 2);
     int w = pk_h5_write_particles(h, &box, &p, job->unit);
     w |= pk_h5_write_parameters(h, "fe2", job_json, 0);
     w |= pk_fe2_record_write(h, &rec, &units);
-    w |= pk_h5_obs_string(h, "fe2/termination_reason", reason);
-    w |= pk_h5_obs_string(h, "fe2/boundary_condition", pk_homog_bc_name(job->micro.bc));
-    w |= pk_h5_obs_int(h, "fe2/rve_particles", (int64_t)rve.n);
-    w |= pk_h5_obs_double(h, "fe2/E_n", job->micro.E_n, pk_fe2_unit_of("fe2/E_n", &units));
+    w |= pk_h5_obs_rows(h, pk_fe2_observables, obs, &units);
     if (pk_verdict_close_h5(h, w, sum, out_path, err, errlen) != 0)
         goto out;
     *summary = sum;
@@ -373,6 +375,7 @@ out:
         pk_fe2_mpi_stop(&mpi);
     pk_schema_errors_free(&errs);
     json_decref(sum);
+    json_decref(obs);
     free(uD);
     free(micro_x);
     free(fext);

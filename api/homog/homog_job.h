@@ -7,6 +7,7 @@
 #include <stddef.h>
 
 #include "api/inputs/check_ctx.h"
+#include "api/results/h5_observables.h"
 #include "api/run_ctx.h"
 #include "core/homog/homog_bc.h"
 #include "core/homog/homog_rve.h"
@@ -63,6 +64,9 @@ typedef struct pk_homog_job {
 
 /* The options of the process (homog_job.c). */
 extern const pk_option_table pk_homog_options;
+/* The process's observable list (api/results/h5_observables.h; in
+ * homog_record.c). */
+extern const pk_obs_row pk_homog_observables[];
 
 /* Inputs (schema-valid) → job; semantic errors appended with pointers
  * relative to the inputs object.  Returns their number (job->F is freed on

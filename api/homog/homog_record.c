@@ -245,32 +245,81 @@ int pk_homog_record_audit(json_t *aud, const pk_homog_audit *a)
 
 #define OBS "/observables/"
 
-/* The homogenization's observables with a unit (h5_units.h); every other
- * one is a count, a ratio or dimensionless (J, strains, iterations). */
-static const pk_unit_row homog_units[] = {
-    {"homogenize/rve_volume", PK_U_VOLUME},
-    {"homogenize/E_n", PK_U_STIFFNESS},
-    {"homogenize/friction/E_t", PK_U_STIFFNESS},
-    {"homogenize/P", PK_U_STRESS},
-    {"homogenize/sigma", PK_U_STRESS},
-    {"homogenize/sigma_skew", PK_U_STRESS},
-    {"homogenize/energy", PK_U_ENERGY},
-    {"homogenize/energy_density", PK_U_STRESS},
-    {"homogenize/energy_tangential", PK_U_ENERGY},
-    {"homogenize/dissipation", PK_U_ENERGY},
-    {"homogenize/sum_force", PK_U_FORCE},
-    {"homogenize/dr/residual", PK_U_FORCE},
-    {"homogenize/dr/residual_initial", PK_U_FORCE},
-    {"homogenize/tangent/A", PK_U_STRESS},
-    {"homogenize/tangent/seconds", PK_U_SECONDS},
-    {"homogenize/final_state/position", PK_U_LENGTH},
-    {"homogenize/final_state/fluctuation", PK_U_LENGTH},
-    {NULL, PK_U_NONE},
+/* The homogenize process's observables (h5_observables.h): the summary's
+ * members, their datasets under /observables and their units.  Scalars are
+ * written from the run's values (pk_h5_obs_rows); the record's series are
+ * written here, the summary holding their last step. */
+#define S(name, kind, file)                                                                        \
+    {                                                                                              \
+        name, kind, PK_OBS_SCALAR, "homogenize/" file                                              \
+    }
+#define R(name, kind, file)                                                                        \
+    {                                                                                              \
+        name, kind, PK_OBS_RECORD, file                                                            \
+    }
+#define FILE_ONLY(file, kind)                                                                      \
+    {                                                                                              \
+        "homogenize/" file, kind, PK_OBS_FILE, NULL                                                \
+    }
+const pk_obs_row pk_homog_observables[] = {
+    S("boundary_condition", PK_U_NONE, "boundary_condition"),
+    S("termination_reason", PK_U_NONE, "termination_reason"),
+    S("steps", PK_U_NONE, "steps"),
+    S("steps_requested", PK_U_NONE, "steps_requested"),
+    S("steps_not_converged", PK_U_NONE, "steps_not_converged"),
+    S("resumed", PK_U_NONE, "resumed"), /* with a checkpoint file */
+    S("resumed_from_step", PK_U_NONE, "resumed_from_step"),
+    S("checkpoint_error", PK_U_NONE, "checkpoint_error"),
+    S("rve_particles", PK_U_NONE, "rve_particles"),
+    S("rve_volume", PK_U_VOLUME, "rve_volume"),
+    S("E_n", PK_U_STIFFNESS, "E_n"),
+    S("friction/E_t", PK_U_STIFFNESS, "friction/E_t"),
+    S("friction/tan_rho", PK_U_NONE, "friction/tan_rho"),
+    S("friction/h", PK_U_NONE, "friction/h"),
+    S("radius_factor", PK_U_NONE, "radius_factor"),
+    S("precompression", PK_U_NONE, "precompression"),
+    S("dr_iterations_total", PK_U_NONE, "dr_iterations_total"),
+    S("dr_iterations_max", PK_U_NONE, "dr_iterations_max"),
+    {"threads", PK_U_NONE, PK_OBS_RUN, NULL},
+    S("hull/widest_gap_over_d_min", PK_U_NONE, "hull/widest_gap_over_d_min"),
+    S("hull/full", PK_U_NONE, "hull/full"),
+    /* the audit over the steps (its series: /observables/audit) */
+    {"audit/passed", PK_U_NONE, PK_OBS_SCALAR, "audit/all_passed"},
+    {"audit/steps_audited", PK_U_NONE, PK_OBS_SCALAR, "audit/steps_audited"},
+    {"audit/max_residual_ratio", PK_U_NONE, PK_OBS_SCALAR, "audit/max_residual_ratio"},
+    {"audit/max_balance_ratio", PK_U_NONE, PK_OBS_SCALAR, "audit/max_balance_ratio"},
+    {"audit/max_overlap_ratio", PK_U_NONE, PK_OBS_SCALAR, "audit/max_overlap_ratio"},
+    R("audit/overlap_ratio_bound", PK_U_NONE, "audit/overlap_ratio_bound"),
+    R("model", PK_U_NONE, "modelled"),
+    /* the last committed step of the series */
+    R("F", PK_U_NONE, "homogenize/F"),
+    R("P", PK_U_STRESS, "homogenize/P"),
+    R("sigma", PK_U_STRESS, "homogenize/sigma"),
+    R("energy_density", PK_U_STRESS, "homogenize/energy_density"),
+    R("contacts", PK_U_NONE, "homogenize/contacts"),
+    R("rattlers", PK_U_NONE, "homogenize/rattlers"),
+    R("tangent", PK_U_STRESS, "homogenize/tangent/A"), /* Ā as [d²][d²] */
+    /* series and arrays of the file alone with a unit; every other one is
+     * a count, a ratio or dimensionless (J, iterations) */
+    FILE_ONLY("sigma_skew", PK_U_STRESS),
+    FILE_ONLY("energy", PK_U_ENERGY),
+    FILE_ONLY("energy_tangential", PK_U_ENERGY),
+    FILE_ONLY("dissipation", PK_U_ENERGY),
+    FILE_ONLY("sum_force", PK_U_FORCE),
+    FILE_ONLY("dr/residual", PK_U_FORCE),
+    FILE_ONLY("dr/residual_initial", PK_U_FORCE),
+    FILE_ONLY("tangent/seconds", PK_U_SECONDS),
+    FILE_ONLY("final_state/position", PK_U_LENGTH),
+    FILE_ONLY("final_state/fluctuation", PK_U_LENGTH),
+    {NULL, PK_U_NONE, PK_OBS_SCALAR, NULL},
 };
+#undef S
+#undef R
+#undef FILE_ONLY
 
 const char *pk_homog_unit_of(const char *name, const void *units)
 {
-    return pk_unit_in(homog_units, name, units);
+    return pk_obs_unit_at(pk_homog_observables, name, units);
 }
 
 typedef struct {
@@ -524,7 +573,7 @@ int pk_homog_record_write(pk_h5 *h, json_t *rec, json_t *aud, int dim, size_t au
         rc |= final_contacts(&w, fc, dim);
     json_object_del(r, "final_state");
     json_object_del(r, "final_contacts");
-    pk_h5_obs_json_units(h, "homogenize", r, pk_homog_unit_of, u);
+    pk_h5_obs_json_units(h, "homogenize", r, pk_homog_unit_of, u); /* the codes' names */
     /* the audit: one entry per audited step (from audit_first on) */
     const char *aclock = NULL;
     char abuf[256];

@@ -8,6 +8,7 @@
 
 #include <jansson.h>
 
+#include "api/results/h5_observables.h"
 #include "api/results/h5_result.h"
 #include "api/results/h5_units.h"
 

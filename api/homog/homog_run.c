@@ -184,7 +184,7 @@ int pk_homog_run(const void *parsed, const pk_run_ctx *run, const char *job_json
     pk_homog_frames fr = {0};   /* the deformed grains per step (homog_frames.h) */
     pk_sparse_ctx *nctx = NULL; /* Newton's solver context over the whole load path */
     pk_par *pool = NULL;        /* the job's threads (NULL: serial; the same results) */
-    json_t *rec = NULL, *aud = NULL, *sum = NULL;
+    json_t *rec = NULL, *aud = NULL, *sum = NULL, *obs = NULL;
     if (job.fdim && job.fdim != dim) {
         snprintf(err, errlen, "the load path is %dD but the RVE is %dD", job.fdim, dim);
         goto out;
@@ -349,61 +349,58 @@ int pk_homog_run(const void *parsed, const pk_run_ctx *run, const char *job_json
         snprintf(err, errlen, "out of memory");
         goto out;
     }
-    json_object_set_new(rec, "boundary_condition", json_string(pk_homog_bc_name(job.bc)));
-    json_object_set_new(rec, "steps", json_integer((json_int_t)done));
-    json_object_set_new(rec, "steps_requested", json_integer((json_int_t)job.nstep));
-    json_object_set_new(rec, "steps_not_converged", json_integer((json_int_t)not_converged));
-    json_object_set_new(rec, "termination_reason", json_string(reason));
-    json_object_set_new(rec, "rve_particles", json_integer((json_int_t)rve.n));
-    json_object_set_new(rec, "rve_volume", json_real(rve.V));
-    json_object_set_new(rec, "E_n", json_real(job.E_n));
+    /* the observables (pk_homog_observables): the summary's and the file's */
+    obs = json_object();
+    pk_obs_set(obs, "boundary_condition", json_string(pk_homog_bc_name(job.bc)));
+    pk_obs_set(obs, "termination_reason", json_string(reason));
+    pk_obs_set(obs, "steps", json_integer((json_int_t)done));
+    pk_obs_set(obs, "steps_requested", json_integer((json_int_t)job.nstep));
+    pk_obs_set(obs, "steps_not_converged", json_integer((json_int_t)not_converged));
+    pk_obs_set(obs, "rve_particles", json_integer((json_int_t)rve.n));
+    pk_obs_set(obs, "rve_volume", json_real(rve.V));
+    pk_obs_set(obs, "E_n", json_real(job.E_n));
     if (job.friction) {
-        json_t *fj = json_object();
-        json_object_set_new(fj, "E_t", json_real(job.fric.E_t));
-        json_object_set_new(fj, "tan_rho", json_real(job.fric.tan_rho));
-        json_object_set_new(fj, "h", json_real(job.fric.h));
-        json_object_set_new(rec, "friction", fj);
+        pk_obs_set(obs, "friction/E_t", json_real(job.fric.E_t));
+        pk_obs_set(obs, "friction/tan_rho", json_real(job.fric.tan_rho));
+        pk_obs_set(obs, "friction/h", json_real(job.fric.h));
     }
     if (ck_path) {
-        json_object_set_new(rec, "resumed", json_boolean(ck_loaded == 0));
+        pk_obs_set(obs, "resumed", json_boolean(ck_loaded == 0));
         if (ck_loaded == 0)
-            json_object_set_new(rec, "resumed_from_step", json_integer((json_int_t)first));
+            pk_obs_set(obs, "resumed_from_step", json_integer((json_int_t)first));
         if (ck_err[0])
-            json_object_set_new(rec, "checkpoint_error", json_string(ck_err));
+            pk_obs_set(obs, "checkpoint_error", json_string(ck_err));
         if (!strcmp(reason, "complete")) /* the path reached its end: nothing to resume */
             remove(ck_path);
     }
-    json_object_set_new(rec, "radius_factor", json_real(job.radius_factor));
-    json_object_set_new(rec, "precompression", json_real(job.precompress));
+    pk_obs_set(obs, "radius_factor", json_real(job.radius_factor));
+    pk_obs_set(obs, "precompression", json_real(job.precompress));
+    pk_obs_set(obs, "dr_iterations_total", json_integer((json_int_t)total_iter));
+    pk_obs_set(obs, "dr_iterations_max", json_integer((json_int_t)max_iter_step));
+    pk_obs_set(obs, "threads", json_integer(pk_par_threads(pool)));
+    pk_obs_set(obs, "audit/passed", json_boolean(!failure[0]));
+    pk_obs_set(obs, "audit/steps_audited",
+               json_integer((json_int_t)json_array_size(json_object_get(aud, "passed"))));
+    pk_obs_set(obs, "audit/max_residual_ratio",
+               json_real(isfinite(worst_resid) ? worst_resid : DBL_MAX));
+    pk_obs_set(obs, "audit/max_balance_ratio",
+               json_real(isfinite(worst_balance) ? worst_balance : DBL_MAX));
+    pk_obs_set(obs, "audit/max_overlap_ratio",
+               json_real(isfinite(worst_overlap) ? worst_overlap : DBL_MAX));
+    const int has_hull = rve.bc == PK_BC_RESTRICTED_TAYLOR && isfinite(rve.hull_gap);
+    if (has_hull) {
+        pk_obs_set(obs, "hull/widest_gap_over_d_min", json_real(rve.hull_gap));
+        pk_obs_set(obs, "hull/full", json_boolean(rve.hull_gap < 1));
+    }
 
     /* the verdict (api/job_verdict.h): every recorded step audited */
     sum = json_object();
     json_object_set_new(sum, "process", json_string("homogenize"));
-    json_object_set_new(sum, "boundary_condition", json_string(pk_homog_bc_name(job.bc)));
-    json_object_set_new(sum, "termination_reason", json_string(reason));
     json_object_set_new(sum, "complete", json_boolean(done == job.nstep));
-    json_object_set_new(sum, "steps", json_integer((json_int_t)done));
-    json_object_set_new(sum, "steps_not_converged", json_integer((json_int_t)not_converged));
-    if (ck_loaded == 0)
-        json_object_set_new(sum, "resumed_from_step", json_integer((json_int_t)first));
     json_object_set_new(sum, "model", pk_homog_model_json(&job, dim, fr.keep && fr.count > 0));
-    json_object_set_new(sum, "rve_particles", json_integer((json_int_t)rve.n));
-    json_object_set_new(sum, "dr_iterations_total", json_integer((json_int_t)total_iter));
-    json_object_set_new(sum, "dr_iterations_max", json_integer((json_int_t)max_iter_step));
-    /* the threads the job ran with (not in the file: the results are the same for any) */
-    json_object_set_new(sum, "threads", json_integer(pk_par_threads(pool)));
-    json_t *sa = json_object();
-    json_object_set_new(sa, "passed", json_boolean(!failure[0]));
-    json_object_set_new(sa, "steps_audited",
-                        json_integer((json_int_t)json_array_size(json_object_get(aud, "passed"))));
-    json_object_set_new(sa, "max_residual_ratio",
-                        json_real(isfinite(worst_resid) ? worst_resid : DBL_MAX));
-    json_object_set_new(sa, "max_balance_ratio",
-                        json_real(isfinite(worst_balance) ? worst_balance : DBL_MAX));
-    json_object_set_new(sa, "max_overlap_ratio",
-                        json_real(isfinite(worst_overlap) ? worst_overlap : DBL_MAX));
-    json_object_set_new(sa, "overlap_ratio_bound", json_real(PK_AUDIT_OVERLAP_MAX));
-    json_object_set_new(sum, "audit", sa);
+    pk_obs_set(obs, "audit/overlap_ratio_bound",
+               json_real(PK_AUDIT_OVERLAP_MAX)); /* the record's */
+    json_object_update(sum, obs);
     if (failure[0])
         pk_verdict_fail(sum,
                         "%s (the result file holds the %zu steps before it and the failed "
@@ -416,17 +413,12 @@ int pk_homog_run(const void *parsed, const pk_run_ctx *run, const char *job_json
                         job.wall_time_s, done, job.nstep);
     else if (!strcmp(reason, "cancelled"))
         pk_verdict_fail(sum, "cancelled after %zu of %zu load steps", done, job.nstep);
-    if (rve.bc == PK_BC_RESTRICTED_TAYLOR && isfinite(rve.hull_gap)) {
-        json_object_set_new(sum, "hull",
-                            json_pack("{s:f,s:b}", "widest_gap_over_d_min", rve.hull_gap, "full",
-                                      rve.hull_gap < 1));
-        if (!(rve.hull_gap < 1))
-            pk_verdict_warn(sum,
-                            "the hull is not full (Meier 2009 §3.5): neighbouring hull grains "
-                            "leave a gap of %.3g × the smallest diameter, wide enough for an inner "
-                            "grain to leave the RVE",
-                            rve.hull_gap);
-    }
+    if (has_hull && !(rve.hull_gap < 1))
+        pk_verdict_warn(sum,
+                        "the hull is not full (Meier 2009 §3.5): neighbouring hull grains "
+                        "leave a gap of %.3g × the smallest diameter, wide enough for an inner "
+                        "grain to leave the RVE",
+                        rve.hull_gap);
     if (unjammed)
         pk_verdict_warn(sum,
                         "%zu of %zu load steps had no jammed grain (every free grain a "
@@ -463,6 +455,8 @@ int pk_homog_run(const void *parsed, const pk_run_ctx *run, const char *job_json
     w |= pk_homog_frames_write(h, &fr, &rve, &units);
     w |= pk_h5_write_parameters(h, "homogenize", job_json, 0);
     w |= pk_homog_record_write(h, rec, aud, dim, first, job.nstep, &units);
+    w |= pk_h5_obs_rows(h, pk_homog_observables, obs, &units);
+    json_object_set_new(sum, "units", pk_obs_units_json(pk_homog_observables, sum, &units));
     w |= pk_h5_obs_json(h, "modelled", json_object_get(sum, "model"));
     if (pk_verdict_close_h5(h, w, sum, out_path, err, errlen) != 0)
         goto out;
@@ -476,6 +470,7 @@ out:
     json_decref(rec);
     json_decref(aud);
     json_decref(sum);
+    json_decref(obs);
     pk_homog_state_free(&com);
     pk_homog_frames_free(&fr);
     pk_homog_state_free(&tr);

@@ -11,6 +11,7 @@
 #include "api/run_ctx.h"
 #include "api/schemas/json_schema.h"
 #include "api/schemas/option_table.h"
+#include "api/results/h5_observables.h"
 #include "pack_options.h"
 #include "core/base/progress.h"
 #include "core/psd/psd.h"
@@ -85,10 +86,9 @@ void pk_pack_free(void *task);
 /* What the parsed task implies (pk_process.plan): expected grains, target
  * fractions, mass cut, d_max, size classes. */
 json_t *pk_pack_plan_json(const void *task);
-/* The pack process's scalar observables (h5_observables.h): each a member
- * of the summary and a dataset /observables/<name>, with its unit kind. */
-#include "api/results/h5_units.h"
-const pk_unit_row *pk_pack_observables(void);
+/* The pack process's observable list (h5_observables.h): the summary's
+ * members, their datasets under /observables and their units. */
+extern const pk_obs_row pk_pack_observables[];
 
 int pk_pack_run(const void *task, const pk_run_ctx *run, const char *job_json, const char *out_path,
                 json_t **summary, char *err, size_t errlen);

@@ -71,33 +71,34 @@ static size_t grains_outside_walls(const pk_box *b, const pk_particles *p, doubl
     return n;
 }
 
-/* The pack process's scalar observables: the summary's members and
- * /observables/<name> both come from this list (h5_observables.h). */
-static const pk_unit_row pack_observables[] = {
-    {"algorithm", PK_U_NONE},
-    {"termination_reason", PK_U_NONE},
-    {"count_requested", PK_U_NONE},
-    {"count_placed", PK_U_NONE},
-    {"count_expected", PK_U_NONE},
-    {"phi_resolved", PK_U_NONE},
-    {"phi_mix", PK_U_NONE},
-    {"phi_target_resolved", PK_U_NONE},
-    {"phi_target_mix", PK_U_NONE},
-    {"mass_cut_fraction", PK_U_NONE},
-    {"d_min", PK_U_LENGTH},
-    {"delta_d", PK_U_LENGTH},
-    {"size_scale", PK_U_NONE},
-    {"smallest_gap", PK_U_LENGTH},
-    {"smallest_wall_gap", PK_U_LENGTH}, /* -1 when every axis is periodic */
-    {"pairs_below_delta_d", PK_U_NONE},
-    {"grains_below_wall_gap", PK_U_NONE},
-    {"timing/sizes_s", PK_U_SECONDS},
-    {"timing/place_s", PK_U_SECONDS},
-    {"timing/audit_s", PK_U_SECONDS},
-    {NULL, PK_U_NONE},
+/* The pack process's observables: the summary's members, /observables/<name>
+ * and the summary's units all come from this list (h5_observables.h); the
+ * placer's own are /observables/<algorithm>/ with the placer's units. */
+const pk_obs_row pk_pack_observables[] = {
+    {"algorithm", PK_U_NONE, PK_OBS_SCALAR, NULL},
+    {"termination_reason", PK_U_NONE, PK_OBS_SCALAR, NULL},
+    {"count_requested", PK_U_NONE, PK_OBS_SCALAR, NULL},
+    {"count_placed", PK_U_NONE, PK_OBS_SCALAR, NULL},
+    {"count_expected", PK_U_NONE, PK_OBS_SCALAR, NULL},
+    {"phi_resolved", PK_U_NONE, PK_OBS_SCALAR, NULL},
+    {"phi_mix", PK_U_NONE, PK_OBS_SCALAR, NULL},
+    {"phi_target_resolved", PK_U_NONE, PK_OBS_SCALAR, NULL},
+    {"phi_target_mix", PK_U_NONE, PK_OBS_SCALAR, NULL},
+    {"mass_cut_fraction", PK_U_NONE, PK_OBS_SCALAR, NULL},
+    {"d_min", PK_U_LENGTH, PK_OBS_SCALAR, NULL},
+    {"delta_d", PK_U_LENGTH, PK_OBS_SCALAR, NULL},
+    {"size_scale", PK_U_NONE, PK_OBS_SCALAR, NULL},
+    {"smallest_gap", PK_U_LENGTH, PK_OBS_SCALAR, NULL},
+    {"smallest_wall_gap", PK_U_LENGTH, PK_OBS_SCALAR, NULL}, /* -1 when every axis is periodic */
+    {"pairs_below_delta_d", PK_U_NONE, PK_OBS_SCALAR, NULL},
+    {"grains_below_wall_gap", PK_U_NONE, PK_OBS_SCALAR, NULL},
+    {"timing/sizes_s", PK_U_SECONDS, PK_OBS_SCALAR, NULL},
+    {"timing/place_s", PK_U_SECONDS, PK_OBS_SCALAR, NULL},
+    {"timing/audit_s", PK_U_SECONDS, PK_OBS_SCALAR, NULL},
+    {"model", PK_U_NONE, PK_OBS_RECORD, "modelled"}, /* write_scene */
+    {"auto", PK_U_NONE, PK_OBS_RECORD, NULL},
+    {NULL, PK_U_NONE, PK_OBS_SCALAR, NULL},
 };
-
-const pk_unit_row *pk_pack_observables(void) { return pack_observables; }
 
 /* What was modelled and, for "auto", the choice: /observables/modelled,
  * /observables/auto (the summary's "model" and "auto"). */
@@ -142,7 +143,7 @@ static int write_result(const pk_pack_job *job, const pk_pack_plan *plan, const 
     pk_h5_write_parameters(h, "pack", job_json, job->seed);
     pk_units units;
     pk_units_init(&units, u, dim);
-    pk_h5_obs_rows(h, pack_observables, obs_values, &units);
+    rc |= pk_h5_obs_rows(h, pk_pack_observables, obs_values, &units);
     if (st->obs) {
         /* a history {events, time, ...} as H5MD time-dependent elements */
         placer_units pu = {.placer = pk_placer_find(job->algorithm)};
@@ -347,6 +348,9 @@ int pk_pack_run(const void *task, const pk_run_ctx *run, const char *job_json, c
     json_object_set_new(sum, "complete",
                         json_false()); /* here in the listing; pk_pack_verdict sets it */
     json_object_update(sum, o);
+    pk_units units;
+    pk_units_init(&units, job.unit, job.dim);
+    json_object_set_new(sum, "units", pk_obs_units_json(pk_pack_observables, sum, &units));
     pk_pack_verdict(&job, &plan, &st, &p, &gap, phi, audit_dd, sum);
     int rc = write_result(&job, &plan, job_json, &box, V, &p, &sz, scale, &st, o, out_path,
                           rx.author, sum, err, errlen);

@@ -53,7 +53,7 @@ typedef enum pk_edmd_rule {
     /* Elastic reversal, then the smallest lift w' = max(−w, G + ε_v): a
      * pair approaching slower than G leaves at ε_v (restitution 0 in the
      * growing frame; clusters of such pairs collide at vanishing intervals
-     * near jamming).  Kept to measure against. */
+     * near jamming).  A user's choice: its cost, docs/perf/edmd.md. */
     PK_EDMD_RULE_LIFT,
     /* Meier–Kuhl–Steinmann 2007 Eq. (9) (dissertation Eq. 3.9): equal-mass
      * swap of the normal speeds, then i loses g_i and j gains g_j, so the

@@ -17,13 +17,31 @@
 #define RETRIES 3        /* after the first attempt: 2 s, 8 s, 32 s later */
 #define PENDING_MAX 1000 /* deliveries waiting; beyond, the oldest is dropped */
 #define BATCH 200
+/* Deliveries in flight at once (curl multi), and of one owner: a receiver
+ * that stalls holds its owner's slots for the 10 s timeout, never the
+ * others'.  A job's deliveries go one at a time, in order. */
+#define IN_FLIGHT_MAX 32
+#define PER_OWNER_MAX 4
 
 typedef struct delivery {
-    char *uri, *body, job[37];
+    char *uri, *body, *owner, job[37];
     int attempt;
     double due;
     struct delivery *next;
 } delivery;
+
+typedef struct conn_check {
+    char allow[512];
+    char refused[64];
+} conn_check;
+
+/* One POST under way: its delivery, handle, headers and address check. */
+typedef struct transfer {
+    delivery *d;
+    CURL *h;
+    struct curl_slist *hdr;
+    conn_check cc;
+} transfer;
 
 static struct {
     pk_service *svc;
@@ -33,6 +51,9 @@ static struct {
     delivery *head; /* in due order */
     size_t pending;
     long long last; /* the last status event handed on */
+    CURLM *multi;   /* the follower thread's alone */
+    transfer *flying[IN_FLIGHT_MAX];
+    int nflying;
 } C = {.mu = PTHREAD_MUTEX_INITIALIZER};
 
 static int in4(uint32_t a, uint32_t net, int bits)
@@ -119,17 +140,17 @@ static void load_last(void)
 
 /* --- deliveries */
 
-static void enqueue(const char *job, const char *uri, char *body, double due)
+static void delivery_free(delivery *d)
 {
-    delivery *d = calloc(1, sizeof *d);
-    if (!d || !(d->uri = strdup(uri))) {
-        free(d);
-        free(body);
-        return;
-    }
-    d->body = body;
-    snprintf(d->job, sizeof d->job, "%s", job);
-    d->due = due;
+    free(d->uri);
+    free(d->body);
+    free(d->owner);
+    free(d);
+}
+
+/* d into the list at its due time (the oldest dropped when too many wait). */
+static void insert(delivery *d)
+{
     pthread_mutex_lock(&C.mu);
     if (C.pending >= PENDING_MAX && C.head) { /* the oldest goes */
         delivery *old = C.head;
@@ -137,12 +158,10 @@ static void enqueue(const char *job, const char *uri, char *body, double due)
         C.pending--;
         pk_log(PK_LOG_WARN, "callback dropped: too many waiting", "{s:s,s:s}", "job", old->job,
                "uri", old->uri);
-        free(old->uri);
-        free(old->body);
-        free(old);
+        delivery_free(old);
     }
     delivery **p = &C.head;
-    while (*p && (*p)->due <= due)
+    while (*p && (*p)->due <= d->due)
         p = &(*p)->next;
     d->next = *p;
     *p = d;
@@ -150,10 +169,21 @@ static void enqueue(const char *job, const char *uri, char *body, double due)
     pthread_mutex_unlock(&C.mu);
 }
 
-typedef struct conn_check {
-    char allow[512];
-    char refused[64];
-} conn_check;
+static void enqueue(const char *job, const char *owner, const char *uri, char *body, double due)
+{
+    delivery *d = calloc(1, sizeof *d);
+    if (!d || !(d->uri = strdup(uri)) || !(d->owner = strdup(owner ? owner : ""))) {
+        if (d)
+            free(d->uri);
+        free(d);
+        free(body);
+        return;
+    }
+    d->body = body;
+    snprintf(d->job, sizeof d->job, "%s", job);
+    d->due = due;
+    insert(d);
+}
 
 /* libcurl's hook once connected, before the request: the address policy */
 static int check_peer(void *cls, char *ip, char *local, int port, int local_port)
@@ -172,38 +202,51 @@ static size_t discard(char *p, size_t size, size_t n, void *cls)
     return size * n;
 }
 
-/* 1 delivered, 0 to retry, -1 never (refused by the address policy) */
-static int post(const delivery *d, char *why, size_t n)
+/* Start d's POST on the multi handle; 0, or -1 (d left to the caller). */
+static int post_start(delivery *d)
 {
     pk_config cfg = pk_service_config(C.svc);
-    conn_check cc = {{0}, {0}};
-    snprintf(cc.allow, sizeof cc.allow, "%s", cfg.callback_allow);
-    CURL *h = curl_easy_init();
-    if (!h) {
-        snprintf(why, n, "cannot make an HTTP client");
-        return 0;
+    transfer *t = calloc(1, sizeof *t);
+    if (!t || !(t->h = curl_easy_init())) {
+        free(t);
+        return -1;
     }
-    struct curl_slist *hdr = curl_slist_append(NULL, "Content-Type: application/json");
-    hdr = curl_slist_append(hdr, "User-Agent: packd/" PACKD_VERSION);
+    t->d = d;
+    snprintf(t->cc.allow, sizeof t->cc.allow, "%s", cfg.callback_allow);
+    t->hdr = curl_slist_append(NULL, "Content-Type: application/json");
+    t->hdr = curl_slist_append(t->hdr, "User-Agent: packd/" PACKD_VERSION);
+    CURL *h = t->h;
     curl_easy_setopt(h, CURLOPT_URL, d->uri);
     curl_easy_setopt(h, CURLOPT_PROTOCOLS_STR, "http,https");
     curl_easy_setopt(h, CURLOPT_FOLLOWLOCATION, 0L);
     curl_easy_setopt(h, CURLOPT_NOSIGNAL, 1L);
     curl_easy_setopt(h, CURLOPT_CONNECTTIMEOUT, 5L);
     curl_easy_setopt(h, CURLOPT_TIMEOUT, 10L);
-    curl_easy_setopt(h, CURLOPT_HTTPHEADER, hdr);
+    curl_easy_setopt(h, CURLOPT_HTTPHEADER, t->hdr);
     curl_easy_setopt(h, CURLOPT_POSTFIELDS, d->body);
     curl_easy_setopt(h, CURLOPT_PREREQFUNCTION, check_peer);
-    curl_easy_setopt(h, CURLOPT_PREREQDATA, &cc);
+    curl_easy_setopt(h, CURLOPT_PREREQDATA, &t->cc);
     curl_easy_setopt(h, CURLOPT_WRITEFUNCTION, discard);
-    CURLcode rc = curl_easy_perform(h);
+    curl_easy_setopt(h, CURLOPT_PRIVATE, t);
+    if (curl_multi_add_handle(C.multi, h) != CURLM_OK) {
+        curl_slist_free_all(t->hdr);
+        curl_easy_cleanup(h);
+        free(t);
+        return -1;
+    }
+    C.flying[C.nflying++] = t;
+    return 0;
+}
+
+/* How t's POST ended: 1 delivered, 0 to retry, -1 never (refused by the
+ * address policy); why says it. */
+static int post_outcome(transfer *t, CURLcode rc, char *why, size_t n)
+{
     long code = 0;
-    curl_easy_getinfo(h, CURLINFO_RESPONSE_CODE, &code);
-    curl_slist_free_all(hdr);
-    curl_easy_cleanup(h);
-    if (cc.refused[0]) {
+    curl_easy_getinfo(t->h, CURLINFO_RESPONSE_CODE, &code);
+    if (t->cc.refused[0]) {
         snprintf(why, n, "%s is a private, loopback or link-local address (callback_allow)",
-                 cc.refused);
+                 t->cc.refused);
         return -1;
     }
     if (rc != CURLE_OK) {
@@ -214,36 +257,95 @@ static int post(const delivery *d, char *why, size_t n)
     return code >= 200 && code < 300;
 }
 
-/* The deliveries due by now, each tried once. */
-static void deliver_due(double now)
+/* A delivery tried: logged, and re-queued 2/8/32 s later while it may be
+ * retried. */
+static void settle(delivery *d, int ok, const char *why, double now)
 {
-    for (;;) {
-        pthread_mutex_lock(&C.mu);
-        delivery *d = C.head && C.head->due <= now ? C.head : NULL;
-        if (d) {
-            C.head = d->next;
-            C.pending--;
+    if (ok == 0 && d->attempt < RETRIES) {
+        d->attempt++;
+        pk_log(PK_LOG_WARN, "callback failed: retrying", "{s:s,s:s,s:s,s:i}", "job", d->job, "uri",
+               d->uri, "error", why, "attempt", d->attempt);
+        d->due = now + (double)(1 << (2 * d->attempt - 1));
+        insert(d);
+        return;
+    }
+    pk_log(ok > 0 ? PK_LOG_INFO : PK_LOG_WARN, ok > 0 ? "callback delivered" : "callback given up",
+           "{s:s,s:s,s:s}", "job", d->job, "uri", d->uri, "answer", why);
+    delivery_free(d);
+}
+
+static void transfer_end(transfer *t)
+{
+    curl_multi_remove_handle(C.multi, t->h);
+    curl_easy_cleanup(t->h);
+    curl_slist_free_all(t->hdr);
+    for (int i = 0; i < C.nflying; i++)
+        if (C.flying[i] == t) {
+            C.flying[i] = C.flying[--C.nflying];
+            break;
         }
-        pthread_mutex_unlock(&C.mu);
-        if (!d)
-            return;
+    free(t);
+}
+
+/* 1 when d may start now: a slot free, its owner under its share, no
+ * delivery of its job in flight. */
+static int may_start(const delivery *d)
+{
+    int owner = 0;
+    if (C.nflying >= IN_FLIGHT_MAX)
+        return 0;
+    for (int i = 0; i < C.nflying; i++) {
+        const delivery *f = C.flying[i]->d;
+        if (!strcmp(f->job, d->job))
+            return 0;
+        owner += !strcmp(f->owner, d->owner);
+    }
+    return owner < PER_OWNER_MAX;
+}
+
+/* Start the deliveries due by now that may start, in due order. */
+static void start_due(double now)
+{
+    pthread_mutex_lock(&C.mu);
+    for (delivery **p = &C.head; *p && (*p)->due <= now && C.nflying < IN_FLIGHT_MAX;) {
+        delivery *d = *p;
+        if (!may_start(d)) {
+            p = &d->next;
+            continue;
+        }
+        *p = d->next;
+        C.pending--;
+        if (post_start(d) != 0) {
+            pthread_mutex_unlock(&C.mu);
+            settle(d, 0, "cannot make an HTTP client", now);
+            pthread_mutex_lock(&C.mu);
+            p = &C.head; /* the list changed */
+        }
+    }
+    pthread_mutex_unlock(&C.mu);
+}
+
+/* Move the transfers along for up to wait_ms (less when one ends) and
+ * settle those that ended. */
+static void run_transfers(int wait_ms)
+{
+    int still = 0, left = 0;
+    curl_multi_perform(C.multi, &still);
+    if (still)
+        curl_multi_poll(C.multi, NULL, 0, wait_ms, NULL);
+    curl_multi_perform(C.multi, &still);
+    CURLMsg *m;
+    while ((m = curl_multi_info_read(C.multi, &left))) {
+        if (m->msg != CURLMSG_DONE)
+            continue;
+        char *priv = NULL;
+        curl_easy_getinfo(m->easy_handle, CURLINFO_PRIVATE, &priv);
+        transfer *t = (transfer *)priv;
         char why[200];
-        int ok = post(d, why, sizeof why);
-        if (ok == 0 && d->attempt < RETRIES) {
-            d->attempt++;
-            pk_log(PK_LOG_WARN, "callback failed: retrying", "{s:s,s:s,s:s,s:i}", "job", d->job,
-                   "uri", d->uri, "error", why, "attempt", d->attempt);
-            char *body = d->body;
-            d->body = NULL;
-            enqueue(d->job, d->uri, body, now + (double)(1 << (2 * d->attempt - 1)));
-        } else {
-            pk_log(ok > 0 ? PK_LOG_INFO : PK_LOG_WARN,
-                   ok > 0 ? "callback delivered" : "callback given up", "{s:s,s:s,s:s}", "job",
-                   d->job, "uri", d->uri, "answer", why);
-        }
-        free(d->uri);
-        free(d->body);
-        free(d);
+        int ok = post_outcome(t, m->data.result, why, sizeof why);
+        delivery *d = t->d;
+        transfer_end(t);
+        settle(d, ok, why, pk_queue_now());
     }
 }
 
@@ -277,7 +379,8 @@ static void hand_on(json_t *ev)
         pk_absolute_links_at(doc, o.base);
         char *body = json_dumps(doc, JSON_COMPACT | JSON_REAL_PRECISION(10));
         if (body)
-            enqueue(job, uri, body, pk_queue_now());
+            enqueue(job, json_string_value(json_object_get(row, "owner")), uri, body,
+                    pk_queue_now());
         json_decref(info);
         json_decref(doc);
         json_decref(row);
@@ -308,11 +411,16 @@ static void *follow(void *arg)
         int more = json_array_size(evs) == BATCH;
         json_decref(evs);
         double now = pk_queue_now();
-        deliver_due(now);
+        start_due(now);
         if (more)
             continue;
         int wait_ms = next > now ? (int)((next - now) * 1000) + 1 : 1000;
-        seen = pk_queue_wait_event(C.svc->q, seen, wait_ms < 1000 ? wait_ms : 1000);
+        if (wait_ms > 1000)
+            wait_ms = 1000;
+        if (C.nflying) /* the transfers, with a look at the queue's events every 0.1 s */
+            run_transfers(wait_ms < 100 ? wait_ms : 100);
+        else
+            seen = pk_queue_wait_event(C.svc->q, seen, wait_ms);
     }
 }
 
@@ -322,8 +430,13 @@ int pk_callbacks_start(pk_service *svc)
     C.quit = 0;
     curl_global_init(CURL_GLOBAL_DEFAULT);
     load_last();
-    if (pthread_create(&C.thread, NULL, follow, NULL) != 0)
+    if (!(C.multi = curl_multi_init()))
         return -1;
+    if (pthread_create(&C.thread, NULL, follow, NULL) != 0) {
+        curl_multi_cleanup(C.multi);
+        C.multi = NULL;
+        return -1;
+    }
     C.running = 1;
     return 0;
 }
@@ -338,14 +451,20 @@ void pk_callbacks_stop(void)
     pk_queue_wake_all(C.svc->q);
     pthread_join(C.thread, NULL);
     C.running = 0;
+    while (C.nflying) { /* cut off: not delivered */
+        delivery *d = C.flying[0]->d;
+        transfer_end(C.flying[0]);
+        d->next = C.head;
+        C.head = d;
+    }
+    curl_multi_cleanup(C.multi);
+    C.multi = NULL;
     while (C.head) { /* not delivered: said so */
         delivery *d = C.head;
         C.head = d->next;
         pk_log(PK_LOG_WARN, "callback not delivered: the daemon stops", "{s:s,s:s}", "job", d->job,
                "uri", d->uri);
-        free(d->uri);
-        free(d->body);
-        free(d);
+        delivery_free(d);
     }
     C.pending = 0;
 }

@@ -2,7 +2,9 @@
  * change of a job whose execute request named a subscriber is POSTed there
  * (inProgressUri: the statusInfo of accepted and running; successUri: the
  * results document; failedUri: the statusInfo of the failed job), as JSON,
- * from one thread that follows the queue's status events.  A delivery
+ * by one thread that follows the queue's status events and runs the POSTs
+ * side by side (libcurl multi; a bounded share per owner, a job's in
+ * order), so a receiver that hangs delays no other owner's.  A delivery
  * answered other than 2xx is retried (RETRIES times, backing off); one to
  * a private, loopback or link-local address is refused unless that address
  * is in the config key callback_allow (checked on the address connected

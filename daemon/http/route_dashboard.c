@@ -161,6 +161,13 @@ enum MHD_Result route_dashboard_queue(pk_req *r)
     return pk_send_json(r, 200, doc, NULL);
 }
 
+/* {owner, admin} of the request: an admin's list may be filtered by owner
+ * (GET /jobs?owner=), so the page offers that filter to admins only. */
+enum MHD_Result route_dashboard_me(pk_req *r)
+{
+    return pk_send_json(r, 200, json_pack("{s:s,s:b}", "owner", r->owner, "admin", r->admin), NULL);
+}
+
 /* {process, inputs} as the job was submitted: the queue's row, from which the
  * job file its worker reads is written when it starts (so also while it waits). */
 enum MHD_Result route_dashboard_inputs(pk_req *r)

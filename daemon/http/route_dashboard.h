@@ -17,5 +17,7 @@ enum MHD_Result route_dashboard_asset(pk_req *r);    /* GET /dashboard/{file} */
 enum MHD_Result route_dashboard_examples(pk_req *r); /* GET /dashboard/examples */
 enum MHD_Result route_dashboard_inputs(pk_req *r);   /* GET /dashboard/jobs/{id}/inputs */
 enum MHD_Result route_dashboard_queue(pk_req *r);    /* GET /dashboard/queue */
+enum MHD_Result route_dashboard_me(pk_req *r);       /* GET /dashboard/me */
+enum MHD_Result route_dashboard_units(pk_req *r);    /* GET /dashboard/jobs/{id}/units */
 
 #endif

@@ -4,7 +4,8 @@
  * status, processID and type are arrays: repeated parameters and
  * comma-separated values add up (any of them matches).  datetime filters on
  * the job's created time, minDuration/maxDuration (seconds) on started..finished
- * (..now while running).  limit is 1..10000 (default 10; above the maximum it
+ * (..now while running).  owner (admins) lists one owner's jobs; a user's
+ * list is its own whatever it names.  limit is 1..10000 (default 10; above the maximum it
  * is the maximum, not an error).  A bad value is a 400 naming the parameter
  * and its rule.  Paging links (self, next, prev) keep the filters.  Also as
  * HTML (f=html or Accept: text/html; html_page.h). */
@@ -28,7 +29,7 @@ static const char *const statuses[] = {"accepted", "running", "successful", "fai
 
 typedef struct list_query {
     json_t *status, *process, *type; /* arrays of the values given, or NULL */
-    const char *datetime, *limit, *offset, *min_duration, *max_duration;
+    const char *datetime, *limit, *offset, *min_duration, *max_duration, *owner;
     char bad[240]; /* the first rule broken */
 } list_query;
 
@@ -72,6 +73,8 @@ static enum MHD_Result collect(void *cls, enum MHD_ValueKind kind, const char *k
         once(q, &q->min_duration, key, value);
     else if (!strcmp(key, "maxDuration"))
         once(q, &q->max_duration, key, value);
+    else if (!strcmp(key, "owner"))
+        once(q, &q->owner, key, value);
     return MHD_YES;
 }
 
@@ -175,6 +178,10 @@ static int parse(list_query *q, pk_job_filter *f, long long *limit, long long *o
         return -1;
     }
     f->max_duration = d < 0 ? NAN : (double)d;
+    if (q->owner && !*q->owner) {
+        snprintf(q->bad, sizeof q->bad, "query parameter owner: an owner's name, not empty");
+        return -1;
+    }
     if (integer(q->limit, 1, LIMIT_DEFAULT, limit) != 0) {
         snprintf(q->bad, sizeof q->bad,
                  "query parameter limit: an integer, 1 or more (at most %d "
@@ -240,6 +247,7 @@ static char *filters_query(const list_query *q)
     put_value(f, "datetime", q->datetime);
     put_value(f, "minDuration", q->min_duration);
     put_value(f, "maxDuration", q->max_duration);
+    put_value(f, "owner", q->owner);
     fclose(f);
     return text;
 }
@@ -269,12 +277,18 @@ enum MHD_Result route_jobs(pk_req *r)
                              NULL, 0);
         goto out;
     }
+    /* owner narrows an admin's list; a user's list is its own, so naming
+     * another owner lists nothing (as if that owner had no jobs) */
+    int other_owner = q.owner && f.owner && strcmp(q.owner, f.owner) != 0;
+    if (q.owner)
+        f.owner = q.owner;
     char *st = json_array_size(q.status) ? json_dumps(q.status, JSON_COMPACT) : NULL;
     char *pr = json_array_size(q.process) ? json_dumps(q.process, JSON_COMPACT) : NULL;
     f.status_json = st;
     f.process_json = pr;
     int total = 0;
-    json_t *rows = pk_queue_list(r->svc->q, &f, (int)limit, (int)offset, &total);
+    json_t *rows =
+        other_owner ? json_array() : pk_queue_list(r->svc->q, &f, (int)limit, (int)offset, &total);
     free(st);
     free(pr);
     json_t *jobs = json_array();

@@ -26,7 +26,9 @@ const pk_route pk_routes[] = {
     /* the browser dashboard: its page is / for a browser (route_landing) */
     {"GET", "/dashboard/examples", route_dashboard_examples, PK_PUBLIC},
     {"GET", "/dashboard/queue", route_dashboard_queue, PK_USER},
+    {"GET", "/dashboard/me", route_dashboard_me, PK_USER},
     {"GET", "/dashboard/*", route_dashboard_asset, PK_PUBLIC},
     {"GET", "/dashboard/jobs/*/inputs", route_dashboard_inputs, PK_USER},
+    {"GET", "/dashboard/jobs/*/units", route_dashboard_units, PK_USER},
     {NULL, NULL, NULL, PK_PUBLIC},
 };

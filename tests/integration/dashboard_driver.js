@@ -16,7 +16,14 @@
 // checkboxes change it, and a job page leads back to it.  Pages of a small
 // limit (a hash parameter) list the API's pages, newer/older and "jobs N–M of
 // TOTAL" as the API counts.  At a 390 px viewport the list and a job page are
-// no wider than the viewport.
+// no wider than the viewport, also with the job form filled.  The job form,
+// made from the pack process's input schema, composes a small RSA job field
+// by field (no example): a negative box edge is refused by the API and the
+// message is shown at that edge's field; the job posted is exactly the one
+// composed; it finishes, and its page shows the summary grouped (asked,
+// achieved, audit, model) with units (mm, s).  Every example, filled into the
+// form and composed back, keeps its inputs.  An admin (auth off) filters
+// the list by owner as GET /jobs?owner= does; a user (auth on) has no such filter.
 // Prints PASS/FAIL lines (tests/integration/check.inc) and saves screenshots
 // and the downloads (result.h5, partial.h5) in OUT_DIR.
 // Env: PLAYWRIGHT_CORE (the installed module), CHROMIUM, SLOW (wait factor),
@@ -49,7 +56,7 @@ const rsaUntilWallTime = (s) => ({
 async function submitEdited(page, label, edit) {
   await page.goto(page.url().replace(/#.*$/, '') + '#/');
   await page.selectOption('#example', { label });
-  if (!(await page.isVisible('#inputs'))) await page.click('#submit-form details summary');
+  if (!(await page.isVisible('#inputs'))) await page.click('#json-inputs summary');
   const inputs = edit(JSON.parse(await page.inputValue('#inputs')));
   await page.fill('#inputs', JSON.stringify(inputs));
   const shown = () => { const a = document.querySelector('#submitted a'); return a ? a.textContent.trim() : ''; };
@@ -130,6 +137,78 @@ async function step(name, fn) {
         await page.click('#token-form button');
       }
     });
+    await step('dashboard_form_composes_job', async () => {
+      const at = (ptr) => `#form-fields [data-pointer="${ptr}"]`;
+      await page.selectOption('#process', 'pack');
+      await page.selectOption('#example', '');
+      await page.waitForSelector(at('/dim') + ' select');
+      await page.selectOption(at('/dim') + ' select', '2');
+      await page.fill(at('/domain/box/size/0') + ' input', '-1');
+      await page.fill(at('/domain/box/size/1') + ' input', '12');
+      await page.selectOption(at('/grading') + ' select.alt', 'fuller');
+      await page.fill(at('/grading/q') + ' input', '0.5');
+      await page.fill(at('/grading/d_max') + ' input', '2');
+      await page.fill(at('/d_min') + ' input', '1');
+      await page.click(at('/phi') + ' summary');
+      await page.fill(at('/phi/value') + ' input', '0.3');
+      await page.selectOption(at('/phi/refers_to') + ' select', 'resolved');
+      await page.selectOption(at('/algorithm') + ' select', 'rsa');
+      await page.fill(at('/seed') + ' input', '7');
+      // the API refuses the negative edge; its message stands at that field
+      const seen = problems.length;
+      await page.click('#submit');
+      const msg = await page.waitForSelector(at('/domain/box/size/0') + ' .field-error');
+      if (!/> 0/.test(await msg.textContent())) throw new Error('the edge\'s error says ' + await msg.textContent());
+      problems.splice(seen); // the 422 was the point
+      await page.screenshot({ path: shot('form-error'), fullPage: true });
+      await page.fill(at('/domain/box/size/0') + ' input', '12');
+      if (await page.isVisible('.field-error')) throw new Error('the error stays after the field is edited');
+      await page.screenshot({ path: shot('form'), fullPage: true });
+      const before = await page.evaluate(() => { const a = document.querySelector('#submitted a'); return a ? a.textContent : ''; });
+      await page.click('#submit');
+      await page.waitForFunction((b) => { const a = document.querySelector('#submitted a'); return a && a.textContent !== b; }, before);
+      const formId = (await page.textContent('#submitted a')).trim();
+      const want = {
+        dim: 2, domain: { box: { size: [12, 12] } }, grading: { type: 'fuller', q: 0.5, d_max: 2 }, d_min: 1,
+        phi: { value: 0.3, refers_to: 'resolved' }, algorithm: 'rsa', seed: 7,
+      };
+      const sent = (await apiCall('dashboard/jobs/' + formId + '/inputs')).inputs;
+      delete sent.limits; // the service's caps (max_particles, wall_time_s), added to every job
+      const canon = (v) => JSON.stringify(v, (k, x) => (x && typeof x === 'object' && !Array.isArray(x) ? Object.fromEntries(Object.entries(x).sort()) : x));
+      if (canon(sent) !== canon(want)) throw new Error('the job posted: ' + JSON.stringify(sent));
+      const formRow = `tr[data-job="${formId}"]`;
+      await page.waitForFunction((sel) => { const tr = document.querySelector(sel); return tr && tr.dataset.status === 'successful'; },
+        formRow, { timeout: 60000 * slow });
+      await openJob(page, formId);
+      await page.waitForSelector('#summary section[data-group="model"]');
+      const groups = await page.$$eval('#summary section', (ss) => ss.map((x) => x.dataset.group));
+      if (groups.join() !== 'asked,achieved,audit,model') throw new Error('groups: ' + groups);
+      const cell = (group, key) => page.textContent(`#summary section[data-group="${group}"] tr[data-key="${key}"] td`);
+      const gap = await cell('audit', 'smallest_gap');
+      if (!/^\d[\d.e+-]* mm$/.test(gap)) throw new Error('smallest_gap shows ' + gap);
+      if (!/ s$/.test(await cell('audit', 'timing.place_s'))) throw new Error('timing.place_s without seconds');
+      if (!/^\d+$/.test(await cell('achieved', 'count_placed'))) throw new Error('count_placed shows ' + await cell('achieved', 'count_placed'));
+      if ((await cell('asked', 'phi_target_resolved')) !== '0.3') throw new Error('phi_target_resolved not asked 0.3');
+      if (!(await cell('model', 'model.dim')).startsWith('2')) throw new Error('the model group lacks dim');
+      await page.screenshot({ path: shot('form-job'), fullPage: true });
+      await page.goto(base + '/#/');
+    });
+    await step('dashboard_form_holds_every_example', async () => {
+      // each example filled into the form and composed back (as any edit of a
+      // field does) gives its inputs unchanged: the form loses nothing
+      const canon = (v) => JSON.stringify(v, (k, x) => (x && typeof x === 'object' && !Array.isArray(x) ? Object.fromEntries(Object.entries(x).sort()) : x));
+      const all = (await apiCall('dashboard/examples')).examples;
+      const lost = [];
+      for (const ex of all) {
+        await page.selectOption('#example', { label: ex.name.replace(/\.json$/, '') + ' (' + ex.process + ')' });
+        await page.waitForFunction((p) => document.getElementById('process').value === p &&
+          document.querySelector('#form-fields [data-pointer=""]'), ex.process);
+        await page.dispatchEvent('#form-fields', 'change');
+        if (canon(JSON.parse(await page.inputValue('#inputs'))) !== canon(ex.inputs)) lost.push(ex.name);
+      }
+      if (lost.length) throw new Error('the form changes ' + lost.join(', '));
+      await page.selectOption('#example', '');
+    });
     await step('dashboard_submits_example', async () => {
       const label = example.replace(/\.json$/, '') + ' (pack)';
       await page.selectOption('#example', { label });
@@ -175,7 +254,7 @@ async function step(name, fn) {
     await step('dashboard_bar_moves', async () => {
       await page.goto(base + '/#/');
       await page.selectOption('#example', { label: 'edmd-quartz-2d (pack)' });
-      await page.click('#submit-form details summary'); // "Inputs (editable JSON)"
+      await page.click('#json-inputs summary'); // "Inputs (editable JSON)"
       const inputs = JSON.parse(await page.inputValue('#inputs'));
       inputs.edmd.growth_rate = 0.004; // ~11 progress events 0.5 s apart
       await page.fill('#inputs', JSON.stringify(inputs));
@@ -221,6 +300,7 @@ async function step(name, fn) {
       await page.waitForFunction(() => window.seenStatus.length >= 100 &&
         window.seenBar.some((v) => v > 0 && v < 100), null, { timeout: 60000 * slow });
       const [st, bar] = await page.evaluate(() => { clearInterval(window.sampler); return [window.seenStatus, window.seenBar]; });
+      await page.screenshot({ path: shot('job-running'), fullPage: true });
       const msg = await page.textContent('#job-message');
       if (!/^rsa, φ = 0\.\d{4}, \d+ s elapsed, about .* left$/.test(msg)) throw new Error('progress line: ' + msg);
       const other = st.filter((x) => x !== 'running').length;
@@ -321,6 +401,21 @@ async function step(name, fn) {
       await page.click('#back');
       await shows('failed');
     });
+    await step('dashboard_owner_filter', async () => {
+      const me = await apiCall('dashboard/me');
+      await page.goto(base + '/#/');
+      await page.waitForSelector(row);
+      await page.waitForFunction((admin) => document.getElementById('f-owner-pick').hidden === !admin, me.admin);
+      if (!me.admin) return; // a user's list is its own: no owner filter to offer
+      const mine = await apiCall('jobs?limit=50&owner=' + encodeURIComponent(me.owner));
+      if (!mine.jobs.length) throw new Error('the API lists no job of ' + me.owner);
+      await page.fill('#f-owner', me.owner);
+      await page.press('#f-owner', 'Enter');
+      await page.waitForFunction((o) => location.hash === '#/?owner=' + encodeURIComponent(o), me.owner);
+      await listShows(page, mine.jobs.map((j) => j.jobID), `jobs 1–${mine.jobs.length} of ${mine.numberMatched}`);
+      await page.goto(base + '/#/?owner=nobody-here');
+      await listShows(page, [], 'no jobs match the filters');
+    });
     await step('dashboard_pages', async () => {
       const limit = 3;
       let total = (await apiCall('jobs?limit=1')).numberMatched;
@@ -371,7 +466,14 @@ async function step(name, fn) {
       await page.waitForFunction(() => [...document.images].every((i) => i.complete));
       const job = await width(page);
       await page.screenshot({ path: shot('job-390'), fullPage: true });
-      if (list > 390 || job > 390) throw new Error(`scrollWidth at 390 px: list ${list}, job page ${job}`);
+      // the form filled by an example, its optional groups opened
+      await page.goto(base + '/#/');
+      await page.selectOption('#example', { label: 'edmd-quartz-2d (pack)' });
+      await page.waitForSelector('#form-fields [data-pointer="/edmd"]:not([hidden])');
+      await page.$$eval('#form-fields details', (ds) => ds.forEach((d) => { d.open = true; }));
+      const form = await width(page);
+      await page.screenshot({ path: shot('form-390'), fullPage: true });
+      if (list > 390 || job > 390 || form > 390) throw new Error(`scrollWidth at 390 px: list ${list}, job page ${job}, form ${form}`);
     });
     if (problems.length) fail('dashboard_no_script_errors', problems.join(' | '));
     else pass('dashboard_no_script_errors');

@@ -2,8 +2,10 @@
 # test_dashboard.sh — the browser dashboard: GET / negotiates (a browser gets
 # the page, a JSON client the landing document as before), its assets carry
 # the Content-Security-Policy, and headless Chromium (Debian's chromium,
-# driven by playwright-core from npm, cached in the build folder) submits an
-# example, watches its bar reach 100 %, sees the picture and downloads the
+# driven by playwright-core from npm, cached in the build folder) composes a
+# small RSA job in the form made from the input schema, field by field (the
+# API's error shown at its field), sees it finish and its summary grouped with
+# units; submits an example, watches its bar reach 100 %, sees the picture and downloads the
 # result, which h5ls reads; then submits the EDMD example edited to run ~5 s
 # and sees its bar strictly between 0 and 100 % while it runs (the values the
 # bar showed are printed as a BAR line); then job pages: the status word kept
@@ -12,7 +14,8 @@
 # zone; the queue line (GET /dashboard/queue, which answers the counts only,
 # to a token when auth is on) as the API counts, the list filtered by status
 # and process through the URL hash (kept across a reload) and paged as the API
-# pages it; and the list and a job page no wider than a 390 px viewport
+# pages it; an admin's owner filter; and the list, a job page and the
+# filled form no wider than a 390 px viewport
 # (dashboard_driver.js).  Screenshots: $PACKD_BUILD/screenshots/.
 . "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
 BUILD=${PACKD_BUILD:-$(dirname "$PACKD")}

@@ -3,7 +3,8 @@
 # auth forced on): 401 + WWW-Authenticate without or with a wrong token, 403
 # for a user on an admin route; another owner's job and upload are invisible
 # (404 exactly like a missing one) and undeletable, an admin sees and
-# dismisses them; X-Packd-Owner counts only from the trusted proxy (quotas);
+# dismisses them, and lists one owner's jobs (owner=; a user naming another
+# owner lists none; GET /dashboard/me says who is an admin); X-Packd-Owner counts only from the trusted proxy (quotas);
 # a revoked token is refused at once; the database holds no token in clear.
 . "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
 
@@ -112,6 +113,27 @@ check bob_link_job_422 sh -c "test $code = 422 && grep -q 'does not exist' '$T/a
 as bob -H 'Content-Type: application/octet-stream' --data-binary "@$SRC/tests/data/meshes/cylinder41.msh" \
     "$B/files" >/dev/null
 check bob_own_upload test "$(as bob "$B/files/${HREF#/files/}")" = 200
+
+# the owner filter (GET /jobs?owner=): an admin's list narrowed to one owner;
+# a user naming another owner gets none of that owner's jobs
+WHO=bob
+BOB_ID=$(submit "$T/fast.json")
+WHO=""
+listed() { python3 -c "import json,sys; print(' '.join(j['jobID'] for j in json.load(open('$T/as.out'))['jobs']))"; }
+as root "$B/jobs?owner=alice&limit=50" >/dev/null
+check admin_owner_filter sh -c "test '$(listed)' = '$ID' && grep -q '\"numberMatched\": 1' '$T/as.out'"
+check admin_owner_filter_paging_link grep -q 'owner=alice' "$T/as.out"
+as root "$B/jobs?owner=bob&limit=50" >/dev/null
+check admin_owner_filter_other test "$(listed)" = "$BOB_ID"
+as bob "$B/jobs?owner=alice" >/dev/null
+check user_owner_filter_isolated sh -c "! grep -q '$ID' '$T/as.out' && grep -q '\"numberMatched\": 0' '$T/as.out'"
+as bob "$B/jobs?owner=bob" >/dev/null
+check user_owner_filter_self test "$(listed)" = "$BOB_ID"
+check owner_filter_empty_400 sh -c "test $(as root "$B/jobs?owner=") = 400 && grep -q 'owner' '$T/as.out'"
+as root "$B/dashboard/me" >/dev/null
+check dashboard_me_admin python3 -c "import json; assert json.load(open('$T/as.out')) == {'owner': 'root', 'admin': True}"
+as bob "$B/dashboard/me" >/dev/null
+check dashboard_me_user python3 -c "import json; assert json.load(open('$T/as.out')) == {'owner': 'bob', 'admin': False}"
 
 # the admin sees and dismisses it
 as root "$B/jobs" >/dev/null

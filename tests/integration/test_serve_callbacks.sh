@@ -3,6 +3,7 @@
 # against a real HTTP receiver on loopback (callback_receiver.py): a job's
 # accepted/running statusInfo reaches inProgressUri, its results document
 # successUri; a failed job's statusInfo failedUri; a 500 is retried; a
+# receiver that hangs holds up no other owner's callbacks; a
 # loopback receiver is refused unless callback_allow lists it; a subscriber
 # that is not http(s) is a 400 naming the field; /conformance says callback.
 . "${PACKD_SRC:-.}/tests/integration/serve_helpers.inc"
@@ -65,6 +66,24 @@ with_subscriber "$T/fast.json" "$T/flaky.json" "$R/flaky"
 FL=$(submit "$T/flaky.json")
 check retried_after_500 wait_for 30 sh -c "[ \$(grep -c '\"path\": \"/flaky\"' '$T/posts.jsonl') -ge 2 ]"
 check retry_logged grep -q '"msg":"callback failed: retrying"' "$LOG"
+
+# deliveries run side by side: while alice's receiver hangs (no answer for
+# 30 s; the daemon gives up on each attempt after 10 s and retries), bob's
+# job's callback arrives as soon as it is done (one after the other, it
+# would wait >= 10 s behind the hung one)
+for who in alice bob; do
+    tok=$("$PACKD" token add "$who" --data "$T/owners" 2>/dev/null) || fail "token_$who"
+    printf 'Authorization: Bearer %s\n' "$tok" >"$T/$who.h"
+done
+printf 'auth = on\nworkers = 2\ncallback_allow = 127.0.0.1\n' >"$T/owners.conf"
+start_daemon owners --config "$T/owners.conf" || { fail serve_starts_owners; exit 1; }
+with_subscriber "$T/fast.json" "$T/hang.json" "$R/hang/stall" "$R/hang/stall"
+HANG=$(submit "$T/hang.json" -H "@$T/alice.h")
+check hung_receiver_reached wait_for 30 sh -c "grep -q '\"path\": \"/hang/stall\"' '$T/posts.jsonl'"
+with_subscriber "$T/fast.json" "$T/other.json" "$R/other"
+OTHER=$(submit "$T/other.json" -H "@$T/bob.h")
+check other_owner_not_held_up wait_for 8 posted /other "$OTHER"
+check hung_one_retried wait_for 30 sh -c "grep '\"msg\":\"callback failed: retrying\"' '$LOG' | grep -q '$HANG'"
 
 # refused: 127.0.0.1 is loopback, and this daemon does not allow it
 start_daemon strict --workers 1 || { fail serve_starts_strict; exit 1; }

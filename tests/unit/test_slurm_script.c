@@ -79,19 +79,26 @@ static void test_job_asks(void)
     json_decref(pack);
 }
 
+/* A job of `ranks` tasks of 2 threads each under /opt/packd, its wall limit
+ * wall_s, and the defaults' config with slurm_mem_mb mem. */
+static pk_slurm_job job_with(const char *id, int ranks, double wall_s, pk_config *c, int mem)
+{
+    pk_config_defaults(c);
+    c->slurm_mem_mb = mem;
+    return (pk_slurm_job){.id = id,
+                          .dir = dir,
+                          .author = "lab",
+                          .packd = "/opt/packd",
+                          .threads = 2,
+                          .ranks = ranks,
+                          .wall_s = wall_s,
+                          .checkpoint_interval_s = 30};
+}
+
 static void test_one_task(void)
 {
     pk_config c;
-    pk_config_defaults(&c);
-    c.slurm_mem_mb = 1000;
-    pk_slurm_job j = {.id = "one",
-                      .dir = dir,
-                      .author = "lab",
-                      .packd = "/opt/packd",
-                      .threads = 2,
-                      .ranks = 1,
-                      .wall_s = 90,
-                      .checkpoint_interval_s = 30};
+    pk_slurm_job j = job_with("one", 1, 90, &c, 1000);
     char *s = script_of(&j, &c);
     CHECK(s != NULL);
     if (!s)
@@ -113,16 +120,7 @@ static void test_one_task(void)
 static void test_ranks(void)
 {
     pk_config c;
-    pk_config_defaults(&c);
-    c.slurm_mem_mb = 1001;
-    pk_slurm_job j = {.id = "ranks",
-                      .dir = dir,
-                      .author = "lab",
-                      .packd = "/opt/packd",
-                      .threads = 2,
-                      .ranks = 3,
-                      .wall_s = 600,
-                      .checkpoint_interval_s = 30};
+    pk_slurm_job j = job_with("ranks", 3, 600, &c, 1001);
     char *s = script_of(&j, &c);
     CHECK(s != NULL);
     if (!s)
