@@ -35,7 +35,10 @@ static void pack_units(json_t *into, json_t *inputs, json_t *summary)
     pk_units u;
     pk_units_init(&u, length ? length : "mm",
                   json_is_integer(dim) ? (int)json_integer_value(dim) : 3);
-    add_rows(into, "", pk_pack_observables(), &u);
+    json_t *own = pk_obs_units_json(pk_pack_observables, summary, &u);
+    if (own)
+        json_object_update(into, own);
+    json_decref(own);
     const char *algorithm = json_string_value(json_object_get(summary, "algorithm"));
     const pk_placer *placer = algorithm ? pk_placer_find(algorithm) : NULL;
     if (placer) {
