@@ -12,20 +12,19 @@
 #include "api/pack/pack_job.h"
 #include "api/pack/pack_placer.h"
 
-/* Each row of rows with a unit under prefix ("" or "edmd."), '/' as '.'. */
-static void add_rows(json_t *into, const char *prefix, const pk_unit_row *rows, const pk_units *u)
+/* name's unit under prefix ("" or "edmd."), '/' as '.', if it has one. */
+static void add_row(json_t *into, const char *prefix, const char *name, pk_unit_kind kind,
+                    const pk_units *u)
 {
-    for (; rows && rows->name; rows++) {
-        const char *unit = pk_unit_string(u, rows->kind);
-        if (!unit)
-            continue;
-        char key[160];
-        snprintf(key, sizeof key, "%s%s", prefix, rows->name);
-        for (char *s = key; *s; s++)
-            if (*s == '/')
-                *s = '.';
-        json_object_set_new(into, key, json_string(unit));
-    }
+    const char *unit = pk_unit_string(u, kind);
+    if (!unit)
+        return;
+    char key[160];
+    snprintf(key, sizeof key, "%s%s", prefix, name);
+    for (char *s = key; *s; s++)
+        if (*s == '/')
+            *s = '.';
+    json_object_set_new(into, key, json_string(unit));
 }
 
 static void pack_units(json_t *into, json_t *inputs, json_t *summary)
@@ -35,16 +34,16 @@ static void pack_units(json_t *into, json_t *inputs, json_t *summary)
     pk_units u;
     pk_units_init(&u, length ? length : "mm",
                   json_is_integer(dim) ? (int)json_integer_value(dim) : 3);
-    json_t *own = pk_obs_units_json(pk_pack_observables, summary, &u);
-    if (own)
-        json_object_update(into, own);
-    json_decref(own);
+    for (const pk_obs_row *row = pk_pack_observables; row->name; row++)
+        if (row->form != PK_OBS_FILE)
+            add_row(into, "", row->name, row->kind, &u);
     const char *algorithm = json_string_value(json_object_get(summary, "algorithm"));
     const pk_placer *placer = algorithm ? pk_placer_find(algorithm) : NULL;
     if (placer) {
         char prefix[64];
         snprintf(prefix, sizeof prefix, "%s.", placer->name);
-        add_rows(into, prefix, placer->units, &u);
+        for (const pk_unit_row *row = placer->units; row && row->name; row++)
+            add_row(into, prefix, row->name, row->kind, &u);
     }
 }
 
