@@ -128,8 +128,8 @@ static int open_run(rsa_run *u, const pk_box *b, const double *diameters, size_t
     /* the clearance kept at walls: Δd/2 (Titscher & Unger §6.3: the diameters
      * are enlarged by Δd), or none */
     u->wall = prm->wall_gap == PK_RSA_WALL_GAP_NONE ? 0 : 0.5 * u->gap;
-    if (pk_grid_init(&u->grid, b, 0.5 * diameters[n - 1], 0.5 * diameters[0], u->gap, out->n + n) !=
-        0)
+    if (pk_grid_init_dense(&u->grid, b, 0.5 * diameters[n - 1], 0.5 * diameters[0], u->gap,
+                           out->n + n) != 0)
         return -1;
     for (size_t j = 0; j < out->n; j++)
         pk_grid_insert(&u->grid, out, j);

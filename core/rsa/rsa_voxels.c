@@ -83,6 +83,12 @@ static void set_bit_layout(pk_rsa_vox *v)
         }
     }
     int S = v->sub, Sz = v->box.dim == 3 ? S : 1;
+    for (unsigned m = 0; m < (1u << S); m++) {
+        v->row_bits[m] = 0;
+        for (int lx = 0; lx < S; lx++)
+            if (m >> lx & 1)
+                v->row_bits[m] |= (uint64_t)1 << v->boff[0][lx];
+    }
     for (int lz = 0; lz < Sz; lz++)
         for (int ly = 0; ly < S; ly++)
             for (int lx = 0; lx < S; lx++) {
@@ -266,6 +272,36 @@ static inline void sub_far2(const pk_rsa_vox *v, int k, int64_t i, double c, dou
     }
 }
 
+/* The sub-voxels of one voxel whose farthest corners are inside the ball
+ * (squared far distances per axis fx, fy, fz): a row along x is all out when
+ * its nearest far corner is, all in when its farthest is, else its bits
+ * come from the row's mask (rows are most of the boundary voxels' cost). */
+static inline uint64_t cover_word(const pk_rsa_vox *v, const double *fx, const double *fy,
+                                  const double *fz, double R2, int S, int Sz)
+{
+    double xmin = fx[0], xmax = fx[0];
+    for (int lx = 1; lx < S; lx++) {
+        xmin = fx[lx] < xmin ? fx[lx] : xmin; /* fmin/fmax are libm calls at -O2 */
+        xmax = fx[lx] > xmax ? fx[lx] : xmax;
+    }
+    uint64_t covered = 0;
+    for (int lz = 0; lz < Sz; lz++)
+        for (int ly = 0; ly < S; ly++) {
+            double rem = R2 - fz[lz] - fy[ly];
+            if (!(xmin <= rem))
+                continue;
+            unsigned row = (unsigned)v->boff[2][lz] + v->boff[1][ly];
+            unsigned m = (1u << S) - 1;
+            if (!(xmax <= rem)) {
+                m = 0;
+                for (int lx = 0; lx < S; lx++)
+                    m |= (unsigned)(fx[lx] <= rem) << lx;
+            }
+            covered |= v->row_bits[m] << row;
+        }
+    return covered;
+}
+
 /* A sub-voxel is marked covered when its farthest corner is inside the ball:
  * the ball is convex, so the whole sub-voxel is, and every point in it is
  * closer than r + r_valid + Δd <= r + r' + Δd to the grain, for every
@@ -325,14 +361,7 @@ void pk_rsa_vox_cover(pk_rsa_vox *v, const double x[PK_MAXDIM], double r)
                     continue;
                 }
                 sub_far2(v, 0, ix, x[0], fx);
-                uint64_t covered = 0;
-                for (int lz = 0; lz < Sz; lz++)
-                    for (int ly = 0; ly < S; ly++) {
-                        double rem = R2 - fz[lz] - fy[ly];
-                        unsigned row = (unsigned)v->boff[2][lz] + v->boff[1][ly];
-                        for (int lx = 0; lx < S; lx++)
-                            covered |= (uint64_t)(fx[lx] <= rem) << (row + v->boff[0][lx]);
-                    }
+                uint64_t covered = cover_word(v, fx, fy, fz, R2, S, Sz);
                 if (covered & ~was) {
                     uint64_t now = was | covered;
                     v->covered[vid] = now;

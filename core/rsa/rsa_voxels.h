@@ -61,6 +61,8 @@ typedef struct pk_rsa_vox {
      * (group·8 + place in the group) */
     uint8_t boff[PK_MAXDIM][8];
     uint8_t lsub[64][PK_MAXDIM]; /* the inverse: sub-voxel coordinates of a bit */
+    uint64_t row_bits[256];      /* bits of the sub-voxels lx with bit lx of the index set,
+                                    in row (ly, lz) = (0, 0) */
     uint64_t *covered;           /* [nvox] sub-voxels known covered */
     uint32_t *list;              /* voxels (grouped: groups) with an open sub-voxel at the
                                     last compaction (NULL before the first: all voxels) */

@@ -8,6 +8,12 @@
 #include <string.h>
 
 #define MAX_CELLS_PER_AXIS ((int64_t)1 << 20)
+/* A level whose cells number at most this many per grain (plus a constant)
+ * gets one head per cell instead of hashed buckets: a cell visit is one load,
+ * with no other cells' grains to walk past (that walk was ~40 % of RSA's
+ * overlap test at A16 Δd 1 mm; docs/perf/rsa-gap.md). */
+#define DENSE_CELLS_PER_GRAIN 4
+#define DENSE_CELLS_FREE 4096
 
 static uint64_t next_pow2(uint64_t v)
 {
@@ -29,7 +35,8 @@ static int level_of(const pk_grid *g, double r)
     return l;
 }
 
-int pk_grid_init(pk_grid *g, const pk_box *b, double r_min, double r_max, double gap, size_t cap)
+static int grid_init(pk_grid *g, const pk_box *b, double r_min, double r_max, double gap,
+                     size_t cap, int dense_ok)
 {
     memset(g, 0, sizeof *g);
     if (!b || !(r_max > 0) || !(gap >= 0) || !(r_min >= 0) || b->dim < 2 || b->dim > 3)
@@ -61,15 +68,22 @@ int pk_grid_init(pk_grid *g, const pk_box *b, double r_min, double r_max, double
             lv->ncell[k] = n;
             lv->h[k] = b->periodic[k] ? L / (double)n : fmax(want, L / (double)n);
         }
-        lv->mask = 15;
-        lv->head = malloc(16 * sizeof *lv->head);
+    }
+    g->cap = cap ? cap : 1;
+    for (int l = 0; l < g->nlevel; l++) {
+        pk_grid_level *lv = &g->lv[l];
+        double cells = (double)lv->ncell[0] * (double)lv->ncell[1] * (double)lv->ncell[2];
+        lv->dense =
+            dense_ok && cells <= (double)DENSE_CELLS_PER_GRAIN * (double)g->cap + DENSE_CELLS_FREE;
+        uint64_t nb = lv->dense ? (uint64_t)cells : 16;
+        lv->mask = nb - 1;
+        lv->head = malloc(nb * sizeof *lv->head);
         if (!lv->head) {
             pk_grid_free(g);
             return -1;
         }
-        memset(lv->head, 0xff, 16 * sizeof *lv->head);
+        memset(lv->head, 0xff, nb * sizeof *lv->head);
     }
-    g->cap = cap ? cap : 1;
     g->next = malloc(g->cap * sizeof *g->next);
     g->cell = malloc(g->cap * sizeof *g->cell);
     g->level = malloc(g->cap * sizeof *g->level);
@@ -79,6 +93,17 @@ int pk_grid_init(pk_grid *g, const pk_box *b, double r_min, double r_max, double
     }
     memset(g->level, 0xff, g->cap * sizeof *g->level);
     return 0;
+}
+
+int pk_grid_init(pk_grid *g, const pk_box *b, double r_min, double r_max, double gap, size_t cap)
+{
+    return grid_init(g, b, r_min, r_max, gap, cap, 0);
+}
+
+int pk_grid_init_dense(pk_grid *g, const pk_box *b, double r_min, double r_max, double gap,
+                       size_t cap)
+{
+    return grid_init(g, b, r_min, r_max, gap, cap, 1);
 }
 
 void pk_grid_free(pk_grid *g)
@@ -93,6 +118,8 @@ void pk_grid_free(pk_grid *g)
 
 static inline uint64_t bucket_of(const pk_grid_level *lv, uint64_t lin)
 {
+    if (lv->dense)
+        return lin;
     /* Fibonacci hashing: neighbouring cells land in unrelated buckets. */
     return (lin * 0x9E3779B97F4A7C15ull) >> 17 & lv->mask;
 }
@@ -161,7 +188,7 @@ int pk_grid_insert(pk_grid *g, const pk_particles *p, size_t i)
         pk_grid_remove(g, i);
     int l = level_of(g, p->r[i]);
     pk_grid_level *lv = &g->lv[l];
-    if (lv->count + 1 > lv->mask + 1 && grow_level(g, lv) != 0)
+    if (!lv->dense && lv->count + 1 > lv->mask + 1 && grow_level(g, lv) != 0)
         return -1;
     g->level[i] = (int8_t)l;
     /* A grain larger than the range given at init (a growing grain) lands in
@@ -172,7 +199,7 @@ int pk_grid_insert(pk_grid *g, const pk_particles *p, size_t i)
     link_grain(lv, g, i);
     lv->count++;
     /* queries reach a level's grains through its bound; buckets >= grains */
-    assert(p->r[i] <= lv->r_hi && lv->count <= lv->mask + 1);
+    assert(p->r[i] <= lv->r_hi && (lv->dense || lv->count <= lv->mask + 1));
     return 0;
 }
 
@@ -253,7 +280,7 @@ static inline int scan(const pk_grid *g, const pk_particles *p, const double *x,
                     int64_t ix = WRAPPED(cx, 0);
                     uint64_t lin = base + (uint64_t)ix;
                     for (int32_t j = lv->head[bucket_of(lv, lin)]; j >= 0; j = g->next[j]) {
-                        if (g->cell[j] != lin)
+                        if (!lv->dense && g->cell[j] != lin)
                             continue; /* hash collision: another cell's grain */
                         const double *xj = &p->x[3 * (size_t)j];
                         double d[PK_MAXDIM] = {0, 0, 0};

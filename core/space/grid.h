@@ -8,7 +8,9 @@
  * O(1) cells per non-empty level (Titscher §4's halving cell size, without
  * the rebuilds).  Cells live in a hash table per level (power-of-two buckets,
  * each grain remembers its cell, so hash collisions never report a grain
- * twice) — memory is O(N), independent of the box/finest-grain ratio.
+ * twice) — memory is O(N), independent of the box/finest-grain ratio — or
+ * (pk_grid_init_dense), where a level has few cells per grain, in one head
+ * per cell.
  *
  * Used by RSA (insert + overlap test), the gap audit's cross-check, EDMD's
  * neighbour lists and DEM contact detection (insert/move/remove + query).
@@ -30,7 +32,8 @@ typedef struct pk_grid_level {
     int64_t ncell[PK_MAXDIM]; /* cells per axis */
     double r_hi;              /* radii in this level are <= r_hi */
     size_t count;             /* grains registered */
-    uint64_t mask;            /* nbucket - 1 (nbucket a power of two) */
+    int dense;                /* one bucket per cell (index = linear cell index) */
+    uint64_t mask;            /* hashed: nbucket - 1 (nbucket a power of two) */
     int32_t *head;            /* [nbucket] first grain of each bucket, -1 = empty */
 } pk_grid_level;
 
@@ -50,6 +53,12 @@ typedef struct pk_grid {
  * gap: the extra contact distance (Δd, >= 0); cap: grains indices < cap.
  * Returns 0 or -1 (bad arguments / out of memory). */
 int pk_grid_init(pk_grid *g, const pk_box *b, double r_min, double r_max, double gap, size_t cap);
+/* The same, but levels with at most 4 cells per grain (+4096) get one head
+ * per cell instead of hashed buckets (faster cell visits; RSA).  Queries
+ * find the same grains; the order of the visits within a cell may differ
+ * from pk_grid_init's, whose chains reorder when buckets grow. */
+int pk_grid_init_dense(pk_grid *g, const pk_box *b, double r_min, double r_max, double gap,
+                       size_t cap);
 void pk_grid_free(pk_grid *g);
 
 /* Register grain i of p (its position and radius are read now). */
