@@ -46,7 +46,8 @@ static const char *const bases[] = {
     "\"delta_d\":0.1,\"algorithm\":\"edmd\",\"limits\":{\"wall_time_s\":5},"
     "\"edmd\":{\"delta\":0.5,\"growth_rate\":0.05,\"jamming\":{\"reduced_pressure\":1e6,\"rate_"
     "factor\":0.1,"
-    "\"delta_phi\":1e-9,\"events\":100},\"stall\":{\"events\":1000,\"growth\":1e-12},"
+    "\"full_rate_above\":1e5,\"delta_phi\":1e-9,\"events\":100},\"stall\":{\"events\":1000,"
+    "\"growth\":1e-12},"
     "\"rescale_tolerance\":0.1,\"skin\":0.6,\"max_events\":1000000}}",
 
     "{\"dim\":3,\"domain\":{\"box\":{\"size\":[8,8,8]}},\"algorithm\":\"tetfill\",\"count\":40,"
